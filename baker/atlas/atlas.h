@@ -1,0 +1,50 @@
+// Lightmap UV atlas: charts, parameterisation (planar / LSCM), packing into pages -> TEXCOORD_1.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "common/progress.h"
+#include "scene/scene.h"
+
+namespace irbake {
+
+struct AtlasOptions {
+  float texelsPerUnit = 0.0f;  // texels per metre; 0 = auto-fit so the charts fill about one targetPageSize page
+  int targetPageSize = 1024;   // page edge used by the auto-fit when texelsPerUnit is 0
+  int padding = 2;             // empty texels kept around every chart (bilinear-safe)
+  int maxPageSize = 2048;      // largest page edge; more pages are opened when one is full
+  bool keepUv1 = false;        // keep an input TEXCOORD_1 and only repack its islands
+  ProgressCallback progress;   // optional
+};
+
+struct AtlasPage {
+  int width = 0, height = 0;   // multiples of 4
+};
+
+struct AtlasStats {
+  size_t charts = 0, planarCharts = 0, lscmCharts = 0;
+  size_t degenerateFaces = 0;      // faces with no area (reported, still mapped to a point)
+  size_t uncoveredTriangles = 0;   // non-degenerate triangles covering no texel centre
+  size_t overlappingTexels = 0;    // must be 0
+  size_t flippedTriangles = 0;     // must be 0
+  double centreUtilisation = 0.0;  // texels whose centre lies inside a triangle / page area
+  double areaStretchP5 = 0.0, areaStretchP50 = 0.0, areaStretchP95 = 0.0;
+  double l2Stretch = 0.0;
+  double texelsPerUnit = 0.0;      // the density used
+  double secondsMesh = 0.0, secondsCharts = 0.0, secondsParam = 0.0, secondsPack = 0.0;
+  std::vector<std::string> warnings;
+};
+
+struct AtlasResult {
+  std::vector<AtlasPage> pages;
+  AtlasStats stats;
+};
+
+// Unwraps every primitive of `scene` in place: vertices are split along chart seams (sourceVertex
+// records where each came from), uv1 is set in [0,1] over the primitive's page, and
+// primitive.lightmap names the page. A primitive whose charts land on several pages is split into
+// one primitive per page. Emissive-only or non-lightmapped primitives keep lightmap.page = -1 only
+// if the options say so (by default every triangle is lightmapped).
+AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options);
+
+}  // namespace irbake

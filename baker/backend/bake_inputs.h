@@ -1,0 +1,30 @@
+// What every backend (embree | gl | reference) receives. Backends return one Lightmap per page.
+#pragma once
+#include <vector>
+
+#include "backend/lightmap.h"
+#include "common/progress.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/scene.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+struct VplEvalOptions {
+  float clampBound = 0.0f;         // upper bound on the VPL geometry term cosθx cosθy / r² (1/m²); 0 = no clamp
+  bool biasCompensation = false;   // Kollig & Keller 2004: recover the clamped energy (Embree backend)
+  bool includeDirect = true;       // punctual lights evaluated exactly (shadow ray / shadow map)
+  bool includeVpls = true;         // area emitters and bounces through the VPLs
+};
+
+struct BakeInputs {
+  const Scene& scene;
+  const RayTracer& rayTracer;
+  const std::vector<TexelSamples>& texels;  // one per page
+  const VplSet& vpls;
+  VplEvalOptions eval;
+  ProgressCallback progress;
+};
+
+}  // namespace irbake

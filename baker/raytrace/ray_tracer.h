@@ -1,0 +1,48 @@
+// Embree 3 scene over the scene model: closest-hit and occlusion queries, scene-scaled offsets,
+// textured albedo at hits. Alpha MASK cut-outs are holes. Thread-safe for queries.
+#pragma once
+#include <cstdint>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace irbake {
+
+struct RayHit {
+  bool hit = false;
+  float t = 0.0f;
+  uint32_t primitive = 0, triangle = 0;
+  glm::vec2 barycentric{0.0f};      // (u, v): p = (1-u-v) v0 + u v1 + v v2
+  glm::vec3 position{0.0f};
+  glm::vec3 geometricNormal{0.0f};  // unit, as wound (front face is counter-clockwise)
+  glm::vec3 shadingNormal{0.0f};    // interpolated vertex normal, unit
+  bool backFace = false;            // the ray hit the back of the triangle
+};
+
+class RayTracer {
+ public:
+  explicit RayTracer(const Scene& scene);
+  ~RayTracer();
+  RayTracer(const RayTracer&) = delete;
+  RayTracer& operator=(const RayTracer&) = delete;
+
+  RayHit intersect(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
+  bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
+  // Mutual visibility of two surface points, offset along their normals by epsilon().
+  bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
+  // Self-intersection offset scaled to the scene (relative to its bounding-box size).
+  float epsilon() const { return epsilon_; }
+  // Textured diffuse albedo (linear RGB) at a hit: baseColorFactor × baseColorTexture.
+  glm::vec3 albedoAt(const RayHit& hit) const;
+  const Scene& scene() const { return scene_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  const Scene& scene_;
+  float epsilon_ = 1e-4f;
+};
+
+}  // namespace irbake

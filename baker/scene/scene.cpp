@@ -1,0 +1,139 @@
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace irbake {
+
+namespace {
+constexpr float kPi = 3.14159265358979323846f;
+
+float wrapCoord(float t, WrapMode mode) {
+  switch (mode) {
+    case WrapMode::Repeat: return t - std::floor(t);
+    case WrapMode::ClampToEdge: return std::clamp(t, 0.0f, 1.0f);
+    case WrapMode::MirroredRepeat: {
+      float f = t - 2.0f * std::floor(t * 0.5f);  // [0,2)
+      return f > 1.0f ? 2.0f - f : f;
+    }
+  }
+  return t;
+}
+
+int wrapIndex(int i, int n, WrapMode mode) {
+  switch (mode) {
+    case WrapMode::Repeat: return ((i % n) + n) % n;
+    case WrapMode::ClampToEdge: return std::clamp(i, 0, n - 1);
+    case WrapMode::MirroredRepeat: {
+      int period = 2 * n;
+      int m = ((i % period) + period) % period;
+      return m < n ? m : period - 1 - m;
+    }
+  }
+  return 0;
+}
+
+glm::vec2 interpolate(const std::vector<glm::vec2>& uv, const Primitive& p, uint32_t tri, glm::vec2 b) {
+  if (uv.empty()) return glm::vec2(0.0f);
+  const uint32_t* idx = &p.indices[3 * tri];
+  return uv[idx[0]] * (1.0f - b.x - b.y) + uv[idx[1]] * b.x + uv[idx[2]] * b.y;
+}
+}  // namespace
+
+glm::vec4 sampleBilinear(const Texture& tex, glm::vec2 uv) {
+  if (tex.width <= 0 || tex.height <= 0 || tex.texels.empty()) return glm::vec4(1.0f);
+  // Texel centres at (i + 0.5) / width.
+  float x = wrapCoord(uv.x, tex.wrapS) * tex.width - 0.5f;
+  float y = wrapCoord(uv.y, tex.wrapT) * tex.height - 0.5f;
+  int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  float fx = x - x0, fy = y - y0;
+  int xa = wrapIndex(x0, tex.width, tex.wrapS), xb = wrapIndex(x0 + 1, tex.width, tex.wrapS);
+  int ya = wrapIndex(y0, tex.height, tex.wrapT), yb = wrapIndex(y0 + 1, tex.height, tex.wrapT);
+  auto at = [&](int xi, int yi) { return tex.texels[static_cast<size_t>(yi) * tex.width + xi]; };
+  return (at(xa, ya) * (1.0f - fx) + at(xb, ya) * fx) * (1.0f - fy) + (at(xa, yb) * (1.0f - fx) + at(xb, yb) * fx) * fy;
+}
+
+glm::vec3 Light::intensityToward(const glm::vec3& dirFromLight) const {
+  glm::vec3 I = color * intensity;
+  if (type != LightType::Spot) return I;
+  float cosOuter = std::cos(outerConeAngle), cosInner = std::cos(innerConeAngle);
+  float scale = 1.0f / std::max(0.001f, cosInner - cosOuter);
+  float t = std::clamp((glm::dot(direction, dirFromLight) - cosOuter) * scale, 0.0f, 1.0f);
+  return I * (t * t);
+}
+
+glm::vec3 Light::power() const {
+  glm::vec3 I = color * intensity;
+  switch (type) {
+    case LightType::Point: return 4.0f * kPi * I;
+    case LightType::Spot: {
+      // ∫ over the cone of t(cosθ)² dω with t linear in cosθ: full inside the inner cone,
+      // (cosI − cosO)/3 of the band between the cones (exact when cosI − cosO ≥ 0.001).
+      double cosO = std::cos(outerConeAngle), cosI = std::cos(innerConeAngle);
+      double band = std::max(0.0, cosI - cosO);
+      double solid = 2.0 * M_PI * ((1.0 - cosI) + band / 3.0);
+      return static_cast<float>(solid) * I;
+    }
+    case LightType::Directional: return glm::vec3(0.0f);
+  }
+  return glm::vec3(0.0f);
+}
+
+Bounds3 Scene::bounds() const {
+  Bounds3 b;
+  for (const auto& p : primitives)
+    for (const auto& v : p.positions) b.extend(v);
+  return b;
+}
+
+size_t Scene::triangleCount() const {
+  size_t n = 0;
+  for (const auto& p : primitives) n += p.triangleCount();
+  return n;
+}
+
+glm::vec3 Scene::emitterPower() const {
+  glm::dvec3 total(0.0);
+  for (const auto& p : primitives) {
+    const Material& m = materials[p.material];
+    if (!m.isEmissive()) continue;
+    for (uint32_t t = 0; t < p.triangleCount(); ++t) {
+      const glm::vec3& a = p.positions[p.indices[3 * t]];
+      const glm::vec3& b = p.positions[p.indices[3 * t + 1]];
+      const glm::vec3& c = p.positions[p.indices[3 * t + 2]];
+      double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+      glm::vec3 Le = emissionAt(p, t, glm::vec2(1.0f / 3.0f));  // texture at the centroid
+      total += glm::dvec3(Le) * (kPi * area);
+    }
+  }
+  return glm::vec3(total);
+}
+
+bool Scene::hasLightOrEmitter() const {
+  if (!lights.empty()) return true;
+  for (const auto& p : primitives)
+    if (materials[p.material].isEmissive()) return true;
+  return false;
+}
+
+glm::vec4 Scene::baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 b) const {
+  const Material& m = materials[prim.material];
+  glm::vec4 c = m.baseColorFactor;
+  if (m.baseColorTexture >= 0) {
+    const auto& uv = m.baseColorTexCoord == 1 ? prim.uv1 : prim.uv0;
+    c *= sampleBilinear(textures[m.baseColorTexture], interpolate(uv, prim, triangle, b));
+  }
+  return c;
+}
+
+glm::vec3 Scene::emissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 b) const {
+  const Material& m = materials[prim.material];
+  glm::vec3 e = m.emission();
+  if (m.emissiveTexture >= 0 && m.isEmissive()) {
+    const auto& uv = m.emissiveTexCoord == 1 ? prim.uv1 : prim.uv0;
+    e *= glm::vec3(sampleBilinear(textures[m.emissiveTexture], interpolate(uv, prim, triangle, b)));
+  }
+  return e;
+}
+
+}  // namespace irbake

@@ -1,0 +1,140 @@
+// The scene model every stage reads: world-space triangles, materials, textures, lights, cameras.
+// Units: metres; radiometric quantities in watts (see docs/units.md).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace irbake {
+
+struct Bounds3 {
+  glm::vec3 min{1e30f};
+  glm::vec3 max{-1e30f};
+  void extend(const glm::vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+  void extend(const Bounds3& b) { min = glm::min(min, b.min); max = glm::max(max, b.max); }
+  bool valid() const { return min.x <= max.x && min.y <= max.y && min.z <= max.z; }
+  glm::vec3 extent() const { return valid() ? max - min : glm::vec3(0.0f); }
+  float diagonal() const { return glm::length(extent()); }
+};
+
+enum class WrapMode { Repeat, ClampToEdge, MirroredRepeat };
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// A decoded image, linear RGBA float (colour textures are sRGB-decoded at load).
+struct Texture {
+  std::string name;           // image name or URI, for messages
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;  // row-major, row 0 = top of the image (glTF UV v=0)
+  WrapMode wrapS = WrapMode::Repeat, wrapT = WrapMode::Repeat;
+  int gltfImage = -1;         // source image index in the glTF
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 baseColorFactor{1.0f};  // linear
+  int baseColorTexture = -1;        // index into Scene::textures, -1 none
+  int baseColorTexCoord = 0;        // which TEXCOORD set the texture reads
+  glm::vec3 emissiveFactor{0.0f};
+  float emissiveStrength = 1.0f;    // KHR_materials_emissive_strength
+  int emissiveTexture = -1;
+  int emissiveTexCoord = 0;
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;
+  bool doubleSided = false;
+  int gltfMaterial = -1;            // source index, -1 for the default material
+  // Emitted radiance scale (W/(m² sr)) before the emissive texture: factor × strength.
+  glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
+  bool isEmissive() const { return glm::max(emissiveFactor.x, glm::max(emissiveFactor.y, emissiveFactor.z)) * emissiveStrength > 0.0f; }
+};
+
+// Where a lightmapped primitive's texels live (set by the atlas).
+struct LightmapRef {
+  int page = -1;               // -1: not lightmapped
+  int width = 0, height = 0;   // page size in texels
+};
+
+// One glTF primitive instanced by one node, flattened to world space.
+// Vertex i is accessor vertex i of the source primitive (strips and fans are triangulated in indices).
+struct Primitive {
+  std::string name;
+  std::vector<glm::vec3> positions;  // world space, metres
+  std::vector<glm::vec3> normals;    // world space, unit length (computed, area-weighted, when absent)
+  std::vector<glm::vec2> uv0;        // TEXCOORD_0 (empty when absent)
+  std::vector<glm::vec2> uv1;        // TEXCOORD_1: lightmap UV in [0,1] over the page (empty when absent)
+  std::vector<uint32_t> indices;     // triangle list, counter-clockwise front faces in world space
+  int material = 0;                  // index into Scene::materials (always valid: a default is added)
+  int node = -1, gltfMesh = -1, gltfPrimitive = -1;  // provenance for export
+  glm::mat4 nodeToWorld{1.0f};       // the node's world matrix (positions here are already transformed)
+  // Atlas output: vertex i came from source vertex sourceVertex[i] (empty: identity).
+  std::vector<uint32_t> sourceVertex;
+  LightmapRef lightmap;
+  size_t triangleCount() const { return indices.size() / 3; }
+};
+
+enum class LightType { Point, Spot, Directional };
+
+// KHR_lights_punctual. intensity is radiant intensity (W/sr) for point/spot, irradiance (W/m²) for
+// directional, so a point light gives E = I cosθ / r² and a directional light E = I cosθ.
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = 0.0f;                  // 0: infinite
+  float innerConeAngle = 0.0f;         // radians (spot)
+  float outerConeAngle = 0.785398163f; // radians (spot), glTF default π/4
+  glm::vec3 position{0.0f};            // world (point/spot)
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // world, unit, direction light travels (spot/directional)
+  int node = -1;                       // -1 for lights from the command line
+  // Radiant intensity (W/sr, RGB) towards a direction leaving the light (unit vector), spot falloff
+  // included (glTF's recommended smooth falloff, linear in cosθ between outer and inner cone).
+  glm::vec3 intensityToward(const glm::vec3& dirFromLight) const;
+  // glTF: intensity is zero beyond range (inverse-square inside it). 1 inside, 0 beyond; range 0 = infinite.
+  float rangeWindow(float distance) const { return (range > 0.0f && distance > range) ? 0.0f : 1.0f; }
+  // Total emitted power (W, RGB): 4πI point; spot integrates its falloff; directional: 0 (infinite).
+  glm::vec3 power() const;
+};
+
+struct Camera {
+  std::string name;
+  glm::mat4 cameraToWorld{1.0f};  // looks down -Z, +Y up (glTF)
+  float yfov = 0.8f;              // radians
+  float aspectRatio = 0.0f;       // 0: from the viewport
+  float znear = 0.01f, zfar = 0.0f;  // zfar 0: infinite
+  int node = -1;
+};
+
+struct LoadStats {
+  size_t trianglesKept = 0;
+  size_t trianglesDropped = 0;     // degenerate: zero area or repeated indices
+  size_t primitivesSkipped = 0;    // points/lines
+  size_t normalsComputed = 0;      // primitives whose normals were computed
+  std::vector<std::string> warnings;
+};
+
+struct Scene {
+  std::string sourcePath;          // the glTF it came from ("" for generated scenes)
+  std::vector<Primitive> primitives;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<Camera> cameras;
+  LoadStats stats;
+
+  Bounds3 bounds() const;
+  size_t triangleCount() const;
+  // Total emitted power of emissive surfaces (W, RGB): π · Le · area, emissive texture averaged per triangle.
+  glm::vec3 emitterPower() const;
+  bool hasLightOrEmitter() const;
+  // Base colour (linear RGBA) at a point of a triangle: factor × texture(bilinear, wrap) at its UV.
+  glm::vec4 baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;
+  // Emitted radiance (W/(m² sr)) at a point of a triangle: emissiveFactor × strength × texture.
+  glm::vec3 emissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;
+};
+
+// Bilinear texture lookup with the texture's wrap modes; uv as in glTF (v down).
+glm::vec4 sampleBilinear(const Texture& tex, glm::vec2 uv);
+
+}  // namespace irbake

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Installs the Debian packages irbake needs, and only those that are missing.
+# Idempotent: when everything is present it installs nothing and says so.
+# Usage: scripts/install-deps.sh [--bench]   (--bench adds the plotting tools for bench/)
+set -euo pipefail
+
+packages=(
+  cmake g++ pkg-config
+  libembree-dev            # Embree 3: ray tracing for the walk, the reference and the Embree backend
+  libopenmesh-dev          # OpenMesh: half-edge meshes for the atlas
+  libopenimageio-dev openimageio-tools   # OIIO: image decode and EXR output (its CMake config needs the tools)
+  libglm-dev               # GLM: vector maths
+  libtinygltf-dev          # tinygltf: glTF 2.0 parsing and writing
+  libeigen3-dev            # Eigen: sparse solves for LSCM
+  libtbb-dev               # TBB: parallel loops
+  libepoxy-dev libegl-dev libgl1-mesa-dri libegl-mesa0   # GL entry points + headless EGL (Mesa llvmpipe)
+  libglfw3-dev             # GLFW: the viewer's window
+  libgtest-dev             # GoogleTest
+  libbenchmark-dev         # Google Benchmark
+  nlohmann-json3-dev       # JSON reports
+  xvfb xauth               # windowed viewer test without a display
+)
+if [[ "${1:-}" == "--bench" ]]; then
+  packages+=(python3-matplotlib python3-numpy)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#packages[@]} packages present, nothing to install"
+  exit 0
+fi
+
+echo "install-deps: installing ${#missing[@]} missing package(s): ${missing[*]}"
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "install-deps: not root and no sudo; install these by hand: ${missing[*]}" >&2; exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+echo "install-deps: done"

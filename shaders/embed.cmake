@@ -1,0 +1,10 @@
+# Writes OUT: a table {file name, source} of every shader in FILES (raw string literals).
+set(_body "#include <cstddef>\nnamespace irbake::detail {\nstruct EmbeddedShader { const char* name; const char* source; };\nextern const EmbeddedShader kEmbeddedShaders[] = {\n")
+foreach(_f ${FILES})
+  get_filename_component(_name ${_f} NAME)
+  file(READ ${_f} _src)
+  string(APPEND _body "  {\"${_name}\", R\"irbake_glsl(${_src})irbake_glsl\"},\n")
+endforeach()
+string(APPEND _body "  {nullptr, nullptr}};\n}  // namespace irbake::detail\n")
+file(WRITE ${OUT}.tmp "${_body}")
+file(RENAME ${OUT}.tmp ${OUT})
