@@ -44,6 +44,8 @@ struct Material {
   float alphaCutoff = 0.5f;
   bool doubleSided = false;
   int gltfMaterial = -1;            // source index, -1 for the default material
+  int lightmapTexture = -1;         // MOZ_lightmap texture (index into Scene::textures), -1 none
+  float lightmapIntensity = 1.0f;   // MOZ_lightmap intensity: map value = PNG value × intensity
   // Emitted radiance scale (W/(m² sr)) before the emissive texture: factor × strength.
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   bool isEmissive() const { return glm::max(emissiveFactor.x, glm::max(emissiveFactor.y, emissiveFactor.z)) * emissiveStrength > 0.0f; }
@@ -122,6 +124,9 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<Camera> cameras;
   LoadStats stats;
+  // Baked float pages named in the root extras of an irbake export ("lightmapPages": [uri, ...]),
+  // resolved to paths beside the glTF; empty for other scenes.
+  std::vector<std::string> lightmapExrPaths;
 
   Bounds3 bounds() const;
   size_t triangleCount() const;

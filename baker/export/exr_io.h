@@ -1,0 +1,14 @@
+// Float EXR pages through OpenImageIO (RGB half or float, linear), written atomically.
+#pragma once
+#include <filesystem>
+
+#include "backend/lightmap.h"
+
+namespace irbake {
+
+// Writes map.texels as a 32-bit float RGB EXR (row 0 = v = 0 at the top). Throws Error(Io/NumericError).
+void writeExr(const Lightmap& map, const std::filesystem::path& path);
+// Reads an EXR written by writeExr (valid = 1 everywhere). Throws Error(Io) naming the file.
+Lightmap readExr(const std::filesystem::path& path);
+
+}  // namespace irbake

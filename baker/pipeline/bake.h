@@ -1,0 +1,43 @@
+// The bake: every stage in order, one way — scene → atlas → texels → VPLs → backend → post.
+#pragma once
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "atlas/atlas.h"
+#include "backend/bake_inputs.h"
+#include "backend/lightmap.h"
+#include "scene/scene.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+enum class BackendKind { Gl, Embree, Reference };
+
+struct BakeOptions {
+  BackendKind backend = BackendKind::Gl;  // gl (default), embree, reference
+  AtlasOptions atlas;                     // texel density, padding, page size
+  TexelSampleOptions texels;              // supersampling, leak control
+  WalkOptions walk;                       // VPL paths, bounces, seed
+  VplEvalOptions eval;                    // clamp (0 = derived from the scene), bias compensation
+  bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
+  int referenceSpp = 256;                 // reference backend: paths per texel sample
+  bool postDilate = true;                 // fill padding from valid texels
+  bool postSeams = true;                  // stitch chart seams
+  ProgressCallback progress;
+};
+
+struct BakeResult {
+  Scene scene;                       // with the atlas applied (uv1, lightmap pages)
+  AtlasResult atlas;
+  VplSet vpls;
+  std::vector<Lightmap> maps;        // one per page, post-processed
+  nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
+};
+
+// Runs the whole bake on a loaded scene. Throws Error on failure.
+BakeResult bake(Scene scene, const BakeOptions& options);
+
+}  // namespace irbake
