@@ -1,0 +1,126 @@
+#include "raytrace/ray_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include "raytrace/test_scenes.h"
+
+using namespace irbake;
+using namespace irbake::testing;
+
+TEST(RayTracer, HitsQuadWithExactDistanceBarycentricsAndNormals) {
+  Scene s;
+  int m = addMaterial(s, glm::vec3(0.25f, 0.5f, 0.75f));
+  addQuad(s, m, glm::vec3(0, 0, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));  // z = 0, normal +z
+  RayTracer rt(s);
+  RayHit h = rt.intersect(glm::vec3(0.5f, 0.25f, 3.0f), glm::vec3(0, 0, -1), 0.0f, 1e30f);
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.t, 3.0f, 1e-6f);
+  EXPECT_NEAR(h.position.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(h.position.y, 0.25f, 1e-6f);
+  EXPECT_NEAR(h.geometricNormal.z, 1.0f, 1e-6f);
+  EXPECT_NEAR(h.shadingNormal.z, 1.0f, 1e-6f);
+  EXPECT_FALSE(h.backFace);
+  EXPECT_EQ(h.primitive, 0u);
+  // Triangle 0 is (0,0),(2,0),(2,2): p = u·(2,0) + v·(2,2) → v = y/2, u = x/2 − v.
+  EXPECT_EQ(h.triangle, 0u);
+  EXPECT_NEAR(h.barycentric.y, 0.125f, 1e-6f);
+  EXPECT_NEAR(h.barycentric.x, 0.125f, 1e-6f);
+  glm::vec3 a = rt.albedoAt(h);
+  EXPECT_FLOAT_EQ(a.x, 0.25f);
+  EXPECT_FLOAT_EQ(a.z, 0.75f);
+
+  RayHit back = rt.intersect(glm::vec3(1.0f, 1.5f, -2.0f), glm::vec3(0, 0, 1), 0.0f, 1e30f);
+  ASSERT_TRUE(back.hit);
+  EXPECT_TRUE(back.backFace);
+  EXPECT_NEAR(back.t, 2.0f, 1e-6f);
+  // tmax shorter than the distance: no hit; outside the quad: no hit.
+  EXPECT_FALSE(rt.intersect(glm::vec3(0.5f, 0.5f, 3.0f), glm::vec3(0, 0, -1), 0.0f, 2.9f).hit);
+  EXPECT_FALSE(rt.intersect(glm::vec3(2.5f, 0.5f, 3.0f), glm::vec3(0, 0, -1), 0.0f, 1e30f).hit);
+}
+
+TEST(RayTracer, OcclusionAndVisibilityAcrossAWall) {
+  Scene s;
+  int m = addMaterial(s, glm::vec3(0.5f));
+  addQuad(s, m, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));  // floor z = 0
+  addQuad(s, m, glm::vec3(0, -1, 0), glm::vec3(0, 2, 0), glm::vec3(0, 0, 1));   // wall x = 0, normal +x (y × z)
+  RayTracer rt(s);
+  glm::vec3 up(0, 0, 1);
+  EXPECT_TRUE(rt.occluded(glm::vec3(-0.5f, 0, 0.5f), glm::vec3(1, 0, 0), 0.0f, 1.0f));
+  EXPECT_FALSE(rt.occluded(glm::vec3(-0.5f, 0, 0.5f), glm::vec3(1, 0, 0), 0.0f, 0.4f));
+  EXPECT_FALSE(rt.occluded(glm::vec3(-0.5f, 0, 1.5f), glm::vec3(1, 0, 0), 0.0f, 1.0f));  // above the wall
+  // Two floor points on either side of the wall, right at floor level: the wall hides them.
+  EXPECT_FALSE(rt.visible(glm::vec3(-0.01f, 0, 0), up, glm::vec3(0.01f, 0, 0), up));
+  EXPECT_TRUE(rt.visible(glm::vec3(0.2f, 0, 0), up, glm::vec3(0.6f, 0.3f, 0), up));
+  // A point on the wall's front and one on the floor in front of it see each other.
+  EXPECT_TRUE(rt.visible(glm::vec3(0, 0, 0.5f), glm::vec3(1, 0, 0), glm::vec3(0.5f, 0, 0), up));
+}
+
+TEST(RayTracer, EpsilonScalesWithTheScene) {
+  Scene small, big;
+  int m1 = addMaterial(small, glm::vec3(0.5f)), m2 = addMaterial(big, glm::vec3(0.5f));
+  addQuad(small, m1, glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0));
+  addQuad(big, m2, glm::vec3(0), glm::vec3(1000, 0, 0), glm::vec3(0, 1000, 0));
+  RayTracer a(small), b(big);
+  EXPECT_NEAR(b.epsilon() / a.epsilon(), 1000.0f, 1.0f);
+  EXPECT_GT(a.epsilon(), 0.0f);
+  EXPECT_LT(a.epsilon(), 1e-3f);
+}
+
+TEST(RayTracer, TexturedAlbedoAndAlphaMaskHoles) {
+  Scene s;
+  int m = addMaterial(s, glm::vec3(1.0f));
+  s.materials[m].baseColorFactor = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);
+  s.materials[m].alphaMode = AlphaMode::Mask;
+  s.materials[m].alphaCutoff = 0.5f;
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  t.texels = {glm::vec4(0.2f, 0.2f, 0.2f, 0.0f), glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)};  // left: hole
+  s.textures.push_back(t);
+  s.materials[m].baseColorTexture = 0;
+  addQuad(s, m, glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0));  // uv0 = (x, y)
+  // A floor below to catch rays through the hole.
+  int f = addMaterial(s, glm::vec3(0.3f));
+  addQuad(s, f, glm::vec3(-1, -1, -1), glm::vec3(3, 0, 0), glm::vec3(0, 3, 0));
+  RayTracer rt(s);
+  RayHit solid = rt.intersect(glm::vec3(0.9f, 0.5f, 1), glm::vec3(0, 0, -1), 0.0f, 1e30f);
+  ASSERT_TRUE(solid.hit);
+  EXPECT_EQ(solid.primitive, 0u);
+  // Bilinear between texel centres 0.25 and 0.75 (clamped beyond): at u = 0.9 the right texel only.
+  EXPECT_NEAR(rt.albedoAt(solid).x, 0.5f * 0.8f, 1e-5f);
+  RayHit mid = rt.intersect(glm::vec3(0.625f, 0.5f, 1), glm::vec3(0, 0, -1), 0.0f, 1e30f);
+  ASSERT_TRUE(mid.hit);
+  EXPECT_EQ(mid.primitive, 0u);  // alpha 0.75 ≥ cutoff
+  EXPECT_NEAR(rt.albedoAt(mid).y, 0.2f * 0.25f + 0.8f * 0.75f, 1e-5f);
+  RayHit hole = rt.intersect(glm::vec3(0.1f, 0.5f, 1), glm::vec3(0, 0, -1), 0.0f, 1e30f);
+  ASSERT_TRUE(hole.hit);
+  EXPECT_EQ(hole.primitive, 1u);  // fell through the cut-out onto the floor
+  EXPECT_NEAR(hole.t, 2.0f, 1e-5f);
+  EXPECT_FALSE(rt.occluded(glm::vec3(0.1f, 0.5f, 1), glm::vec3(0, 0, -1), 0.0f, 1.5f));
+  EXPECT_TRUE(rt.occluded(glm::vec3(0.9f, 0.5f, 1), glm::vec3(0, 0, -1), 0.0f, 1.5f));
+}
+
+TEST(RayTracer, ClosedBoxDoesNotLeakRays) {
+  Scene s;
+  int m = addMaterial(s, glm::vec3(0.5f));
+  addBox(s, m, glm::vec3(0), glm::vec3(1), true, 3);
+  RayTracer rt(s);
+  // Rays from the centre through a fine grid of directions, many through edges and corners.
+  int misses = 0, backHits = 0;
+  for (int i = 0; i < 64; ++i)
+    for (int j = 0; j < 64; ++j) {
+      float z = -1.0f + (i + 0.5f) / 32.0f, phi = 6.2831853f * j / 64.0f;
+      float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      glm::vec3 d(r * std::cos(phi), r * std::sin(phi), z);
+      RayHit h = rt.intersect(glm::vec3(0.5f), d, 0.0f, 1e30f);
+      misses += !h.hit;
+      backHits += h.hit && h.backFace;
+    }
+  for (int k = 0; k < 8; ++k) {  // exactly at the corners
+    glm::vec3 c((k & 1) ? 1.0f : 0.0f, (k & 2) ? 1.0f : 0.0f, (k & 4) ? 1.0f : 0.0f);
+    misses += !rt.intersect(glm::vec3(0.5f), glm::normalize(c - glm::vec3(0.5f)), 0.0f, 1e30f).hit;
+  }
+  EXPECT_EQ(misses, 0);
+  EXPECT_EQ(backHits, 0);
+}

@@ -1,0 +1,101 @@
+// Hand-built scenes and texel-sample grids for the light-transport tests (header only, test use).
+// Plain geometry with closed-form answers: a quad is two triangles, boxes are six quads.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+#include "texels/texel_samples.h"
+
+namespace irbake::testing {
+
+inline int addMaterial(Scene& s, glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f)) {
+  Material m;
+  m.name = "m" + std::to_string(s.materials.size());
+  m.baseColorFactor = glm::vec4(albedo, 1.0f);
+  m.emissiveFactor = emission;
+  s.materials.push_back(m);
+  return static_cast<int>(s.materials.size()) - 1;
+}
+
+// Quad p0, p0+e1, p0+e1+e2, p0+e2 split into `div`×`div` cells; front face normal = normalize(e1 × e2).
+inline int addQuad(Scene& s, int material, glm::vec3 p0, glm::vec3 e1, glm::vec3 e2, int div = 1) {
+  Primitive p;
+  p.name = "quad" + std::to_string(s.primitives.size());
+  p.material = material;
+  glm::vec3 n = glm::normalize(glm::cross(e1, e2));
+  for (int j = 0; j <= div; ++j)
+    for (int i = 0; i <= div; ++i) {
+      p.positions.push_back(p0 + e1 * (float(i) / div) + e2 * (float(j) / div));
+      p.normals.push_back(n);
+      p.uv0.push_back(glm::vec2(float(i) / div, float(j) / div));
+    }
+  for (int j = 0; j < div; ++j)
+    for (int i = 0; i < div; ++i) {
+      uint32_t a = j * (div + 1) + i, b = a + 1, c = a + div + 2, d = a + div + 1;
+      p.indices.insert(p.indices.end(), {a, b, c, a, c, d});
+    }
+  s.primitives.push_back(p);
+  return static_cast<int>(s.primitives.size()) - 1;
+}
+
+// Axis-aligned box from six quads; inward = true for a room (normals point inside).
+inline void addBox(Scene& s, int material, glm::vec3 lo, glm::vec3 hi, bool inward, int div = 1) {
+  glm::vec3 d = hi - lo;
+  glm::vec3 X(d.x, 0, 0), Y(0, d.y, 0), Z(0, 0, d.z);
+  // Outward-facing quads (e1 × e2 points out); swap edges for inward.
+  struct F { glm::vec3 p0, e1, e2; };
+  F faces[6] = {{lo, Y, X}, {lo + Z, X, Y}, {lo, X, Z}, {lo + Y, Z, X}, {lo, Z, Y}, {lo + X, Y, Z}};
+  for (const F& f : faces) {
+    if (inward) addQuad(s, material, f.p0, f.e2, f.e1, div);
+    else addQuad(s, material, f.p0, f.e1, f.e2, div);
+  }
+}
+
+inline Light pointLight(glm::vec3 position, float intensity) {
+  Light l;
+  l.type = LightType::Point;
+  l.position = position;
+  l.intensity = intensity;
+  return l;
+}
+
+// A W×H grid of texel samples (supersample 1) over the rectangle p0 + [0,1]e1 + [0,1]e2, texel centres,
+// all valid, normal = normalize(e1 × e2). Texel (x, y) sits at p0 + (x+0.5)/W e1 + (y+0.5)/H e2.
+inline TexelSamples gridSamples(glm::vec3 p0, glm::vec3 e1, glm::vec3 e2, int W, int H, uint32_t primitive = 0) {
+  TexelSamples t;
+  t.width = W;
+  t.height = H;
+  t.supersample = 1;
+  glm::vec3 n = glm::normalize(glm::cross(e1, e2));
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      glm::vec3 p = p0 + e1 * ((x + 0.5f) / W) + e2 * ((y + 0.5f) / H);
+      t.positionWeight.push_back(glm::vec4(p, 1.0f));
+      t.normal.push_back(glm::vec4(n, 0.0f));
+      t.primitive.push_back(primitive);
+      t.triangle.push_back(0);
+    }
+  t.covered.assign(t.layerSize(), 1);
+  t.valid.assign(t.layerSize(), 1);
+  return t;
+}
+
+// Illuminance of a Lambertian polygon of radiance 1 seen from (x, n), divided by π: the point-to-polygon
+// form factor (Lambert's edge formula). The polygon must lie entirely above x's tangent plane.
+inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& poly) {
+  double sum = 0.0;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    glm::dvec3 a = glm::normalize(poly[i] - x), b = glm::normalize(poly[(i + 1) % poly.size()] - x);
+    glm::dvec3 c = glm::cross(a, b);
+    double len = glm::length(c);
+    if (len < 1e-15) continue;
+    double angle = std::atan2(len, glm::dot(a, b));
+    sum += angle * glm::dot(n, c / len);
+  }
+  return std::abs(sum) / (2.0 * 3.14159265358979323846);
+}
+
+}  // namespace irbake::testing
