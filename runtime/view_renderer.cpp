@@ -1,0 +1,371 @@
+#include "view_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <epoxy/gl.h>
+
+#include "common/error.h"
+#include "shaders.h"
+
+namespace irbake::view {
+namespace {
+
+void throwOnGlError(const char* what) {
+  GLenum e = glGetError(), first = e;
+  while (e != GL_NO_ERROR) e = glGetError();  // drain the queue
+  if (first != GL_NO_ERROR) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "0x%04x", first);
+    throw Error(ErrorCode::Gl, "", std::string(what) + ": GL error " + buf);
+  }
+}
+
+GLuint compileShader(GLenum type, const std::string& file) {
+  const std::string src = shaderSource(file);
+  GLuint s = glCreateShader(type);
+  const char* p = src.c_str();
+  glShaderSource(s, 1, &p, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    glDeleteShader(s);
+    throw Error(ErrorCode::Gl, "shaders/" + file, std::string("compile failed: ") + log);
+  }
+  return s;
+}
+
+GLenum glWrap(WrapMode m) {
+  switch (m) {
+    case WrapMode::ClampToEdge: return GL_CLAMP_TO_EDGE;
+    case WrapMode::MirroredRepeat: return GL_MIRRORED_REPEAT;
+    default: return GL_REPEAT;
+  }
+}
+
+// Colour textures: half float (linear values ≤ 1 keep 11 bits), mipmapped for minification.
+GLuint uploadColorTexture(const Texture& t) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT, t.texels.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, glWrap(t.wrapS));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, glWrap(t.wrapT));
+  return tex;
+}
+
+// Light maps: full-range float, bilinear, no mipmaps (a coarser level would mix in the padding
+// between charts), clamped at the page edge.
+GLuint uploadLightmap(int width, int height, GLenum format, const void* data) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  GLenum internal = format == GL_RGB ? GL_RGB32F : GL_RGBA32F;
+  glTexImage2D(GL_TEXTURE_2D, 0, internal, width, height, 0, format, GL_FLOAT, data);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+struct Vertex {
+  glm::vec3 position, normal;
+  glm::vec2 uv0, uv1;
+  float chart;
+};
+
+}  // namespace
+
+const char* toString(ViewMode mode) {
+  switch (mode) {
+    case ViewMode::Lit: return "lit";
+    case ViewMode::Lightmap: return "lightmap";
+    case ViewMode::Albedo: return "albedo";
+    case ViewMode::Charts: return "charts";
+    case ViewMode::TexelDensity: return "density";
+    case ViewMode::Wireframe: return "wireframe";
+  }
+  return "?";
+}
+
+ViewMode parseViewMode(const std::string& name) {
+  for (ViewMode m : {ViewMode::Lit, ViewMode::Lightmap, ViewMode::Albedo, ViewMode::Charts,
+                     ViewMode::TexelDensity, ViewMode::Wireframe})
+    if (name == toString(m)) return m;
+  throw Error(ErrorCode::Usage, "",
+              "unknown view '" + name + "' (lit, lightmap, albedo, charts, density, wireframe)");
+}
+
+struct ViewRenderer::Impl {
+  struct GpuPrimitive {
+    GLuint vao = 0, vbo = 0, ebo = 0;
+    GLsizei indexCount = 0;
+    int material = 0;
+    GLuint lightmap = 0;          // 0: none (albedo only)
+    float lightmapScale = 1.0f;   // MOZ_lightmap intensity
+    glm::vec2 lightmapSize{1.0f};
+  };
+  const Scene& scene;
+  GLuint program = 0;
+  std::map<int, GLuint> colorTextures;     // Scene::textures index → GL texture
+  std::map<int, GLuint> textureLightmaps;  // Scene::textures index → float light map texture
+  std::vector<GLuint> pageTextures;        // ViewerScene::pages index → GL texture
+  std::vector<GpuPrimitive> prims;
+  GLuint fbo = 0, colorRb = 0, depthRb = 0;
+  int fboWidth = 0, fboHeight = 0;
+  std::map<std::string, GLint> uniforms;
+
+  explicit Impl(const Scene& s) : scene(s) {}
+
+  GLint u(const char* name) {
+    auto it = uniforms.find(name);
+    if (it != uniforms.end()) return it->second;
+    return uniforms[name] = glGetUniformLocation(program, name);
+  }
+
+  GLuint colorTexture(int index) {
+    if (index < 0 || index >= static_cast<int>(scene.textures.size())) return 0;
+    const Texture& t = scene.textures[index];
+    if (t.width <= 0 || t.height <= 0 || t.texels.size() != static_cast<size_t>(t.width) * t.height) return 0;
+    auto it = colorTextures.find(index);
+    if (it != colorTextures.end()) return it->second;
+    return colorTextures[index] = uploadColorTexture(t);
+  }
+
+  void ensureFramebuffer(int w, int h) {
+    if (fbo && w == fboWidth && h == fboHeight) return;
+    if (!fbo) {
+      glGenFramebuffers(1, &fbo);
+      glGenRenderbuffers(1, &colorRb);
+      glGenRenderbuffers(1, &depthRb);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, colorRb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, depthRb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colorRb);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw Error(ErrorCode::Gl, "", "offscreen float framebuffer " + std::to_string(w) + "x" +
+                                         std::to_string(h) + " is incomplete");
+    fboWidth = w;
+    fboHeight = h;
+  }
+};
+
+ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(v.scene)) {
+  Impl& I = *impl_;
+  GLuint vs = compileShader(GL_VERTEX_SHADER, "view_mesh.vert");
+  GLuint fs = compileShader(GL_FRAGMENT_SHADER, "view_mesh.frag");
+  I.program = glCreateProgram();
+  glAttachShader(I.program, vs);
+  glAttachShader(I.program, fs);
+  glLinkProgram(I.program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(I.program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    glGetProgramInfoLog(I.program, sizeof log, nullptr, log);
+    throw Error(ErrorCode::Gl, "shaders/view_mesh.frag", std::string("link failed: ") + log);
+  }
+
+  for (const Lightmap& page : v.pages)
+    I.pageTextures.push_back(page.size() > 0 && page.texels.size() == page.size()
+                                 ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
+                                 : 0);
+
+  for (const Primitive& p : v.scene.primitives) {
+    if (p.indices.empty()) continue;
+    Impl::GpuPrimitive g;
+    g.material = p.material;
+    const Material& m = v.scene.materials.at(p.material);
+    switch (lightmapSourceOf(v, p)) {
+      case LightmapSource::Page: {
+        g.lightmap = I.pageTextures[p.lightmap.page];
+        const Lightmap& page = v.pages[p.lightmap.page];
+        g.lightmapSize = glm::vec2(page.width, page.height);
+        break;
+      }
+      case LightmapSource::MaterialTexture: {
+        const Texture& t = v.scene.textures[m.lightmapTexture];
+        auto it = I.textureLightmaps.find(m.lightmapTexture);
+        if (it == I.textureLightmaps.end())
+          it = I.textureLightmaps.emplace(m.lightmapTexture,
+                                          uploadLightmap(t.width, t.height, GL_RGBA, t.texels.data())).first;
+        g.lightmap = it->second;
+        g.lightmapScale = m.lightmapIntensity;
+        g.lightmapSize = glm::vec2(t.width, t.height);
+        break;
+      }
+      case LightmapSource::None:
+        if (p.lightmap.width > 0) g.lightmapSize = glm::vec2(p.lightmap.width, p.lightmap.height);
+        break;
+    }
+    const std::vector<uint32_t> charts = chartIds(p);
+    std::vector<Vertex> verts(p.positions.size());
+    for (size_t i = 0; i < verts.size(); ++i) {
+      verts[i].position = p.positions[i];
+      verts[i].normal = i < p.normals.size() ? p.normals[i] : glm::vec3(0, 1, 0);
+      verts[i].uv0 = i < p.uv0.size() ? p.uv0[i] : glm::vec2(0.0f);
+      verts[i].uv1 = i < p.uv1.size() ? p.uv1[i] : glm::vec2(0.0f);
+      verts[i].chart = static_cast<float>(charts[i]);
+    }
+    glGenVertexArrays(1, &g.vao);
+    glBindVertexArray(g.vao);
+    glGenBuffers(1, &g.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
+    glBufferData(GL_ARRAY_BUFFER, verts.size() * sizeof(Vertex), verts.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &g.ebo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(), GL_STATIC_DRAW);
+    const GLsizei stride = sizeof(Vertex);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, position)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, normal)));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv0)));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv1)));
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, chart)));
+    glBindVertexArray(0);
+    g.indexCount = static_cast<GLsizei>(p.indices.size());
+    triangles_ += p.indices.size() / 3;
+    // Upload the material's colour textures now so the first frame does no uploads.
+    I.colorTexture(m.baseColorTexture);
+    I.colorTexture(m.emissiveTexture);
+    I.prims.push_back(g);
+  }
+  throwOnGlError("uploading the scene");
+}
+
+ViewRenderer::~ViewRenderer() {
+  Impl& I = *impl_;
+  for (auto& g : I.prims) {
+    glDeleteVertexArrays(1, &g.vao);
+    glDeleteBuffers(1, &g.vbo);
+    glDeleteBuffers(1, &g.ebo);
+  }
+  for (auto& [i, t] : I.colorTextures) glDeleteTextures(1, &t);
+  for (auto& [i, t] : I.textureLightmaps) glDeleteTextures(1, &t);
+  for (GLuint t : I.pageTextures)
+    if (t) glDeleteTextures(1, &t);
+  if (I.fbo) {
+    glDeleteFramebuffers(1, &I.fbo);
+    glDeleteRenderbuffers(1, &I.colorRb);
+    glDeleteRenderbuffers(1, &I.depthRb);
+  }
+  glDeleteProgram(I.program);
+}
+
+void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const DrawSettings& settings) {
+  Impl& I = *impl_;
+  glViewport(0, 0, width, height);
+  glClearColor(settings.background.r, settings.background.g, settings.background.b, 1.0f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);  // light maps cover both sides that matter; never hide a wall seen from behind
+  glDisable(GL_BLEND);
+  glUseProgram(I.program);
+  const float aspect = static_cast<float>(width) / std::max(height, 1);
+  const glm::mat4 vp = camera.projection(aspect) * camera.view();
+  glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
+  glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
+  glUniform1i(I.u("uEncodeSrgb"), settings.encodeSrgb ? 1 : 0);
+  glUniform1i(I.u("uBaseColorTex"), 0);
+  glUniform1i(I.u("uEmissiveTex"), 1);
+  glUniform1i(I.u("uLightmap"), 2);
+  glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
+
+  auto drawAll = [&](int mode) {
+    glUniform1i(I.u("uMode"), mode);
+    for (const auto& g : I.prims) {
+      const Material& m = I.scene.materials.at(g.material);
+      glUniform4fv(I.u("uBaseColorFactor"), 1, &m.baseColorFactor[0]);
+      GLuint base = I.colorTexture(m.baseColorTexture);
+      glUniform1i(I.u("uHasBaseColorTex"), base ? 1 : 0);
+      glUniform1i(I.u("uBaseColorUv1"), m.baseColorTexCoord == 1 ? 1 : 0);
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, base);
+      const glm::vec3 emission = m.emission();
+      glUniform3fv(I.u("uEmissive"), 1, &emission[0]);
+      GLuint emissive = I.colorTexture(m.emissiveTexture);
+      glUniform1i(I.u("uHasEmissiveTex"), emissive ? 1 : 0);
+      glUniform1i(I.u("uEmissiveUv1"), m.emissiveTexCoord == 1 ? 1 : 0);
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, emissive);
+      glUniform1i(I.u("uHasLightmap"), g.lightmap ? 1 : 0);
+      glUniform1f(I.u("uLightmapScale"), g.lightmapScale);
+      glUniform2fv(I.u("uLightmapSize"), 1, &g.lightmapSize[0]);
+      glActiveTexture(GL_TEXTURE2);
+      glBindTexture(GL_TEXTURE_2D, g.lightmap);
+      glUniform1i(I.u("uAlphaMask"), m.alphaMode == AlphaMode::Mask ? 1 : 0);
+      glUniform1f(I.u("uAlphaCutoff"), m.alphaCutoff);
+      glBindVertexArray(g.vao);
+      glDrawElements(GL_TRIANGLES, g.indexCount, GL_UNSIGNED_INT, nullptr);
+    }
+  };
+
+  if (settings.mode == ViewMode::Wireframe) {
+    // Filled and pushed back slightly, then the edges on top.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0f, 1.0f);
+    drawAll(static_cast<int>(ViewMode::Lit));
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+    drawAll(5);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+  } else {
+    drawAll(static_cast<int>(settings.mode));
+  }
+  glBindVertexArray(0);
+  glActiveTexture(GL_TEXTURE0);
+  throwOnGlError("drawing the scene");
+}
+
+RgbaImage ViewRenderer::render(const ViewCamera& camera, int width, int height, DrawSettings settings) {
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
+    throw Error(ErrorCode::Usage, "", "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                                          " is out of range (1..16384)");
+  Impl& I = *impl_;
+  GLint previous = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &previous);
+  I.ensureFramebuffer(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, I.fbo);
+  settings.encodeSrgb = false;
+  draw(camera, width, height, settings);
+  RgbaImage img;
+  img.width = width;
+  img.height = height;
+  std::vector<glm::vec4> rows(static_cast<size_t>(width) * height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rows.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(previous));
+  throwOnGlError("reading the offscreen image");
+  // GL's row 0 is the bottom; images here have row 0 at the top.
+  img.pixels.resize(rows.size());
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rows.begin() + static_cast<size_t>(height - 1 - y) * width, width,
+                img.pixels.begin() + static_cast<size_t>(y) * width);
+  return img;
+}
+
+}  // namespace irbake::view

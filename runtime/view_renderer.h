@@ -1,0 +1,55 @@
+// Draws a ViewerScene with OpenGL (3.3 core or later, current context required): one textured draw
+// per primitive, since the baked light is view-independent. Offscreen renders are linear radiance.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "view_camera.h"
+#include "viewer_scene.h"
+
+namespace irbake::view {
+
+enum class ViewMode { Lit, Lightmap, Albedo, Charts, TexelDensity, Wireframe };
+const char* toString(ViewMode mode);
+// "lit", "lightmap", "albedo", "charts", "density", "wireframe"; throws Error(Usage) otherwise.
+ViewMode parseViewMode(const std::string& name);
+
+struct DrawSettings {
+  ViewMode mode = ViewMode::Lit;   // what to show
+  float exposure = 0.0f;           // EV stops, display only (×2^EV before the sRGB encode)
+  bool encodeSrgb = false;         // true: exposure + sRGB in the shader (window); false: linear out
+  glm::vec3 background{0.0f};      // clear colour (linear)
+};
+
+// Linear RGBA float image, row 0 at the top.
+struct RgbaImage {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> pixels;
+  const glm::vec4& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
+};
+
+class ViewRenderer {
+ public:
+  // Uploads every primitive and texture to the current context.
+  explicit ViewRenderer(const ViewerScene& scene);
+  ~ViewRenderer();
+  ViewRenderer(const ViewRenderer&) = delete;
+  ViewRenderer& operator=(const ViewRenderer&) = delete;
+
+  // Draws into the bound framebuffer (viewport = width × height).
+  void draw(const ViewCamera& camera, int width, int height, const DrawSettings& settings);
+  // Renders into an offscreen float framebuffer and reads it back; settings.encodeSrgb is ignored
+  // (always linear), so the pixels are radiance in the scene's units.
+  RgbaImage render(const ViewCamera& camera, int width, int height, DrawSettings settings);
+  size_t triangleCount() const { return triangles_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  size_t triangles_ = 0;
+};
+
+}  // namespace irbake::view

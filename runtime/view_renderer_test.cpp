@@ -1,0 +1,254 @@
+// Renderer tests on scenes built in code with closed-form light maps: pixels are compared with
+// baseColor × map + emissive evaluated on the CPU at the surface point each pixel sees.
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "glcontext/gl_context.h"
+#include "view_renderer.h"
+
+namespace irbake::view {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+
+// A quad p0,p1,p2,p3 (counter-clockwise seen from the side it faces), uv0 and uv1 = the unit square.
+void addQuad(Scene& s, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, int material, int page,
+             int pageSize) {
+  Primitive p;
+  p.positions = {p0, p1, p2, p3};
+  glm::vec3 n = glm::normalize(glm::cross(p1 - p0, p3 - p0));
+  p.normals.assign(4, n);
+  p.uv0 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  p.uv1 = p.uv0;
+  p.indices = {0, 1, 2, 0, 2, 3};
+  p.material = material;
+  p.lightmap = {page, pageSize, pageSize};
+  s.primitives.push_back(p);
+}
+
+Lightmap constantPage(int page, int size, glm::vec3 value) {
+  Lightmap m;
+  m.page = page;
+  m.width = m.height = size;
+  m.texels.assign(m.size(), value);
+  m.valid.assign(m.size(), 1);
+  return m;
+}
+
+// Inside a closed cube of albedo ρ = 0.5 and emission Le = 0.5: the converged radiance is
+// Le/(1−ρ) = 1 everywhere, so the map (irradiance/π = incident radiance) is 1 and every pixel shows
+// ρ·1 + Le = 1.
+ViewerScene furnaceInside() {
+  Scene s;
+  Material m;
+  m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  m.emissiveFactor = glm::vec3(0.5f);
+  s.materials.push_back(m);
+  const float a = 1.0f;
+  std::vector<Lightmap> pages;
+  auto face = [&](glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3) {
+    int page = static_cast<int>(pages.size());
+    addQuad(s, p0, p1, p2, p3, 0, page, 8);
+    pages.push_back(constantPage(page, 8, glm::vec3(1.0f)));
+  };
+  // Faces wound to face the inside.
+  face({-a, -a, -a}, {a, -a, -a}, {a, -a, a}, {-a, -a, a});    // floor, normal +y
+  face({-a, a, -a}, {-a, a, a}, {a, a, a}, {a, a, -a});        // ceiling, normal -y
+  face({-a, -a, -a}, {-a, -a, a}, {-a, a, a}, {-a, a, -a});    // x = -a, normal +x
+  face({a, -a, -a}, {a, a, -a}, {a, a, a}, {a, -a, a});        // x = +a, normal -x
+  face({-a, -a, -a}, {-a, a, -a}, {a, a, -a}, {a, -a, -a});    // z = -a, normal +z
+  face({-a, -a, a}, {a, -a, a}, {a, a, a}, {-a, a, a});        // z = +a, normal -z
+  return makeViewerScene(std::move(s), std::move(pages));
+}
+
+TEST(ViewRenderer, FurnaceSeenFromInsideIsOneEverywhere) {
+  GlContext gl;
+  ViewerScene v = furnaceInside();
+  EXPECT_TRUE(v.warnings.empty());
+  ViewRenderer r(v);
+  EXPECT_EQ(r.triangleCount(), 12u);
+  const Bounds3 b = v.scene.bounds();
+  // Six directions plus an oblique one: every pixel sees a wall (the eye is inside the closed cube).
+  const glm::vec3 targets[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {1, 0.7f, -0.4f}};
+  for (const auto& t : targets) {
+    RgbaImage img = r.render(lookAt(glm::vec3(0.1f, -0.2f, 0.15f), glm::vec3(0.1f, -0.2f, 0.15f) + t, 100.0f, b),
+                             96, 64, {});
+    ASSERT_EQ(img.pixels.size(), 96u * 64u);
+    float worst = 0.0f;
+    for (const auto& p : img.pixels)
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(p[c] - 1.0f));
+    EXPECT_LT(worst, 0.02f) << "direction " << t.x << "," << t.y << "," << t.z;
+  }
+}
+
+// A 4 m × 4 m floor (y = 0) with a smooth albedo texture, lit by a point light of intensity I at
+// height h: irradiance/π = I h / (π r³). The page stores that at texel centres.
+struct PlaneCase {
+  ViewerScene view;
+  glm::vec3 light{0.3f, 1.0f, -0.2f};
+  float intensity = 3.0f;
+  float mapAt(glm::vec3 x) const {
+    float r = glm::length(light - x);
+    return intensity * light.y / (kPi * r * r * r);
+  }
+};
+
+Texture smoothAlbedo() {
+  Texture t;
+  t.name = "smooth albedo";
+  t.width = t.height = 64;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      float u = (x + 0.5f) / t.width, v = (y + 0.5f) / t.height;
+      t.texels.emplace_back(0.45f + 0.3f * std::sin(2 * kPi * u), 0.3f + 0.5f * v, 0.7f - 0.4f * u * v, 1.0f);
+    }
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  return t;
+}
+
+PlaneCase texturedPlane() {
+  PlaneCase c;
+  Scene s;
+  s.textures.push_back(smoothAlbedo());
+  Material m;
+  m.baseColorTexture = 0;
+  s.materials.push_back(m);
+  const int size = 256;
+  addQuad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0, 0, size);
+  // uv0 = uv1 = ((x+2)/4, (z+2)/4).
+  auto& p = s.primitives[0];
+  for (size_t i = 0; i < 4; ++i) p.uv0[i] = p.uv1[i] = glm::vec2(p.positions[i].x + 2, p.positions[i].z + 2) / 4.0f;
+  Lightmap page = constantPage(0, size, glm::vec3(0.0f));
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      glm::vec2 uv((x + 0.5f) / size, (y + 0.5f) / size);
+      page.texels[static_cast<size_t>(y) * size + x] = glm::vec3(c.mapAt(glm::vec3(uv.x * 4 - 2, 0, uv.y * 4 - 2)));
+    }
+  c.view = makeViewerScene(std::move(s), {page});
+  return c;
+}
+
+// The floor point a pixel centre sees (row 0 at the top), or false when the ray misses the floor.
+bool floorPointAt(const ViewCamera& cam, int w, int h, int px, int py, glm::vec3& hit) {
+  glm::mat4 inv = glm::inverse(cam.projection(static_cast<float>(w) / h) * cam.view());
+  glm::vec2 ndc((px + 0.5f) / w * 2 - 1, 1 - (py + 0.5f) / h * 2);
+  glm::vec4 a = inv * glm::vec4(ndc, -1, 1), b = inv * glm::vec4(ndc, 0, 1);
+  glm::vec3 o = glm::vec3(a) / a.w, d = glm::vec3(b) / b.w - o;
+  if (d.y >= 0) return false;
+  hit = o + d * (-o.y / d.y);
+  return true;
+}
+
+TEST(ViewRenderer, TexturedPlaneMatchesAlbedoTimesClosedFormMap) {
+  GlContext gl;
+  PlaneCase c = texturedPlane();
+  ViewRenderer r(c.view);
+  const int w = 160, h = 120;
+  ViewCamera cam = lookAt({0.2f, 3.0f, 2.5f}, {0, 0, -0.3f}, 55.0f, c.view.scene.bounds());
+  RgbaImage img = r.render(cam, w, h, {});
+  size_t checked = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      glm::vec3 p;
+      if (!floorPointAt(cam, w, h, x, y, p) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f) continue;
+      glm::vec2 uv = (glm::vec2(p.x, p.z) + 2.0f) / 4.0f;
+      glm::vec3 expected = glm::vec3(sampleBilinear(c.view.scene.textures[0], uv)) * c.mapAt(p);
+      for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(img.at(x, y)[k] / expected[k] - 1.0f));
+      ++checked;
+    }
+  EXPECT_GT(checked, static_cast<size_t>(w * h / 3));
+  EXPECT_LT(worst, 0.02f);
+  // The other views read the same inputs: albedo only and light map only.
+  int cx = w / 2, cy = h / 2;
+  glm::vec3 p;
+  ASSERT_TRUE(floorPointAt(cam, w, h, cx, cy, p));
+  glm::vec2 uv = (glm::vec2(p.x, p.z) + 2.0f) / 4.0f;
+  RgbaImage albedo = r.render(cam, w, h, {ViewMode::Albedo});
+  RgbaImage map = r.render(cam, w, h, {ViewMode::Lightmap});
+  EXPECT_NEAR(albedo.at(cx, cy).g, sampleBilinear(c.view.scene.textures[0], uv).g, 0.01f);
+  EXPECT_NEAR(map.at(cx, cy).r / c.mapAt(p), 1.0f, 0.02f);
+}
+
+TEST(ViewRenderer, MaterialLightmapTextureIsScaledByIntensity) {
+  // No float pages: MOZ_lightmap texture (0.25) × intensity (4) = 1, on albedo 0.6.
+  GlContext gl;
+  Scene s;
+  Texture lm;
+  lm.width = lm.height = 4;
+  lm.texels.assign(16, glm::vec4(0.25f, 0.25f, 0.25f, 1.0f));
+  s.textures.push_back(lm);
+  Material m;
+  m.baseColorFactor = glm::vec4(0.6f, 0.6f, 0.6f, 1.0f);
+  m.lightmapTexture = 0;
+  m.lightmapIntensity = 4.0f;
+  s.materials.push_back(m);
+  addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0, 0, 4);
+  ViewerScene v = makeViewerScene(std::move(s), {});
+  EXPECT_EQ(lightmapSourceOf(v, v.scene.primitives[0]), LightmapSource::MaterialTexture);
+  ViewRenderer r(v);
+  RgbaImage img = r.render(lookAt({0, 2, 0.01f}, {0, 0, 0}, 40.0f, v.scene.bounds()), 32, 32, {});
+  EXPECT_NEAR(img.at(16, 16).r, 0.6f, 0.006f);
+}
+
+TEST(ViewRenderer, SceneWithoutLightmapShowsAlbedoAndWarns) {
+  GlContext gl;
+  Scene s;
+  Material m;
+  m.baseColorFactor = glm::vec4(0.2f, 0.4f, 0.8f, 1.0f);
+  s.materials.push_back(m);
+  addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0, -1, 0);
+  ViewerScene v = makeViewerScene(std::move(s), {});
+  ASSERT_EQ(v.warnings.size(), 1u);
+  EXPECT_NE(v.warnings[0].find("albedo only"), std::string::npos);
+  ViewRenderer r(v);
+  // 90° from 2 m: the 2 m quad fills the middle, the corners see the background.
+  RgbaImage img = r.render(lookAt({0, 2, 0.01f}, {0, 0, 0}, 90.0f, v.scene.bounds()), 32, 32, {});
+  EXPECT_NEAR(img.at(16, 16).b, 0.8f, 0.005f);
+  EXPECT_NEAR(img.at(16, 16).r, 0.2f, 0.005f);
+  EXPECT_EQ(img.at(0, 0), glm::vec4(0, 0, 0, 1));  // background outside the quad
+}
+
+TEST(ViewRenderer, DebugViewsDifferFromLitAndStayFinite) {
+  GlContext gl;
+  PlaneCase c = texturedPlane();
+  ViewRenderer r(c.view);
+  ViewCamera cam = lookAt({0.2f, 3.0f, 2.5f}, {0, 0, -0.3f}, 55.0f, c.view.scene.bounds());
+  RgbaImage lit = r.render(cam, 64, 48, {});
+  for (ViewMode m : {ViewMode::Charts, ViewMode::TexelDensity, ViewMode::Wireframe}) {
+    RgbaImage img = r.render(cam, 64, 48, {m});
+    double diff = 0.0;
+    for (size_t i = 0; i < img.pixels.size(); ++i) {
+      for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isfinite(img.pixels[i][k]));
+      diff += glm::length(glm::vec3(img.pixels[i] - lit.pixels[i]));
+    }
+    EXPECT_GT(diff / img.pixels.size(), 0.01) << toString(m);
+  }
+  // The density checker alternates at the page's texel size: two neighbouring texels differ.
+  RgbaImage density = r.render(lookAt({0, 0.5f, 0.0f}, {0, 0, -0.001f}, 10.0f, c.view.scene.bounds()), 64, 64,
+                               {ViewMode::TexelDensity});
+  float lo = 1e9f, hi = -1e9f;
+  for (const auto& p : density.pixels) lo = std::min(lo, p.g), hi = std::max(hi, p.g);
+  EXPECT_GT(hi, lo * 2.0f);
+}
+
+TEST(ViewRenderer, ViewModeNamesRoundTrip) {
+  for (ViewMode m : {ViewMode::Lit, ViewMode::Lightmap, ViewMode::Albedo, ViewMode::Charts, ViewMode::TexelDensity,
+                     ViewMode::Wireframe})
+    EXPECT_EQ(parseViewMode(toString(m)), m);
+  EXPECT_THROW(parseViewMode("shiny"), Error);
+}
+
+TEST(ViewerScene, ChartIdsAreConnectedComponents) {
+  Primitive p;
+  p.positions.assign(7, glm::vec3(0));
+  p.indices = {0, 1, 2, 2, 1, 3, 4, 5, 6};  // two triangles sharing an edge, and one apart
+  auto ids = chartIds(p);
+  EXPECT_EQ(ids, (std::vector<uint32_t>{0, 0, 0, 0, 1, 1, 1}));
+}
+
+}  // namespace
+}  // namespace irbake::view

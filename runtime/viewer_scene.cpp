@@ -1,0 +1,62 @@
+#include "viewer_scene.h"
+
+#include <numeric>
+
+#include "common/log.h"
+
+namespace irbake::view {
+
+LightmapSource lightmapSourceOf(const ViewerScene& v, const Primitive& p) {
+  if (p.uv1.size() == p.positions.size() && !p.uv1.empty()) {
+    if (p.lightmap.page >= 0 && p.lightmap.page < static_cast<int>(v.pages.size()) &&
+        v.pages[p.lightmap.page].size() > 0)
+      return LightmapSource::Page;
+    const Material& m = v.scene.materials.at(p.material);
+    if (m.lightmapTexture >= 0 && m.lightmapTexture < static_cast<int>(v.scene.textures.size()))
+      return LightmapSource::MaterialTexture;
+  }
+  return LightmapSource::None;
+}
+
+ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages) {
+  ViewerScene v;
+  v.scene = std::move(scene);
+  v.pages = std::move(pages);
+  size_t unlit = 0;
+  for (const auto& p : v.scene.primitives)
+    if (lightmapSourceOf(v, p) == LightmapSource::None) ++unlit;
+  const std::string where = v.scene.sourcePath.empty() ? std::string("scene") : v.scene.sourcePath;
+  if (!v.scene.primitives.empty() && unlit == v.scene.primitives.size())
+    v.warnings.push_back(where + ": no light map: showing albedo only");
+  else if (unlit > 0)
+    v.warnings.push_back(where + ": " + std::to_string(unlit) + " primitive(s) without a light map show albedo only");
+  return v;
+}
+
+std::vector<uint32_t> chartIds(const Primitive& p) {
+  const size_t n = p.positions.size();
+  std::vector<uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+    uint32_t a = find(p.indices[t]);
+    for (int k = 1; k < 3; ++k) {
+      uint32_t b = find(p.indices[t + k]);
+      if (a != b) parent[b] = a;
+    }
+  }
+  // Dense ids in order of first appearance, so colours are stable between runs.
+  std::vector<uint32_t> id(n, UINT32_MAX), out(n);
+  uint32_t next = 0;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t r = find(static_cast<uint32_t>(i));
+    if (id[r] == UINT32_MAX) id[r] = next++;
+    out[i] = id[r];
+  }
+  return out;
+}
+
+}  // namespace irbake::view
