@@ -1,0 +1,810 @@
+// glTF → Scene. Two passes: readGltfSource() checks the container, JSON, URIs and buffers before
+// tinygltf reads anything; tinygltf then parses the document (images kept as encoded bytes), and
+// this file flattens nodes to world space while validating accessors, indices and values.
+#include "scene/gltf_loader.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <cmath>
+#include <future>
+#include <map>
+#include <thread>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <tiny_gltf.h>
+
+#include "common/error.h"
+#include "common/log.h"
+#include "scene/gltf_source.h"
+#include "scene/image_codec.h"
+
+namespace irbake {
+
+namespace {
+
+using json = nlohmann::json;
+
+// Accessors declaring more than this many times their whole buffer are "absurd" rather than merely
+// out of bounds: the declared count cannot be a near miss.
+constexpr double kAbsurdFactor = 64.0;
+constexpr int kMaxNodeDepth = 1024;
+
+// tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
+// material uses). EXR and unknown formats load too; they are simply recorded.
+bool keepEncodedImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + size);
+  image->as_is = true;
+  return true;
+}
+
+const json* child(const json& j, const char* key) {
+  if (!j.is_object()) return nullptr;
+  auto it = j.find(key);
+  return it == j.end() ? nullptr : &*it;
+}
+
+const json* path(const json& j, std::initializer_list<const char*> keys) {
+  const json* cur = &j;
+  for (const char* k : keys) {
+    cur = child(*cur, k);
+    if (!cur) return nullptr;
+  }
+  return cur;
+}
+
+const json* element(const json& j, const char* arrayKey, size_t index) {
+  const json* a = child(j, arrayKey);
+  if (!a || !a->is_array() || index >= a->size()) return nullptr;
+  return &(*a)[index];
+}
+
+double numberOr(const json* j, double fallback) { return (j && j->is_number()) ? j->get<double>() : fallback; }
+
+int componentSize(int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+  }
+  return 0;
+}
+
+int componentCount(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+  }
+  return 0;
+}
+
+float readComponent(const uint8_t* p, int componentType, bool normalized) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? *p / 255.0f : *p;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0f : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return static_cast<float>(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+  return 0.0f;
+}
+
+uint32_t readIndex(const uint8_t* p, int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+  return 0;
+}
+
+WrapMode wrapFromGl(int mode) {
+  switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::MirroredRepeat;
+  }
+  return WrapMode::Repeat;
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// A primitive's data in mesh space, read once per (mesh, primitive) however many nodes instance it.
+struct LocalPrimitive {
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> uv0, uv1;
+  std::vector<uint32_t> indices;  // triangle list (strips and fans expanded)
+  int material = -1;
+  LightmapRef lightmap;
+  bool skipped = false;           // points or lines
+};
+
+class Loader {
+ public:
+  Loader(GltfSource source, const LoadOptions& options)
+      : src_(std::move(source)), options_(options), file_(src_.path.string()) {}
+
+  Scene load() {
+    parseWithTinygltf();
+    scene_.sourcePath = file_;
+    materialMap_.assign(model_.materials.size(), -1);
+    std::vector<int> roots = rootNodes();
+    checkNodeGraph(roots);
+    for (int r : roots) visitNode(r, glm::mat4(1.0f), 0);
+    if (scene_.triangleCount() == 0) {
+      std::string why = std::to_string(scene_.stats.primitivesSkipped) + " point/line primitives skipped, " +
+                        std::to_string(scene_.stats.trianglesDropped) + " degenerate triangles dropped";
+      throw Error(ErrorCode::EmptyScene, file_, "no triangles to bake (" + why + ")");
+    }
+    decodeTextures();
+    readLightmapPages();
+    for (const auto& w : scene_.stats.warnings) log::warn(file_ + ": " + w);
+    return std::move(scene_);
+  }
+
+ private:
+  [[noreturn]] void invalid(const std::string& message) const { throw Error(ErrorCode::InvalidData, file_, message); }
+
+  void warn(const std::string& message) {
+    // Many identical warnings (one per primitive) are summarised by the count in LoadStats.
+    if (scene_.stats.warnings.size() < 32) scene_.stats.warnings.push_back(message);
+  }
+
+  void parseWithTinygltf() {
+    tinygltf::TinyGLTF gltf;
+    gltf.SetImageLoader(&keepEncodedImage, nullptr);
+    std::string err, warn;
+    bool ok;
+    std::string base = src_.folder.string();
+    if (src_.binary) {
+      ok = gltf.LoadBinaryFromMemory(&model_, &err, &warn, src_.bytes.data(), static_cast<unsigned>(src_.bytes.size()), base,
+                                     tinygltf::REQUIRE_VERSION);
+    } else {
+      ok = gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(src_.bytes.data()) + src_.jsonOffset,
+                                    static_cast<unsigned>(src_.jsonSize), base, tinygltf::REQUIRE_VERSION);
+    }
+    if (!ok) {
+      std::string line = err.substr(0, err.find('\n'));
+      throw Error(ErrorCode::Parse, file_, "invalid glTF: " + (line.empty() ? std::string("tinygltf refused the file") : line));
+    }
+    size_t start = 0;
+    while (start < warn.size()) {
+      size_t end = warn.find('\n', start);
+      if (end == std::string::npos) end = warn.size();
+      if (end > start) this->warn(warn.substr(start, end - start));
+      start = end + 1;
+    }
+  }
+
+  std::vector<int> rootNodes() {
+    const int nodeCount = static_cast<int>(model_.nodes.size());
+    auto checkNode = [&](int n, const std::string& from) {
+      if (n < 0 || n >= nodeCount) invalid(from + " references node " + std::to_string(n) + ", out of range (" + std::to_string(nodeCount) + " nodes)");
+    };
+    for (int i = 0; i < nodeCount; ++i)
+      for (int c : model_.nodes[i].children) checkNode(c, "node " + std::to_string(i));
+    if (!model_.scenes.empty()) {
+      int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+      if (s >= static_cast<int>(model_.scenes.size())) invalid("default scene " + std::to_string(s) + " out of range");
+      for (int n : model_.scenes[s].nodes) checkNode(n, "scene " + std::to_string(s));
+      return model_.scenes[s].nodes;
+    }
+    // No scenes: every node that is nobody's child is a root.
+    std::vector<char> isChild(nodeCount, 0);
+    for (const auto& n : model_.nodes)
+      for (int c : n.children) isChild[c] = 1;
+    std::vector<int> roots;
+    for (int i = 0; i < nodeCount; ++i)
+      if (!isChild[i]) roots.push_back(i);
+    if (roots.empty() && nodeCount > 0) invalid("recursive node graph: every node is some node's child");
+    return roots;
+  }
+
+  // Depth-first walk with an on-stack mark: a node met again while it is on the stack is a cycle.
+  void checkNodeGraph(const std::vector<int>& roots) {
+    std::vector<uint8_t> state(model_.nodes.size(), 0);  // 0 new, 1 on stack, 2 done
+    std::vector<std::pair<int, size_t>> stack;
+    for (int r : roots) {
+      if (state[r] == 2) continue;
+      stack.push_back({r, 0});
+      state[r] = 1;
+      while (!stack.empty()) {
+        auto& [n, next] = stack.back();
+        const auto& children = model_.nodes[n].children;
+        if (next < children.size()) {
+          int c = children[next++];
+          if (state[c] == 1)
+            invalid("recursive node graph: node " + std::to_string(c) + nodeName(c) + " is its own ancestor");
+          if (state[c] == 0) {
+            if (stack.size() >= kMaxNodeDepth) invalid("node hierarchy deeper than " + std::to_string(kMaxNodeDepth) + " levels");
+            state[c] = 1;
+            stack.push_back({c, 0});
+          }
+        } else {
+          state[n] = 2;
+          stack.pop_back();
+        }
+      }
+    }
+  }
+
+  std::string nodeName(int n) const {
+    const std::string& name = model_.nodes[n].name;
+    return name.empty() ? std::string() : " ('" + name + "')";
+  }
+
+  glm::mat4 localMatrix(int n) {
+    const auto& node = model_.nodes[n];
+    glm::mat4 m(1.0f);
+    if (node.matrix.size() == 16) {
+      for (int i = 0; i < 16; ++i) glm::value_ptr(m)[i] = static_cast<float>(node.matrix[i]);  // both column-major
+    } else {
+      glm::mat4 t(1.0f), r(1.0f), s(1.0f);
+      if (node.translation.size() == 3)
+        t = glm::translate(glm::mat4(1.0f), glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+      if (node.rotation.size() == 4) {
+        glm::quat q(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                    static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]));
+        float len = glm::length(q);
+        if (len > 0.0f && std::isfinite(len)) r = glm::mat4_cast(q / len);
+        else if (!std::isfinite(len)) invalid("node " + std::to_string(n) + nodeName(n) + " has a non-finite rotation");
+      }
+      if (node.scale.size() == 3) s = glm::scale(glm::mat4(1.0f), glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+      m = t * r * s;
+    }
+    for (int i = 0; i < 16; ++i)
+      if (!std::isfinite(glm::value_ptr(m)[i])) invalid("node " + std::to_string(n) + nodeName(n) + " has a NaN/Inf in its transform");
+    return m;
+  }
+
+  void visitNode(int n, const glm::mat4& parent, int depth) {
+    const auto& node = model_.nodes[n];
+    glm::mat4 world = parent * localMatrix(n);
+    if (node.mesh >= 0) {
+      if (node.mesh >= static_cast<int>(model_.meshes.size()))
+        invalid("node " + std::to_string(n) + nodeName(n) + " references mesh " + std::to_string(node.mesh) + ", out of range");
+      addMeshInstance(n, node.mesh, world);
+    }
+    if (node.camera >= 0) addCamera(n, world);
+    if (const json* l = path(nodeJson(n), {"extensions", "KHR_lights_punctual", "light"})) addLight(n, l, world);
+    for (int c : node.children) visitNode(c, world, depth + 1);
+  }
+
+  const json& nodeJson(int n) const {
+    static const json empty = json::object();
+    const json* j = element(src_.json, "nodes", n);
+    return j ? *j : empty;
+  }
+
+  void addCamera(int n, const glm::mat4& world) {
+    int ci = model_.nodes[n].camera;
+    if (ci >= static_cast<int>(model_.cameras.size()))
+      invalid("node " + std::to_string(n) + nodeName(n) + " references camera " + std::to_string(ci) + ", out of range");
+    const auto& c = model_.cameras[ci];
+    if (c.type != "perspective") {
+      warn("camera " + std::to_string(ci) + " is " + c.type + "; only perspective cameras are used");
+      return;
+    }
+    Camera cam;
+    cam.name = c.name.empty() ? model_.nodes[n].name : c.name;
+    // Keep rotation and translation; a scaled camera node would distort the view.
+    glm::mat4 m = world;
+    for (int i = 0; i < 3; ++i) {
+      float len = glm::length(glm::vec3(m[i]));
+      if (len > 0.0f) m[i] /= len;
+    }
+    cam.cameraToWorld = m;
+    cam.yfov = c.perspective.yfov > 0.0 ? static_cast<float>(c.perspective.yfov) : cam.yfov;
+    cam.aspectRatio = static_cast<float>(c.perspective.aspectRatio);
+    cam.znear = c.perspective.znear > 0.0 ? static_cast<float>(c.perspective.znear) : cam.znear;
+    cam.zfar = static_cast<float>(c.perspective.zfar);
+    cam.node = n;
+    scene_.cameras.push_back(cam);
+  }
+
+  void addLight(int n, const json* lightRef, const glm::mat4& world) {
+    if (!lightRef->is_number_integer()) invalid("node " + std::to_string(n) + nodeName(n) + " has a non-integer light index");
+    int li = lightRef->get<int>();
+    if (li < 0 || li >= static_cast<int>(model_.lights.size()))
+      invalid("node " + std::to_string(n) + nodeName(n) + " references light " + std::to_string(li) + ", out of range");
+    const auto& l = model_.lights[li];
+    Light light;
+    light.name = l.name.empty() ? model_.nodes[n].name : l.name;
+    if (l.type == "point") light.type = LightType::Point;
+    else if (l.type == "spot") light.type = LightType::Spot;
+    else if (l.type == "directional") light.type = LightType::Directional;
+    else invalid("light " + std::to_string(li) + " has unknown type '" + l.type + "'");
+    if (l.color.size() == 3) light.color = glm::vec3(l.color[0], l.color[1], l.color[2]);
+    light.intensity = static_cast<float>(l.intensity);
+    light.range = static_cast<float>(l.range);
+    light.innerConeAngle = static_cast<float>(l.spot.innerConeAngle);
+    light.outerConeAngle = static_cast<float>(l.spot.outerConeAngle);
+    if (!finite(light.color) || !std::isfinite(light.intensity) || light.intensity < 0.0f || !(light.range >= 0.0f))
+      invalid("light " + std::to_string(li) + " has a negative or non-finite colour, intensity or range");
+    light.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
+    glm::vec3 dir = glm::vec3(world * glm::vec4(0, 0, -1, 0));
+    float len = glm::length(dir);
+    light.direction = len > 0.0f ? dir / len : glm::vec3(0, 0, -1);
+    light.node = n;
+    scene_.lights.push_back(light);
+  }
+
+  // Reads an accessor as floats (count × components), sparse substitution applied, bounds checked.
+  std::vector<float> readAccessor(int index, const std::string& what, int& components, size_t& count) {
+    if (index < 0 || index >= static_cast<int>(model_.accessors.size()))
+      invalid(what + " references accessor " + std::to_string(index) + ", out of range (" + std::to_string(model_.accessors.size()) + " accessors)");
+    const auto& a = model_.accessors[index];
+    std::string name = "accessor " + std::to_string(index) + " (" + what + ")";
+    components = componentCount(a.type);
+    int csize = componentSize(a.componentType);
+    if (components == 0 || csize == 0) invalid(name + " has an unsupported type or component type");
+    count = a.count;
+    const size_t elemSize = static_cast<size_t>(components) * csize;
+    std::vector<float> out;
+    if (a.bufferView >= 0) {
+      const uint8_t* base;
+      size_t viewLength, stride;
+      viewBytes(a.bufferView, name, base, viewLength, stride);
+      if (stride == 0) stride = elemSize;
+      if (stride < elemSize) invalid(name + " has byteStride " + std::to_string(stride) + " smaller than its element");
+      double need = static_cast<double>(a.byteOffset) + static_cast<double>(stride) * (count ? count - 1 : 0) + elemSize;
+      const auto& buffer = model_.buffers[model_.bufferViews[a.bufferView].buffer];
+      if (count > 0 && need > kAbsurdFactor * static_cast<double>(buffer.data.size()) + 1024.0)
+        invalid(name + " declares an absurd size: " + std::to_string(count) + " elements (" + std::to_string(need / 1e6) +
+                " MB) in a buffer of " + std::to_string(buffer.data.size()) + " bytes");
+      if (count > 0 && need > static_cast<double>(viewLength))
+        invalid(name + " is out of bounds: needs " + std::to_string(static_cast<uint64_t>(need)) + " bytes of buffer view " +
+                std::to_string(a.bufferView) + ", which has " + std::to_string(viewLength));
+      out.resize(count * components);
+      for (size_t i = 0; i < count; ++i) {
+        const uint8_t* p = base + a.byteOffset + i * stride;
+        for (int c = 0; c < components; ++c) out[i * components + c] = readComponent(p + c * csize, a.componentType, a.normalized);
+      }
+    } else {
+      if (count > (size_t(1) << 28)) invalid(name + " declares an absurd size: " + std::to_string(count) + " elements and no buffer");
+      out.assign(count * components, 0.0f);  // no buffer view: zeros (sparse may fill some)
+    }
+    if (a.sparse.isSparse) applySparse(a, name, components, csize, out);
+    return out;
+  }
+
+  void applySparse(const tinygltf::Accessor& a, const std::string& name, int components, int csize, std::vector<float>& out) {
+    const size_t n = static_cast<size_t>(std::max(0, a.sparse.count));
+    const uint8_t *ib, *vb;
+    size_t il, vl, stride;
+    viewBytes(a.sparse.indices.bufferView, name + " sparse indices", ib, il, stride);
+    viewBytes(a.sparse.values.bufferView, name + " sparse values", vb, vl, stride);
+    int isize = componentSize(a.sparse.indices.componentType);
+    if (isize == 0 || a.sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE)
+      invalid(name + " has sparse indices of an invalid component type");
+    if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0 ||
+        a.sparse.indices.byteOffset + n * isize > il || a.sparse.values.byteOffset + n * components * csize > vl)
+      invalid(name + " sparse data is out of bounds of its buffer views");
+    for (size_t k = 0; k < n; ++k) {
+      uint32_t target = readIndex(ib + a.sparse.indices.byteOffset + k * isize, a.sparse.indices.componentType);
+      if (target >= a.count) invalid(name + " sparse index " + std::to_string(target) + " out of range");
+      for (int c = 0; c < components; ++c)
+        out[target * components + c] =
+            readComponent(vb + a.sparse.values.byteOffset + (k * components + c) * csize, a.componentType, a.normalized);
+    }
+  }
+
+  void viewBytes(int viewIndex, const std::string& name, const uint8_t*& base, size_t& length, size_t& stride) {
+    if (viewIndex < 0 || viewIndex >= static_cast<int>(model_.bufferViews.size()))
+      invalid(name + " references buffer view " + std::to_string(viewIndex) + ", out of range");
+    const auto& v = model_.bufferViews[viewIndex];
+    if (v.buffer < 0 || v.buffer >= static_cast<int>(model_.buffers.size()))
+      invalid("buffer view " + std::to_string(viewIndex) + " references buffer " + std::to_string(v.buffer) + ", out of range");
+    const auto& b = model_.buffers[v.buffer];
+    if (static_cast<double>(v.byteOffset) + static_cast<double>(v.byteLength) > static_cast<double>(b.data.size()))
+      invalid("buffer view " + std::to_string(viewIndex) + " is out of bounds: bytes " + std::to_string(v.byteOffset) + ".." +
+              std::to_string(v.byteOffset + v.byteLength) + " of buffer " + std::to_string(v.buffer) + " (" +
+              std::to_string(b.data.size()) + " bytes)");
+    base = b.data.data() + v.byteOffset;
+    length = v.byteLength;
+    stride = v.byteStride;
+  }
+
+  std::vector<uint32_t> readIndices(int index, const std::string& what) {
+    if (index < 0 || index >= static_cast<int>(model_.accessors.size()))
+      invalid(what + " references index accessor " + std::to_string(index) + ", out of range");
+    const auto& a = model_.accessors[index];
+    if (a.type != TINYGLTF_TYPE_SCALAR || (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                           a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                           a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+      invalid("accessor " + std::to_string(index) + " (" + what + ") is not an unsigned integer scalar accessor");
+    if (a.sparse.isSparse || a.bufferView < 0) {
+      int comps;
+      size_t count;
+      std::vector<float> f = readAccessor(index, what, comps, count);
+      std::vector<uint32_t> out(count);
+      for (size_t i = 0; i < count; ++i) out[i] = static_cast<uint32_t>(f[i]);
+      return out;
+    }
+    std::string name = "accessor " + std::to_string(index) + " (" + what + ")";
+    const uint8_t* base;
+    size_t length, stride;
+    viewBytes(a.bufferView, name, base, length, stride);
+    const size_t csize = componentSize(a.componentType);
+    if (stride == 0) stride = csize;
+    double need = static_cast<double>(a.byteOffset) + static_cast<double>(stride) * (a.count ? a.count - 1 : 0) + csize;
+    const auto& buffer = model_.buffers[model_.bufferViews[a.bufferView].buffer];
+    if (a.count > 0 && need > kAbsurdFactor * static_cast<double>(buffer.data.size()) + 1024.0)
+      invalid(name + " declares an absurd size: " + std::to_string(a.count) + " indices in a buffer of " +
+              std::to_string(buffer.data.size()) + " bytes");
+    if (a.count > 0 && need > static_cast<double>(length))
+      invalid(name + " is out of bounds: needs " + std::to_string(static_cast<uint64_t>(need)) + " bytes of buffer view " +
+              std::to_string(a.bufferView) + ", which has " + std::to_string(length));
+    std::vector<uint32_t> out(a.count);
+    for (size_t i = 0; i < a.count; ++i) out[i] = readIndex(base + a.byteOffset + i * stride, a.componentType);
+    return out;
+  }
+
+  const LocalPrimitive& localPrimitive(int meshIndex, int primIndex) {
+    auto key = std::make_pair(meshIndex, primIndex);
+    auto it = localCache_.find(key);
+    if (it != localCache_.end()) return it->second;
+    LocalPrimitive& lp = localCache_[key];
+    const auto& mesh = model_.meshes[meshIndex];
+    const auto& prim = mesh.primitives[primIndex];
+    std::string what = "mesh " + std::to_string(meshIndex) + (mesh.name.empty() ? "" : " '" + mesh.name + "'") + " primitive " +
+                       std::to_string(primIndex);
+    int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      lp.skipped = true;
+      ++scene_.stats.primitivesSkipped;
+      warn(what + " is made of points or lines (mode " + std::to_string(mode) + "): skipped");
+      return lp;
+    }
+    auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) invalid(what + " has no POSITION attribute");
+    int comps;
+    size_t vertexCount;
+    std::vector<float> p = readAccessor(pos->second, what + " POSITION", comps, vertexCount);
+    if (comps != 3) invalid(what + " POSITION is not VEC3");
+    lp.positions.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) {
+      lp.positions[i] = glm::vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+      if (!finite(lp.positions[i]))
+        invalid(what + " has a NaN/Inf position at vertex " + std::to_string(i) + " (accessor " + std::to_string(pos->second) + ")");
+    }
+    auto readVec = [&](const char* attr, int want, auto& dst) {
+      auto a = prim.attributes.find(attr);
+      if (a == prim.attributes.end()) return;
+      int c;
+      size_t n;
+      std::vector<float> v = readAccessor(a->second, what + " " + attr, c, n);
+      if (c != want) invalid(what + " " + attr + " has " + std::to_string(c) + " components, expected " + std::to_string(want));
+      if (n != vertexCount)
+        invalid(what + " " + attr + " has " + std::to_string(n) + " elements but POSITION has " + std::to_string(vertexCount));
+      dst.resize(n);
+      for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < want; ++k) {
+          float x = v[i * want + k];
+          dst[i][k] = std::isfinite(x) ? x : 0.0f;  // a bad normal/UV is repaired, never propagated
+        }
+    };
+    readVec("NORMAL", 3, lp.normals);
+    readVec("TEXCOORD_0", 2, lp.uv0);
+    readVec("TEXCOORD_1", 2, lp.uv1);
+
+    std::vector<uint32_t> raw;
+    if (prim.indices >= 0) {
+      raw = readIndices(prim.indices, what + " indices");
+      for (size_t i = 0; i < raw.size(); ++i)
+        if (raw[i] >= vertexCount)
+          invalid(what + " index " + std::to_string(raw[i]) + " at position " + std::to_string(i) + " is out of range (" +
+                  std::to_string(vertexCount) + " vertices)");
+    } else {
+      raw.resize(vertexCount);
+      for (size_t i = 0; i < vertexCount; ++i) raw[i] = static_cast<uint32_t>(i);
+    }
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (raw.size() % 3 != 0) warn(what + " has " + std::to_string(raw.size()) + " indices, not a multiple of 3: the tail is ignored");
+      lp.indices.assign(raw.begin(), raw.begin() + raw.size() / 3 * 3);
+    } else {
+      for (size_t i = 0; i + 2 < raw.size(); ++i) {
+        uint32_t a, b, c;
+        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+          // Odd triangles of a strip swap their first two vertices to keep the winding.
+          a = (i % 2 == 0) ? raw[i] : raw[i + 1];
+          b = (i % 2 == 0) ? raw[i + 1] : raw[i];
+          c = raw[i + 2];
+        } else {
+          a = raw[0];
+          b = raw[i + 1];
+          c = raw[i + 2];
+        }
+        lp.indices.insert(lp.indices.end(), {a, b, c});
+      }
+    }
+    lp.material = prim.material;
+    if (const json* rec = primitiveExtras(meshIndex, primIndex)) {
+      lp.lightmap.page = static_cast<int>(numberOr(child(*rec, "page"), -1));
+      lp.lightmap.width = static_cast<int>(numberOr(child(*rec, "width"), 0));
+      lp.lightmap.height = static_cast<int>(numberOr(child(*rec, "height"), 0));
+    }
+    return lp;
+  }
+
+  const json* primitiveExtras(int meshIndex, int primIndex) const {
+    const json* mesh = element(src_.json, "meshes", meshIndex);
+    if (!mesh) return nullptr;
+    const json* prim = element(*mesh, "primitives", primIndex);
+    if (!prim) return nullptr;
+    const json* rec = path(*prim, {"extras", "lightmap"});
+    return (rec && rec->is_object()) ? rec : nullptr;
+  }
+
+  void addMeshInstance(int nodeIndex, int meshIndex, const glm::mat4& world) {
+    const auto& mesh = model_.meshes[meshIndex];
+    const glm::mat3 linear(world);
+    const float det = glm::determinant(linear);
+    const glm::mat3 normalMatrix = std::abs(det) > 0.0f ? glm::transpose(glm::inverse(linear)) : linear;
+    for (int pi = 0; pi < static_cast<int>(mesh.primitives.size()); ++pi) {
+      const LocalPrimitive& lp = localPrimitive(meshIndex, pi);
+      if (lp.skipped) continue;
+      Primitive out;
+      out.name = (mesh.name.empty() ? "mesh" + std::to_string(meshIndex) : mesh.name) + "/" + std::to_string(pi);
+      out.node = nodeIndex;
+      out.gltfMesh = meshIndex;
+      out.gltfPrimitive = pi;
+      out.nodeToWorld = world;
+      out.material = materialIndex(lp.material, "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi));
+      out.lightmap = lp.lightmap;
+      out.uv0 = lp.uv0;
+      out.uv1 = lp.uv1;
+      out.positions.resize(lp.positions.size());
+      for (size_t i = 0; i < lp.positions.size(); ++i) {
+        out.positions[i] = glm::vec3(world * glm::vec4(lp.positions[i], 1.0f));
+        if (!finite(out.positions[i]))
+          invalid("node " + std::to_string(nodeIndex) + nodeName(nodeIndex) + " puts a vertex at NaN/Inf in world space");
+      }
+      // A mirroring transform (det < 0) turns counter-clockwise into clockwise: swap two corners.
+      const bool mirrored = det < 0.0f;
+      out.indices.reserve(lp.indices.size());
+      for (size_t t = 0; t + 2 < lp.indices.size(); t += 3) {
+        uint32_t a = lp.indices[t], b = lp.indices[t + 1], c = lp.indices[t + 2];
+        if (mirrored) std::swap(b, c);
+        const glm::vec3 &pa = out.positions[a], &pb = out.positions[b], &pc = out.positions[c];
+        glm::vec3 e0 = pb - pa, e1 = pc - pa, e2 = pc - pb;
+        float cross = glm::length(glm::cross(e0, e1));
+        float scale = glm::dot(e0, e0) + glm::dot(e1, e1) + glm::dot(e2, e2);
+        // Zero area relative to the triangle's own size (so millimetre triangles are not dropped).
+        if (a == b || b == c || a == c || !(cross > 1e-7f * scale)) {
+          ++scene_.stats.trianglesDropped;
+          continue;
+        }
+        out.indices.insert(out.indices.end(), {a, b, c});
+      }
+      if (out.indices.empty()) continue;
+      scene_.stats.trianglesKept += out.indices.size() / 3;
+      finishNormals(lp, normalMatrix, out);
+      scene_.primitives.push_back(std::move(out));
+    }
+  }
+
+  // Provided normals go through the inverse-transpose; missing or zero ones come from the
+  // area-weighted sum of the adjacent world-space face normals.
+  void finishNormals(const LocalPrimitive& lp, const glm::mat3& normalMatrix, Primitive& out) {
+    const size_t n = out.positions.size();
+    std::vector<glm::vec3> computed;
+    auto faceWeighted = [&]() {
+      computed.assign(n, glm::vec3(0.0f));
+      for (size_t t = 0; t < out.indices.size(); t += 3) {
+        uint32_t a = out.indices[t], b = out.indices[t + 1], c = out.indices[t + 2];
+        glm::vec3 f = glm::cross(out.positions[b] - out.positions[a], out.positions[c] - out.positions[a]);  // |f| = 2·area
+        computed[a] += f;
+        computed[b] += f;
+        computed[c] += f;
+      }
+      for (auto& v : computed) {
+        float len = glm::length(v);
+        v = len > 0.0f ? v / len : glm::vec3(0, 1, 0);
+      }
+    };
+    out.normals.resize(n);
+    if (lp.normals.empty() && options_.computeMissingNormals) {
+      faceWeighted();
+      out.normals = computed;
+      ++scene_.stats.normalsComputed;
+      return;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      glm::vec3 v = lp.normals.empty() ? glm::vec3(0.0f) : normalMatrix * lp.normals[i];
+      float len = glm::length(v);
+      if (len > 0.0f && std::isfinite(len)) {
+        out.normals[i] = v / len;
+      } else {
+        if (computed.empty()) faceWeighted();
+        out.normals[i] = computed[i];
+      }
+    }
+  }
+
+  // glTF material index → Scene material index (created on first use; -1 → the default material).
+  int materialIndex(int gltfMaterial, const std::string& what) {
+    if (gltfMaterial < 0) {
+      if (defaultMaterial_ < 0) {
+        Material m;
+        m.name = "default";
+        defaultMaterial_ = static_cast<int>(scene_.materials.size());
+        scene_.materials.push_back(m);
+      }
+      return defaultMaterial_;
+    }
+    if (gltfMaterial >= static_cast<int>(model_.materials.size()))
+      invalid(what + " references material " + std::to_string(gltfMaterial) + ", out of range");
+    int& slot = materialMap_[gltfMaterial];
+    if (slot < 0) {
+      slot = static_cast<int>(scene_.materials.size());
+      scene_.materials.push_back(convertMaterial(gltfMaterial));
+    }
+    return slot;
+  }
+
+  Material convertMaterial(int index) {
+    const auto& g = model_.materials[index];
+    Material m;
+    m.name = g.name.empty() ? "material" + std::to_string(index) : g.name;
+    m.gltfMaterial = index;
+    const auto& pbr = g.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() == 4)
+      m.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1], pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
+    if (pbr.baseColorTexture.index >= 0) {
+      m.baseColorTexture = textureIndex(pbr.baseColorTexture.index, true, m.name);
+      m.baseColorTexCoord = pbr.baseColorTexture.texCoord;
+    }
+    if (g.emissiveFactor.size() == 3) m.emissiveFactor = glm::vec3(g.emissiveFactor[0], g.emissiveFactor[1], g.emissiveFactor[2]);
+    if (g.emissiveTexture.index >= 0) {
+      m.emissiveTexture = textureIndex(g.emissiveTexture.index, true, m.name);
+      m.emissiveTexCoord = g.emissiveTexture.texCoord;
+    }
+    const json* mj = element(src_.json, "materials", index);
+    if (mj) {
+      m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
+      if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) {
+        const json* ti = child(*moz, "index");
+        if (ti && ti->is_number_integer()) m.lightmapTexture = textureIndex(ti->get<int>(), false, m.name);
+        m.lightmapIntensity = static_cast<float>(numberOr(child(*moz, "intensity"), 1.0));
+      }
+    }
+    if (g.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
+    else if (g.alphaMode == "BLEND") m.alphaMode = AlphaMode::Blend;
+    m.alphaCutoff = static_cast<float>(g.alphaCutoff);
+    m.doubleSided = g.doubleSided;
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(m.baseColorFactor[c])) invalid("material " + std::to_string(index) + " has a NaN/Inf baseColorFactor");
+    if (!finite(m.emissiveFactor) || !std::isfinite(m.emissiveStrength) || !std::isfinite(m.lightmapIntensity))
+      invalid("material " + std::to_string(index) + " has a NaN/Inf emissive factor, strength or lightmap intensity");
+    return m;
+  }
+
+  // (glTF texture, colour space) → Scene texture; texels are filled by decodeTextures().
+  int textureIndex(int gltfTexture, bool srgb, const std::string& materialName) {
+    if (gltfTexture < 0 || gltfTexture >= static_cast<int>(model_.textures.size()))
+      invalid("material '" + materialName + "' references texture " + std::to_string(gltfTexture) + ", out of range");
+    auto key = std::make_pair(gltfTexture, srgb);
+    auto it = textureMap_.find(key);
+    if (it != textureMap_.end()) return it->second;
+    const auto& t = model_.textures[gltfTexture];
+    if (t.source < 0 || t.source >= static_cast<int>(model_.images.size()))
+      invalid("texture " + std::to_string(gltfTexture) + " references image " + std::to_string(t.source) + ", out of range");
+    Texture tex;
+    const auto& img = model_.images[t.source];
+    tex.name = !img.name.empty() ? img.name : !img.uri.empty() ? img.uri : "image" + std::to_string(t.source);
+    tex.gltfImage = t.source;
+    if (t.sampler >= 0) {
+      if (t.sampler >= static_cast<int>(model_.samplers.size())) invalid("texture " + std::to_string(gltfTexture) + " references a missing sampler");
+      tex.wrapS = wrapFromGl(model_.samplers[t.sampler].wrapS);
+      tex.wrapT = wrapFromGl(model_.samplers[t.sampler].wrapT);
+    }
+    int index = static_cast<int>(scene_.textures.size());
+    scene_.textures.push_back(std::move(tex));
+    textureSrgb_.push_back(srgb);
+    textureMap_[key] = index;
+    return index;
+  }
+
+  // Decodes every used texture, in parallel (JPEG/PNG decoding dominates load time on textured scenes).
+  void decodeTextures() {
+    if (!options_.decodeImages || scene_.textures.empty()) return;
+    const size_t n = scene_.textures.size();
+    std::vector<std::string> failures(n);
+    std::atomic<size_t> next{0};
+    auto work = [&]() {
+      for (size_t i = next++; i < n; i = next++) {
+        Texture& tex = scene_.textures[i];
+        const auto& img = model_.images[tex.gltfImage];
+        if (img.image.empty()) {
+          failures[i] = "image " + std::to_string(tex.gltfImage) + " '" + tex.name + "' has no data (file missing?): treated as white";
+          continue;
+        }
+        try {
+          Texture decoded = decodeImageToTexture(img.image.data(), img.image.size(), textureSrgb_[i], tex.name);
+          tex.width = decoded.width;
+          tex.height = decoded.height;
+          tex.texels = std::move(decoded.texels);
+        } catch (const Error& e) {
+          failures[i] = "image " + std::to_string(tex.gltfImage) + " '" + tex.name + "' cannot be decoded (treated as white): " + e.what();
+        }
+      }
+    };
+    unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), static_cast<unsigned>(n)));
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+    for (const auto& f : failures)
+      if (!f.empty()) warn(f);
+  }
+
+  void readLightmapPages() {
+    const json* pages = path(src_.json, {"extras", "lightmapPages"});
+    if (!pages || !pages->is_array()) return;
+    for (const auto& p : *pages)
+      if (p.is_string()) scene_.lightmapExrPaths.push_back((src_.folder / decodeUriEscapes(p.get<std::string>())).string());
+  }
+
+  GltfSource src_;
+  const LoadOptions& options_;
+  std::string file_;
+  tinygltf::Model model_;
+  Scene scene_;
+  std::map<std::pair<int, int>, LocalPrimitive> localCache_;
+  std::vector<int> materialMap_;
+  int defaultMaterial_ = -1;
+  std::map<std::pair<int, bool>, int> textureMap_;
+  std::vector<bool> textureSrgb_;
+};
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& path, const LoadOptions& options) {
+  return Loader(readGltfSource(path), options).load();
+}
+
+void requireLight(const Scene& scene, const std::filesystem::path& path) {
+  if (!scene.hasLightOrEmitter())
+    throw Error(ErrorCode::NoLight, path.string(),
+                "no light and no emissive material: add KHR_lights_punctual lights or emissive materials, "
+                "or give a light on the command line (--sun DIRX,DIRY,DIRZ,IRRADIANCE)");
+}
+
+}  // namespace irbake

@@ -1,0 +1,22 @@
+// glTF 2.0 (.gltf / .glb) → world-space Scene, with validation (see docs/scene.md).
+#pragma once
+#include <filesystem>
+
+#include "scene/scene.h"
+
+namespace irbake {
+
+struct LoadOptions {
+  bool decodeImages = true;      // decode base colour / emissive / lightmap images (false: textures stay empty)
+  bool computeMissingNormals = true;  // area-weighted vertex normals when NORMAL is absent
+};
+
+// Loads a glTF or GLB file. Throws Error(Io | Parse | InvalidData | EmptyScene, path, one-line message).
+// Warnings (skipped points/lines, undecodable images, ...) go to Scene::stats.warnings and the log.
+Scene loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
+
+// A bake needs light: throws Error(NoLight, path) when the scene has neither a punctual light nor an
+// emissive material (the command line may add a light before calling this).
+void requireLight(const Scene& scene, const std::filesystem::path& path);
+
+}  // namespace irbake

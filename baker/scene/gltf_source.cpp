@@ -1,0 +1,227 @@
+#include "scene/gltf_source.h"
+
+#include <cstring>
+#include <fstream>
+#include <system_error>
+
+#include "common/error.h"
+
+namespace irbake {
+
+namespace {
+
+// A buffer or accessor larger than this is refused outright: no real scene comes near it, and
+// trusting it would mean multi-gigabyte allocations from a few bytes of JSON.
+constexpr uint64_t kAbsurdBytes = uint64_t(1) << 34;  // 16 GiB
+
+uint32_t readU32(const uint8_t* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;  // GLB is little-endian, as is every machine we build for
+}
+
+[[noreturn]] void fail(ErrorCode code, const GltfSource& s, const std::string& message) {
+  throw Error(code, s.path.string(), message);
+}
+
+std::string firstLine(std::string s) {
+  size_t nl = s.find('\n');
+  if (nl != std::string::npos) s.resize(nl);
+  return s;
+}
+
+// Decoded size of a base64 data URI payload (without decoding it).
+uint64_t dataUriPayloadSize(const std::string& uri) {
+  size_t comma = uri.find(',');
+  if (comma == std::string::npos) return 0;
+  uint64_t n = uri.size() - comma - 1;
+  uint64_t pad = 0;
+  if (n >= 1 && uri[uri.size() - 1] == '=') ++pad;
+  if (n >= 2 && uri[uri.size() - 2] == '=') ++pad;
+  return n / 4 * 3 - pad;
+}
+
+void checkUri(const GltfSource& s, const std::string& what, const std::string& uri) {
+  if (uri.rfind("data:", 0) == 0) return;
+  std::string decoded = decodeUriEscapes(uri);
+  if (!uriStaysInFolder(decoded))
+    fail(ErrorCode::InvalidData, s, what + " URI '" + uri + "' escapes the scene folder (absolute paths and '..' are refused)");
+}
+
+void checkBuffers(const GltfSource& s) {
+  const auto& j = s.json;
+  if (!j.contains("buffers")) return;
+  if (!j["buffers"].is_array()) fail(ErrorCode::Parse, s, "'buffers' is not an array");
+  const auto& buffers = j["buffers"];
+  for (size_t i = 0; i < buffers.size(); ++i) {
+    const auto& b = buffers[i];
+    std::string what = "buffer " + std::to_string(i);
+    if (!b.is_object() || !b.contains("byteLength") || !b["byteLength"].is_number())
+      fail(ErrorCode::Parse, s, what + " has no numeric byteLength");
+    double declaredD = b["byteLength"].get<double>();
+    if (!(declaredD >= 0.0)) fail(ErrorCode::InvalidData, s, what + " has a negative byteLength");
+    if (declaredD > static_cast<double>(kAbsurdBytes))
+      fail(ErrorCode::InvalidData, s, what + " declares an absurd size (byteLength " + b["byteLength"].dump() + ")");
+    uint64_t declared = static_cast<uint64_t>(declaredD);
+    uint64_t actual = 0;
+    std::string where;
+    if (b.contains("uri")) {
+      if (!b["uri"].is_string()) fail(ErrorCode::Parse, s, what + " uri is not a string");
+      std::string uri = b["uri"].get<std::string>();
+      checkUri(s, what, uri);
+      if (uri.rfind("data:", 0) == 0) {
+        actual = dataUriPayloadSize(uri);
+        where = "data URI";
+      } else {
+        std::filesystem::path file = s.folder / decodeUriEscapes(uri);
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(file, ec))
+          fail(ErrorCode::Io, s, "missing buffer: " + what + " file '" + uri + "' not found");
+        actual = std::filesystem::file_size(file, ec);
+        where = "'" + uri + "'";
+      }
+    } else if (s.binary && i == 0) {
+      actual = s.binSize;
+      where = "GLB BIN chunk";
+    } else {
+      fail(ErrorCode::InvalidData, s, "missing buffer: " + what + " has no uri and no GLB BIN chunk");
+    }
+    if (actual < declared)
+      fail(ErrorCode::InvalidData, s,
+           "short buffer: " + what + " (" + where + ") has " + std::to_string(actual) + " bytes, byteLength says " +
+               std::to_string(declared));
+  }
+}
+
+void checkImages(const GltfSource& s) {
+  const auto& j = s.json;
+  if (!j.contains("images") || !j["images"].is_array()) return;
+  const auto& images = j["images"];
+  for (size_t i = 0; i < images.size(); ++i)
+    if (images[i].is_object() && images[i].contains("uri") && images[i]["uri"].is_string())
+      checkUri(s, "image " + std::to_string(i), images[i]["uri"].get<std::string>());
+}
+
+void checkRootExtras(const GltfSource& s) {
+  const auto& j = s.json;
+  if (!j.contains("extras") || !j["extras"].is_object() || !j["extras"].contains("lightmapPages")) return;
+  const auto& pages = j["extras"]["lightmapPages"];
+  if (!pages.is_array()) return;
+  for (const auto& p : pages)
+    if (p.is_string()) checkUri(s, "lightmap page", p.get<std::string>());
+}
+
+void splitGlb(GltfSource& s) {
+  const auto& b = s.bytes;
+  if (b.size() < 20) fail(ErrorCode::Parse, s, "bad GLB container: file is only " + std::to_string(b.size()) + " bytes");
+  uint32_t version = readU32(&b[4]), length = readU32(&b[8]);
+  if (version != 2) fail(ErrorCode::Parse, s, "bad GLB container: version " + std::to_string(version) + " (only 2 is supported)");
+  if (length > b.size())
+    fail(ErrorCode::Parse, s, "bad GLB container: header says " + std::to_string(length) + " bytes, file has " + std::to_string(b.size()));
+  uint32_t jsonLen = readU32(&b[12]), jsonType = readU32(&b[16]);
+  if (jsonType != 0x4E4F534Au) fail(ErrorCode::Parse, s, "bad GLB container: first chunk is not JSON");
+  if (uint64_t(20) + jsonLen > length) fail(ErrorCode::Parse, s, "bad GLB container: JSON chunk runs past the end of the file");
+  s.jsonOffset = 20;
+  s.jsonSize = jsonLen;
+  uint64_t next = 20 + uint64_t(jsonLen);
+  next = (next + 3) & ~uint64_t(3);
+  if (next + 8 <= length) {
+    uint32_t binLen = readU32(&b[next]), binType = readU32(&b[next + 4]);
+    if (binType == 0x004E4942u) {
+      if (next + 8 + binLen > length) fail(ErrorCode::Parse, s, "bad GLB container: BIN chunk runs past the end of the file");
+      s.binOffset = next + 8;
+      s.binSize = binLen;
+    }
+  }
+}
+
+}  // namespace
+
+std::string decodeUriEscapes(const std::string& uri) {
+  std::string out;
+  out.reserve(uri.size());
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+      out.push_back(static_cast<char>(hex(uri[i + 1]) * 16 + hex(uri[i + 2])));
+      i += 2;
+    } else {
+      out.push_back(uri[i]);
+    }
+  }
+  return out;
+}
+
+bool uriStaysInFolder(const std::string& uri) {
+  if (uri.empty()) return false;
+  if (uri[0] == '/' || uri[0] == '\\' || uri[0] == '~') return false;
+  // A scheme ("file:", "http:") or a drive letter ("C:") is never a relative reference.
+  size_t colon = uri.find(':'), slash = uri.find_first_of("/\\");
+  if (colon != std::string::npos && (slash == std::string::npos || colon < slash)) return false;
+  size_t start = 0;
+  while (start <= uri.size()) {
+    size_t end = uri.find_first_of("/\\", start);
+    if (end == std::string::npos) end = uri.size();
+    if (uri.compare(start, end - start, "..") == 0 && end - start == 2) return false;
+    start = end + 1;
+  }
+  return uri.find('\0') == std::string::npos;
+}
+
+GltfSource readGltfSource(const std::filesystem::path& path) {
+  GltfSource s;
+  s.path = path;
+  s.folder = path.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: no such file");
+  if (std::filesystem::is_directory(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ErrorCode::Io, path.string(), "cannot read file: permission denied or unreadable");
+  in.seekg(0, std::ios::end);
+  std::streamoff size = in.tellg();
+  if (size < 0) throw Error(ErrorCode::Io, path.string(), "cannot read file");
+  in.seekg(0);
+  s.bytes.resize(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(s.bytes.data()), size))
+    throw Error(ErrorCode::Io, path.string(), "cannot read file: read failed");
+
+  if (s.bytes.size() >= 4 && std::memcmp(s.bytes.data(), "glTF", 4) == 0) {
+    s.binary = true;
+    splitGlb(s);
+  } else {
+    size_t first = 0;
+    while (first < s.bytes.size() && std::isspace(s.bytes[first])) ++first;
+    // A UTF-8 byte order mark is tolerated (some exporters write one).
+    if (s.bytes.size() - first >= 3 && s.bytes[first] == 0xEF && s.bytes[first + 1] == 0xBB && s.bytes[first + 2] == 0xBF)
+      first += 3;
+    if (first >= s.bytes.size() || s.bytes[first] != '{')
+      fail(ErrorCode::Parse, s, "not a glTF file (neither a JSON object nor a GLB container)");
+    s.jsonOffset = first;
+    s.jsonSize = s.bytes.size() - first;
+  }
+  const char* text = reinterpret_cast<const char*>(s.bytes.data()) + s.jsonOffset;
+  try {
+    s.json = nlohmann::json::parse(text, text + s.jsonSize);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::string msg = e.what();
+    size_t at = msg.find("parse error");
+    fail(ErrorCode::Parse, s, "malformed JSON: " + firstLine(at == std::string::npos ? msg : msg.substr(at)));
+  }
+  if (!s.json.is_object()) fail(ErrorCode::Parse, s, "not a glTF file: the JSON is not an object");
+  if (!s.json.contains("asset") || !s.json["asset"].is_object())
+    fail(ErrorCode::Parse, s, "not a glTF file: no \"asset\" object");
+  const auto& asset = s.json["asset"];
+  if (!asset.contains("version") || !asset["version"].is_string() || asset["version"].get<std::string>().rfind("2.", 0) != 0)
+    fail(ErrorCode::Parse, s, "not a glTF 2.0 file: asset.version is " + (asset.contains("version") ? asset["version"].dump() : std::string("missing")));
+  checkBuffers(s);
+  checkImages(s);
+  checkRootExtras(s);
+  return s;
+}
+
+}  // namespace irbake

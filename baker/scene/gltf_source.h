@@ -1,0 +1,33 @@
+// First pass over a glTF file, before tinygltf touches anything: reads the bytes, tells JSON from
+// GLB, parses the JSON, and checks what tinygltf would otherwise read blindly (URIs that escape
+// the scene folder, missing or short buffers, absurd declared sizes). Every failure is an
+// irbake::Error naming the file with a one-line message.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace irbake {
+
+struct GltfSource {
+  std::filesystem::path path;       // the file as given
+  std::filesystem::path folder;     // its folder: every relative URI resolves here
+  bool binary = false;              // GLB container
+  std::vector<uint8_t> bytes;       // the whole file
+  size_t jsonOffset = 0, jsonSize = 0;  // the JSON text inside bytes (the whole file for .gltf)
+  size_t binOffset = 0, binSize = 0;    // the GLB BIN chunk (binSize 0: none)
+  nlohmann::json json;              // the parsed document
+};
+
+// Reads and checks `path`. Throws Error(Io | Parse | InvalidData, path, ...).
+GltfSource readGltfSource(const std::filesystem::path& path);
+
+// Decodes %XX escapes of a URI (glTF URIs are RFC 3986 references).
+std::string decodeUriEscapes(const std::string& uri);
+// True when a (decoded) relative URI stays inside the scene folder: not absolute, no scheme, no "..".
+bool uriStaysInFolder(const std::string& decodedUri);
+
+}  // namespace irbake
