@@ -1,0 +1,162 @@
+#include "vpl/sampling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace irbake {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+std::vector<uint32_t> firstPrimes(int count) {
+  std::vector<uint32_t> primes;
+  for (uint32_t n = 2; static_cast<int>(primes.size()) < count; ++n) {
+    bool prime = true;
+    for (uint32_t p : primes) {
+      if (p * p > n) break;
+      if (n % p == 0) { prime = false; break; }
+    }
+    if (prime) primes.push_back(n);
+  }
+  return primes;
+}
+}  // namespace
+
+uint64_t Rng::nextU64() {
+  uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+uint64_t hashSeed(uint64_t a, uint64_t b, uint64_t c) {
+  Rng r(a * 0x9E3779B97F4A7C15ull ^ (b + 0x632BE59BD9B4E019ull) * 0xC2B2AE3D27D4EB4Full ^ (c + 0x165667B19E3779F9ull));
+  r.nextU64();
+  return r.nextU64();
+}
+
+double radicalInverse(uint32_t base, uint64_t index) {
+  const double inv = 1.0 / base;
+  double f = inv, r = 0.0;
+  while (index > 0) {
+    r += static_cast<double>(index % base) * f;
+    index /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+Halton::Halton(int dimensions, uint32_t seed) : primes_(firstPrimes(std::max(dimensions, 2))) {
+  permutations_.resize(primes_.size());
+  for (size_t d = 2; d < primes_.size(); ++d) {
+    uint32_t b = primes_[d];
+    std::vector<uint16_t> perm(b);
+    std::iota(perm.begin(), perm.end(), uint16_t(0));
+    Rng rng(hashSeed(seed, d, 0x4A17));
+    for (uint32_t k = b - 1; k >= 2; --k) {  // Fisher–Yates on digits 1..b-1; 0 stays (no infinite tail)
+      uint32_t j = 1 + static_cast<uint32_t>(rng.nextU64() % k);
+      std::swap(perm[k], perm[j]);
+    }
+    permutations_[d] = std::move(perm);
+  }
+  if (seed != 0) {
+    Rng rng(hashSeed(seed, 0x5EED));
+    shift_[0] = rng.uniform();
+    shift_[1] = rng.uniform();
+  }
+}
+
+double Halton::sample(int dim, uint64_t index) const {
+  uint32_t base = primes_[dim];
+  if (dim < 2) {
+    double r = radicalInverse(base, index) + shift_[dim];
+    r -= std::floor(r);
+    return std::min(r, 0.99999999999999989);
+  }
+  const auto& perm = permutations_[dim];
+  const double inv = 1.0 / base;
+  double f = inv, r = 0.0;
+  while (index > 0) {
+    r += perm[index % base] * f;
+    index /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+AliasTable::AliasTable(const std::vector<double>& weights) {
+  size_t n = weights.size();
+  if (n == 0) return;
+  total_ = 0.0;
+  for (double w : weights) total_ += std::max(0.0, w);
+  prob_.assign(n, 1.0);
+  alias_.resize(n);
+  pdf_.resize(n);
+  std::iota(alias_.begin(), alias_.end(), 0u);
+  if (total_ <= 0.0) {  // all zero: uniform
+    std::fill(pdf_.begin(), pdf_.end(), 1.0 / n);
+    return;
+  }
+  std::vector<double> scaled(n);
+  std::vector<uint32_t> small, large;
+  for (size_t i = 0; i < n; ++i) {
+    pdf_[i] = std::max(0.0, weights[i]) / total_;
+    scaled[i] = pdf_[i] * n;
+    (scaled[i] < 1.0 ? small : large).push_back(static_cast<uint32_t>(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    uint32_t s = small.back(), l = large.back();
+    small.pop_back();
+    prob_[s] = scaled[s];
+    alias_[s] = l;
+    scaled[l] = (scaled[l] + scaled[s]) - 1.0;
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  for (uint32_t i : large) prob_[i] = 1.0;  // round-off leftovers
+  for (uint32_t i : small) prob_[i] = 1.0;
+}
+
+size_t AliasTable::sample(double u, double* residual) const {
+  size_t n = prob_.size();
+  double x = u * static_cast<double>(n);
+  size_t k = std::min(static_cast<size_t>(x), n - 1);
+  double frac = std::clamp(x - static_cast<double>(k), 0.0, 1.0);
+  if (frac < prob_[k]) {
+    if (residual) *residual = std::min(frac / prob_[k], 0.99999999999999989);
+    return k;
+  }
+  if (residual) *residual = std::min((frac - prob_[k]) / (1.0 - prob_[k]), 0.99999999999999989);
+  return alias_[k];
+}
+
+void orthonormalBasis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  float sign = std::copysign(1.0f, n.z);
+  float a = -1.0f / (sign + n.z);
+  float c = n.x * n.y * a;
+  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+glm::vec3 cosineHemisphere(const glm::vec3& n, double u, double v) {
+  double r = std::sqrt(u), phi = 2.0 * kPi * v;
+  double z = std::sqrt(std::max(0.0, 1.0 - u));
+  glm::vec3 t, b;
+  orthonormalBasis(n, t, b);
+  return glm::normalize(t * float(r * std::cos(phi)) + b * float(r * std::sin(phi)) + n * float(z));
+}
+
+glm::vec3 uniformSphere(double u, double v) {
+  double z = 1.0 - 2.0 * u, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * v;
+  return glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
+}
+
+glm::vec2 uniformTriangle(double u, double v) {
+  double su = std::sqrt(u);
+  return glm::vec2(float(su * (1.0 - v)), float(su * v));
+}
+
+}  // namespace irbake

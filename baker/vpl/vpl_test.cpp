@@ -1,0 +1,217 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "raytrace/test_scenes.h"
+#include "vpl/light_sources.h"
+#include "vpl/sampling.h"
+#include "vpl/vpl.h"
+
+using namespace irbake;
+using namespace irbake::testing;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+double sumPower(const VplSet& set, int fromBounce = 0) {
+  double s = 0.0;
+  for (const Vpl& v : set.vpls)
+    if (v.bounce >= fromBounce) s += channelMean(glm::dvec3(v.power));
+  return s;
+}
+}  // namespace
+
+TEST(Halton, RadicalInversesAreKellersPhi) {
+  EXPECT_DOUBLE_EQ(radicalInverse(2, 1), 0.5);
+  EXPECT_DOUBLE_EQ(radicalInverse(2, 6), 0.375);  // 110b → 0.011b
+  EXPECT_DOUBLE_EQ(radicalInverse(3, 5), 2.0 / 3.0 + 1.0 / 9.0);  // 12 in base 3 → 0.21
+  Halton h(8, 0);
+  EXPECT_DOUBLE_EQ(h.sample(0, 3), 0.75);
+  EXPECT_DOUBLE_EQ(h.sample(1, 1), 1.0 / 3.0);
+}
+
+TEST(Halton, EveryDimensionIsStratifiedOverFullDigitBlocks) {
+  for (uint32_t seed : {0u, 7u}) {
+    Halton h(12, seed);
+    for (int d = 0; d < 12; ++d) {
+      static const uint32_t primes[12] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37};
+      uint32_t b = primes[d], n = b * b;
+      std::set<uint32_t> cells;
+      for (uint32_t i = 0; i < n; ++i) {
+        double x = h.sample(d, i);
+        ASSERT_GE(x, 0.0);
+        ASSERT_LT(x, 1.0);
+        // With a rotation (seed ≠ 0, dims 0/1) cells shift by a constant; count distinct cells either way.
+        cells.insert(static_cast<uint32_t>(std::floor(x * n + 1e-9)));  // radical inverses hit k/n exactly
+      }
+      EXPECT_EQ(cells.size(), n) << "dimension " << d << " seed " << seed;
+    }
+  }
+  // Scrambling changes high dimensions with the seed.
+  Halton a(6, 1), b(6, 2);
+  int differ = 0;
+  for (int i = 1; i < 20; ++i) differ += a.sample(5, i) != b.sample(5, i);
+  EXPECT_GT(differ, 10);
+}
+
+TEST(AliasTable, ProbabilitiesAndResidualsAreExact) {
+  std::vector<double> w = {1.0, 3.0, 0.0, 4.0};
+  AliasTable t(w);
+  EXPECT_DOUBLE_EQ(t.total(), 8.0);
+  EXPECT_DOUBLE_EQ(t.pdf(1), 3.0 / 8.0);
+  const int M = 80000;
+  std::vector<int> count(4, 0);
+  std::vector<double> residualSum(4, 0.0);
+  for (int k = 0; k < M; ++k) {
+    double r;
+    size_t i = t.sample((k + 0.5) / M, &r);
+    ++count[i];
+    residualSum[i] += r;
+    ASSERT_GE(r, 0.0);
+    ASSERT_LT(r, 1.0);
+  }
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(count[i] / double(M), w[i] / 8.0, 2.0 / M);
+    if (count[i] > 0) { EXPECT_NEAR(residualSum[i] / count[i], 0.5, 1e-3); }
+  }
+}
+
+TEST(MeanReflectivity, AreaWeighted) {
+  Scene s;
+  int a = addMaterial(s, glm::vec3(0.2f)), b = addMaterial(s, glm::vec3(0.8f, 0.5f, 0.2f));
+  addQuad(s, a, glm::vec3(0), glm::vec3(3, 0, 0), glm::vec3(0, 1, 0));  // area 3, ρ 0.2
+  addQuad(s, b, glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1));  // area 1, ρ mean 0.5
+  EXPECT_NEAR(meanReflectivity(s), (3 * 0.2 + 1 * 0.5) / 4.0, 1e-7);
+}
+
+// Closed grey room: every path stays inside, so the bookkeeping must give exactly Φ Σ_j ρ̄^j.
+TEST(Walk, EnergyOfAreaEmitterWalkIsExactInAClosedRoom) {
+  Scene s;
+  int wall = addMaterial(s, glm::vec3(0.6f));
+  int lamp = addMaterial(s, glm::vec3(0.6f), glm::vec3(3.0f));
+  addBox(s, wall, glm::vec3(0), glm::vec3(2, 1.5f, 1), true, 2);
+  addQuad(s, lamp, glm::vec3(0.8f, 0.6f, 0.999f), glm::vec3(0.4f, 0, 0), glm::vec3(0, 0.3f, 0));  // faces up...
+  s.primitives.back().indices = {0, 2, 1, 0, 3, 2};  // ...flipped to face down into the room
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 1000;
+  VplSet set = generateVpls(s, rt, o);
+  double rho = set.meanReflectivity;
+  EXPECT_NEAR(rho, 0.6, 1e-6);
+  double Phi = kPi * 3.0 * 0.4 * 0.3;
+  EXPECT_NEAR(set.emittedPower.x, Phi, 1e-5 * Phi);
+  ASSERT_GE(set.bounces, 5);
+  double expected = 0.0;
+  for (int j = 0; j <= set.bounces; ++j) {
+    expected += Phi * std::pow(rho, j);
+    EXPECT_EQ(set.countPerBounce[j], static_cast<size_t>(std::floor(1000 * std::pow(rho, j) + 1e-9))) << "bounce " << j;
+    EXPECT_NEAR(set.powerPerBounce[j].x, Phi * std::pow(rho, j), 1e-6 * Phi) << "bounce " << j;
+  }
+  EXPECT_NEAR(sumPower(set), expected, 1e-6 * expected);
+  EXPECT_EQ(set.bounces, static_cast<int>(std::floor(std::log(1000.0) / -std::log(0.6) + 1e-9)));
+  for (const Vpl& v : set.vpls) {  // VPLs lie inside the room, facing into it
+    ASSERT_GE(v.position.x, -1e-4f);
+    ASSERT_LE(v.position.z, 1.0f + 1e-4f);
+    if (v.position.z > 0.99f) continue;  // the lamp's back and the ceiling above it face each other
+    glm::vec3 toCentre = glm::vec3(1, 0.75f, 0.5f) - v.position;
+    ASSERT_GT(glm::dot(toCentre, v.normal), 0.0f);
+  }
+}
+
+TEST(Walk, PointLightStartsAtBounceOneWithExactEnergy) {
+  Scene s;
+  int wall = addMaterial(s, glm::vec3(0.5f));
+  addBox(s, wall, glm::vec3(-1), glm::vec3(1), true);
+  s.lights.push_back(pointLight(glm::vec3(0.1f, 0.2f, 0.3f), 2.0f));
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 512;
+  o.maxBounces = 4;
+  VplSet set = generateVpls(s, rt, o);
+  double Phi = 4.0 * kPi * 2.0;
+  EXPECT_EQ(set.countPerBounce[0], 0u);
+  EXPECT_EQ(set.bounces, 4);
+  double expected = 0.0;
+  for (int j = 1; j <= 4; ++j) expected += Phi * std::pow(0.5, j);
+  EXPECT_NEAR(sumPower(set), expected, 1e-6 * expected);
+  EXPECT_EQ(set.countPerBounce[1], 256u);
+  EXPECT_EQ(set.countPerBounce[4], 32u);
+}
+
+TEST(Walk, BounceVplsCarryTheTexturedAlbedoAtTheirHit) {
+  Scene s;
+  int lamp = addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
+  int floor = addMaterial(s, glm::vec3(1.0f));
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  t.texels = {glm::vec4(0.9f, 0.3f, 0.1f, 1.0f), glm::vec4(0.1f, 0.3f, 0.9f, 1.0f)};
+  s.textures.push_back(t);
+  s.materials[floor].baseColorTexture = 0;
+  addQuad(s, lamp, glm::vec3(-0.5f, -0.5f, 1), glm::vec3(0, 1, 0), glm::vec3(1, 0, 0));  // faces down
+  addQuad(s, floor, glm::vec3(-5, -5, 0), glm::vec3(10, 0, 0), glm::vec3(0, 10, 0));
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 256;
+  o.maxBounces = 1;
+  VplSet set = generateVpls(s, rt, o);
+  ASSERT_EQ(set.countPerBounce.size(), 2u);
+  double Phi = kPi * 1.0 * 1.0;
+  size_t M1 = static_cast<size_t>(std::floor(256 * set.meanReflectivity));
+  ASSERT_GT(set.countPerBounce[1], 0u);
+  for (const Vpl& v : set.vpls) {
+    if (v.bounce != 1) continue;
+    glm::vec2 uv((v.position.x + 5) / 10, (v.position.y + 5) / 10);
+    glm::vec3 albedo(sampleBilinear(t, uv));
+    EXPECT_NEAR(v.power.x, Phi * albedo.x / M1, 1e-4 * Phi / M1);
+    EXPECT_NEAR(v.power.z, Phi * albedo.z / M1, 1e-4 * Phi / M1);
+    EXPECT_NEAR(v.position.z, 0.0f, 1e-5f);
+  }
+}
+
+TEST(Walk, SpotPathsFollowTheFalloffAndDirectionalCoversTheScene) {
+  Scene s;
+  int wall = addMaterial(s, glm::vec3(0.5f));
+  addBox(s, wall, glm::vec3(-2), glm::vec3(2), true, 2);
+  Light spot;
+  spot.type = LightType::Spot;
+  spot.position = glm::vec3(0, 0, 1.5f);
+  spot.direction = glm::vec3(0, 0, -1);
+  spot.innerConeAngle = 0.3f;
+  spot.outerConeAngle = 0.6f;
+  s.lights.push_back(spot);
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 4096;
+  o.maxBounces = 1;
+  VplSet set = generateVpls(s, rt, o);
+  double cosO = std::cos(0.6), cosI = std::cos(0.3);
+  double inner = (1 - cosI) / ((1 - cosI) + (cosI - cosO) / 3.0);
+  int in = 0, n = 0;
+  for (const Vpl& v : set.vpls) {
+    glm::vec3 d = glm::normalize(v.position - spot.position);
+    ASSERT_GE(-d.z, cosO - 1e-4);
+    in += -d.z >= cosI;
+    ++n;
+  }
+  EXPECT_NEAR(double(in) / n, inner, 0.01);
+  EXPECT_NEAR(set.emittedPower.x, spot.power().x, 1e-5);
+
+  // Directional light onto an open floor: the flux reaching the floor is I · area (the disc covers it).
+  Scene d;
+  int f = addMaterial(d, glm::vec3(0.5f));
+  addQuad(d, f, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
+  sun.intensity = 2.0f;
+  d.lights.push_back(sun);
+  RayTracer rt2(d);
+  o.paths = 8192;
+  VplSet ds = generateVpls(d, rt2, o);
+  // Bounce-1 power = albedo · (flux onto the floor) = 0.5 · I cosθ · 4.
+  double expected = 0.5 * 2.0 * (1.0 / std::sqrt(1.09)) * 4.0;
+  EXPECT_NEAR(sumPower(ds, 1), expected, 0.01 * expected);
+}

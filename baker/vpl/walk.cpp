@@ -1,0 +1,173 @@
+// Keller's quasi-random walk (Instant Radiosity, 1997).
+//
+// N paths start on the lights (chosen by power with one alias table over emissive triangles and punctual
+// lights). Path i uses the i-th Halton point: dimension 0 picks the light and, through the alias
+// residual, gives with dimension 1 the point on the emitter (Φ2, Φ3); dimensions 2+2j, 3+2j give the
+// direction leaving bounce j (cosine for surfaces; by intensity for punctual lights).
+//
+// Fractional absorption: at bounce j only the first M_j = floor(N ρ̄^j) paths continue. A path that
+// starts with power Φ_s / (p_s N) leaves at bounce j a VPL of power
+//     Φ_s / (p_s N) · Π_k (a_k / ρ̄) · ρ̄^j N / M_j  =  Φ_s / (p_s M_j) · Π_k a_k,
+// i.e. "power scaled by albedo over ρ̄" with the ρ̄^j N / M_j factor that makes the bookkeeping exact:
+// with a grey scene of albedo ρ̄ in a closed room the bounce-j VPLs carry exactly Φ ρ̄^j.
+// Punctual lights leave no bounce-0 VPL (the backends evaluate them exactly); their paths start at bounce 1.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "common/error.h"
+#include "vpl/light_sources.h"
+#include "vpl/sampling.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+// Direction from a spot light distributed like its intensity t(cosθ)² (t linear in cosθ between the
+// outer and inner cone, 1 inside), so every path carries the same power.
+glm::vec3 spotDirection(const Light& l, double u, double v) {
+  double cosO = std::cos(l.outerConeAngle), cosI = std::cos(l.innerConeAngle);
+  double band = std::max(0.0, cosI - cosO);
+  if (band < 0.001) {  // matches Light::intensityToward's minimum band
+    band = 0.001;
+    cosI = cosO + band;
+  }
+  double massBand = band / 3.0, massInner = std::max(0.0, 1.0 - cosI);
+  double c;
+  if (u * (massBand + massInner) < massBand) {
+    double s = u * (massBand + massInner) / massBand;  // CDF ∝ x³ over the band
+    c = cosO + band * std::cbrt(s);
+  } else {
+    double s = (u * (massBand + massInner) - massBand) / std::max(massInner, 1e-300);
+    c = cosI + (1.0 - cosI) * std::min(s, 1.0);
+  }
+  c = std::clamp(c, -1.0, 1.0);
+  double sn = std::sqrt(std::max(0.0, 1.0 - c * c)), phi = 2.0 * kPi * v;
+  glm::vec3 t, b, d = glm::normalize(l.direction);
+  orthonormalBasis(d, t, b);
+  return glm::normalize(t * float(sn * std::cos(phi)) + b * float(sn * std::sin(phi)) + d * float(c));
+}
+
+}  // namespace
+
+VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options) {
+  VplSet out;
+  if (options.paths <= 0) throw Error(ErrorCode::Usage, "", "the walk needs at least one path (--vpls)");
+  LightSources sources = collectLightSources(scene);
+  out.emittedPower = sources.totalPower;
+  const double rho = meanReflectivity(scene);
+  out.meanReflectivity = rho;
+  if (sources.all.empty() || channelMean(sources.totalPower) <= 0.0) return out;
+
+  // Surviving path counts M_j (fractional absorption) and the deepest bounce.
+  const uint64_t N = static_cast<uint64_t>(options.paths);
+  const int cap = options.maxBounces >= 0 ? options.maxBounces : std::max(0, options.bounceCap);
+  std::vector<uint64_t> survivors{N};
+  for (int j = 1; j <= cap; ++j) {
+    auto m = static_cast<uint64_t>(std::floor(static_cast<double>(N) * std::pow(rho, j) + 1e-9));
+    if (m == 0) break;
+    survivors.push_back(m);
+  }
+  const int maxBounce = static_cast<int>(survivors.size()) - 1;
+  const Halton halton(4 + 2 * std::max(maxBounce, 1), options.seed);
+  const float eps = rt.epsilon();
+  const size_t numTriangles = sources.triangles.size();
+
+  std::vector<std::vector<Vpl>> perPath(N);
+  std::atomic<uint64_t> done{0};
+  if (options.progress) options.progress("walk", 0.0);
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, N, 64), [&](const tbb::blocked_range<uint64_t>& range) {
+    for (uint64_t i = range.begin(); i != range.end(); ++i) {
+      std::vector<Vpl>& vpls = perPath[i];
+      double residual = 0.0;
+      size_t s = sources.all.sample(halton.sample(0, i), &residual);
+      double u1 = halton.sample(1, i);
+      double p = sources.all.pdf(s);
+      glm::dvec3 pathPower(0.0);  // Φ_s / (p_s N), before the albedo products
+      glm::vec3 origin, dir, normal(0.0f);
+      bool surfaceStart = false;
+      if (s < numTriangles) {
+        const EmitterTriangle& e = sources.triangles[s];
+        const Primitive& prim = scene.primitives[e.primitive];
+        glm::vec2 bary = uniformTriangle(residual, u1);
+        const uint32_t* idx = &prim.indices[3 * e.triangle];
+        origin = prim.positions[idx[0]] * (1.0f - bary.x - bary.y) + prim.positions[idx[1]] * bary.x + prim.positions[idx[2]] * bary.y;
+        normal = e.normal;
+        // Emission at the sampled point (textures), so the estimate is unbiased for textured emitters.
+        glm::dvec3 Le(scene.emissionAt(prim, e.triangle, bary));
+        pathPower = Le * (kPi * e.area) / (p * static_cast<double>(N));
+        vpls.push_back(Vpl{origin, normal, glm::vec3(pathPower), 0});
+        dir = cosineHemisphere(normal, halton.sample(2, i), halton.sample(3, i));
+        surfaceStart = true;
+      } else {
+        const Light& l = scene.lights[s - numTriangles];
+        pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
+        switch (l.type) {
+          case LightType::Point:
+            origin = l.position;
+            dir = uniformSphere(halton.sample(2, i), halton.sample(3, i));
+            break;
+          case LightType::Spot:
+            origin = l.position;
+            dir = spotDirection(l, halton.sample(2, i), halton.sample(3, i));
+            break;
+          case LightType::Directional: {
+            // Uniform point on a disc covering the scene's bounding sphere, upstream of it.
+            dir = glm::normalize(l.direction);
+            glm::vec3 t, b;
+            orthonormalBasis(dir, t, b);
+            double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
+            origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+                     b * float(r * std::sin(phi));
+            break;
+          }
+        }
+      }
+      // Follow the path while it is among the survivors of the next bounce.
+      glm::dvec3 throughput(1.0);
+      for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
+        glm::vec3 start = surfaceStart ? origin + normal * eps : origin;
+        RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+        if (!hit.hit) break;  // escaped: its energy leaves the scene
+        throughput *= glm::dvec3(rt.albedoAt(hit));
+        glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
+        glm::dvec3 power = pathPower * throughput * (static_cast<double>(N) / static_cast<double>(survivors[j]));
+        vpls.push_back(Vpl{hit.position, n, glm::vec3(power), j});
+        if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
+        origin = hit.position;
+        normal = n;
+        surfaceStart = true;
+        dir = cosineHemisphere(n, halton.sample(2 + 2 * j, i), halton.sample(3 + 2 * j, i));
+      }
+      uint64_t d = ++done;
+      if (options.progress && (d & 1023) == 0) options.progress("walk", static_cast<double>(d) / N);
+    }
+  });
+
+  // Order by bounce, then path: deterministic whatever the thread schedule.
+  out.countPerBounce.assign(maxBounce + 1, 0);
+  out.powerPerBounce.assign(maxBounce + 1, glm::dvec3(0.0));
+  for (const auto& path : perPath)
+    for (const Vpl& v : path) ++out.countPerBounce[v.bounce];
+  std::vector<size_t> offset(maxBounce + 2, 0);
+  for (int j = 0; j <= maxBounce; ++j) offset[j + 1] = offset[j] + out.countPerBounce[j];
+  out.vpls.resize(offset.back());
+  for (const auto& path : perPath)
+    for (const Vpl& v : path) {
+      out.vpls[offset[v.bounce]++] = v;
+      out.powerPerBounce[v.bounce] += glm::dvec3(v.power);
+    }
+  while (!out.countPerBounce.empty() && out.countPerBounce.back() == 0) {
+    out.countPerBounce.pop_back();
+    out.powerPerBounce.pop_back();
+  }
+  out.bounces = std::max(0, static_cast<int>(out.countPerBounce.size()) - 1);
+  if (options.progress) options.progress("walk", 1.0);
+  return out;
+}
+
+}  // namespace irbake
