@@ -164,6 +164,8 @@ class Loader {
     parseWithTinygltf();
     scene_.sourcePath = file_;
     materialMap_.assign(model_.materials.size(), -1);
+    // Scene material i is glTF material i (the default material, when needed, comes after them).
+    for (size_t i = 0; i < model_.materials.size(); ++i) materialIndex(static_cast<int>(i), "scene");
     std::vector<int> roots = rootNodes();
     checkNodeGraph(roots);
     for (int r : roots) visitNode(r, glm::mat4(1.0f), 0);

@@ -1,0 +1,336 @@
+// Loader tests on hand-made glTF files: transforms, winding, primitive modes, normals, materials,
+// textures, lights, cameras, extensions, and the DamagedHelmet counts (skipped without ../shared).
+#include <cmath>
+#include <fstream>
+
+#include <glm/gtc/quaternion.hpp>
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "scene/gltf_loader.h"
+#include "scene/image_codec.h"
+#include "scene/test_gltf_builder.h"
+
+using namespace irbake;
+using irbake::testing::meshDocument;
+using irbake::testing::testFolder;
+using irbake::testing::writeDocument;
+using json = nlohmann::json;
+
+namespace {
+
+const std::vector<glm::vec3> kTriangle = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // CCW seen from +Z
+
+glm::vec3 faceNormal(const Primitive& p, size_t t) {
+  const glm::vec3 &a = p.positions[p.indices[3 * t]], &b = p.positions[p.indices[3 * t + 1]], &c = p.positions[p.indices[3 * t + 2]];
+  return glm::normalize(glm::cross(b - a, c - a));
+}
+
+void expectNear(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+}  // namespace
+
+TEST(GltfLoader, NodeHierarchyTrsLandsInWorldSpace) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}});
+  // Parent: translate (1,2,3). Child (holds the mesh): rotate +90° about Y, scale 2.
+  glm::quat q = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 1, 0));
+  doc.root["nodes"] = json::array({{{"translation", {1, 2, 3}}, {"children", {1}}},
+                                   {{"mesh", 0}, {"rotation", {q.x, q.y, q.z, q.w}}, {"scale", {2, 2, 2}}}});
+  auto dir = testFolder("loader_hierarchy");
+  writeDocument(doc, dir / "h.gltf");
+  Scene s = loadScene(dir / "h.gltf");
+  ASSERT_EQ(s.primitives.size(), 1u);
+  const Primitive& p = s.primitives[0];
+  // R_y(90°) maps (1,0,0) → (0,0,−1) and (0,0,1) → (1,0,0).
+  expectNear(p.positions[0], {1, 2, 3});
+  expectNear(p.positions[1], {1, 2, 1});
+  expectNear(p.positions[2], {1, 4, 3});
+  expectNear(p.normals[0], {1, 0, 0});
+  expectNear(faceNormal(p, 0), {1, 0, 0});
+  EXPECT_EQ(p.node, 1);
+  EXPECT_NEAR(p.nodeToWorld[3].x, 1.0f, 1e-6f);
+}
+
+TEST(GltfLoader, MirroredTransformFlipsWindingAndKeepsNormalsOutward) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}});
+  doc.root["nodes"][0]["scale"] = {-1, 1, 1};
+  // A second instance with a non-uniform scale tests the inverse-transpose on normals.
+  doc.root["nodes"].push_back({{"mesh", 0}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -3, 0, 5, 0, 0, 1}}});
+  doc.root["scenes"][0]["nodes"] = {0, 1};
+  auto dir = testFolder("loader_mirror");
+  writeDocument(doc, dir / "m.gltf");
+  Scene s = loadScene(dir / "m.gltf");
+  ASSERT_EQ(s.primitives.size(), 2u);
+  const Primitive& mirrored = s.primitives[0];
+  expectNear(mirrored.positions[1], {-1, 0, 0});
+  // Mirroring in x keeps the normal (0,0,1) but reverses the visual winding: the loader swaps corners
+  // so the geometric normal still agrees with the shading normal.
+  expectNear(mirrored.normals[0], {0, 0, 1});
+  expectNear(faceNormal(mirrored, 0), {0, 0, 1});
+  EXPECT_EQ(mirrored.indices[1], 2u);
+  const Primitive& flippedZ = s.primitives[1];
+  expectNear(flippedZ.positions[0], {5, 0, 0});
+  expectNear(flippedZ.normals[0], {0, 0, -1});
+  expectNear(faceNormal(flippedZ, 0), {0, 0, -1});
+}
+
+TEST(GltfLoader, StripsAndFansAreTriangulatedWithConsistentWinding) {
+  // Four vertices in the z = 0 plane, strip order; then the same as a fan.
+  std::vector<glm::vec3> quad = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  GltfDocument doc = meshDocument(quad, {});
+  doc.root["meshes"][0]["primitives"][0]["mode"] = 5;  // TRIANGLE_STRIP
+  json fan = doc.root["meshes"][0]["primitives"][0];
+  fan["mode"] = 6;  // TRIANGLE_FAN over 0,1,3,2 (same square)
+  fan["indices"] = doc.addIndices({0, 1, 3, 2});
+  doc.root["meshes"][0]["primitives"].push_back(fan);
+  auto dir = testFolder("loader_strip");
+  writeDocument(doc, dir / "s.gltf");
+  Scene s = loadScene(dir / "s.gltf");
+  ASSERT_EQ(s.primitives.size(), 2u);
+  for (const auto& p : s.primitives) {
+    ASSERT_EQ(p.triangleCount(), 2u);
+    for (size_t t = 0; t < 2; ++t) expectNear(faceNormal(p, t), {0, 0, 1});
+  }
+  EXPECT_EQ(s.stats.normalsComputed, 2u);
+}
+
+TEST(GltfLoader, PointsAndLinesAreSkippedWithAWarning) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  json lines = doc.root["meshes"][0]["primitives"][0];
+  lines["mode"] = 1;
+  doc.root["meshes"][0]["primitives"].push_back(lines);
+  auto dir = testFolder("loader_lines");
+  writeDocument(doc, dir / "l.gltf");
+  Scene s = loadScene(dir / "l.gltf");
+  EXPECT_EQ(s.primitives.size(), 1u);
+  EXPECT_EQ(s.stats.primitivesSkipped, 1u);
+  ASSERT_FALSE(s.stats.warnings.empty());
+  EXPECT_NE(s.stats.warnings[0].find("points or lines"), std::string::npos);
+}
+
+TEST(GltfLoader, MissingNormalsAreAreaWeighted) {
+  // Vertex 0 is shared by a unit right triangle in z = 0 (area 0.5) and a 2×2 one in x = 0 (area 2).
+  std::vector<glm::vec3> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 0, 2}};
+  GltfDocument doc = meshDocument(pos, {0, 1, 2, 0, 3, 4});
+  auto dir = testFolder("loader_normals");
+  writeDocument(doc, dir / "n.gltf");
+  Scene s = loadScene(dir / "n.gltf");
+  const Primitive& p = s.primitives[0];
+  // Face normals: (0,0,1) × 0.5 and (1,0,0) × 2 → normalise (2, 0, 0.5).
+  expectNear(p.normals[0], glm::normalize(glm::vec3(2.0f, 0.0f, 0.5f)));
+  expectNear(p.normals[1], {0, 0, 1});
+  expectNear(p.normals[3], {1, 0, 0});
+}
+
+TEST(GltfLoader, DegenerateTrianglesAreDroppedAndCounted) {
+  std::vector<glm::vec3> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}};
+  // valid, repeated index, collinear (0,1,3), valid
+  GltfDocument doc = meshDocument(pos, {0, 1, 2, 0, 0, 1, 0, 1, 3, 1, 2, 0});
+  auto dir = testFolder("loader_degenerate");
+  writeDocument(doc, dir / "d.gltf");
+  Scene s = loadScene(dir / "d.gltf");
+  EXPECT_EQ(s.stats.trianglesKept, 2u);
+  EXPECT_EQ(s.stats.trianglesDropped, 2u);
+  EXPECT_EQ(s.triangleCount(), 2u);
+}
+
+TEST(GltfLoader, MaterialsTexturesAndEmissiveStrength) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = doc.addVec2({{0, 0}, {1, 0}, {0, 1}});
+  doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+  // 2×1 texture: sRGB 188 (linear 0.5029) and sRGB 255, written as PNG bytes.
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.texels = {glm::vec4(188 / 255.0f, 188 / 255.0f, 188 / 255.0f, 1.0f), glm::vec4(1.0f)};
+  int image = doc.addPngImage(encodePng(t, false), "tex");
+  int tex = doc.addTexture(image, doc.addSampler(WrapMode::ClampToEdge, WrapMode::MirroredRepeat, false));
+  doc.append("materials", {{"name", "m"},
+                           {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 1, 1}}, {"baseColorTexture", {{"index", tex}}}}},
+                           {"emissiveFactor", {1, 0.5, 0.25}},
+                           {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 8}}}}},
+                           {"alphaMode", "MASK"},
+                           {"alphaCutoff", 0.25},
+                           {"doubleSided", true}});
+  auto dir = testFolder("loader_material");
+  writeDocument(doc, dir / "t.gltf");
+  Scene s = loadScene(dir / "t.gltf");
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.name, "m");
+  expectNear(m.emission(), {8, 4, 2});
+  EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
+  EXPECT_FLOAT_EQ(m.alphaCutoff, 0.25f);
+  EXPECT_TRUE(m.doubleSided);
+  ASSERT_EQ(m.baseColorTexture, 0);
+  const Texture& tx = s.textures[0];
+  ASSERT_EQ(tx.width, 2);
+  EXPECT_EQ(tx.wrapS, WrapMode::ClampToEdge);
+  EXPECT_EQ(tx.wrapT, WrapMode::MirroredRepeat);
+  // sRGB decode: ((188/255 + 0.055)/1.055)^2.4 = 0.50289.
+  EXPECT_NEAR(tx.texels[0].r, 0.50289f, 1e-4f);
+  EXPECT_NEAR(tx.texels[1].g, 1.0f, 1e-6f);
+  // baseColorAt multiplies the factor: at vertex 0 (uv (0,0), clamped to texel 0's centre region).
+  glm::vec4 c = s.baseColorAt(s.primitives[0], 0, glm::vec2(0.0f));
+  EXPECT_NEAR(c.r, 0.5f * 0.50289f, 1e-4f);
+  EXPECT_NEAR(c.g, 0.50289f, 1e-4f);
+}
+
+TEST(GltfLoader, PunctualLightsTakeNodeTransforms) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
+      {{{"type", "point"}, {"intensity", 10}, {"color", {1, 0.5, 0.25}}, {"range", 4}},
+       {{"type", "spot"}, {"intensity", 3}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.6}}}},
+       {{"type", "directional"}, {"intensity", 2}}});
+  // Rotating −Z by −90° about X gives −Y: a light pointing straight down.
+  glm::quat down = glm::angleAxis(glm::radians(-90.0f), glm::vec3(1, 0, 0));
+  doc.root["nodes"].push_back({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  doc.root["nodes"].push_back({{"translation", {0, 5, 0}}, {"rotation", {down.x, down.y, down.z, down.w}},
+                               {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  doc.root["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  doc.root["scenes"][0]["nodes"] = {0, 1, 2, 3};
+  auto dir = testFolder("loader_lights");
+  writeDocument(doc, dir / "l.gltf");
+  Scene s = loadScene(dir / "l.gltf");
+  ASSERT_EQ(s.lights.size(), 3u);
+  EXPECT_EQ(s.lights[0].type, LightType::Point);
+  expectNear(s.lights[0].position, {1, 2, 3});
+  expectNear(s.lights[0].color, {1, 0.5f, 0.25f});
+  EXPECT_FLOAT_EQ(s.lights[0].range, 4.0f);
+  // Point power = 4π I colour.
+  EXPECT_NEAR(s.lights[0].power().x, 4.0 * M_PI * 10.0, 1e-3);
+  EXPECT_EQ(s.lights[1].type, LightType::Spot);
+  expectNear(s.lights[1].direction, {0, -1, 0});
+  EXPECT_FLOAT_EQ(s.lights[1].outerConeAngle, 0.6f);
+  EXPECT_EQ(s.lights[2].type, LightType::Directional);
+  expectNear(s.lights[2].direction, {0, 0, -1});
+}
+
+TEST(GltfLoader, PerspectiveCameraFromNode) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.append("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.05}, {"aspectRatio", 1.5}}}});
+  glm::quat half = glm::angleAxis(glm::radians(180.0f), glm::vec3(0, 1, 0));
+  doc.root["nodes"].push_back({{"camera", 0}, {"translation", {0, 1, -4}}, {"rotation", {half.x, half.y, half.z, half.w}}});
+  doc.root["scenes"][0]["nodes"] = {0, 1};
+  auto dir = testFolder("loader_camera");
+  writeDocument(doc, dir / "c.gltf");
+  Scene s = loadScene(dir / "c.gltf");
+  ASSERT_EQ(s.cameras.size(), 1u);
+  EXPECT_FLOAT_EQ(s.cameras[0].yfov, 0.7f);
+  EXPECT_FLOAT_EQ(s.cameras[0].aspectRatio, 1.5f);
+  expectNear(glm::vec3(s.cameras[0].cameraToWorld[3]), {0, 1, -4});
+  expectNear(-glm::vec3(s.cameras[0].cameraToWorld[2]), {0, 0, 1});  // looks down −Z locally → +Z
+}
+
+TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  auto& prim = doc.root["meshes"][0]["primitives"][0];
+  prim["attributes"]["TEXCOORD_1"] = doc.addVec2({{0.1f, 0.1f}, {0.9f, 0.1f}, {0.1f, 0.9f}});
+  prim["extras"]["lightmap"] = {{"page", 2}, {"width", 256}, {"height", 128}};
+  prim["material"] = 0;
+  Texture t;
+  t.width = t.height = 1;
+  t.texels = {glm::vec4(0.5f, 0.25f, 1.0f, 1.0f)};
+  int tex = doc.addTexture(doc.addPngImage(encodePng(t, false), "lm"), -1);
+  doc.append("materials", {{"extensions", {{"MOZ_lightmap", {{"index", tex}, {"texCoord", 1}, {"intensity", 3.5}}}}}});
+  doc.root["extras"]["lightmapPages"] = {"pages/lightmap_0.exr"};
+  auto dir = testFolder("loader_moz");
+  writeDocument(doc, dir / "m.gltf");
+  Scene s = loadScene(dir / "m.gltf");
+  const Primitive& p = s.primitives[0];
+  EXPECT_EQ(p.lightmap.page, 2);
+  EXPECT_EQ(p.lightmap.width, 256);
+  EXPECT_EQ(p.lightmap.height, 128);
+  ASSERT_EQ(p.uv1.size(), 3u);
+  EXPECT_FLOAT_EQ(p.uv1[1].x, 0.9f);
+  const Material& m = s.materials[0];
+  ASSERT_GE(m.lightmapTexture, 0);
+  EXPECT_FLOAT_EQ(m.lightmapIntensity, 3.5f);
+  // Light-map PNGs are linear: 128/255 stays 0.50196, not sRGB-decoded.
+  EXPECT_NEAR(s.textures[m.lightmapTexture].texels[0].r, 128.0f / 255.0f, 1e-5f);
+  ASSERT_EQ(s.lightmapExrPaths.size(), 1u);
+  EXPECT_EQ(std::filesystem::path(s.lightmapExrPaths[0]), dir / "pages/lightmap_0.exr");
+}
+
+TEST(GltfLoader, ExrAndMissingImagesLoadWithWarnings) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+  doc.append("images", {{"uri", "lightmap_0.exr"}});
+  doc.append("images", {{"uri", "missing.png"}});
+  doc.append("textures", {{"source", 0}});
+  doc.append("textures", {{"source", 1}});
+  doc.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}});
+  auto dir = testFolder("loader_exr");
+  std::ofstream(dir / "lightmap_0.exr") << "not really an exr";
+  writeDocument(doc, dir / "e.gltf");
+  Scene s = loadScene(dir / "e.gltf");
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 0);  // missing: sampled as white
+  EXPECT_FALSE(s.stats.warnings.empty());
+  EXPECT_NEAR(s.baseColorAt(s.primitives[0], 0, glm::vec2(0.3f)).r, 1.0f, 1e-6f);
+}
+
+TEST(GltfLoader, GlbRoundTripThroughOurWriter) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  auto dir = testFolder("loader_glb");
+  writeDocument(doc, dir / "t.glb");
+  EXPECT_FALSE(std::filesystem::exists(dir / "t.bin"));
+  Scene s = loadScene(dir / "t.glb");
+  ASSERT_EQ(s.triangleCount(), 1u);
+  expectNear(s.primitives[0].positions[2], {0, 1, 0});
+}
+
+TEST(GltfLoader, RequireLightNeedsALightOrAnEmitter) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  auto dir = testFolder("loader_nolight");
+  writeDocument(doc, dir / "n.gltf");
+  Scene s = loadScene(dir / "n.gltf");
+  try {
+    requireLight(s, dir / "n.gltf");
+    FAIL() << "expected NoLight";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NoLight);
+    EXPECT_NE(std::string(e.what()).find("--sun"), std::string::npos);
+  }
+  s.materials[s.primitives[0].material].emissiveFactor = glm::vec3(1.0f);
+  EXPECT_NO_THROW(requireLight(s, dir / "n.gltf"));
+}
+
+TEST(GltfLoader, UriEscapeIsRefusedBeforeAnyRead) {
+  auto dir = testFolder("loader_escape");
+  std::filesystem::create_directories(dir / "scene");
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  writeDocument(doc, dir / "outside.gltf");  // writes outside.bin next to the scene folder
+  json j = json::parse(std::ifstream(dir / "outside.gltf"));
+  j["buffers"][0]["uri"] = "%2E%2E/outside.bin";  // "../" hidden behind escapes: still refused
+  std::ofstream(dir / "scene" / "s.gltf") << j.dump();
+  try {
+    loadScene(dir / "scene" / "s.gltf");
+    FAIL() << "expected InvalidData";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("escapes the scene folder"), std::string::npos);
+  }
+}
+
+TEST(GltfLoader, DamagedHelmetCounts) {
+  const char* src = std::getenv("IRBAKE_SOURCE_DIR");
+  std::filesystem::path file = std::filesystem::path(src ? src : ".") / "../shared/scenes/damaged_helmet/DamagedHelmet.gltf";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "third-party scene not present: " << file;
+  Scene s = loadScene(file);
+  EXPECT_EQ(s.triangleCount(), 15452u);
+  EXPECT_EQ(s.stats.trianglesDropped, 0u);
+  ASSERT_EQ(s.materials.size(), 1u);
+  // Base colour and emissive textures are the ones the baker uses (normal/metal/AO are not decoded).
+  ASSERT_EQ(s.textures.size(), 2u);
+  for (const auto& t : s.textures) {
+    EXPECT_EQ(t.width, 2048);
+    EXPECT_EQ(t.height, 2048);
+  }
+  EXPECT_TRUE(s.materials[0].isEmissive());
+  EXPECT_GE(s.materials[0].emissiveTexture, 0);
+}
