@@ -1,0 +1,448 @@
+#include "backend/gl/gl_backend.h"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "backend/gl/shadow_views.h"
+#include "common/error.h"
+#include "common/log.h"
+#include "common/progress.h"
+#include "glcontext/gl_context.h"
+#include "glcontext/gl_program.h"
+
+namespace irbake {
+
+namespace {
+
+constexpr int kFaces = 6;
+
+// std140 layout of one VPL in the VplBatch uniform block (shaders/vpl_accumulate.frag).
+struct VplGpu {
+  glm::vec4 origin;     // xyz position, w: shadow-origin offset along the normal
+  glm::vec4 normal;
+  glm::vec4 power;
+  glm::vec4 tangent;
+  glm::vec4 bitangent;
+};
+
+// Scene triangles on the GPU (world positions, one index buffer) with culling clusters.
+struct GpuGeometry {
+  GLuint vao = 0, vbo = 0, ibo = 0;
+  std::vector<TriangleCluster> clusters;
+  size_t triangles = 0;
+  ~GpuGeometry() {
+    glDeleteVertexArrays(1, &vao);
+    glDeleteBuffers(1, &vbo);
+    glDeleteBuffers(1, &ibo);
+  }
+};
+
+void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g) {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  for (const Primitive& prim : scene.primitives) {
+    const uint32_t base = static_cast<uint32_t>(positions.size());
+    positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
+    const size_t first = indices.size();
+    for (uint32_t i : prim.indices) indices.push_back(base + i);
+    appendClusters(positions, indices, first, prim.triangleCount(), clusterTriangles, g.clusters);
+  }
+  g.triangles = indices.size() / 3;
+  glCreateVertexArrays(1, &g.vao);
+  glCreateBuffers(1, &g.vbo);
+  glCreateBuffers(1, &g.ibo);
+  glNamedBufferStorage(g.vbo, std::max<size_t>(1, positions.size()) * sizeof(glm::vec3),
+                       positions.empty() ? nullptr : positions.data(), 0);
+  glNamedBufferStorage(g.ibo, std::max<size_t>(1, indices.size()) * sizeof(uint32_t),
+                       indices.empty() ? nullptr : indices.data(), 0);
+  glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
+  glVertexArrayElementBuffer(g.vao, g.ibo);
+  glEnableVertexArrayAttrib(g.vao, 0);
+  glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(g.vao, 0, 0);
+}
+
+// Depth-only render target array: `layers` layers of size×size (cube-map array or 2D), one FBO per layer.
+struct DepthTargets {
+  GLuint texture = 0;
+  GLenum target = 0;
+  int size = 0;
+  std::vector<GLuint> fbos;
+  DepthTargets(GLenum tgt, int sz, int layers) : target(tgt), size(sz) {
+    glCreateTextures(target, 1, &texture);
+    if (target == GL_TEXTURE_2D)
+      glTextureStorage2D(texture, 1, GL_DEPTH_COMPONENT32F, size, size);
+    else
+      glTextureStorage3D(texture, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
+    glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(texture, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    fbos.resize(layers);
+    glCreateFramebuffers(layers, fbos.data());
+    for (int l = 0; l < layers; ++l) {
+      if (target == GL_TEXTURE_2D)
+        glNamedFramebufferTexture(fbos[l], GL_DEPTH_ATTACHMENT, texture, 0);
+      else
+        glNamedFramebufferTextureLayer(fbos[l], GL_DEPTH_ATTACHMENT, texture, 0, l);
+      glNamedFramebufferDrawBuffer(fbos[l], GL_NONE);
+      glNamedFramebufferReadBuffer(fbos[l], GL_NONE);
+      if (glCheckNamedFramebufferStatus(fbos[l], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw Error(ErrorCode::Gl, "", "depth framebuffer incomplete");
+    }
+  }
+  ~DepthTargets() {
+    glDeleteFramebuffers(static_cast<GLsizei>(fbos.size()), fbos.data());
+    glDeleteTextures(1, &texture);
+  }
+};
+
+// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator.
+struct GpuPage {
+  const TexelSamples* samples = nullptr;
+  GLuint positionWeight = 0, normal = 0, accum = 0, fbo = 0;
+  std::vector<glm::dvec3> sum;
+  std::vector<glm::vec4> readback;
+  explicit GpuPage(const TexelSamples& s) : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
+    const int layers = s.supersample * s.supersample;
+    if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
+      throw Error(ErrorCode::InvalidData, "", "texel samples of page " + std::to_string(s.page) + " are incomplete");
+    for (GLuint* t : {&positionWeight, &normal}) {
+      glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, t);
+      glTextureStorage3D(*t, 1, GL_RGBA32F, s.width, s.height, layers);
+      glTextureParameteri(*t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(*t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glTextureSubImage3D(positionWeight, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT,
+                        s.positionWeight.data());
+    glTextureSubImage3D(normal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, s.normal.data());
+    glCreateTextures(GL_TEXTURE_2D, 1, &accum);
+    glTextureStorage2D(accum, 1, GL_RGBA32F, s.width, s.height);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, accum, 0);
+    if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw Error(ErrorCode::Gl, "", "accumulation framebuffer incomplete");
+    clear();
+  }
+  ~GpuPage() {
+    glDeleteFramebuffers(1, &fbo);
+    GLuint t[3] = {positionWeight, normal, accum};
+    glDeleteTextures(3, t);
+  }
+  void clear() {
+    const float zero[4] = {0, 0, 0, 0};
+    glClearTexImage(accum, 0, GL_RGBA, GL_FLOAT, zero);
+  }
+  // Adds the float partial sums into the double accumulator and restarts them from zero.
+  void fold() {
+    readback.resize(samples->layerSize());
+    glGetTextureImage(accum, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(readback.size() * sizeof(glm::vec4)),
+                      readback.data());
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += glm::dvec3(readback[i]);
+    clear();
+  }
+};
+
+class GlBaker {
+ public:
+  GlBaker(const BakeInputs& in, const GlBackendOptions& opt, GlBakeStats& stats)
+      : in_(in), opt_(opt), stats_(stats) {}
+
+  std::vector<Lightmap> run();
+
+ private:
+  void drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ);
+  void renderVplBatch(size_t first, size_t count, DepthTargets& cubes);
+  void accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes);
+  void bakeDirect(const Light& light);
+  void bindGBuffer(const GpuPage& page) const;
+  void finishStage(double& seconds, Stopwatch& sw) const;
+
+  const BakeInputs& in_;
+  const GlBackendOptions& opt_;
+  GlBakeStats& stats_;
+  ShadowScale scale_;
+  std::unique_ptr<GpuGeometry> geometry_;
+  std::vector<std::unique_ptr<GpuPage>> pages_;
+  std::unique_ptr<GlProgram> depthProgram_, vplProgram_, directProgram_;
+  GLuint vplUbo_ = 0, emptyVao_ = 0;
+  std::vector<GLsizei> drawCounts_;
+  std::vector<const void*> drawOffsets_;
+};
+
+void GlBaker::finishStage(double& seconds, Stopwatch& sw) const {
+  if (opt_.stageTimings) glFinish();
+  seconds += sw.seconds();
+  sw.reset();
+}
+
+void GlBaker::drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ) {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, size, size);
+  glScissor(view.scissor.x, view.scissor.y, view.scissor.z, view.scissor.w);
+  glClearDepthf(reversedZ ? 0.0f : 1.0f);
+  glDepthFunc(reversedZ ? GL_GREATER : GL_LESS);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glUniformMatrix4fv(depthProgram_->uniform("shadowClip"), 1, GL_FALSE, &view.clip[0][0]);
+  drawCounts_.clear();
+  drawOffsets_.clear();
+  cullClusters(view, geometry_->clusters, drawCounts_, drawOffsets_, stats_.trianglesDrawn);
+  stats_.trianglesBeforeCulling += geometry_->triangles;
+  ++stats_.facesRendered;
+  if (!drawCounts_.empty())
+    glMultiDrawElements(GL_TRIANGLES, drawCounts_.data(), GL_UNSIGNED_INT, drawOffsets_.data(),
+                        static_cast<GLsizei>(drawCounts_.size()));
+}
+
+void GlBaker::renderVplBatch(size_t first, size_t count, DepthTargets& cubes) {
+  depthProgram_->use();
+  glBindVertexArray(geometry_->vao);
+  for (size_t k = 0; k < count; ++k) {
+    const Vpl& v = in_.vpls.vpls[first + k];
+    const VplFrame frame = vplFrame(v.normal);
+    const glm::vec3 origin = v.position + frame.normal * scale_.originOffset;
+    for (int face = 0; face < kFaces; ++face) {
+      std::optional<ShadowView> view = cubeFaceView(origin, frame, face, cubes.size, scale_.nearPlane, true);
+      if (view) drawView(*view, cubes.fbos[k * kFaces + face], cubes.size, true);
+    }
+  }
+}
+
+void GlBaker::bindGBuffer(const GpuPage& page) const {
+  glBindTextureUnit(0, page.positionWeight);
+  glBindTextureUnit(1, page.normal);
+}
+
+void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes) {
+  std::vector<VplGpu> batch(opt_.vplsPerPass);
+  for (size_t k = 0; k < count; ++k) {
+    const Vpl& v = in_.vpls.vpls[first + k];
+    const VplFrame f = vplFrame(v.normal);
+    batch[k] = {glm::vec4(v.position, scale_.originOffset), glm::vec4(f.normal, 0), glm::vec4(v.power, 0),
+                glm::vec4(f.tangent, 0), glm::vec4(f.bitangent, 0)};
+  }
+  glNamedBufferSubData(vplUbo_, 0, batch.size() * sizeof(VplGpu), batch.data());
+  vplProgram_->use();
+  glUniform1i(vplProgram_->uniform("vplCount"), static_cast<GLint>(count));
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, vplUbo_);
+  glBindTextureUnit(2, cubes.texture);
+  glBindVertexArray(emptyVao_);
+  for (auto& page : pages_) {
+    glBindFramebuffer(GL_FRAMEBUFFER, page->fbo);
+    glViewport(0, 0, page->samples->width, page->samples->height);
+    bindGBuffer(*page);
+    glUniform1i(vplProgram_->uniform("layers"), page->samples->supersample * page->samples->supersample);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+}
+
+void GlBaker::bakeDirect(const Light& light) {
+  const Bounds3 bounds = in_.scene.bounds();
+  Stopwatch sw;
+  // Shadow map: full cube for points and wide spots, perspective map for spots, ortho box for directional.
+  const bool cube = light.type == LightType::Point ||
+                    (light.type == LightType::Spot && light.outerConeAngle > opt_.maxSpotPerspectiveAngle);
+  std::unique_ptr<DepthTargets> maps;
+  std::optional<ShadowView> view2d;
+  float texelAngle = 0.0f, orthoRange = 0.0f;
+  int shadowKind = 0;
+  depthProgram_->use();
+  glBindVertexArray(geometry_->vao);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_SCISSOR_TEST);
+  if (cube) {
+    maps = std::make_unique<DepthTargets>(GL_TEXTURE_CUBE_MAP_ARRAY, opt_.pointFaceSize, kFaces);
+    const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+    for (int face = 0; face < kFaces; ++face)
+      drawView(*cubeFaceView(light.position, identity, face, maps->size, scale_.nearPlane, false), maps->fbos[face],
+               maps->size, true);
+    texelAngle = 2.0f / maps->size;
+  } else if (light.type == LightType::Spot) {
+    maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D, opt_.lightMapSize, 1);
+    float tanHalf = 0.0f;
+    view2d = spotView(light.position, light.direction, light.outerConeAngle, opt_.lightMapSize, scale_.nearPlane,
+                      tanHalf);
+    drawView(*view2d, maps->fbos[0], maps->size, true);
+    texelAngle = 2.0f * tanHalf / maps->size;
+    shadowKind = 1;
+  } else {
+    maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D, opt_.lightMapSize, 1);
+    float texelSize = 0.0f;
+    view2d = directionalView(light.direction, bounds, opt_.lightMapSize, texelSize, orthoRange);
+    drawView(*view2d, maps->fbos[0], maps->size, false);
+    texelAngle = texelSize;
+    shadowKind = 2;
+  }
+  finishStage(stats_.shadowSeconds, sw);
+
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_SCISSOR_TEST);
+  directProgram_->use();
+  const GlProgram& p = *directProgram_;
+  glUniform1i(p.uniform("lightType"), light.type == LightType::Point ? 0 : light.type == LightType::Spot ? 1 : 2);
+  glUniform1i(p.uniform("shadowKind"), shadowKind);
+  glUniform3fv(p.uniform("lightPosition"), 1, &light.position[0]);
+  glUniform3fv(p.uniform("lightDirection"), 1, &light.direction[0]);
+  const glm::vec3 intensity = light.color * light.intensity;
+  glUniform3fv(p.uniform("lightIntensity"), 1, &intensity[0]);
+  glUniform1f(p.uniform("lightRange"), light.range);
+  const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
+  glUniform1f(p.uniform("cosOuter"), cosOuter);
+  glUniform1f(p.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
+  const glm::mat4 clip = view2d ? view2d->clip : glm::mat4(1.0f);
+  glUniformMatrix4fv(p.uniform("shadowClip"), 1, GL_FALSE, &clip[0][0]);
+  glUniform1f(p.uniform("orthoDepthRange"), orthoRange);
+  glUniform1f(p.uniform("texelAngle"), texelAngle);
+  glBindTextureUnit(cube ? 2 : 3, maps->texture);
+  glBindVertexArray(emptyVao_);
+  for (auto& page : pages_) {
+    glBindFramebuffer(GL_FRAMEBUFFER, page->fbo);
+    glViewport(0, 0, page->samples->width, page->samples->height);
+    bindGBuffer(*page);
+    glUniform1i(p.uniform("layers"), page->samples->supersample * page->samples->supersample);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  finishStage(stats_.accumulateSeconds, sw);
+}
+
+std::vector<Lightmap> GlBaker::run() {
+  Stopwatch sw;
+  const float diagonal = std::max(in_.scene.bounds().diagonal(), 1e-6f);
+  scale_.nearPlane = opt_.nearPlaneScale * diagonal;
+  scale_.constantBias = opt_.constantBiasScale * diagonal;
+  scale_.originOffset = std::max(in_.rayTracer.epsilon(), scale_.constantBias);
+
+  geometry_ = std::make_unique<GpuGeometry>();
+  uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
+  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s));
+
+  const int K = std::clamp(opt_.vplsPerPass, 1, 256);
+  const std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(K)};
+  depthProgram_ = std::make_unique<GlProgram>(
+      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
+  vplProgram_ = std::make_unique<GlProgram>(
+      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
+                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
+      defines);
+  directProgram_ = std::make_unique<GlProgram>(
+      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
+                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}},
+      defines);
+  for (const GlProgram* p : {vplProgram_.get(), directProgram_.get()}) {
+    p->use();
+    glUniform1f(p->uniform("clampBound"), in_.eval.clampBound);
+    glUniform1f(p->uniform("nearPlane"), scale_.nearPlane);
+    glUniform1f(p->uniform("constantBias"), scale_.constantBias);
+    glUniform1f(p->uniform("slopeBias"), opt_.slopeBias);
+    glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
+  }
+  vplProgram_->use();
+  glUniform1f(vplProgram_->uniform("texelAngle"), 2.0f / opt_.cubeFaceSize);
+  glCreateBuffers(1, &vplUbo_);
+  glNamedBufferStorage(vplUbo_, K * sizeof(VplGpu), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateVertexArrays(1, &emptyVao_);
+  // Reversed-Z with [0,1] clip depth: depth = near / distance keeps float precision at every range.
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glBlendFunc(GL_ONE, GL_ONE);
+  glBlendEquation(GL_FUNC_ADD);
+  checkGlError("GL backend setup");
+  finishStage(stats_.setupSeconds, sw);
+
+  const auto& vpls = in_.vpls.vpls;
+  const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
+  const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
+  const size_t totalWork = vplCount + lightCount * K;
+  if (vplCount > 0) {
+    DepthTargets cubes(GL_TEXTURE_CUBE_MAP_ARRAY, opt_.cubeFaceSize, K * kFaces);
+    int passesSinceFold = 0;
+    for (size_t first = 0; first < vplCount; first += K) {
+      const size_t count = std::min<size_t>(K, vplCount - first);
+      glEnable(GL_DEPTH_TEST);
+      glEnable(GL_SCISSOR_TEST);
+      glDisable(GL_BLEND);
+      renderVplBatch(first, count, cubes);
+      finishStage(stats_.shadowSeconds, sw);
+      glDisable(GL_DEPTH_TEST);
+      glDisable(GL_SCISSOR_TEST);
+      glEnable(GL_BLEND);
+      accumulateVplBatch(first, count, cubes);
+      finishStage(stats_.accumulateSeconds, sw);
+      ++stats_.passes;
+      stats_.vpls += count;
+      if (++passesSinceFold >= std::max(1, opt_.foldEveryPasses)) {
+        for (auto& page : pages_) page->fold();
+        passesSinceFold = 0;
+        finishStage(stats_.foldSeconds, sw);
+      }
+      if (in_.progress) in_.progress("gl", double(first + count) / std::max<size_t>(1, totalWork));
+    }
+  }
+  for (size_t i = 0; i < lightCount; ++i) {
+    glDisable(GL_BLEND);
+    bakeDirect(in_.scene.lights[i]);
+    glEnable(GL_BLEND);
+    ++stats_.passes;
+    if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * K) / std::max<size_t>(1, totalWork));
+  }
+  sw.reset();
+  for (auto& page : pages_) page->fold();
+  checkGlError("GL backend passes");
+  finishStage(stats_.foldSeconds, sw);
+
+  std::vector<Lightmap> maps;
+  for (const auto& page : pages_) {
+    const TexelSamples& s = *page->samples;
+    Lightmap m;
+    m.page = s.page;
+    m.width = s.width;
+    m.height = s.height;
+    m.texels.resize(m.size());
+    m.valid.assign(m.size(), 0);
+    for (size_t i = 0; i < m.size(); ++i) {
+      const bool valid = i < s.valid.size() && s.valid[i];
+      m.valid[i] = valid ? 1 : 0;
+      const glm::dvec3 v = valid ? page->sum[i] : glm::dvec3(0.0);
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        throw Error(ErrorCode::NumericError, "", "GL backend produced a non-finite texel on page " +
+                                                     std::to_string(s.page));
+      m.texels[i] = glm::vec3(v);
+    }
+    maps.push_back(std::move(m));
+  }
+  glDeleteBuffers(1, &vplUbo_);
+  glDeleteVertexArrays(1, &emptyVao_);
+  if (in_.progress) in_.progress("gl", 1.0);
+  return maps;
+}
+
+}  // namespace
+
+std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& options) {
+  GlBakeStats localStats;
+  GlBakeStats& stats = options.stats ? *options.stats : localStats;
+  stats = GlBakeStats{};
+  Stopwatch contextTime;
+  std::unique_ptr<GlContext> owned;
+  const GlContext* ctx = options.context;
+  if (ctx)
+    ctx->makeCurrent();
+  else
+    ctx = (owned = std::make_unique<GlContext>()).get();
+  const double contextSeconds = contextTime.seconds();
+  stats.renderer = ctx->description();
+  log::info("GL backend: " + stats.renderer);
+  std::vector<Lightmap> maps;
+  {
+    GlBaker baker(inputs, options, stats);
+    maps = baker.run();
+  }
+  stats.setupSeconds += contextSeconds;
+  return maps;
+}
+
+}  // namespace irbake

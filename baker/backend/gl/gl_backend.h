@@ -1,0 +1,49 @@
+// The OpenGL backend: each VPL's shadowed contribution rendered into the light-map pages (EGL,
+// headless) and accumulated in float, folded into double. Same transport as the Embree backend.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "backend/bake_inputs.h"
+#include "backend/lightmap.h"
+
+namespace irbake {
+
+class GlContext;
+
+// Measured by bakeGl (wall clock with glFinish between stages when GlBackendOptions::stageTimings).
+struct GlBakeStats {
+  std::string renderer;          // GL_RENDERER | GL_VERSION | EGL platform
+  double setupSeconds = 0.0;     // context, programs, geometry and G-buffer upload
+  double shadowSeconds = 0.0;    // VPL depth cubes and punctual shadow maps
+  double accumulateSeconds = 0.0;// accumulation passes (VPLs and direct lights)
+  double foldSeconds = 0.0;      // read-backs into the double accumulators
+  size_t vpls = 0;               // VPLs evaluated
+  size_t passes = 0;             // accumulation passes per page
+  size_t facesRendered = 0;      // shadow views drawn (cube faces, spot/directional maps)
+  size_t trianglesDrawn = 0;     // triangles submitted to shadow views after CPU culling
+  size_t trianglesBeforeCulling = 0;  // triangles that would be submitted without culling
+};
+
+struct GlBackendOptions {
+  int vplsPerPass = 16;          // K: VPLs (cube-map array layers) evaluated per accumulation pass
+  int cubeFaceSize = 256;        // VPL depth-cube face size (texels)
+  int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
+  int lightMapSize = 2048;       // spot / directional shadow map size (texels)
+  int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
+  int clusterTriangles = 256;    // triangles per culling cluster (CPU per-face culling)
+  float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
+  float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
+  float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal
+  float slopeBias = 1.5f;        // depth bias in shadow texel footprints × tanθ
+  float normalOffset = 1.0f;     // lookup point pushed along the receiver normal, in texel footprints
+  bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
+  const GlContext* context = nullptr;  // an existing current context; null: bakeGl creates one
+  GlBakeStats* stats = nullptr;  // out: timings and counts (may be null)
+};
+
+// One Lightmap per TexelSamples page (irradiance/π). Throws Error(Gl) when no GL 4.5 context can be
+// created (hint: --backend embree) and Error(NumericError) if a non-finite value appears.
+std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& options = {});
+
+}  // namespace irbake

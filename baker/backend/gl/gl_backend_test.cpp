@@ -1,0 +1,337 @@
+// GL backend against closed forms and CPU ray-traced visibility on hand-made scenes (small pages,
+// small shadow maps: each test runs in well under a second on llvmpipe).
+#include "backend/gl/gl_backend.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "backend/gl/shadow_views.h"
+#include "common/error.h"
+#include "glcontext/gl_context.h"
+#include "raytrace/ray_tracer.h"
+#include "raytrace/test_scenes.h"
+
+namespace irbake {
+namespace {
+
+using testing::addMaterial;
+using testing::addQuad;
+using testing::gridSamples;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// CPU value of one VPL at a sample: Φ cosθx cosθy / (π² r²) (clamped), visibility from Embree.
+glm::dvec3 cpuVpl(const Vpl& v, glm::vec3 x, glm::vec3 n, float clampBound, const RayTracer* rt) {
+  glm::dvec3 d = glm::dvec3(v.position) - glm::dvec3(x);
+  double r2 = glm::dot(d, d);
+  double cx = glm::dot(glm::dvec3(n), d), cy = -glm::dot(glm::dvec3(v.normal), d);
+  if (cx <= 0 || cy <= 0) return glm::dvec3(0.0);
+  double g = cx * cy / (r2 * r2);
+  if (clampBound > 0) g = std::min(g, double(clampBound));
+  if (rt && !rt->visible(x, n, v.position, v.normal)) return glm::dvec3(0.0);
+  return glm::dvec3(v.power) * g / (kPi * kPi);
+}
+
+struct Fixture {
+  Scene scene;
+  std::unique_ptr<RayTracer> rt;
+  std::vector<TexelSamples> pages;
+  VplSet vpls;
+  std::vector<Lightmap> bake(VplEvalOptions eval = {}, GlBackendOptions opt = {}) {
+    if (!rt) rt = std::make_unique<RayTracer>(scene);
+    BakeInputs in{scene, *rt, pages, vpls, eval, {}};
+    return bakeGl(in, opt);
+  }
+};
+
+// Floor z = 0 of 2×2 m, sampled 32×32; optional occluder square at height h.
+Fixture floorScene(bool occluder) {
+  Fixture f;
+  int white = addMaterial(f.scene, glm::vec3(0.5f));
+  addQuad(f.scene, white, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 4);
+  if (occluder) addQuad(f.scene, white, {-0.3f, -0.3f, 0.5f}, {0.6f, 0, 0}, {0, 0.6f, 0});
+  f.pages.push_back(gridSamples({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 32, 32));
+  return f;
+}
+
+double relativeRmse(const std::vector<glm::dvec3>& ref, const Lightmap& m) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < ref.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      double e = double(m.texels[i][c]) - ref[i][c];
+      num += e * e;
+      den += ref[i][c] * ref[i][c];
+    }
+  }
+  return std::sqrt(num / std::max(den, 1e-300));
+}
+
+std::vector<glm::dvec3> cpuReference(const Fixture& f, const TexelSamples& s, float clampBound, bool shadows) {
+  std::vector<glm::dvec3> ref(s.layerSize(), glm::dvec3(0.0));
+  const int L = s.supersample * s.supersample;
+  for (int l = 0; l < L; ++l)
+    for (size_t i = 0; i < s.layerSize(); ++i) {
+      const glm::vec4 pw = s.positionWeight[l * s.layerSize() + i];
+      if (pw.w <= 0) continue;
+      const glm::vec3 n = glm::vec3(s.normal[l * s.layerSize() + i]);
+      for (const Vpl& v : f.vpls.vpls)
+        ref[i] += double(pw.w) * cpuVpl(v, glm::vec3(pw), n, clampBound, shadows ? f.rt.get() : nullptr);
+    }
+  return ref;
+}
+
+TEST(GlShadowViews, CubeFaceMatrixMatchesGlFaceSelection) {
+  // A direction through each face's clip matrix lands on the (s, t) the GL spec's table gives.
+  const VplFrame identity{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const glm::vec3 dirs[] = {{1, 0.2f, -0.3f}, {-1, 0.4f, 0.1f}, {0.3f, 1, -0.2f},
+                            {-0.1f, -1, 0.6f}, {0.5f, -0.25f, 1}, {0.2f, 0.3f, -1}};
+  for (const glm::vec3& d : dirs) {
+    glm::vec2 st;
+    const int face = cubeFaceOf(d, st);
+    auto view = cubeFaceView(glm::vec3(0), identity, face, 64, 0.01f, false);
+    ASSERT_TRUE(view);
+    glm::vec4 c = view->clip * glm::vec4(d, 1.0f);
+    EXPECT_NEAR(0.5f * (c.x / c.w + 1), st.x, 1e-6f);
+    EXPECT_NEAR(0.5f * (c.y / c.w + 1), st.y, 1e-6f);
+    // Reversed-Z: window depth = near / distance along the face axis.
+    EXPECT_NEAR(c.z / c.w, 0.01f / std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}), 1e-6f);
+  }
+}
+
+TEST(GlShadowViews, HemisphereSkipsBackFaceAndHalvesSides) {
+  const VplFrame f = vplFrame(glm::normalize(glm::vec3(0.3f, -0.2f, 1.0f)));
+  EXPECT_NEAR(glm::dot(f.tangent, f.normal), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::dot(f.bitangent, f.normal), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::dot(glm::cross(f.tangent, f.bitangent), f.normal), 1.0f, 1e-6f);
+  int faces = 0, fullFaces = 0;
+  for (int face = 0; face < 6; ++face) {
+    auto v = cubeFaceView(glm::vec3(0), f, face, 256, 0.01f, true);
+    if (!v) continue;
+    ++faces;
+    const int area = v->scissor.z * v->scissor.w;
+    if (area == 256 * 256) ++fullFaces;
+    else EXPECT_EQ(area, 129 * 256);
+  }
+  EXPECT_EQ(faces, 5);
+  EXPECT_EQ(fullFaces, 1);
+}
+
+TEST(GlShadowViews, CullsClustersOutsideTheFace) {
+  Scene s;
+  int m = addMaterial(s, glm::vec3(0.5f));
+  addQuad(s, m, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 8);  // 128 triangles
+  std::vector<glm::vec3> pos = s.primitives[0].positions;
+  std::vector<uint32_t> idx = s.primitives[0].indices;
+  std::vector<TriangleCluster> clusters;
+  appendClusters(pos, idx, 0, 128, 16, clusters);  // 8 clusters, one row of cells each... (2 rows of 8 cells)
+  ASSERT_EQ(clusters.size(), 8u);
+  // Looking up (+Z) from below the plane sees it; the −Z face of a VPL above looking down too,
+  // but the +Z face of a VPL above the plane sees nothing.
+  const VplFrame id{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  std::vector<int> counts;
+  std::vector<const void*> offsets;
+  size_t drawn = 0;
+  cullClusters(*cubeFaceView({0, 0, 1}, id, 4, 64, 0.01f, false), clusters, counts, offsets, drawn);
+  EXPECT_EQ(drawn, 0u);
+  cullClusters(*cubeFaceView({0, 0, 1}, id, 5, 64, 0.01f, false), clusters, counts, offsets, drawn);
+  EXPECT_EQ(drawn, 128u);
+  EXPECT_EQ(counts.size(), 1u);  // neighbours merged into one draw range
+  // Per-cell clusters; the +X face from (0.3, 0, 0.01) sees only cells reaching beyond x = 0.3:
+  // the 5 columns of cells with x ≤ 0.25 (80 triangles) are culled, the last column is drawn.
+  clusters.clear();
+  appendClusters(pos, idx, 0, 128, 2, clusters);
+  ASSERT_EQ(clusters.size(), 64u);
+  drawn = 0;
+  cullClusters(*cubeFaceView({0.3f, 0, 0.01f}, id, 0, 64, 0.001f, false), clusters, counts, offsets, drawn);
+  EXPECT_LE(drawn, 48u);
+  EXPECT_GE(drawn, 2u * 4u);
+}
+
+// One VPL over an open floor: exactly the closed form Φ cosθx cosθy / (π² r²) per texel.
+TEST(GlBackend, SingleVplMatchesClosedForm) {
+  Fixture f = floorScene(false);
+  Vpl v;
+  v.position = {0.2f, -0.1f, 0.8f};
+  v.normal = glm::normalize(glm::vec3(0.3f, 0.1f, -1.0f));
+  v.power = {2.0f, 1.0f, 0.5f};
+  f.vpls.vpls.push_back(v);
+  auto maps = f.bake();
+  ASSERT_EQ(maps.size(), 1u);
+  const auto ref = cpuReference(f, f.pages[0], 0.0f, false);
+  double maxRel = 0;
+  for (size_t i = 0; i < ref.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      maxRel = std::max(maxRel, std::abs(maps[0].texels[i][c] - ref[i][c]) / std::max(ref[i][c], 1e-6));
+  EXPECT_LT(maxRel, 1e-4);
+  EXPECT_EQ(maps[0].valid[0], 1);
+  // Spot value: texel (16,16) centre (1/32, 1/32, 0).
+  EXPECT_GT(maps[0].texels[16 * 32 + 16].r, 0.1f);
+}
+
+// VPLs above an occluder: the shadow cubes agree with Embree visibility (texels on the penumbra
+// boundary can differ by a shadow texel; the relative RMSE is what must be small).
+TEST(GlBackend, VplShadowsMatchRayTracedVisibility) {
+  Fixture f = floorScene(true);
+  f.rt = std::make_unique<RayTracer>(f.scene);
+  for (int i = 0; i < 5; ++i) {
+    Vpl v;
+    v.position = {-0.4f + 0.2f * i, 0.1f * i - 0.2f, 0.9f + 0.05f * i};
+    v.normal = glm::normalize(glm::vec3(0.1f * i - 0.2f, 0.05f, -1.0f));
+    v.power = glm::vec3(1.0f);
+    f.vpls.vpls.push_back(v);
+  }
+  GlBackendOptions opt;
+  opt.vplsPerPass = 2;  // several passes and folds
+  opt.foldEveryPasses = 1;
+  opt.cubeFaceSize = 1024;  // shadow edges within a millimetre on this 6 cm texel grid
+  auto maps = f.bake({}, opt);
+  const auto ref = cpuReference(f, f.pages[0], 0.0f, true);
+  const auto open = cpuReference(f, f.pages[0], 0.0f, false);
+  double shadowed = 0, total = 0;
+  for (size_t i = 0; i < ref.size(); ++i) shadowed += open[i].x - ref[i].x, total += open[i].x;
+  EXPECT_GT(shadowed / total, 0.1);  // the occluder matters
+  EXPECT_LT(relativeRmse(ref, maps[0]), 0.03);
+  size_t off = 0;
+  for (size_t i = 0; i < ref.size(); ++i) off += std::abs(maps[0].texels[i].x - ref[i].x) > 0.02 * ref[i].x + 1e-6;
+  EXPECT_LT(off, ref.size() / 50);  // only texels on a shadow edge may differ
+}
+
+TEST(GlBackend, ClampBoundsGeometryTerm) {
+  Fixture f = floorScene(false);
+  Vpl v;
+  v.position = {0.0f, 0.0f, 0.05f};
+  v.normal = {0, 0, -1};
+  v.power = glm::vec3(1.0f);
+  f.vpls.vpls.push_back(v);
+  VplEvalOptions eval;
+  eval.clampBound = 10.0f;  // 1/r² = 400 below the VPL
+  auto maps = f.bake(eval);
+  const auto ref = cpuReference(f, f.pages[0], eval.clampBound, false);
+  EXPECT_LT(relativeRmse(ref, maps[0]), 1e-4);
+  float peak = 0;
+  for (auto& t : maps[0].texels) peak = std::max(peak, t.x);
+  EXPECT_NEAR(peak, 10.0 / (kPi * kPi), 1e-5);
+}
+
+TEST(GlBackend, ManyVplsAccumulateWithoutPrecisionLoss) {
+  // 3000 VPLs over 24 passes of 128, folded in double: the sum matches the CPU double sum.
+  Fixture f = floorScene(false);
+  f.pages[0] = gridSamples({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 8, 8);
+  for (int i = 0; i < 3000; ++i) {
+    Vpl v;
+    const double a = 2.399963 * i;  // golden-angle spiral
+    v.position = glm::vec3(0.8 * std::cos(a) * std::sqrt(i / 3000.0), 0.8 * std::sin(a) * std::sqrt(i / 3000.0),
+                           0.5 + 0.3 * ((i * 7) % 11) / 11.0);
+    v.normal = {0, 0, -1};
+    v.power = glm::vec3(1e-3f * (1 + i % 5));
+    f.vpls.vpls.push_back(v);
+  }
+  GlBackendOptions opt;
+  opt.vplsPerPass = 128;
+  opt.cubeFaceSize = 16;
+  opt.foldEveryPasses = 4;
+  GlBakeStats stats;
+  opt.stats = &stats;
+  auto maps = f.bake({}, opt);
+  const auto ref = cpuReference(f, f.pages[0], 0.0f, false);
+  for (size_t i = 0; i < ref.size(); ++i) EXPECT_NEAR(maps[0].texels[i].x / ref[i].x, 1.0, 2e-5) << i;
+  EXPECT_EQ(stats.vpls, 3000u);
+  EXPECT_EQ(stats.passes, 24u);
+  EXPECT_EQ(stats.facesRendered, 5u * 3000u);
+  EXPECT_FALSE(stats.renderer.empty());
+}
+
+TEST(GlBackend, SupersampleLayersAreWeighted) {
+  // S = 2: four layers; weights 0.4/0.3/0.2/0.1 of four distinct positions.
+  Fixture f = floorScene(false);
+  TexelSamples s = gridSamples({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 4, 4);
+  TexelSamples ss = s;
+  ss.supersample = 2;
+  ss.positionWeight.clear();
+  ss.normal.clear();
+  const float w[4] = {0.4f, 0.3f, 0.2f, 0.1f};
+  for (int l = 0; l < 4; ++l)
+    for (size_t i = 0; i < s.layerSize(); ++i) {
+      glm::vec4 p = s.positionWeight[i];
+      ss.positionWeight.push_back(glm::vec4(p.x + 0.1f * l, p.y, 0.0f, w[l]));
+      ss.normal.push_back(s.normal[i]);
+    }
+  f.pages[0] = ss;
+  Vpl v;
+  v.position = {0.1f, 0.2f, 0.6f};
+  v.normal = {0, 0, -1};
+  v.power = glm::vec3(1.0f);
+  f.vpls.vpls.push_back(v);
+  auto maps = f.bake();
+  const auto ref = cpuReference(f, ss, 0.0f, false);
+  EXPECT_LT(relativeRmse(ref, maps[0]), 1e-5);
+}
+
+double pointLightCpu(const Light& L, glm::vec3 x, glm::vec3 n, const RayTracer& rt) {
+  glm::vec3 d = L.position - x;
+  float r = glm::length(d);
+  float c = glm::dot(n, d / r);
+  if (c <= 0 || rt.occluded(x + n * rt.epsilon(), d / r, 0.0f, r - rt.epsilon())) return 0.0;
+  return L.intensityToward(-d / r).x * c / (r * r) / kPi;
+}
+
+TEST(GlBackend, PointAndSpotLightsAreExactWithShadowMaps) {
+  for (LightType type : {LightType::Point, LightType::Spot}) {
+    Fixture f = floorScene(true);
+    f.rt = std::make_unique<RayTracer>(f.scene);
+    Light L = testing::pointLight({0.1f, 0.05f, 1.2f}, 3.0f);
+    L.type = type;
+    L.direction = glm::normalize(glm::vec3(0.1f, 0.0f, -1.0f));
+    L.innerConeAngle = 0.4f;
+    L.outerConeAngle = 0.7f;
+    f.scene.lights.push_back(L);
+    GlBackendOptions opt;
+    opt.pointFaceSize = 256;
+    opt.lightMapSize = 512;
+    auto maps = f.bake({}, opt);
+    std::vector<glm::dvec3> ref;
+    for (const glm::vec4& p : f.pages[0].positionWeight)
+      ref.push_back(glm::dvec3(pointLightCpu(L, glm::vec3(p), {0, 0, 1}, *f.rt)));
+    double rmse = 0, den = 0;
+    for (size_t i = 0; i < ref.size(); ++i) rmse += std::pow(maps[0].texels[i].x - ref[i].x, 2), den += ref[i].x * ref[i].x;
+    EXPECT_LT(std::sqrt(rmse / den), 0.03) << (type == LightType::Point ? "point" : "spot");
+    // A texel far from the shadow edge: exact. Texel (2, 2) at (-0.84, -0.84).
+    EXPECT_NEAR(maps[0].texels[2 * 32 + 2].x, ref[2 * 32 + 2].x, 1e-4 * ref[2 * 32 + 2].x + 1e-9);
+  }
+}
+
+TEST(GlBackend, DirectionalLightIsExactWithOrthoShadowMap) {
+  Fixture f = floorScene(true);
+  f.rt = std::make_unique<RayTracer>(f.scene);
+  Light L;
+  L.type = LightType::Directional;
+  L.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
+  L.intensity = 2.0f;
+  f.scene.lights.push_back(L);
+  GlBackendOptions opt;
+  opt.lightMapSize = 512;
+  auto maps = f.bake({}, opt);
+  const glm::vec3 toLight = -L.direction;
+  const double open = 2.0 * toLight.z / kPi;
+  size_t inShadow = 0, mismatched = 0;
+  for (size_t i = 0; i < f.pages[0].layerSize(); ++i) {
+    glm::vec3 x = glm::vec3(f.pages[0].positionWeight[i]);
+    bool lit = !f.rt->occluded(x + glm::vec3(0, 0, 1e-4f), toLight, 0.0f, 100.0f);
+    inShadow += !lit;
+    double expect = lit ? open : 0.0;
+    if (std::abs(maps[0].texels[i].x - expect) > 1e-5) ++mismatched;
+  }
+  EXPECT_GT(inShadow, 50u);
+  EXPECT_LE(mismatched, 8u);  // at most a few texels on the shadow edge
+}
+
+TEST(GlBackend, EmptyInputsGiveZeroMaps) {
+  Fixture f = floorScene(false);
+  auto maps = f.bake();
+  ASSERT_EQ(maps.size(), 1u);
+  for (auto& t : maps[0].texels) EXPECT_EQ(t, glm::vec3(0.0f));
+}
+
+}  // namespace
+}  // namespace irbake

@@ -1,0 +1,31 @@
+// A linked GLSL program built from embedded sources (shaders/), with errors that name the file.
+#pragma once
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+namespace irbake {
+
+struct ShaderStage {
+  GLenum type;                       // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER
+  std::vector<std::string> files;    // shaders/<file> sources concatenated after the #version line
+};
+
+class GlProgram {
+ public:
+  // defines: lines placed after "#version 450 core" ("#define MAX_BATCH 16").
+  GlProgram(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines = {});
+  ~GlProgram();
+  GlProgram(const GlProgram&) = delete;
+  GlProgram& operator=(const GlProgram&) = delete;
+
+  GLuint id() const { return program_; }
+  void use() const { glUseProgram(program_); }
+  GLint uniform(const char* name) const { return glGetUniformLocation(program_, name); }
+
+ private:
+  GLuint program_ = 0;
+};
+
+}  // namespace irbake
