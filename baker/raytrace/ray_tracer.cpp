@@ -186,6 +186,16 @@ bool RayTracer::visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3
   return !occluded(pa, d / dist, 0.0f, dist - epsilon_);
 }
 
+glm::vec3 RayTracer::insetPoint(uint32_t primitive, uint32_t triangle, const glm::vec3& p) const {
+  const Primitive& prim = scene_.primitives[primitive];
+  const uint32_t* idx = &prim.indices[3 * triangle];
+  glm::vec3 c = (prim.positions[idx[0]] + prim.positions[idx[1]] + prim.positions[idx[2]]) / 3.0f;
+  glm::vec3 d = c - p;
+  float len = glm::length(d);
+  if (!(len > 0.0f)) return p;
+  return p + d * (std::min(epsilon_, 0.5f * len) / len);
+}
+
 glm::vec3 RayTracer::albedoAt(const RayHit& hit) const {
   if (!hit.hit) return glm::vec3(0.0f);
   return glm::vec3(scene_.baseColorAt(scene_.primitives[hit.primitive], hit.triangle, hit.barycentric));

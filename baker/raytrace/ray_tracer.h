@@ -32,6 +32,14 @@ class RayTracer {
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
   // Mutual visibility of two surface points, offset along their normals by epsilon().
   bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
+  // A surface point of triangle (primitive, triangle) moved epsilon() towards the triangle's centroid:
+  // points on edges and corners (quasi-random samples hit vertices exactly) then lie strictly inside
+  // their face, so a normal offset never lands on a neighbouring face's plane (no leaks at corners).
+  glm::vec3 insetPoint(uint32_t primitive, uint32_t triangle, const glm::vec3& p) const;
+  // Ray origin for leaving that surface point on the side of n: insetPoint + epsilon() · n.
+  glm::vec3 spawnPoint(uint32_t primitive, uint32_t triangle, const glm::vec3& p, const glm::vec3& n) const {
+    return insetPoint(primitive, triangle, p) + n * epsilon_;
+  }
   // Self-intersection offset scaled to the scene (relative to its bounding-box size).
   float epsilon() const { return epsilon_; }
   // Textured diffuse albedo (linear RGB) at a hit: baseColorFactor × baseColorTexture.

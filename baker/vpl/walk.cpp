@@ -95,7 +95,9 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
         const Primitive& prim = scene.primitives[e.primitive];
         glm::vec2 bary = uniformTriangle(residual, u1);
         const uint32_t* idx = &prim.indices[3 * e.triangle];
-        origin = prim.positions[idx[0]] * (1.0f - bary.x - bary.y) + prim.positions[idx[1]] * bary.x + prim.positions[idx[2]] * bary.y;
+        origin = rt.insetPoint(e.primitive, e.triangle,
+                               prim.positions[idx[0]] * (1.0f - bary.x - bary.y) + prim.positions[idx[1]] * bary.x +
+                                   prim.positions[idx[2]] * bary.y);
         normal = e.normal;
         // Emission at the sampled point (textures), so the estimate is unbiased for textured emitters.
         glm::dvec3 Le(scene.emissionAt(prim, e.triangle, bary));
@@ -130,15 +132,16 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
       // Follow the path while it is among the survivors of the next bounce.
       glm::dvec3 throughput(1.0);
       for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
-        glm::vec3 start = surfaceStart ? origin + normal * eps : origin;
+        glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
         RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
         if (!hit.hit) break;  // escaped: its energy leaves the scene
         throughput *= glm::dvec3(rt.albedoAt(hit));
         glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
         glm::dvec3 power = pathPower * throughput * (static_cast<double>(N) / static_cast<double>(survivors[j]));
-        vpls.push_back(Vpl{hit.position, n, glm::vec3(power), j});
+        glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
+        vpls.push_back(Vpl{at, n, glm::vec3(power), j});
         if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
-        origin = hit.position;
+        origin = at;
         normal = n;
         surfaceStart = true;
         dir = cosineHemisphere(n, halton.sample(2 + 2 * j, i), halton.sample(3 + 2 * j, i));
