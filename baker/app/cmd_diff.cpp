@@ -1,7 +1,53 @@
-// irbake diff (placeholder until its issue lands).
+// irbake diff A B: error figures of bake A against bake B (the reference) on the same atlas.
+#include <cstdio>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
+#include "common/args.h"
 #include "common/error.h"
+#include "pipeline/diff.h"
 
 namespace irbake::app {
-int runDiff(const Args&) { throw Error(ErrorCode::Usage, "", "'irbake diff' is not built yet"); }
+namespace {
+const char* kDiffHelp =
+    "usage: irbake diff A B [--json]\n"
+    "  A, B: bake folders (lightmap_<page>.exr, scene.gltf) or single EXR files; B is the reference.\n"
+    "  Texels are weighted by the surface area they stand for when a folder holds scene.gltf, else\n"
+    "  every texel counts once. relative RMSE = RMSE / RMS(B); bias = mean(A - B).\n"
+    "  --json   print the figures as one JSON object\n";
+}
+
+int runDiff(const Args& args) {
+  ArgParser a(args, {}, {"--help", "-h", "--json"});
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(kDiffHelp, stdout);
+    return 0;
+  }
+  if (a.positionals().size() != 2) throw Error(ErrorCode::Usage, "", "diff needs two bakes A B; see 'irbake diff --help'");
+  BakeOnDisk bakeA = readBakeFromDisk(a.positionals()[0]);
+  BakeOnDisk bakeB = readBakeFromDisk(a.positionals()[1]);
+  const auto& areas = !bakeB.areas.empty() ? bakeB.areas : bakeA.areas;
+  MapDifference d = compareMaps(bakeA.pages, bakeB.pages, areas);
+  if (d.texels == 0) throw Error(ErrorCode::InvalidData, a.positionals()[0], "no texel to compare");
+  const bool areaWeighted = !areas.empty();
+  if (a.flag("--json")) {
+    nlohmann::json j = {{"pages", d.pages},         {"texels", d.texels},
+                        {"areaWeighted", areaWeighted}, {"weightSum", d.weightSum},
+                        {"rmse", d.rmse},           {"relativeRmse", d.relativeRmse},
+                        {"maxError", d.maxError},   {"meanBias", d.meanBias},
+                        {"relativeBias", d.relativeBias}, {"meanA", d.meanA},
+                        {"meanB", d.meanB}};
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  std::printf("pages %zu, texels compared %zu (%s)\n", d.pages, d.texels,
+              areaWeighted ? "weighted by surface area" : "unweighted");
+  std::printf("relative RMSE  %.6g  (RMSE %.6g, reference RMS-normalised)\n", d.relativeRmse, d.rmse);
+  std::printf("max error      %.6g\n", d.maxError);
+  std::printf("mean bias      %.6g  (%+.4g%% of the reference mean %.6g)\n", d.meanBias, 100.0 * d.relativeBias, d.meanB);
+  return 0;
+}
+
 }  // namespace irbake::app

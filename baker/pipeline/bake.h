@@ -1,6 +1,7 @@
 // The bake: every stage in order, one way — scene → atlas → texels → VPLs → backend → post.
 #pragma once
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -39,5 +40,25 @@ struct BakeResult {
 
 // Runs the whole bake on a loaded scene. Throws Error on failure.
 BakeResult bake(Scene scene, const BakeOptions& options);
+
+// "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
+BackendKind parseBackend(const std::string& name);
+const char* toString(BackendKind kind);
+
+// A directional light from the command line (--sun): direction the light travels, irradiance W/m².
+Light sunLight(const glm::vec3& direction, float irradiance);
+
+struct OutputOptions {
+  std::filesystem::path outDir;      // OUTDIR: lightmap_<page>.exr, scene.gltf
+  std::filesystem::path reportPath;  // report JSON; empty = OUTDIR/report.json
+  bool writeGltf = true;             // export scene.gltf (+ .bin, PNG maps) beside the EXR pages
+};
+
+// Writes the EXR pages, the glTF (through exportGltf) and the report, each atomically. Returns the
+// files written.
+std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options);
+
+// Peak resident memory of this process so far (MiB, getrusage).
+double peakMemoryMiB();
 
 }  // namespace irbake

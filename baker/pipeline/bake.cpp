@@ -1,0 +1,206 @@
+// The bake, stage by stage, with the report the benchmarks and users read.
+#include "pipeline/bake.h"
+
+#include <sys/resource.h>
+
+#include <cmath>
+#include <memory>
+
+#include "backend/embree/embree_backend.h"
+#include "backend/embree/geometry_term.h"
+#include "backend/gl/gl_backend.h"
+#if __has_include("backend/reference/reference_integrator.h")
+#include "backend/reference/reference_integrator.h"
+#define IRBAKE_HAVE_REFERENCE 1
+#endif
+#include "common/error.h"
+#include "common/log.h"
+#include "common/progress.h"
+#include "post/post.h"
+#include "raytrace/ray_tracer.h"
+
+namespace irbake {
+namespace {
+
+nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+// The backend stage. The GL engineer owns the GL line (options, stats); every backend returns one
+// Lightmap per texel page.
+std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& inputs, nlohmann::json& report) {
+  switch (options.backend) {
+    case BackendKind::Gl: {
+      GlBakeStats stats;
+      GlBackendOptions gl;
+      gl.stats = &stats;
+      std::vector<Lightmap> maps = bakeGl(inputs, gl);
+      report["renderer"] = stats.renderer;
+      report["gl"] = {{"setupSeconds", stats.setupSeconds},   {"shadowSeconds", stats.shadowSeconds},
+                      {"accumulateSeconds", stats.accumulateSeconds}, {"foldSeconds", stats.foldSeconds},
+                      {"passes", stats.passes},               {"facesRendered", stats.facesRendered},
+                      {"trianglesDrawn", stats.trianglesDrawn}};
+      return maps;
+    }
+    case BackendKind::Embree:
+      return bakeEmbree(inputs);
+    case BackendKind::Reference: {
+#ifdef IRBAKE_HAVE_REFERENCE
+      ReferenceOptions ref;
+      ref.samplesPerTexel = options.referenceSpp;
+      ref.seed = options.walk.seed;
+      return bakeReference(inputs, ref);
+#else
+      throw Error(ErrorCode::Usage, "", "the reference backend is not built yet");
+#endif
+    }
+  }
+  throw Error(ErrorCode::Usage, "", "unknown backend");
+}
+
+}  // namespace
+
+BackendKind parseBackend(const std::string& name) {
+  if (name == "gl") return BackendKind::Gl;
+  if (name == "embree") return BackendKind::Embree;
+  if (name == "reference") return BackendKind::Reference;
+  throw Error(ErrorCode::Usage, "", "unknown backend '" + name + "' (gl, embree or reference)");
+}
+
+const char* toString(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::Gl: return "gl";
+    case BackendKind::Embree: return "embree";
+    case BackendKind::Reference: return "reference";
+  }
+  return "?";
+}
+
+Light sunLight(const glm::vec3& direction, float irradiance) {
+  float len = glm::length(direction);
+  if (!(len > 0.0f) || !std::isfinite(len))
+    throw Error(ErrorCode::Usage, "", "--sun needs a non-zero direction");
+  if (!(irradiance > 0.0f) || !std::isfinite(irradiance))
+    throw Error(ErrorCode::Usage, "", "--sun needs a positive irradiance");
+  Light sun;
+  sun.name = "sun (command line)";
+  sun.type = LightType::Directional;
+  sun.direction = direction / len;
+  sun.intensity = irradiance;
+  return sun;
+}
+
+double peakMemoryMiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux: kilobytes
+}
+
+BakeResult bake(Scene scene, const BakeOptions& options) {
+  BakeResult r;
+  r.scene = std::move(scene);
+  Scene& s = r.scene;
+  if (s.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.sourcePath, "no triangles to bake");
+  nlohmann::json& report = r.report;
+  nlohmann::json seconds;
+  Stopwatch total, stage;
+  auto withProgress = [&](ProgressCallback cb) { return cb ? cb : options.progress; };
+
+  AtlasOptions atlasOptions = options.atlas;
+  atlasOptions.progress = withProgress(atlasOptions.progress);
+  r.atlas = buildAtlas(s, atlasOptions);
+  seconds["atlas"] = stage.seconds();
+
+  stage.reset();
+  RayTracer rt(s);
+  seconds["raytrace"] = stage.seconds();
+
+  stage.reset();
+  TexelSampleOptions texelOptions = options.texels;
+  texelOptions.progress = withProgress(texelOptions.progress);
+  std::vector<TexelSamples> texels = buildTexelSamples(s, rt, texelOptions);
+  seconds["texels"] = stage.seconds();
+
+  stage.reset();
+  WalkOptions walk = options.walk;
+  walk.progress = withProgress(walk.progress);
+  r.vpls = generateVpls(s, rt, walk);
+  seconds["vpls"] = stage.seconds();
+
+  VplEvalOptions eval = options.eval;
+  bool clampDerived = false;
+  if (options.autoClamp && eval.clampBound == 0.0f) {
+    eval.clampBound = deriveClampBound(s, r.vpls);
+    clampDerived = true;
+  }
+
+  stage.reset();
+  BakeInputs inputs{s, rt, texels, r.vpls, eval, options.progress};
+  r.maps = runBackend(options, inputs, report);
+  if (r.maps.size() != texels.size())
+    throw Error(ErrorCode::InvalidData, s.sourcePath, "the backend returned " + std::to_string(r.maps.size()) +
+                                                          " pages for " + std::to_string(texels.size()));
+  for (size_t p = 0; p < r.maps.size(); ++p) {
+    r.maps[p].page = static_cast<int>(p);
+    if (r.maps[p].valid.size() != r.maps[p].size()) r.maps[p].valid = texels[p].valid;
+  }
+  seconds["backend"] = stage.seconds();
+
+  stage.reset();
+  PostOptions post;
+  post.dilate = options.postDilate;
+  post.stitchSeams = options.postSeams;
+  PostStats postStats = postProcess(s, r.maps, post);
+  seconds["post"] = stage.seconds();
+  seconds["bake"] = total.seconds();
+
+  // The report: what was baked, how, how long, and where the energy went.
+  size_t texelCount = 0, covered = 0, valid = 0;
+  for (const auto& t : texels) {
+    texelCount += t.layerSize();
+    for (auto c : t.covered) covered += c != 0;
+    for (auto v : t.valid) valid += v != 0;
+  }
+  nlohmann::json pages = nlohmann::json::array();
+  for (const auto& pg : r.atlas.pages) pages.push_back({{"width", pg.width}, {"height", pg.height}});
+  nlohmann::json perBounce = nlohmann::json::array();
+  glm::dvec3 vplPower(0.0);
+  for (size_t b = 0; b < r.vpls.countPerBounce.size(); ++b) {
+    glm::dvec3 pw = b < r.vpls.powerPerBounce.size() ? r.vpls.powerPerBounce[b] : glm::dvec3(0.0);
+    vplPower += pw;
+    perBounce.push_back({{"bounce", b}, {"count", r.vpls.countPerBounce[b]}, {"power", rgb(pw)}});
+  }
+  report["backend"] = toString(options.backend);
+  report["scene"] = {{"source", s.sourcePath},
+                     {"triangles", s.triangleCount()},
+                     {"primitives", s.primitives.size()},
+                     {"lights", s.lights.size()},
+                     {"emitterPower", rgb(glm::dvec3(s.emitterPower()))}};
+  report["atlas"] = {{"pages", pages},
+                     {"charts", r.atlas.stats.charts},
+                     {"texelsPerUnit", r.atlas.stats.texelsPerUnit},
+                     {"centreUtilisation", r.atlas.stats.centreUtilisation},
+                     {"warnings", r.atlas.stats.warnings}};
+  report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
+                      {"supersample", std::max(1, options.texels.supersample)},
+                      {"leakControl", options.texels.leakControl}};
+  report["vpls"] = {{"paths", options.walk.paths},
+                    {"count", r.vpls.vpls.size()},
+                    {"bounces", r.vpls.bounces},
+                    {"meanReflectivity", r.vpls.meanReflectivity},
+                    {"emittedPower", rgb(r.vpls.emittedPower)},
+                    {"totalPower", rgb(vplPower)},
+                    {"perBounce", perBounce},
+                    {"seed", options.walk.seed}};
+  report["eval"] = {{"clampBound", eval.clampBound},
+                    {"clampDerived", clampDerived},
+                    {"biasCompensation", eval.biasCompensation}};
+  if (options.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
+  report["post"] = {{"texelsFilled", postStats.texelsFilled},
+                    {"seamEdges", postStats.seamEdges},
+                    {"seamMismatchBefore", postStats.seamMismatchBefore},
+                    {"seamMismatchAfter", postStats.seamMismatchAfter}};
+  report["seconds"] = seconds;
+  report["memoryPeakMiB"] = peakMemoryMiB();
+  return r;
+}
+
+}  // namespace irbake
