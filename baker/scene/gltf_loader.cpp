@@ -583,7 +583,8 @@ class Loader {
       const LocalPrimitive& lp = localPrimitive(meshIndex, pi);
       if (lp.skipped) continue;
       Primitive out;
-      out.name = (mesh.name.empty() ? "mesh" + std::to_string(meshIndex) : mesh.name) + "/" + std::to_string(pi);
+      out.name = mesh.name.empty() ? "mesh" + std::to_string(meshIndex) : mesh.name;
+      if (mesh.primitives.size() > 1) out.name += "/" + std::to_string(pi);
       out.node = nodeIndex;
       out.gltfMesh = meshIndex;
       out.gltfPrimitive = pi;
