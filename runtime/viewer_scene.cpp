@@ -2,7 +2,10 @@
 
 #include <numeric>
 
+#include "common/error.h"
 #include "common/log.h"
+#include "export/exr_io.h"
+#include "scene/gltf_loader.h"
 
 namespace irbake::view {
 
@@ -30,6 +33,28 @@ ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages) {
     v.warnings.push_back(where + ": no light map: showing albedo only");
   else if (unlit > 0)
     v.warnings.push_back(where + ": " + std::to_string(unlit) + " primitive(s) without a light map show albedo only");
+  return v;
+}
+
+ViewerScene loadViewerScene(const std::filesystem::path& path) {
+  Scene scene = loadScene(path);
+  std::vector<Lightmap> pages;
+  std::vector<std::string> warnings;
+  // The float pages carry the full range; if one cannot be read the PNG × intensity still shows.
+  for (size_t i = 0; i < scene.lightmapExrPaths.size(); ++i) {
+    try {
+      Lightmap m = readExr(scene.lightmapExrPaths[i]);
+      m.page = static_cast<int>(i);
+      pages.push_back(std::move(m));
+    } catch (const Error& e) {
+      warnings.push_back(std::string(e.what()) + ": using the MOZ_lightmap textures instead");
+      pages.clear();
+      break;
+    }
+  }
+  ViewerScene v = makeViewerScene(std::move(scene), std::move(pages));
+  v.warnings.insert(v.warnings.begin(), warnings.begin(), warnings.end());
+  for (const auto& w : v.scene.stats.warnings) v.warnings.push_back(w);
   return v;
 }
 

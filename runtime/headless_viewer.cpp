@@ -1,0 +1,38 @@
+#include "headless_viewer.h"
+
+#include "common/log.h"
+#include "common/progress.h"
+#include "glcontext/gl_context.h"
+#include "screenshot.h"
+#include "view_renderer.h"
+
+namespace irbake::view {
+
+std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const ViewerOptions& o) {
+  // Check the output name before any GL work, so a typo fails fast.
+  imageFormatFor(o.screenshot);
+  GlContext gl;
+  ViewRenderer renderer(v);
+  DrawSettings settings;
+  settings.mode = o.mode;
+  settings.exposure = o.exposure;
+  std::vector<std::filesystem::path> written;
+  if (o.walkthrough > 0) {
+    for (int i = 0; i < o.walkthrough; ++i) {
+      RgbaImage img = renderer.render(walkthroughFrame(v.scene, i, o.walkthrough), o.width, o.height, settings);
+      written.push_back(frameName(o.screenshot, i));
+      writeScreenshot(img, written.back(), o.exposure);
+    }
+    log::info("wrote " + std::to_string(written.size()) + " walkthrough frames " +
+              frameName(o.screenshot, 0).string() + " ..");
+    return written;
+  }
+  RgbaImage img = renderer.render(startCamera(o, v.scene), o.width, o.height, settings);
+  writeScreenshot(img, o.screenshot, o.exposure);
+  log::info("wrote " + o.screenshot.string() + " (" + std::to_string(o.width) + "x" +
+            std::to_string(o.height) + ", " + toString(o.mode) + ", " + gl.renderer() + ")");
+  written.push_back(o.screenshot);
+  return written;
+}
+
+}  // namespace irbake::view
