@@ -1,0 +1,135 @@
+// The irview command end to end: bad input, headless PNG/EXR, walkthrough frames, and a windowed run
+// under Xvfb. Scenes are the project's own samples written to the build folder.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include "samples/sample_scenes.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path workDir() {
+  fs::path d = fs::path(std::getenv("IRBAKE_BINARY_DIR") ? std::getenv("IRBAKE_BINARY_DIR") : ".") / "runtime_cli_test";
+  fs::create_directories(d);
+  return d;
+}
+
+// The samples as glTF (no light maps), written once.
+fs::path sampleFile(const std::string& name) {
+  static fs::path dir = [] {
+    fs::path d = workDir() / "samples";
+    irbake::samples::writeSamples(d);
+    return d;
+  }();
+  return dir / (name + ".gltf");
+}
+
+struct RunResult {
+  int status = -1;
+  std::string output;  // stdout + stderr
+};
+
+RunResult run(const std::string& args, const std::string& prefix = "") {
+  static int counter = 0;
+  fs::path log = workDir() / ("run_" + std::to_string(counter++) + ".log");
+  std::string cmd = prefix + "\"" IRVIEW_EXE "\" " + args + " > \"" + log.string() + "\" 2>&1";
+  int raw = std::system(cmd.c_str());
+  RunResult r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  return r;
+}
+
+// Reads an image as float RGB (row 0 at the top).
+std::vector<float> readImage(const fs::path& path, int& w, int& h) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return {};
+  const auto& spec = in->spec();
+  w = spec.width;
+  h = spec.height;
+  std::vector<float> px(static_cast<size_t>(w) * h * spec.nchannels);
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data());
+  std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
+  for (size_t i = 0; i < static_cast<size_t>(w) * h; ++i)
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = px[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+  return rgb;
+}
+
+TEST(IrviewCli, MissingSceneIsAnErrorNamingTheFile) {
+  RunResult r = run("no_such_scene.glb --screenshot x.png");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("no_such_scene.glb"), std::string::npos) << r.output;
+}
+
+TEST(IrviewCli, GarbageSceneIsAnErrorNamingTheFile) {
+  fs::path bad = workDir() / "garbage.gltf";
+  std::ofstream(bad) << "{ this is not json";
+  RunResult r = run(bad.string() + " --screenshot " + (workDir() / "never.png").string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("garbage.gltf"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(workDir() / "never.png"));
+}
+
+TEST(IrviewCli, BadOptionsAreUsageErrors) {
+  const std::string scene = sampleFile("furnace").string();
+  for (const std::string& opts : {std::string("--view shiny --screenshot a.png"), std::string("--screenshot a.jpg"),
+                                  std::string("--camera 7 --screenshot a.png"), std::string("--width 0 --screenshot a.png"),
+                                  std::string("--eye 1,2 --target 0,0,0 --screenshot a.png")}) {
+    RunResult r = run(scene + " " + opts);
+    EXPECT_NE(r.status, 0) << opts;
+    EXPECT_NE(r.output.find("error"), std::string::npos) << opts << ": " << r.output;
+  }
+}
+
+// Without light maps the viewer shows albedo (+ emission) and says so: furnace ρ = 0.5, Le = 1 → 1.5.
+TEST(IrviewCli, UnbakedSceneShowsAlbedoWithAWarning) {
+  fs::path out = workDir() / "furnace_unbaked.exr";
+  fs::remove(out);
+  RunResult r = run(sampleFile("furnace").string() + " --eye 0.1,0.2,0.3 --target 1,0.2,0.3 --fov 90 --width 64 --height 48 --screenshot " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("albedo only"), std::string::npos) << r.output;
+  int w = 0, h = 0;
+  auto px = readImage(out, w, h);
+  ASSERT_EQ(w, 64);
+  ASSERT_EQ(h, 48);
+  for (float v : px) ASSERT_NEAR(v, 1.5f, 0.01f);
+}
+
+TEST(IrviewCli, WalkthroughWritesNumberedFrames) {
+  fs::path out = workDir() / "walk.png";
+  RunResult r = run(sampleFile("cornell_box").string() + " --walkthrough 3 --width 48 --height 32 --screenshot " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(fs::exists(workDir() / ("walk_000" + std::to_string(i) + ".png"))) << i;
+  EXPECT_FALSE(fs::exists(workDir() / "walk_0003.png"));
+}
+
+TEST(IrviewCli, WindowUnderXvfbRendersTenFramesAndWritesAScreenshot) {
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run not installed (package xvfb)";
+  fs::path out = workDir() / "window.png";
+  fs::remove(out);
+  RunResult r = run(sampleFile("cornell_box").string() + " --window --frames 10 --width 160 --height 120 --screenshot " +
+                        out.string(),
+                    "xvfb-run -a ");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("after 10 frames"), std::string::npos) << r.output;
+  int w = 0, h = 0;
+  auto px = readImage(out, w, h);
+  ASSERT_EQ(w, 160);
+  ASSERT_EQ(h, 120);
+  double sum = 0;
+  for (float v : px) sum += v;
+  EXPECT_GT(sum / px.size(), 0.05) << "screenshot is black";
+}
+
+}  // namespace
