@@ -2,7 +2,7 @@
 // the shadow-map resolution: value = I(ω) cosθx / r² / π (point, spot) or E cosθx / π (directional).
 layout(binding = 0) uniform sampler2DArray gPositionWeight;
 layout(binding = 1) uniform sampler2DArray gNormal;
-layout(binding = 2) uniform samplerCubeArray cubeDepth;  // point (and wide spot): layer 0
+layout(binding = 2) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
 layout(binding = 3) uniform sampler2D mapDepth;          // spot (perspective) / directional (ortho)
 
 uniform int layers;
@@ -28,18 +28,17 @@ float lit(vec3 p, vec3 n, float cosTheta, float r) {
   float bias = shadowBias(constantBias, slopeBias, footprint, cosTheta);
   if (shadowKind == 0) {
     vec3 local = q - lightPosition;
-    float depth = texture(cubeDepth, vec4(local, 0.0)).r;
-    float occluder = depth > 0.0 ? nearPlane / depth : 1e30;
-    return cubeAxisDistance(local) > occluder + bias ? 0.0 : 1.0;
+    float axisDistance;
+    float depth = cubeDepth(cubeMaps, 0, local, axisDistance);
+    return cubeLit(depth, axisDistance, nearPlane, bias) ? 1.0 : 0.0;
   }
   vec4 c = shadowClip * vec4(q, 1.0);
   if (c.w <= 0.0) return 0.0;
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadowKind == 2 ? 1.0 : 0.0;
-  float depth = texture(mapDepth, uv).r;
+  float depth = textureLod(mapDepth, uv, 0.0).r;
   if (shadowKind == 1) {
-    float occluder = depth > 0.0 ? nearPlane / depth : 1e30;
-    return c.w > occluder + bias ? 0.0 : 1.0;
+    return cubeLit(depth, c.w, nearPlane, bias) ? 1.0 : 0.0;
   }
   return c.z * orthoDepthRange > depth * orthoDepthRange + bias ? 0.0 : 1.0;
 }

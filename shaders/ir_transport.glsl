@@ -14,8 +14,27 @@ float vplGeometryTerm(vec3 d, vec3 nx, vec3 ny, float clampBound) {
   return clampBound > 0.0 ? min(g, clampBound) : g;
 }
 
-// Distance along the cube face axis of a direction (the depth a cube face stores).
-float cubeAxisDistance(vec3 local) { return max(max(abs(local.x), abs(local.y)), abs(local.z)); }
+// Depth cubes are stored as 6 layers of a 2D array per cube (GL face order +X −X +Y −Y +Z −Z) and
+// looked up by hand with the GL cube-map face table (OpenGL 4.5 table 8.19): on llvmpipe a texelFetch
+// is cheaper than a cube-array sample. Returns the stored reversed-Z depth (near / occluder axis
+// distance; 0 where nothing was drawn) and the lookup point's own axis distance in axisDistance.
+float cubeDepth(sampler2DArray cubes, int cube, vec3 v, out float axisDistance) {
+  vec3 a = abs(v);
+  bool xMajor = a.x >= a.y && a.x >= a.z;
+  bool yMajor = !xMajor && a.y >= a.z;
+  axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
+  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
+  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
+                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  int size = textureSize(cubes, 0).x;
+  ivec2 texel = clamp(ivec2((sctc / axisDistance * 0.5 + 0.5) * float(size)), ivec2(0), ivec2(size - 1));
+  return texelFetch(cubes, ivec3(texel, 6 * cube + face), 0).r;
+}
+
+// Lit test against reversed-Z depth without a division: axis ≤ near/depth + bias.
+bool cubeLit(float depth, float axisDistance, float nearPlane, float bias) {
+  return axisDistance * depth <= nearPlane + bias * depth;
+}
 
 // Depth bias for a shadow lookup: a constant (scene scale) plus the depth change across one shadow
 // texel of footprint `footprint` on a surface tilted by θ (tanθ = sinθ / cosθ, capped).

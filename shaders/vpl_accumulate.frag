@@ -1,9 +1,9 @@
 // Accumulation: every texel sample of a page against a batch of VPLs, each with its depth cube
-// (cube-map array layer k, cube in the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance).
+// (layers 6k..6k+5 of a 2D array: a cube in the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance).
 // Output: the batch's contribution to irradiance/π, summed by additive blending.
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
-layout(binding = 2) uniform samplerCubeArray vplDepth;
+layout(binding = 2) uniform sampler2DArray vplDepth;     // 6 layers per VPL cube
 
 struct VplGpu {
   vec4 origin;     // xyz: shadow origin (VPL offset along its normal)
@@ -28,26 +28,29 @@ layout(location = 0) out vec4 result;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
+  float noClamp = clampBound > 0.0 ? clampBound : 3.0e38;
   for (int l = 0; l < layers; ++l) {
     vec4 pw = texelFetch(gPositionWeight, ivec3(p, l), 0);
     if (pw.w <= 0.0) continue;
     vec3 nx = texelFetch(gNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
     for (int k = 0; k < vplCount; ++k) {
-      vec3 o = vpls[k].origin.xyz;
       vec3 ny = vpls[k].normal.xyz;
-      vec3 d = o - pw.xyz;
-      float g = vplGeometryTerm(d, nx, ny, clampBound);
-      if (g <= 0.0) continue;
-      float r = length(d);
+      vec3 d = vpls[k].origin.xyz - pw.xyz;  // receiver → VPL
+      float cx = dot(nx, d), cy = -dot(ny, d);
+      if (cx <= 0.0 || cy <= 0.0) continue;
+      float r2 = dot(d, d);
+      float g = min(cx * cy / (r2 * r2), noClamp);  // vplGeometryTerm, inlined
+      float r = sqrt(r2);
       float footprint = r * texelAngle;
-      vec3 q = pw.xyz + nx * (normalOffset * footprint) - o;
+      // Lookup point: pushed along the receiver normal, relative to the shadow origin (VPL + offset·ny).
+      vec3 q = nx * (normalOffset * footprint) - d - ny * vpls[k].origin.w;
       vec3 local = vec3(dot(q, vpls[k].tangent.xyz), dot(q, vpls[k].bitangent.xyz), dot(q, ny));
-      float depth = texture(vplDepth, vec4(local, float(k))).r;
-      float occluder = depth > 0.0 ? nearPlane / depth : 1e30;
-      float bias = shadowBias(constantBias, slopeBias, footprint, dot(nx, d) / r);
-      if (cubeAxisDistance(local) > occluder + bias) continue;
-      s += vpls[k].power.rgb * g;
+      float axisDistance;
+      float depth = cubeDepth(vplDepth, k, local, axisDistance);
+      float tanTheta = min(sqrt(max(r2 - cx * cx, 0.0)) / cx, 20.0);
+      float bias = constantBias + slopeBias * footprint * tanTheta;
+      if (cubeLit(depth, axisDistance, nearPlane, bias)) s += vpls[k].power.rgb * g;
     }
     sum += pw.w * s;
   }

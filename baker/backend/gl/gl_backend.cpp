@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 
+#include <time.h>
+
 #include "backend/gl/shadow_views.h"
 #include "common/error.h"
 #include "common/log.h"
@@ -19,6 +21,23 @@ namespace irbake {
 namespace {
 
 constexpr int kFaces = 6;
+
+// Process CPU time (every thread, so llvmpipe's rasteriser threads count): comparable across machine load.
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// Wall and CPU stopwatch for one stage.
+struct StageClock {
+  Stopwatch wall;
+  double cpuStart = processCpuSeconds();
+  void reset() {
+    wall.reset();
+    cpuStart = processCpuSeconds();
+  }
+};
 
 // std140 layout of one VPL in the VplBatch uniform block (shaders/vpl_accumulate.frag).
 struct VplGpu {
@@ -41,16 +60,43 @@ struct GpuGeometry {
   }
 };
 
+// 30-bit Morton code of a point in the unit cube: spatially close triangles get close codes.
+uint32_t morton3(glm::vec3 u) {
+  auto spread = [](uint32_t v) {
+    v = (v | (v << 16)) & 0x030000FFu;
+    v = (v | (v << 8)) & 0x0300F00Fu;
+    v = (v | (v << 4)) & 0x030C30C3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+  };
+  const glm::uvec3 q = glm::uvec3(glm::clamp(u, glm::vec3(0.0f), glm::vec3(1.0f)) * 1023.0f);
+  return (spread(q.x) << 2) | (spread(q.y) << 1) | spread(q.z);
+}
+
 void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g) {
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;
   for (const Primitive& prim : scene.primitives) {
     const uint32_t base = static_cast<uint32_t>(positions.size());
     positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
-    const size_t first = indices.size();
     for (uint32_t i : prim.indices) indices.push_back(base + i);
-    appendClusters(positions, indices, first, prim.triangleCount(), clusterTriangles, g.clusters);
   }
+  // Triangles in Morton order of their centroids, so each culling cluster is spatially compact
+  // (consecutive triangles of a long strip would give clusters spanning a whole wall).
+  const size_t triangleCount = indices.size() / 3;
+  const Bounds3 b = scene.bounds();
+  const glm::vec3 inv = 1.0f / glm::max(b.extent(), glm::vec3(1e-12f));
+  std::vector<std::pair<uint32_t, uint32_t>> order(triangleCount);
+  for (size_t t = 0; t < triangleCount; ++t) {
+    const glm::vec3 c = (positions[indices[3 * t]] + positions[indices[3 * t + 1]] + positions[indices[3 * t + 2]]) / 3.0f;
+    order[t] = {morton3((c - b.min) * inv), static_cast<uint32_t>(t)};
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<uint32_t> sorted(indices.size());
+  for (size_t t = 0; t < triangleCount; ++t)
+    for (int k = 0; k < 3; ++k) sorted[3 * t + k] = indices[3 * order[t].second + k];
+  indices.swap(sorted);
+  appendClusters(positions, indices, 0, triangleCount, clusterTriangles, g.clusters);
   g.triangles = indices.size() / 3;
   glCreateVertexArrays(1, &g.vao);
   glCreateBuffers(1, &g.vbo);
@@ -66,7 +112,7 @@ void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g) {
   glVertexArrayAttribBinding(g.vao, 0, 0);
 }
 
-// Depth-only render target array: `layers` layers of size×size (cube-map array or 2D), one FBO per layer.
+// Depth-only render targets: `layers` layers of size×size (a 2D array: 6 per cube) or one 2D map; one FBO per layer.
 struct DepthTargets {
   GLuint texture = 0;
   GLenum target = 0;
@@ -161,7 +207,7 @@ class GlBaker {
   void accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes);
   void bakeDirect(const Light& light);
   void bindGBuffer(const GpuPage& page) const;
-  void finishStage(double& seconds, Stopwatch& sw) const;
+  void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
 
   const BakeInputs& in_;
   const GlBackendOptions& opt_;
@@ -175,9 +221,10 @@ class GlBaker {
   std::vector<const void*> drawOffsets_;
 };
 
-void GlBaker::finishStage(double& seconds, Stopwatch& sw) const {
+void GlBaker::finishStage(double& seconds, StageClock& sw, double* cpuSeconds) const {
   if (opt_.stageTimings) glFinish();
-  seconds += sw.seconds();
+  seconds += sw.wall.seconds();
+  if (cpuSeconds) *cpuSeconds += processCpuSeconds() - sw.cpuStart;
   sw.reset();
 }
 
@@ -243,7 +290,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets&
 
 void GlBaker::bakeDirect(const Light& light) {
   const Bounds3 bounds = in_.scene.bounds();
-  Stopwatch sw;
+  StageClock sw;
   // Shadow map: full cube for points and wide spots, perspective map for spots, ortho box for directional.
   const bool cube = light.type == LightType::Point ||
                     (light.type == LightType::Spot && light.outerConeAngle > opt_.maxSpotPerspectiveAngle);
@@ -256,7 +303,7 @@ void GlBaker::bakeDirect(const Light& light) {
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_SCISSOR_TEST);
   if (cube) {
-    maps = std::make_unique<DepthTargets>(GL_TEXTURE_CUBE_MAP_ARRAY, opt_.pointFaceSize, kFaces);
+    maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.pointFaceSize, kFaces);
     const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
     for (int face = 0; face < kFaces; ++face)
       drawView(*cubeFaceView(light.position, identity, face, maps->size, scale_.nearPlane, false), maps->fbos[face],
@@ -278,7 +325,7 @@ void GlBaker::bakeDirect(const Light& light) {
     texelAngle = texelSize;
     shadowKind = 2;
   }
-  finishStage(stats_.shadowSeconds, sw);
+  finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
 
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_SCISSOR_TEST);
@@ -307,11 +354,11 @@ void GlBaker::bakeDirect(const Light& light) {
     glUniform1i(p.uniform("layers"), page->samples->supersample * page->samples->supersample);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
-  finishStage(stats_.accumulateSeconds, sw);
+  finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
 }
 
 std::vector<Lightmap> GlBaker::run() {
-  Stopwatch sw;
+  StageClock sw;
   const float diagonal = std::max(in_.scene.bounds().diagonal(), 1e-6f);
   scale_.nearPlane = opt_.nearPlaneScale * diagonal;
   scale_.constantBias = opt_.constantBiasScale * diagonal;
@@ -358,7 +405,7 @@ std::vector<Lightmap> GlBaker::run() {
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
   const size_t totalWork = vplCount + lightCount * K;
   if (vplCount > 0) {
-    DepthTargets cubes(GL_TEXTURE_CUBE_MAP_ARRAY, opt_.cubeFaceSize, K * kFaces);
+    DepthTargets cubes(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
     int passesSinceFold = 0;
     for (size_t first = 0; first < vplCount; first += K) {
       const size_t count = std::min<size_t>(K, vplCount - first);
@@ -366,12 +413,12 @@ std::vector<Lightmap> GlBaker::run() {
       glEnable(GL_SCISSOR_TEST);
       glDisable(GL_BLEND);
       renderVplBatch(first, count, cubes);
-      finishStage(stats_.shadowSeconds, sw);
+      finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
       glDisable(GL_DEPTH_TEST);
       glDisable(GL_SCISSOR_TEST);
       glEnable(GL_BLEND);
       accumulateVplBatch(first, count, cubes);
-      finishStage(stats_.accumulateSeconds, sw);
+      finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
       ++stats_.passes;
       stats_.vpls += count;
       if (++passesSinceFold >= std::max(1, opt_.foldEveryPasses)) {

@@ -18,6 +18,8 @@ struct GlBakeStats {
   double shadowSeconds = 0.0;    // VPL depth cubes and punctual shadow maps
   double accumulateSeconds = 0.0;// accumulation passes (VPLs and direct lights)
   double foldSeconds = 0.0;      // read-backs into the double accumulators
+  double shadowCpuSeconds = 0.0;     // process CPU time (all llvmpipe threads) in the shadow stage
+  double accumulateCpuSeconds = 0.0; // process CPU time in the accumulation stage (load-independent figures)
   size_t vpls = 0;               // VPLs evaluated
   size_t passes = 0;             // accumulation passes per page
   size_t facesRendered = 0;      // shadow views drawn (cube faces, spot/directional maps)
@@ -26,7 +28,7 @@ struct GlBakeStats {
 };
 
 struct GlBackendOptions {
-  int vplsPerPass = 16;          // K: VPLs (cube-map array layers) evaluated per accumulation pass
+  int vplsPerPass = 16;          // K: VPLs (depth cubes, 6 array layers each) evaluated per accumulation pass
   int cubeFaceSize = 256;        // VPL depth-cube face size (texels)
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
   int lightMapSize = 2048;       // spot / directional shadow map size (texels)
