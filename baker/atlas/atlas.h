@@ -32,6 +32,9 @@ struct AtlasStats {
   double l2Stretch = 0.0;
   double texelsPerUnit = 0.0;      // the density used
   double secondsMesh = 0.0, secondsCharts = 0.0, secondsParam = 0.0, secondsPack = 0.0;
+  size_t nonManifoldFaces = 0;     // faces given their own vertex copies so the half-edge mesh accepts them
+  size_t chartsSplit = 0;          // charts that failed a check (flip, zero area, overlap, stretch) and were bisected
+  double secondsOutput = 0.0, secondsStats = 0.0;
   std::vector<std::string> warnings;
 };
 
@@ -40,6 +43,8 @@ struct AtlasResult {
   AtlasStats stats;
 };
 
+// UV winding: every non-degenerate triangle has a positive signed area (u1-u0)(v2-v0)-(v1-v0)(u2-u0)
+// in uv1, as its counter-clockwise 3D winding; charts are only rotated, never mirrored.
 // Unwraps every primitive of `scene` in place: vertices are split along chart seams (sourceVertex
 // records where each came from), uv1 is set in [0,1] over the primitive's page, and
 // primitive.lightmap names the page. A primitive whose charts land on several pages is split into

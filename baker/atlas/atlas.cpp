@@ -1,0 +1,253 @@
+#include "atlas/atlas.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+
+#include "atlas/atlas_mesh.h"
+#include "atlas/atlas_stats.h"
+#include "atlas/charts.h"
+#include "atlas/pack.h"
+#include "atlas/parameterize.h"
+#include "common/error.h"
+#include "common/log.h"
+
+namespace irbake {
+namespace {
+
+using atlas::AtlasMesh;
+using atlas::ChartUv;
+using atlas::kNone;
+
+struct PrimitiveCharts {
+  AtlasMesh mesh;
+  size_t firstChart = 0, chartCount = 0;  // range in the global chart list
+};
+
+// keepUv1: islands of the input TEXCOORD_1 (faces sharing a vertex index) keep their shape; they
+// are only rescaled to the density and repacked.
+std::vector<ChartUv> chartsFromUv1(const Primitive& prim, const AtlasMesh& mesh) {
+  std::vector<uint32_t> parent(prim.positions.size());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto root = [&](uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (size_t t = 0; t < prim.triangleCount(); ++t)
+    for (int k = 1; k < 3; ++k) parent[root(prim.indices[3 * t + k])] = root(prim.indices[3 * t]);
+  std::unordered_map<uint32_t, size_t> chartOfRoot;
+  std::vector<ChartUv> charts;
+  std::vector<std::unordered_map<uint32_t, uint32_t>> localOf;
+  for (uint32_t t = 0; t < prim.triangleCount(); ++t) {
+    if (mesh.degenerate[t]) continue;
+    auto [it, added] = chartOfRoot.try_emplace(root(prim.indices[3 * t]), charts.size());
+    if (added) {
+      charts.emplace_back();
+      localOf.emplace_back();
+    }
+    ChartUv& c = charts[it->second];
+    c.faces.push_back(t);
+    c.area3d += mesh.faceArea[t];
+    std::array<uint32_t, 3> corner{};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = prim.indices[3 * t + k];
+      auto [lit, ladded] = localOf[it->second].try_emplace(v, uint32_t(c.vertex.size()));
+      if (ladded) {
+        c.vertex.push_back(mesh.faceVertex[t][k]);
+        c.uv.push_back(glm::dvec2(prim.uv1[v]));
+      }
+      corner[size_t(k)] = lit->second;
+    }
+    c.corner.push_back(corner);
+  }
+  for (ChartUv& c : charts) {
+    double uvSum = 0.0;
+    for (size_t i = 0; i < c.faces.size(); ++i) uvSum += atlas::uvArea(c, i);
+    if (uvSum < 0.0) {  // islands authored mirrored keep their shape; flip them to the common winding
+      for (glm::dvec2& uv : c.uv) uv.y = -uv.y;
+      uvSum = -uvSum;
+    }
+    const double s = uvSum > 0.0 ? std::sqrt(c.area3d / uvSum) : 1.0;
+    for (glm::dvec2& uv : c.uv) uv *= s;
+  }
+  return charts;
+}
+
+}  // namespace
+
+AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
+  if (options.padding < 0) throw Error(ErrorCode::Usage, "", "atlas padding must be ≥ 0");
+  if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
+  AtlasResult result;
+  AtlasStats& stats = result.stats;
+  auto progress = [&](double f) {
+    if (options.progress) options.progress("atlas", f);
+  };
+  Stopwatch clock;
+  std::vector<PrimitiveCharts> prims(scene.primitives.size());
+  std::vector<ChartUv> charts;
+  atlas::ParamOptions paramOptions;
+  for (size_t p = 0; p < scene.primitives.size(); ++p) {
+    const Primitive& prim = scene.primitives[p];
+    clock.reset();
+    prims[p].mesh = atlas::buildAtlasMesh(prim);
+    const AtlasMesh& mesh = prims[p].mesh;
+    stats.degenerateFaces += mesh.degenerateFaces;
+    stats.nonManifoldFaces += mesh.nonManifoldFaces;
+    stats.secondsMesh += clock.seconds();
+    prims[p].firstChart = charts.size();
+    if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
+      clock.reset();
+      for (ChartUv& c : chartsFromUv1(prim, mesh)) charts.push_back(std::move(c));
+      stats.secondsParam += clock.seconds();
+    } else {
+      clock.reset();
+      std::vector<atlas::ChartFaces> work = atlas::segmentCharts(mesh);
+      stats.secondsCharts += clock.seconds();
+      clock.reset();
+      // Parameterise every chart; a chart that fails a check is bisected and both halves redone.
+      while (!work.empty()) {
+        std::vector<ChartUv> done(work.size());
+        std::vector<atlas::ChartCheck> checks(work.size());
+        tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
+          checks[i] = atlas::parameterizeChart(mesh, work[i].faces, paramOptions, done[i]);
+        });
+        std::vector<atlas::ChartFaces> again;
+        for (size_t i = 0; i < work.size(); ++i) {
+          if (checks[i] == atlas::ChartCheck::Valid) {
+            charts.push_back(std::move(done[i]));
+            continue;
+          }
+          auto halves = atlas::bisectChart(mesh, work[i]);
+          if (halves.size() < 2) {  // a single face always projects validly; keep it whatever the check said
+            charts.push_back(std::move(done[i]));
+            continue;
+          }
+          ++stats.chartsSplit;
+          for (auto& h : halves) again.push_back(std::move(h));
+        }
+        work = std::move(again);
+      }
+      stats.secondsParam += clock.seconds();
+    }
+    prims[p].chartCount = charts.size() - prims[p].firstChart;
+    progress(0.6 * double(p + 1) / double(scene.primitives.size()));
+  }
+  for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
+
+  // Density: given, or chosen so the charts' area fills about 60% of one target page.
+  double totalArea = 0.0;
+  for (const ChartUv& c : charts) totalArea += c.area3d;
+  double density = options.texelsPerUnit;
+  if (!(density > 0.0)) density = totalArea > 0.0 ? std::sqrt(0.6 * double(options.targetPageSize) * options.targetPageSize / totalArea) : 1.0;
+  if (!std::isfinite(density) || density <= 0.0) throw Error(ErrorCode::InvalidData, scene.sourcePath, "atlas: no surface area to unwrap");
+  stats.texelsPerUnit = density;
+
+  clock.reset();
+  atlas::PackOptions packOptions;
+  packOptions.texelsPerUnit = density;
+  packOptions.padding = options.padding;
+  packOptions.maxPageSize = options.maxPageSize;
+  atlas::PackResult packed = atlas::packCharts(charts, packOptions);
+  for (const std::string& w : packed.warnings) {
+    log::warn("atlas: " + w);
+    stats.warnings.push_back(w);
+  }
+  result.pages = packed.pages;
+  stats.secondsPack = clock.seconds();
+  progress(0.85);
+
+  // Output: a vertex per (chart, input vertex); a primitive per page its charts landed on.
+  clock.reset();
+  std::vector<Primitive> out;
+  out.reserve(scene.primitives.size());
+  for (size_t p = 0; p < scene.primitives.size(); ++p) {
+    const Primitive& src = scene.primitives[p];
+    const AtlasMesh& mesh = prims[p].mesh;
+    const size_t first = prims[p].firstChart, count = prims[p].chartCount;
+    std::vector<uint32_t> chartOfFace(src.triangleCount(), kNone), localFace(src.triangleCount(), kNone);
+    std::unordered_map<uint32_t, std::pair<uint32_t, uint32_t>> anchorOfVertex;  // welded vertex -> (chart, local)
+    for (size_t c = first; c < first + count; ++c)
+      for (size_t i = 0; i < charts[c].faces.size(); ++i) {
+        chartOfFace[charts[c].faces[i]] = uint32_t(c);
+        localFace[charts[c].faces[i]] = uint32_t(i);
+        for (int k = 0; k < 3; ++k) anchorOfVertex.try_emplace(mesh.faceVertex[charts[c].faces[i]][k], uint32_t(c), charts[c].corner[i][k]);
+      }
+    // A degenerate face sits on a point of a chart that holds one of its corners (zero UV area).
+    std::vector<std::pair<uint32_t, uint32_t>> degenerateAnchor(src.triangleCount(), {kNone, kNone});
+    for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+      if (chartOfFace[t] != kNone) continue;
+      for (int k = 0; k < 3 && degenerateAnchor[t].first == kNone; ++k) {
+        auto it = anchorOfVertex.find(mesh.faceVertex[t][k]);
+        if (it != anchorOfVertex.end()) degenerateAnchor[t] = it->second;
+      }
+      if (degenerateAnchor[t].first == kNone && count > 0) degenerateAnchor[t] = {uint32_t(first), 0};
+    }
+    std::vector<int> pagesUsed;
+    for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+      const uint32_t c = chartOfFace[t] != kNone ? chartOfFace[t] : degenerateAnchor[t].first;
+      if (c != kNone) pagesUsed.push_back(packed.chartPage[c]);
+    }
+    std::sort(pagesUsed.begin(), pagesUsed.end());
+    pagesUsed.erase(std::unique(pagesUsed.begin(), pagesUsed.end()), pagesUsed.end());
+    if (pagesUsed.empty()) {  // nothing to map (no faces at all)
+      out.push_back(src);
+      continue;
+    }
+    for (int page : pagesUsed) {
+      Primitive dst;
+      dst.name = pagesUsed.size() > 1 ? src.name + "#page" + std::to_string(page) : src.name;
+      dst.material = src.material;
+      dst.node = src.node;
+      dst.gltfMesh = src.gltfMesh;
+      dst.gltfPrimitive = src.gltfPrimitive;
+      dst.nodeToWorld = src.nodeToWorld;
+      const AtlasPage& pg = result.pages[size_t(page)];
+      dst.lightmap = {page, pg.width, pg.height};
+      const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);
+      std::unordered_map<uint64_t, uint32_t> vertexOf;
+      auto emit = [&](uint32_t inputVertex, glm::dvec2 texelUv) {
+        dst.positions.push_back(src.positions[inputVertex]);
+        if (src.normals.size() == src.positions.size()) dst.normals.push_back(src.normals[inputVertex]);
+        if (src.uv0.size() == src.positions.size()) dst.uv0.push_back(src.uv0[inputVertex]);
+        dst.uv1.push_back(glm::vec2(texelUv * toUnit));
+        dst.sourceVertex.push_back(src.sourceVertex.empty() ? inputVertex : src.sourceVertex[inputVertex]);
+        return uint32_t(dst.positions.size() - 1);
+      };
+      for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+        const bool mapped = chartOfFace[t] != kNone;
+        const uint32_t c = mapped ? chartOfFace[t] : degenerateAnchor[t].first;
+        if (c == kNone || packed.chartPage[c] != page) continue;
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t v = src.indices[3 * t + k];
+          if (!mapped) {
+            dst.indices.push_back(emit(v, charts[c].uv[degenerateAnchor[t].second]));
+            continue;
+          }
+          const uint64_t key = (uint64_t(c) << 32) | v;
+          auto [it, added] = vertexOf.try_emplace(key, 0u);
+          if (added) it->second = emit(v, charts[c].uv[charts[c].corner[localFace[t]][k]]);
+          dst.indices.push_back(it->second);
+        }
+      }
+      out.push_back(std::move(dst));
+    }
+  }
+  scene.primitives = std::move(out);
+  stats.secondsOutput = clock.seconds();
+  progress(0.95);
+
+  clock.reset();
+  const size_t chartsMade = charts.size();
+  atlas::measureAtlas(scene, result.pages, stats);
+  stats.charts = chartsMade;  // islands measured may differ only when a chart's faces touch by a vertex alone
+  stats.secondsStats = clock.seconds();
+  if (stats.degenerateFaces) stats.warnings.push_back(std::to_string(stats.degenerateFaces) + " degenerate faces mapped to a point");
+  if (stats.nonManifoldFaces) stats.warnings.push_back(std::to_string(stats.nonManifoldFaces) + " non-manifold faces split off");
+  progress(1.0);
+  return result;
+}
+
+}  // namespace irbake

@@ -1,0 +1,378 @@
+#include "atlas/pack.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+
+namespace irbake::atlas {
+namespace {
+
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// Convex hull (Andrew's monotone chain), counter-clockwise.
+std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> p) {
+  std::sort(p.begin(), p.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  if (p.size() < 3) return p;
+  std::vector<glm::dvec2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross2(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross2(h[k - 1] - h[k - 2], p[i - 1] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i - 1];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// Rotates the chart so its bounding box has the least area (an edge of the hull lies on the box).
+void rotateToMinimumBox(ChartUv& chart) {
+  const auto hull = convexHull(chart.uv);
+  if (hull.size() < 3) return;
+  double bestArea = 1e300, bestAngle = 0.0;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const glm::dvec2 e = hull[(i + 1) % hull.size()] - hull[i];
+    if (glm::length(e) <= 0.0) continue;
+    const glm::dvec2 d = glm::normalize(e), n(-d.y, d.x);
+    double lo0 = 1e300, hi0 = -1e300, lo1 = 1e300, hi1 = -1e300;
+    for (const glm::dvec2& p : hull) {
+      lo0 = std::min(lo0, glm::dot(p, d)); hi0 = std::max(hi0, glm::dot(p, d));
+      lo1 = std::min(lo1, glm::dot(p, n)); hi1 = std::max(hi1, glm::dot(p, n));
+    }
+    const double area = (hi0 - lo0) * (hi1 - lo1);
+    if (area < bestArea * (1.0 - 1e-9)) { bestArea = area; bestAngle = std::atan2(d.y, d.x); }
+  }
+  const double c = std::cos(-bestAngle), s = std::sin(-bestAngle);
+  for (glm::dvec2& p : chart.uv) p = {c * p.x - s * p.y, s * p.x + c * p.y};
+}
+
+// One orientation of a chart as texels: the conservative mask and the padded mask as row runs.
+struct Mask {
+  int w = 0, h = 0;
+  glm::dvec2 shift{0.0};  // added to the rotated uv so the chart sits in [0,w]×[0,h]
+  std::vector<uint8_t> bits;  // w*h
+  std::vector<std::vector<std::pair<int, int>>> paddedRuns;  // h+2p rows; columns relative to the chart origin
+  std::vector<int> longestRun;  // per padded row: its longest run (a row of the page needs a free gap this long)
+  int widestRow = 0;            // padded row with the longest run: tested first
+  size_t texels = 0;
+};
+
+glm::dvec2 rotate90(const glm::dvec2& p, int quarterTurns) {
+  switch (quarterTurns & 3) {
+    case 1: return {-p.y, p.x};
+    case 2: return {-p.x, -p.y};
+    case 3: return {p.y, -p.x};
+    default: return p;
+  }
+}
+
+Mask buildMask(const ChartUv& chart, int quarterTurns, int padding) {
+  Mask m;
+  glm::dvec2 lo(1e300), hi(-1e300);
+  for (const glm::dvec2& p : chart.uv) {
+    const glm::dvec2 r = rotate90(p, quarterTurns);
+    lo = glm::min(lo, r);
+    hi = glm::max(hi, r);
+  }
+  const glm::dvec2 size = hi - lo;
+  m.w = std::max(1, int(std::ceil(size.x - 1e-9)));
+  m.h = std::max(1, int(std::ceil(size.y - 1e-9)));
+  // Centre the chart in its whole-texel box so partial texels are shared evenly by both sides.
+  m.shift = -lo + (glm::dvec2(m.w, m.h) - size) * 0.5;
+  m.bits.assign(size_t(m.w) * m.h, 0);
+  for (const auto& c : chart.corner) {
+    const glm::dvec2 a = rotate90(chart.uv[c[0]], quarterTurns) + m.shift, b = rotate90(chart.uv[c[1]], quarterTurns) + m.shift,
+                     d = rotate90(chart.uv[c[2]], quarterTurns) + m.shift;
+    const int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, d.x})))), x1 = std::min(m.w - 1, int(std::ceil(std::max({a.x, b.x, d.x}))) - 1);
+    const int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, d.y})))), y1 = std::min(m.h - 1, int(std::ceil(std::max({a.y, b.y, d.y}))) - 1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        if (!m.bits[size_t(y) * m.w + x] && triangleOverlapsTexel(a, b, d, x, y)) m.bits[size_t(y) * m.w + x] = 1;
+  }
+  m.texels = size_t(std::count(m.bits.begin(), m.bits.end(), uint8_t(1)));
+  // Square dilation by the padding: horizontal then vertical, as runs per padded row.
+  const int pw = m.w + 2 * padding, ph = m.h + 2 * padding;
+  std::vector<uint8_t> horiz(size_t(pw) * m.h, 0), padded(size_t(pw) * ph, 0);
+  for (int y = 0; y < m.h; ++y)
+    for (int x = 0; x < m.w; ++x)
+      if (m.bits[size_t(y) * m.w + x])
+        for (int dx = 0; dx <= 2 * padding; ++dx) horiz[size_t(y) * pw + x + dx] = 1;
+  for (int y = 0; y < m.h; ++y)
+    for (int x = 0; x < pw; ++x)
+      if (horiz[size_t(y) * pw + x])
+        for (int dy = 0; dy <= 2 * padding; ++dy) padded[size_t(y + dy) * pw + x] = 1;
+  m.paddedRuns.resize(size_t(ph));
+  for (int y = 0; y < ph; ++y) {
+    for (int x = 0; x < pw;) {
+      if (!padded[size_t(y) * pw + x]) { ++x; continue; }
+      int e = x;
+      while (e + 1 < pw && padded[size_t(y) * pw + e + 1]) ++e;
+      m.paddedRuns[size_t(y)].push_back({x - padding, e - padding});
+      x = e + 1;
+    }
+  }
+  m.longestRun.assign(size_t(ph), 0);
+  for (int y = 0; y < ph; ++y) {
+    for (const auto& [a, b] : m.paddedRuns[size_t(y)]) m.longestRun[size_t(y)] = std::max(m.longestRun[size_t(y)], b - a + 1);
+    if (m.longestRun[size_t(y)] > m.longestRun[size_t(m.widestRow)]) m.widestRow = y;
+  }
+  return m;
+}
+
+// A page's occupancy (conservative chart texels, unpadded), one bit per texel.
+class PageGrid {
+ public:
+  PageGrid(int width, int maxHeight) : width_(width), maxHeight_(maxHeight), words_((width + 63) / 64) {}
+  int width() const { return width_; }
+  int maxHeight() const { return maxHeight_; }
+  int usedWidth() const { return usedW_; }
+  int usedHeight() const { return usedH_; }
+
+  // Highest set column in [lo, hi] of row y, or -1.
+  int lastSet(int y, int lo, int hi) const {
+    if (y < 0 || size_t(y) >= rowsUsed_ || lo > hi) return -1;
+    const uint64_t* row = &bits_[size_t(y) * words_];
+    int wHi = hi >> 6, wLo = lo >> 6;
+    for (int w = wHi; w >= wLo; --w) {
+      uint64_t word = row[w];
+      if (w == wHi && (hi & 63) != 63) word &= (uint64_t(1) << ((hi & 63) + 1)) - 1;
+      if (w == wLo) word &= ~uint64_t(0) << (lo & 63);
+      if (word) return w * 64 + 63 - std::countl_zero(word);
+    }
+    return -1;
+  }
+  // Smallest z ≥ from where columns [z, z+length-1] are all free (z may run past the width).
+  int nextFreeStretch(int y, int from, int length) const {
+    if (y < 0 || size_t(y) >= rowsUsed_) return from;
+    const uint64_t* row = &bits_[size_t(y) * words_];
+    int z = from;
+    for (;;) {
+      z = nextWithValue(row, z, false);  // first free column
+      if (z >= width_) return z;
+      const int s = nextWithValue(row, z, true);  // first occupied column after it
+      if (s - z >= length || s >= width_) return z;
+      z = s;
+    }
+  }
+  void set(int x, int y) {
+    if (size_t(y) >= rowsUsed_) {
+      rowsUsed_ = size_t(y) + 1;
+      bits_.resize(rowsUsed_ * words_, 0);
+      freeGap_.resize(rowsUsed_, width_);
+    }
+    bits_[size_t(y) * words_ + (x >> 6)] |= uint64_t(1) << (x & 63);
+  }
+
+  // Lowest-leftmost position whose padded mask overlaps nothing, with the chart's top at most maxTop.
+  bool firstFit(const Mask& m, int padding, int maxTop, int& outX, int& outY) const {
+    const int lastY = std::min(maxHeight_ - m.h, maxTop - m.h);
+    size_t hint = size_t(padding);
+    const int ph = int(m.paddedRuns.size());
+    size_t gapHint = size_t(m.widestRow);
+    for (int y = 0; y <= lastY; ++y) {
+      // Cheap rejection: each padded row needs a free gap as long as its longest run somewhere in its page row
+      // (runs that reach past the page edges are clipped, so only rows fully inside the page are tested).
+      bool possible = true;
+      for (int i = 0; i < ph && possible; ++i) {
+        const size_t j = i == 0 ? gapHint : (i == int(gapHint) ? 0 : size_t(i));
+        const int row = y - padding + int(j);
+        if (row < 0 || size_t(row) >= rowsUsed_) continue;
+        if (freeGap_[size_t(row)] < std::min(m.longestRun[j] - 2 * padding, width_)) {
+          possible = false;
+          gapHint = j;
+        }
+      }
+      if (!possible) continue;
+      int x = 0;
+      for (;;) {
+        if (x + m.w > width_) break;
+        bool clear = true;
+        for (size_t i = 0; i < m.paddedRuns.size() && clear; ++i) {
+          const size_t j = i == 0 ? hint : (i == hint ? 0 : i);
+          const int row = y - padding + int(j);
+          for (const auto& [a, b] : m.paddedRuns[j]) {
+            const int q = lastSet(row, std::max(0, x + a), std::min(width_ - 1, x + b));
+            if (q >= 0) {
+              // Every x whose run still reaches q fails; jump to where this run finds a long-enough gap.
+              x = nextFreeStretch(row, q + 1, b - a + 1) - a;
+              hint = j;
+              clear = false;
+              break;
+            }
+          }
+        }
+        if (clear) {
+          outX = x;
+          outY = y;
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+  void place(const Mask& m, int x0, int y0) {
+    for (int y = 0; y < m.h; ++y)
+      for (int x = 0; x < m.w; ++x)
+        if (m.bits[size_t(y) * m.w + x]) set(x0 + x, y0 + y);
+    for (int y = 0; y < m.h; ++y) freeGap_[size_t(y0 + y)] = longestFreeGap(y0 + y);
+    usedW_ = std::max(usedW_, x0 + m.w);
+    usedH_ = std::max(usedH_, y0 + m.h);
+  }
+
+ private:
+  // First column ≥ from whose bit equals value (width_ or more when none).
+  int nextWithValue(const uint64_t* row, int from, bool value) const {
+    for (int w = from >> 6; w < words_; ++w) {
+      uint64_t word = value ? row[w] : ~row[w];
+      if (w == (from >> 6)) word &= ~uint64_t(0) << (from & 63);
+      if (word) return std::min(width_ + 64, w * 64 + std::countr_zero(word));
+    }
+    return width_ + 64;
+  }
+  int longestFreeGap(int y) const {
+    const uint64_t* row = &bits_[size_t(y) * words_];
+    int best = 0;
+    for (int z = nextWithValue(row, 0, false); z < width_;) {
+      const int s = std::min(width_, nextWithValue(row, z, true));
+      best = std::max(best, s - z);
+      if (s >= width_) break;
+      z = nextWithValue(row, s, false);
+    }
+    return best;
+  }
+  std::vector<int> freeGap_;  // per used row: its longest run of free columns
+  int width_, maxHeight_, words_;
+  size_t rowsUsed_ = 0;
+  std::vector<uint64_t> bits_;
+  int usedW_ = 0, usedH_ = 0;
+};
+
+int roundUp4(int v) { return std::max(4, (v + 3) / 4 * 4); }
+
+struct Placement {
+  int page = -1, quarterTurns = 0, x = 0, y = 0;
+};
+
+// Packs masks (in order) into pages of the given width; returns the total page area.
+double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<size_t>& order, int width, int maxPage,
+               int padding, std::vector<Placement>& placement, std::vector<PageGrid>& pages) {
+  pages.clear();
+  placement.assign(masks.size(), Placement{});
+  for (size_t c : order) {
+    for (int p = 0;; ++p) {
+      if (p == int(pages.size())) pages.emplace_back(width, maxPage);
+      int bestTop = maxPage + 1, bestX = 0, bestY = 0, bestTurn = -1;
+      for (int t = 0; t < 4; ++t) {
+        const Mask& m = masks[c][size_t(t)];
+        int x, y;
+        if (m.w > width || m.h > maxPage) continue;
+        // Prune: only positions whose top is below the best found so far.
+        if (pages[size_t(p)].firstFit(m, padding, bestTop - 1, x, y) && (y + m.h < bestTop || (y + m.h == bestTop && x < bestX))) {
+          bestTop = y + m.h;
+          bestX = x;
+          bestY = y;
+          bestTurn = t;
+        }
+      }
+      if (bestTurn >= 0) {
+        pages[size_t(p)].place(masks[c][size_t(bestTurn)], bestX, bestY);
+        placement[c] = {p, bestTurn, bestX, bestY};
+        break;
+      }
+    }
+  }
+  double area = 0.0;
+  for (const PageGrid& g : pages) area += double(roundUp4(g.usedWidth())) * roundUp4(g.usedHeight());
+  return area;
+}
+
+}  // namespace
+
+bool triangleOverlapsTexel(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int x, int y) {
+  const double x0 = x, x1 = x + 1.0, y0 = y, y1 = y + 1.0;
+  if (std::max({a.x, b.x, c.x}) <= x0 || std::min({a.x, b.x, c.x}) >= x1) return false;
+  if (std::max({a.y, b.y, c.y}) <= y0 || std::min({a.y, b.y, c.y}) >= y1) return false;
+  double area = cross2(b - a, c - a);
+  if (area == 0.0) return true;  // a segment or point: its box test above is the conservative answer
+  if (area < 0.0) std::swap(b, c);
+  const glm::dvec2 v[3] = {a, b, c};
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec2 p = v[k], e = v[(k + 1) % 3] - v[k];
+    // Inside is left of the edge: cross(e, q - p) > 0. Take the box corner that maximises it.
+    const double qx = e.y < 0.0 ? x1 : x0, qy = e.x > 0.0 ? y1 : y0;
+    if (e.x * (qy - p.y) - e.y * (qx - p.x) <= 0.0) return false;
+  }
+  return true;
+}
+
+PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) {
+  PackResult result;
+  const int pad = std::max(0, options.padding);
+  const int limit = std::max(8, options.maxPageSize);
+  std::vector<std::array<Mask, 4>> masks(charts.size());
+  double paddedArea = 0.0;
+  int widest = 1;
+  for (size_t i = 0; i < charts.size(); ++i) {
+    ChartUv& chart = charts[i];
+    for (glm::dvec2& p : chart.uv) p *= options.texelsPerUnit;
+    rotateToMinimumBox(chart);
+    glm::dvec2 lo(1e300), hi(-1e300);
+    for (const glm::dvec2& p : chart.uv) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+    const double longest = std::max(hi.x - lo.x, hi.y - lo.y);
+    if (longest > limit - 2) {  // keep the chart whole: scale it to fit a page
+      const double s = (limit - 2) / longest;
+      for (glm::dvec2& p : chart.uv) p = lo + (p - lo) * s;
+      result.warnings.push_back("a chart of " + std::to_string(int(std::ceil(longest))) + " texels was scaled by " +
+                                std::to_string(s) + " to fit a " + std::to_string(limit) + "-texel page");
+    }
+    for (int t = 0; t < 4; ++t) masks[i][size_t(t)] = buildMask(chart, t, pad);
+    const Mask& m = masks[i][0];
+    paddedArea += double(m.w + pad) * double(m.h + pad);
+    widest = std::max(widest, std::min(m.w, m.h));
+  }
+  std::vector<size_t> order(charts.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return size_t(masks[a][0].w) * masks[a][0].h > size_t(masks[b][0].w) * masks[b][0].h;
+  });
+
+  // Width trials around the square that would hold every padded chart box.
+  std::vector<int> widths;
+  const double side = std::sqrt(paddedArea);
+  if (side >= limit) {
+    widths.push_back(limit);
+  } else {
+    for (int i = 0; i < std::max(1, options.widthTrials); ++i) {
+      const double f = 0.85 + 0.1 * i;
+      widths.push_back(std::clamp(roundUp4(int(std::ceil(side * f))), roundUp4(widest), limit));
+    }
+    std::sort(widths.begin(), widths.end());
+    widths.erase(std::unique(widths.begin(), widths.end()), widths.end());
+  }
+  double bestArea = 1e300;
+  std::vector<Placement> best, placement;
+  std::vector<PageGrid> grids, bestGrids;
+  for (int w : widths) {
+    const double area = packAll(masks, order, w, limit, pad, placement, grids);
+    if (area < bestArea) {
+      bestArea = area;
+      best = placement;
+      bestGrids = grids;
+    }
+  }
+  for (const PageGrid& g : bestGrids) result.pages.push_back({roundUp4(g.usedWidth()), roundUp4(g.usedHeight())});
+  result.chartPage.resize(charts.size());
+  for (size_t i = 0; i < charts.size(); ++i) {
+    const Placement& p = best[i];
+    const Mask& m = masks[i][size_t(p.quarterTurns)];
+    for (glm::dvec2& uv : charts[i].uv) uv = rotate90(uv, p.quarterTurns) + m.shift + glm::dvec2(p.x, p.y);
+    result.chartPage[i] = p.page;
+  }
+  return result;
+}
+
+}  // namespace irbake::atlas
