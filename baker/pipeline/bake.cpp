@@ -9,10 +9,7 @@
 #include "backend/embree/embree_backend.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/gl/gl_backend.h"
-#if __has_include("backend/reference/reference_integrator.h")
 #include "backend/reference/reference_integrator.h"
-#define IRBAKE_HAVE_REFERENCE 1
-#endif
 #include "common/error.h"
 #include "common/log.h"
 #include "common/progress.h"
@@ -43,14 +40,22 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
     case BackendKind::Embree:
       return bakeEmbree(inputs);
     case BackendKind::Reference: {
-#ifdef IRBAKE_HAVE_REFERENCE
       ReferenceOptions ref;
-      ref.samplesPerTexel = options.referenceSpp;
+      ref.spp = options.referenceSpp;
       ref.seed = options.walk.seed;
-      return bakeReference(inputs, ref);
-#else
-      throw Error(ErrorCode::Usage, "", "the reference backend is not built yet");
-#endif
+      std::vector<Lightmap> standardError;
+      std::vector<Lightmap> maps = bakeReference(inputs, ref, &standardError);
+      // The mean standard error over valid texels says how converged the yardstick is.
+      double se = 0.0, value = 0.0;
+      for (size_t p = 0; p < maps.size() && p < standardError.size(); ++p)
+        for (size_t i = 0; i < maps[p].size() && i < standardError[p].size(); ++i) {
+          if (i < maps[p].valid.size() && !maps[p].valid[i]) continue;
+          const glm::vec3 &e = standardError[p].texels[i], &v = maps[p].texels[i];
+          se += (e.x + e.y + e.z) / 3.0;
+          value += (v.x + v.y + v.z) / 3.0;
+        }
+      report["reference"] = {{"spp", ref.spp}, {"relativeStandardError", value > 0.0 ? se / value : 0.0}};
+      return maps;
     }
   }
   throw Error(ErrorCode::Usage, "", "unknown backend");

@@ -1,0 +1,52 @@
+// Writing a finished bake: EXR pages, glTF with the maps attached, the JSON report.
+#include <fstream>
+#include <string>
+
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "export/exr_io.h"
+#include "export/gltf_export.h"
+#include "pipeline/bake.h"
+
+namespace irbake {
+
+std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(options.outDir, ec);
+  if (!fs::is_directory(options.outDir))
+    throw Error(ErrorCode::Io, options.outDir.string(), "cannot create the output folder");
+  std::vector<fs::path> written;
+  std::vector<fs::path> exrs;
+  for (const Lightmap& m : result.maps) exrs.push_back(options.outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
+
+  if (options.writeGltf) {
+    // The export writes the glTF, its PNG maps and the EXR pages as one atomic set.
+    ExportOptions ex;
+    ex.output = options.outDir / "scene.gltf";
+    ex.writeExrPages = true;
+    ex.exrPrefix = "lightmap";
+    exportGltf(result.scene, result.maps, ex);
+    written.push_back(ex.output);
+  }
+  for (size_t i = 0; i < result.maps.size(); ++i) {
+    if (!options.writeGltf || !fs::exists(exrs[i])) writeExr(result.maps[i], exrs[i]);
+    written.push_back(exrs[i]);
+  }
+
+  fs::path reportPath = options.reportPath.empty() ? options.outDir / "report.json" : options.reportPath;
+  nlohmann::json report = result.report;
+  report["outputs"] = nlohmann::json::array();
+  for (const auto& p : written) report["outputs"].push_back(p.string());
+  std::string text = report.dump(2) + "\n";
+  writeAtomically(reportPath, [&](const fs::path& temp) {
+    std::ofstream out(temp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw Error(ErrorCode::Io, reportPath.string(), "cannot write the report");
+  });
+  written.push_back(reportPath);
+  return written;
+}
+
+}  // namespace irbake

@@ -1,0 +1,182 @@
+// `irbake bake` and `irbake diff` as a user runs them: files written, numbers in them, exit codes.
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "export/exr_io.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/gltf_loader.h"
+#include "texels/texel_samples.h"
+
+namespace fs = std::filesystem;
+using namespace irbake;
+
+namespace {
+fs::path scratch(const std::string& name) {
+  fs::path d = fs::current_path() / "test_scratch" / "bake_command" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// Runs irbake with the arguments (already quoted where needed); returns its exit code and output.
+int runIrbake(const std::string& args, std::string* output = nullptr) {
+  fs::path log = fs::current_path() / "test_scratch" / "bake_command" / "last_output.txt";
+  fs::create_directories(log.parent_path());
+  std::string cmd = std::string("\"") + IRBAKE_EXE + "\" " + args + " > \"" + log.string() + "\" 2>&1";
+  int status = std::system(cmd.c_str());
+  if (output) {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *output = ss.str();
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string q(const fs::path& p) { return "\"" + p.string() + "\""; }
+
+fs::path samplesDir() {
+  static fs::path dir = [] {
+    fs::path d = scratch("samples");
+    return runIrbake("samples " + q(d) + " --quiet") == 0 ? d : fs::path();
+  }();
+  return dir;
+}
+
+// One up-facing triangle and no light at all (base64 of three float3 positions).
+fs::path writeUnlitTriangle(const fs::path& dir) {
+  fs::path p = dir / "unlit_triangle.gltf";
+  std::ofstream(p) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,-1],"max":[1,0,0]}],
+"bufferViews":[{"buffer":0,"byteLength":36}],
+"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIC/"}]})";
+  return p;
+}
+
+void expectFinite(const Lightmap& m) {
+  for (const auto& t : m.texels) ASSERT_TRUE(std::isfinite(t.x) && std::isfinite(t.y) && std::isfinite(t.z));
+}
+}  // namespace
+
+TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path out = scratch("point_over_plane");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(out) +
+                       " --backend embree --texels-per-unit 4 --vpls 64 --seed 3",
+                   &log),
+            0)
+      << log;
+  ASSERT_TRUE(fs::exists(out / "lightmap_0.exr")) << log;
+  ASSERT_TRUE(fs::exists(out / "scene.gltf")) << log;
+  ASSERT_TRUE(fs::exists(out / "report.json")) << log;
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temp file left: " << e.path();
+
+  nlohmann::json report = nlohmann::json::parse(std::ifstream(out / "report.json"));
+  EXPECT_EQ(report["backend"], "embree");
+  for (const char* stage : {"load", "atlas", "texels", "vpls", "backend", "post", "bake"})
+    EXPECT_TRUE(report["seconds"].contains(stage)) << stage;
+  EXPECT_GT(report["memoryPeakMiB"].get<double>(), 1.0);
+  EXPECT_GT(report["texels"]["valid"].get<size_t>(), 1000u);
+
+  // The exported glTF's TEXCOORD_1 and the EXR agree with the closed form I·h/(π r³) at every
+  // valid texel (the plane faces nothing, so there is no bounce light).
+  Scene baked = loadScene(out / "scene.gltf", LoadOptions{false, true});
+  Lightmap map = readExr(out / "lightmap_0.exr");
+  expectFinite(map);
+  RayTracer rt(baked);
+  auto texels = buildTexelSamples(baked, rt, {});
+  ASSERT_GE(texels.size(), 1u);
+  ASSERT_EQ(texels[0].width, map.width);
+  size_t checked = 0;
+  double worst = 0.0;
+  for (size_t i = 0; i < texels[0].layerSize(); ++i) {
+    if (!texels[0].valid[i]) continue;
+    glm::vec3 p(texels[0].positionWeight[i]);
+    double r = glm::length(p - glm::vec3(0, 1, 0));
+    double exact = 10.0 * 1.0 / (M_PI * r * r * r);
+    worst = std::max(worst, std::abs(map.texels[i].x - exact) / exact);
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000u);
+  std::printf("point over plane via irbake bake: %zu texels, worst relative error %.2e\n", checked, worst);
+  EXPECT_LT(worst, 5e-3);
+}
+
+TEST(BakeCommand, SunFromTheCommandLineLightsAnUnlitScene) {
+  fs::path dir = scratch("sun");
+  fs::path scene = writeUnlitTriangle(dir);
+  std::string log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "out") + " --backend embree", &log), 7) << log;  // NoLight
+  EXPECT_NE(log.find("unlit_triangle.gltf"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir / "out" / "lightmap_0.exr"));
+  // Straight down, E = 3 W/m²: map = E/π on the whole triangle.
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "out") + " --backend embree --no-gltf --sun 0,-1,0,3 "
+                       "--texels-per-unit 32 --report " + q(dir / "r.json"), &log), 0) << log;
+  EXPECT_TRUE(fs::exists(dir / "r.json"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "scene.gltf"));
+  Lightmap m = readExr(dir / "out" / "lightmap_0.exr");
+  expectFinite(m);
+  // Every texel (valid or filled by dilation) holds E/π: one flat triangle under a sun.
+  for (const auto& t : m.texels) EXPECT_NEAR(t.y, 3.0 / M_PI, 1e-4);
+}
+
+TEST(BakeCommand, BadArgumentsGiveUsageAndIoExitCodes) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("badargs");
+  fs::path scene = samplesDir() / "point_over_plane.gltf";
+  std::string log;
+  EXPECT_EQ(runIrbake("bake", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene), &log), 2) << log;  // no -o
+  EXPECT_NE(log.find("-o"), std::string::npos) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --frobnicate", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --backend vulkan", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --vpls 0", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --bounces -3", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --sun 0,-1,0", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(dir / "missing.gltf") + " -o " + q(dir), &log), 3) << log;  // Io
+  EXPECT_NE(log.find("missing.gltf"), std::string::npos) << log;
+  std::ofstream(dir / "junk.gltf") << "this is not json";
+  EXPECT_EQ(runIrbake("bake " + q(dir / "junk.gltf") + " -o " + q(dir), &log), 4) << log;  // Parse
+  EXPECT_EQ(runIrbake("diff " + q(dir), &log), 2) << log;
+  EXPECT_EQ(runIrbake("diff " + q(dir / "a") + " " + q(dir / "b"), &log), 3) << log;
+  // No output was left behind by any failed run.
+  for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().extension(), ".gltf") << e.path();
+}
+
+TEST(BakeCommand, DiffScoresTwoBakesOfTheSameAtlas) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("diff");
+  fs::path scene = samplesDir() / "corner.gltf";
+  std::string log;
+  const std::string common = " --backend embree --texels-per-unit 6 --bounces 1 ";
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "a") + common + "--vpls 64 --seed 1", &log), 0) << log;
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "b") + common + "--vpls 512 --seed 2", &log), 0) << log;
+  ASSERT_EQ(runIrbake("diff " + q(dir / "a") + " " + q(dir / "a") + " --json", &log), 0) << log;
+  nlohmann::json same = nlohmann::json::parse(log);
+  EXPECT_EQ(same["relativeRmse"].get<double>(), 0.0);
+  EXPECT_EQ(same["maxError"].get<double>(), 0.0);
+  EXPECT_TRUE(same["areaWeighted"].get<bool>());
+  // The corner's floor and wall are 3 × 3 m each: the area weights add up to the 18 m² lightmapped.
+  EXPECT_NEAR(same["weightSum"].get<double>(), 18.0, 0.5);
+  ASSERT_EQ(runIrbake("diff " + q(dir / "a") + " " + q(dir / "b") + " --json", &log), 0) << log;
+  nlohmann::json d = nlohmann::json::parse(log);
+  std::printf("corner, 64 vs 512 paths: relative RMSE %.4f, bias %.4f%%\n", d["relativeRmse"].get<double>(),
+              100.0 * d["relativeBias"].get<double>());
+  EXPECT_GT(d["relativeRmse"].get<double>(), 0.0);
+  EXPECT_LT(d["relativeRmse"].get<double>(), 0.2);  // same atlas, same direct light: only VPL noise differs
+  ASSERT_EQ(runIrbake("diff " + q(dir / "a" / "lightmap_0.exr") + " " + q(dir / "b" / "lightmap_0.exr"), &log), 0) << log;
+  EXPECT_NE(log.find("relative RMSE"), std::string::npos) << log;
+}

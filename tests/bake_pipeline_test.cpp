@@ -1,0 +1,123 @@
+// End-to-end bakes through the pipeline in-process (Embree backend): the furnace's closed form and
+// the thin wall's darkness, with every stage (atlas, texels, walk, backend, post) in the loop.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/bake.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/gltf_loader.h"
+#include "texels/texel_samples.h"
+
+namespace fs = std::filesystem;
+using namespace irbake;
+
+namespace {
+// The sample scenes, written once by `irbake samples` into the build folder.
+fs::path samplesDir() {
+  static fs::path dir = [] {
+    fs::path d = fs::current_path() / "test_scratch" / "bake_pipeline_samples";
+    fs::create_directories(d);
+    std::string cmd = std::string("\"") + IRBAKE_EXE + "\" samples \"" + d.string() + "\" --quiet";
+    if (std::system(cmd.c_str()) != 0) return fs::path();
+    return d;
+  }();
+  return dir;
+}
+
+Scene loadSample(const std::string& name) {
+  fs::path dir = samplesDir();
+  if (dir.empty()) throw std::runtime_error("irbake samples failed");
+  return loadScene(dir / (name + ".gltf"));
+}
+
+BakeOptions smallEmbreeBake(float texelsPerUnit, int paths) {
+  BakeOptions o;
+  o.backend = BackendKind::Embree;
+  o.atlas.texelsPerUnit = texelsPerUnit;
+  o.walk.paths = paths;
+  o.walk.seed = 7;
+  return o;
+}
+
+// Area-weighted mean over the valid texels of one class (selected by position and normal).
+struct TexelClassMean {
+  double sum = 0.0, weight = 0.0;
+  size_t count = 0;
+  double mean() const { return weight > 0 ? sum / weight : 0.0; }
+};
+}  // namespace
+
+TEST(BakePipeline, FurnaceMatchesTheClosedFormWithBiasCompensation) {
+  // Closed cube, ρ = 0.5, Le = 1 on every wall: every texel sees L = Le/(1−ρ) = 2 (all bounces).
+  BakeOptions o = smallEmbreeBake(8.0f, 1024);
+  o.eval.biasCompensation = true;
+  BakeResult r = bake(loadSample("furnace"), o);
+  ASSERT_FALSE(r.maps.empty());
+  double sum = 0.0, maxDev = 0.0;
+  size_t n = 0;
+  for (const auto& m : r.maps)
+    for (size_t i = 0; i < m.size(); ++i) {
+      if (!m.valid[i]) continue;
+      double v = (m.texels[i].x + m.texels[i].y + m.texels[i].z) / 3.0;
+      ASSERT_TRUE(std::isfinite(v));
+      sum += v;
+      maxDev = std::max(maxDev, std::abs(v - 2.0) / 2.0);
+      ++n;
+    }
+  ASSERT_GT(n, 1000u);
+  double mean = sum / n;
+  RecordProperty("furnace_mean", std::to_string(mean));
+  RecordProperty("furnace_max_relative_deviation", std::to_string(maxDev));
+  std::printf("furnace rho 0.5: mean %.5f (exact 2), %zu texels, max relative deviation %.4f\n", mean, n, maxDev);
+  EXPECT_NEAR(mean, 2.0, 0.02);
+  // The report accounts for the walk: VPL power = emitted × Σ ρ̄^j, so with ρ̄ = 0.5 below 2× emitted.
+  const auto& vp = r.report["vpls"];
+  EXPECT_GT(vp["count"].get<size_t>(), 1024u);
+  double emitted = vp["emittedPower"][0].get<double>(), total = vp["totalPower"][0].get<double>();
+  EXPECT_GT(total, emitted);
+  EXPECT_LT(total, 2.0 * emitted * 1.0001);
+  EXPECT_EQ(r.report["backend"], "embree");
+  EXPECT_TRUE(r.report["eval"]["biasCompensation"].get<bool>());
+}
+
+TEST(BakePipeline, ThinWallDarkSideStaysDark) {
+  // A zero-thickness partition at x = 0 between a lit room (light at x = −1) and a dark one.
+  BakeResult r = bake(loadSample("thin_wall"), smallEmbreeBake(10.0f, 512));
+  // Texel positions from the baked atlas (no leak control: every covered texel gets its centre).
+  RayTracer rt(r.scene);
+  TexelSampleOptions to;
+  to.leakControl = false;
+  auto texels = buildTexelSamples(r.scene, rt, to);
+  ASSERT_EQ(texels.size(), r.maps.size());
+  TexelClassMean lit, dark;
+  for (size_t p = 0; p < texels.size(); ++p)
+    for (size_t i = 0; i < texels[p].layerSize(); ++i) {
+      const glm::vec4& pw = texels[p].positionWeight[i];
+      if (pw.w <= 0.0f || !r.maps[p].valid[i]) continue;
+      // Side of the partition: the partition's own texels go by their normal.
+      float side = pw.x + 0.01f * texels[p].normal[i].x;
+      double v = (r.maps[p].texels[i].x + r.maps[p].texels[i].y + r.maps[p].texels[i].z) / 3.0;
+      TexelClassMean& c = side > 0.0f ? dark : lit;
+      c.sum += v;
+      c.weight += 1.0;
+      ++c.count;
+    }
+  ASSERT_GT(lit.count, 100u);
+  ASSERT_GT(dark.count, 100u);
+  std::printf("thin wall: lit mean %.5g, dark mean %.5g, ratio %.3g\n", lit.mean(), dark.mean(), dark.mean() / lit.mean());
+  EXPECT_GT(lit.mean(), 0.01);
+  EXPECT_LT(dark.mean(), 1e-3 * lit.mean());
+  // And no dark texel anywhere near the lit level (a leak would show as a bright line).
+  for (size_t p = 0; p < texels.size(); ++p)
+    for (size_t i = 0; i < texels[p].layerSize(); ++i) {
+      const glm::vec4& pw = texels[p].positionWeight[i];
+      if (pw.w <= 0.0f || pw.x + 0.01f * texels[p].normal[i].x <= 0.0f) continue;
+      EXPECT_LT(r.maps[p].texels[i].x, 1e-2 * lit.mean()) << "page " << p << " texel " << i;
+    }
+}
