@@ -110,6 +110,8 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
     smooth.swap(next);
   }
 
+  const double maxArea = options.maxAreaFraction * totalArea;
+
   // Phase 2: curved charts grown one at a time from a front of rejected faces, nearest faces first,
   // while every face stays inside the cone around the chart's mean normal.
   std::deque<uint32_t> seeds;
@@ -135,6 +137,10 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
       const uint32_t f = heap.top().second;
       heap.pop();
       if (chartOf[f] != kFree) continue;
+      if (w.area >= maxArea) {
+        rejected.push_back(f);
+        continue;
+      }
       const glm::dvec3 mean = w.area > 0.0 ? glm::normalize(w.normalSum) : smooth[f];
       if (glm::dot(smooth[f], mean) < coneCos) {
         rejected.push_back(f);
@@ -181,6 +187,7 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
       for (auto& [other, length] : shared) byLength.push_back({-length, other});
       std::sort(byLength.begin(), byLength.end());
       for (auto& [negLength, other] : byLength) {
+        if (charts[c].area + charts[other].area > maxArea) continue;
         const glm::dvec3 mean = glm::normalize(charts[c].normalSum + charts[other].normalSum);
         bool inside = true;
         for (const Work* w : {&charts[c], &charts[other]})

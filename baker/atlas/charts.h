@@ -14,6 +14,7 @@ struct ChartOptions {
   double creaseDegrees = 75.0;      // growth never crosses an edge whose dihedral exceeds this
   double mergeAreaFraction = 0.5;   // curved charts below this × the median curved chart area are merged
   double mergeConeDegrees = 75.0;
+  double maxAreaFraction = 1.0;    // a curved chart stops growing at this × mesh area (big charts rarely pass the checks)
   int normalSmoothing = 3;          // rounds of neighbour averaging of face normals for the curved cone tests   // ... into a neighbour if the union stays within this cone
 };
 

@@ -1,6 +1,7 @@
 #include "atlas/pack.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -168,12 +169,12 @@ class PageGrid {
   }
 
   // Lowest-leftmost position whose padded mask overlaps nothing, with the chart's top at most maxTop.
-  bool firstFit(const Mask& m, int padding, int maxTop, int& outX, int& outY) const {
+  bool firstFit(const Mask& m, int padding, int minY, int maxTop, int& outX, int& outY) const {
     const int lastY = std::min(maxHeight_ - m.h, maxTop - m.h);
     size_t hint = size_t(padding);
     const int ph = int(m.paddedRuns.size());
     size_t gapHint = size_t(m.widestRow);
-    for (int y = 0; y <= lastY; ++y) {
+    for (int y = std::max(0, minY); y <= lastY; ++y) {
       // Cheap rejection: each padded row needs a free gap as long as its longest run somewhere in its page row
       // (runs that reach past the page edges are clipped, so only rows fully inside the page are tested).
       bool possible = true;
@@ -214,7 +215,17 @@ class PageGrid {
     }
     return false;
   }
+  // Where to start looking: a chart at least as large (both box sides) as an earlier one found no room
+  // below that one's row, so it starts there (a heuristic for concave shapes; it only costs packing density).
+  int searchStart(const Mask& m) const {
+    const int lo = std::min(m.w, m.h), hi = std::max(m.w, m.h);
+    int y = 0;
+    for (const auto& r : placedRows_)
+      if (lo >= r[0] && hi >= r[1]) y = std::max(y, r[2]);
+    return y;
+  }
   void place(const Mask& m, int x0, int y0) {
+    placedRows_.push_back({std::min(m.w, m.h), std::max(m.w, m.h), y0});
     for (int y = 0; y < m.h; ++y)
       for (int x = 0; x < m.w; ++x)
         if (m.bits[size_t(y) * m.w + x]) set(x0 + x, y0 + y);
@@ -244,6 +255,7 @@ class PageGrid {
     }
     return best;
   }
+  std::vector<std::array<int, 3>> placedRows_;  // (short side, long side, row) of every placed chart
   std::vector<int> freeGap_;  // per used row: its longest run of free columns
   int width_, maxHeight_, words_;
   size_t rowsUsed_ = 0;
@@ -266,12 +278,13 @@ double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<
     for (int p = 0;; ++p) {
       if (p == int(pages.size())) pages.emplace_back(width, maxPage);
       int bestTop = maxPage + 1, bestX = 0, bestY = 0, bestTurn = -1;
+      const int startY = pages[size_t(p)].searchStart(masks[c][0]);
       for (int t = 0; t < 4; ++t) {
         const Mask& m = masks[c][size_t(t)];
         int x, y;
         if (m.w > width || m.h > maxPage) continue;
         // Prune: only positions whose top is below the best found so far.
-        if (pages[size_t(p)].firstFit(m, padding, bestTop - 1, x, y) && (y + m.h < bestTop || (y + m.h == bestTop && x < bestX))) {
+        if (pages[size_t(p)].firstFit(m, padding, startY, bestTop - 1, x, y) && (y + m.h < bestTop || (y + m.h == bestTop && x < bestX))) {
           bestTop = y + m.h;
           bestX = x;
           bestY = y;

@@ -260,6 +260,8 @@ ChartCheck checkChart(const AtlasMesh& mesh, const std::vector<std::array<uint32
       if (!have5 && acc >= 0.05 * out.area3d) { p5 = ratio; have5 = true; }
       if (acc >= 0.95 * out.area3d) { p95 = ratio; break; }
     }
+    out.stretchP5 = p5;
+    out.stretchP95 = p95;
     if (p5 < options.stretchLow || p95 > options.stretchHigh) return ChartCheck::Stretched;
   }
   if (boundarySelfIntersects(out, boundary)) return ChartCheck::SelfIntersecting;
@@ -319,7 +321,8 @@ ChartCheck parameterizeChart(const AtlasMesh& mesh, const std::vector<uint32_t>&
   if (boundary.empty()) return ChartCheck::NoBoundary;
   if (!solveLscm(mesh, out, boundary)) return ChartCheck::SolveFailed;
   const ChartCheck conformal = checkChart(mesh, boundary, options, out);
-  if (options.arapIterations <= 0 || conformal == ChartCheck::SolveFailed) return conformal;
+  if (options.arapIterations <= 0 || conformal == ChartCheck::SolveFailed || conformal == ChartCheck::SelfIntersecting) return conformal;
+  if (conformal == ChartCheck::Stretched && out.stretchP95 > options.arapHopeless * out.stretchP5) return conformal;
   const std::vector<glm::dvec2> conformalUv = out.uv;
   if (refineArap(mesh, out, options.arapIterations)) {
     const ChartCheck rigid = checkChart(mesh, boundary, options, out);

@@ -16,7 +16,8 @@ struct ParamOptions {
   double stretchLow = 0.88;     // area-weighted p5 of (UV area / 3D area ÷ chart mean) must be ≥ this
   double stretchHigh = 1.12;    // ... and p95 ≤ this
   double minAreaRatio = 1e-3;   // a face whose relative UV area is below this counts as zero-area
-  int arapIterations = 10;      // as-rigid-as-possible rounds after LSCM (0: conformal only)
+  double arapHopeless = 10.0;   // skip ARAP when the conformal map's p95/p5 area ratio exceeds this (it will be split)
+  int arapIterations = 5;       // as-rigid-as-possible rounds after LSCM (0: conformal only)
 };
 
 enum class ChartCheck { Valid, NoBoundary, Flipped, ZeroArea, SelfIntersecting, Stretched, SolveFailed };
@@ -30,6 +31,7 @@ struct ChartUv {
   std::vector<glm::dvec2> uv;                     // per local vertex
   bool planar = false;
   double area3d = 0.0;
+  double stretchP5 = 1.0, stretchP95 = 1.0;  // area-weighted percentiles of the relative area (last check)
 };
 
 // Parameterises the faces (an edge-connected chart) and checks the result.
