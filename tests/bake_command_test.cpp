@@ -180,3 +180,21 @@ TEST(BakeCommand, DiffScoresTwoBakesOfTheSameAtlas) {
   ASSERT_EQ(runIrbake("diff " + q(dir / "a" / "lightmap_0.exr") + " " + q(dir / "b" / "lightmap_0.exr"), &log), 0) << log;
   EXPECT_NE(log.find("relative RMSE"), std::string::npos) << log;
 }
+
+TEST(BakeCommand, DefaultBackendIsGlAndAgreesWithEmbree) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("default_gl");
+  fs::path scene = samplesDir() / "point_over_plane.gltf";
+  std::string log;
+  const std::string common = " --texels-per-unit 4 --vpls 64 --seed 5";
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "gl") + common, &log), 0) << log;
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "embree") + " --backend embree" + common, &log), 0) << log;
+  nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "gl" / "report.json"));
+  EXPECT_EQ(report["backend"], "gl");
+  EXPECT_FALSE(report["renderer"].get<std::string>().empty());
+  ASSERT_EQ(runIrbake("diff " + q(dir / "gl") + " " + q(dir / "embree") + " --json", &log), 0) << log;
+  nlohmann::json d = nlohmann::json::parse(log);
+  std::printf("point over plane, GL vs Embree: relative RMSE %.3g, max error %.3g\n", d["relativeRmse"].get<double>(),
+              d["maxError"].get<double>());
+  EXPECT_LT(d["relativeRmse"].get<double>(), 1e-3);  // direct light only: both exact up to shadow-map bias
+}
