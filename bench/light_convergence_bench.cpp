@@ -3,9 +3,10 @@
 //     vpl_halton     Keller's quasi-random walk, N paths (= N VPLs on the emitter)
 //     vpl_random     the same number of VPLs at independent uniform random points (the −0.5 baseline)
 //     reference_spp  the path-traced reference, N paths per texel sample
-//   timing: case,vpls,texels,pairs,median_seconds,pairs_per_second   (Embree backend, median of --runs)
+//   timing: case,vpls,texels,pairs,median_seconds,pairs_per_second   (Embree backend, median of --runs;
+//           case room_floor_occluded1: one rtcOccluded1 per pair, room_floor_occluded8: packets of 8)
 // Plot: python3 bench/plot_convergence.py CSV docs/convergence.png
-//   light_convergence_bench [--csv PATH] [--timing-csv PATH] [--runs N]
+//   light_convergence_bench [--csv PATH] [--timing-csv PATH] [--runs N] [--timing-only 1]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -58,16 +59,19 @@ double relativeRmse(const Lightmap& m, const TexelSamples& t) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bool timingOnly = false;
   std::string csv = "bench/results/light_convergence.csv", timingCsv = "bench/results/light_timing.csv";
   int runs = 3;
   for (int i = 1; i + 1 < argc; i += 2) {
     std::string a = argv[i];
     if (a == "--csv") csv = argv[i + 1];
+    else if (a == "--timing-only") timingOnly = std::atoi(argv[i + 1]) != 0;
     else if (a == "--timing-csv") timingCsv = argv[i + 1];
     else if (a == "--runs") runs = std::max(1, std::atoi(argv[i + 1]));
     else { std::fprintf(stderr, "unknown option %s\n", argv[i]); return 2; }
   }
 
+  if (!timingOnly) {
   Scene s = quadOverPlane();
   RayTracer rt(s);
   std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0), 16, 16)};
@@ -107,6 +111,7 @@ int main(int argc, char** argv) {
   }
   std::filesystem::create_directories(std::filesystem::path(csv).parent_path().empty() ? "." : std::filesystem::path(csv).parent_path());
   writeAtomically(csv, [&](const std::filesystem::path& p) { std::ofstream(p) << out; });
+  }
 
   // Speed: a closed grey room (every pair of sample and VPL needs a shadow ray unless facing away).
   Scene room;
@@ -127,17 +132,22 @@ int main(int argc, char** argv) {
     for (size_t t = 0; t < floor[0].slotCount(); ++t)
       for (const Vpl& p : v.vpls)
         pairs += vplGeometryTerm(glm::vec3(floor[0].positionWeight[t]), glm::vec3(floor[0].normal[t]), p.position, p.normal) > 0.0f;
-    std::vector<double> times;
-    for (int r = 0; r < runs; ++r) {
-      auto t0 = std::chrono::steady_clock::now();
-      bakeEmbree(in);
-      times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    for (bool packets : {false, true}) {
+      EmbreeOptions eo;
+      eo.packets = packets;
+      std::vector<double> times;
+      for (int r = 0; r < runs; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        bakeEmbree(in, eo);
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      }
+      double m = median(times);
+      const char* name = packets ? "room_floor_occluded8" : "room_floor_occluded1";
+      tout += std::string(name) + "," + std::to_string(v.vpls.size()) + "," + std::to_string(floor[0].slotCount()) + "," +
+              std::to_string(pairs) + "," + std::to_string(m) + "," + std::to_string(pairs / m) + "\n";
+      std::printf("%s: %zu VPLs x %zu texels: median %.3f s, %.2f M pairs/s\n", name, v.vpls.size(),
+                  floor[0].slotCount(), m, pairs / m * 1e-6);
     }
-    double m = median(times);
-    tout += "room_floor," + std::to_string(v.vpls.size()) + "," + std::to_string(floor[0].slotCount()) + "," +
-            std::to_string(pairs) + "," + std::to_string(m) + "," + std::to_string(pairs / m) + "\n";
-    std::printf("room: %zu VPLs x %zu texels: median %.3f s, %.2f M pairs/s\n", v.vpls.size(), floor[0].slotCount(), m,
-                pairs / m * 1e-6);
   }
   writeAtomically(timingCsv, [&](const std::filesystem::path& p) { std::ofstream(p) << tout; });
   return 0;

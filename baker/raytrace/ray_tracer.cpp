@@ -44,6 +44,7 @@ struct RayTracer::Impl {
   std::vector<MaskGeometry> masks;  // one per primitive (stable addresses: sized before use)
   std::vector<glm::vec3> faceNormals;  // per primitive, per triangle: unit geometric normal
   std::vector<size_t> faceOffset;      // primitive -> first index in faceNormals
+  bool packets8 = false;               // native rtcOccluded8 support
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -113,6 +114,7 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()), scen
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(I.scene);
+  I.packets8 = rtcGetDeviceProperty(I.device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
   if (rtcGetDeviceError(I.device) != RTC_ERROR_NONE)
     throw Error(ErrorCode::InvalidData, scene.sourcePath, "Embree failed to build the scene");
 }
@@ -174,7 +176,8 @@ bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& dir, float tm
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on an occlusion
 }
 
-bool RayTracer::visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const {
+bool RayTracer::visibilityRay(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb,
+                              ShadowRay& ray) const {
   // Offset each end along its normal towards the other point's side, so rays leave the surface
   // they start on and stop short of the one they end on.
   glm::vec3 d0 = b - a;
@@ -182,8 +185,45 @@ bool RayTracer::visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3
   glm::vec3 pb = b + nb * (glm::dot(nb, d0) <= 0.0f ? epsilon_ : -epsilon_);
   glm::vec3 d = pb - pa;
   float dist = glm::length(d);
-  if (!(dist > epsilon_)) return true;
-  return !occluded(pa, d / dist, 0.0f, dist - epsilon_);
+  if (!(dist > epsilon_)) return false;
+  ray.origin = pa;
+  ray.dir = d / dist;
+  ray.tmax = dist - epsilon_;
+  return true;
+}
+
+bool RayTracer::visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const {
+  ShadowRay ray;
+  if (!visibilityRay(a, na, b, nb, ray)) return true;
+  return !occluded(ray.origin, ray.dir, 0.0f, ray.tmax);
+}
+
+void RayTracer::occludedPackets(const ShadowRay* rays, size_t n, uint8_t* occluded) const {
+  if (!impl_->packets8) {  // this Embree build has no 8-wide packets: single rays
+    for (size_t i = 0; i < n; ++i) occluded[i] = this->occluded(rays[i].origin, rays[i].dir, 0.0f, rays[i].tmax) ? 1 : 0;
+    return;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (size_t base = 0; base < n; base += 8) {
+    alignas(32) RTCRay8 packet;
+    alignas(32) int valid[8];
+    size_t count = std::min<size_t>(8, n - base);
+    for (size_t k = 0; k < 8; ++k) {
+      const ShadowRay& r = rays[base + std::min(k, count - 1)];
+      valid[k] = k < count ? -1 : 0;
+      packet.org_x[k] = r.origin.x; packet.org_y[k] = r.origin.y; packet.org_z[k] = r.origin.z;
+      packet.dir_x[k] = r.dir.x; packet.dir_y[k] = r.dir.y; packet.dir_z[k] = r.dir.z;
+      packet.tnear[k] = 0.0f;
+      packet.tfar[k] = r.tmax;
+      packet.time[k] = 0.0f;
+      packet.mask[k] = 0xFFFFFFFFu;
+      packet.id[k] = static_cast<unsigned>(k);
+      packet.flags[k] = 0;
+    }
+    rtcOccluded8(valid, impl_->scene, &ctx, &packet);
+    for (size_t k = 0; k < count; ++k) occluded[base + k] = packet.tfar[k] < 0.0f ? 1 : 0;
+  }
 }
 
 glm::vec3 RayTracer::insetPoint(uint32_t primitive, uint32_t triangle, const glm::vec3& p) const {

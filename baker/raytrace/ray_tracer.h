@@ -21,6 +21,13 @@ struct RayHit {
   bool backFace = false;            // the ray hit the back of the triangle
 };
 
+// A shadow-ray segment: origin, unit direction, and the distance to test up to.
+struct ShadowRay {
+  glm::vec3 origin{0.0f};
+  glm::vec3 dir{0.0f, 0.0f, 1.0f};
+  float tmax = 0.0f;
+};
+
 class RayTracer {
  public:
   explicit RayTracer(const Scene& scene);
@@ -32,6 +39,10 @@ class RayTracer {
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
   // Mutual visibility of two surface points, offset along their normals by epsilon().
   bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
+  // The shadow ray visible() traces; false when the points are closer than epsilon() (always visible).
+  bool visibilityRay(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb, ShadowRay& ray) const;
+  // Occlusion of n rays in packets of 8 (rtcOccluded8); occluded[i] = 1 when ray i is blocked.
+  void occludedPackets(const ShadowRay* rays, size_t n, uint8_t* occluded) const;
   // A surface point of triangle (primitive, triangle) moved epsilon() towards the triangle's centroid:
   // points on edges and corners (quasi-random samples hit vertices exactly) then lie strictly inside
   // their face, so a normal offset never lands on a neighbouring face's plane (no leaks at corners).

@@ -26,6 +26,37 @@ struct KahanSum {
   }
 };
 
+// Adds the VPLs [begin, end) seen from (x, n) into acc, tracing the shadow rays in packets of 8.
+void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
+                       size_t end, KahanSum& acc) {
+  const auto& vpls = in.vpls.vpls;
+  constexpr size_t kBatch = 64;
+  ShadowRay rays[kBatch];
+  glm::vec3 values[kBatch];
+  uint8_t blocked[kBatch];
+  size_t count = 0;
+  auto flush = [&]() {
+    in.rayTracer.occludedPackets(rays, count, blocked);
+    for (size_t i = 0; i < count; ++i)
+      if (!blocked[i]) acc.add(values[i]);
+    count = 0;
+  };
+  for (size_t k = begin; k < end; ++k) {
+    const Vpl& v = vpls[k];
+    float g = vplGeometryTerm(x, n, v.position, v.normal);
+    if (g <= 0.0f) continue;
+    glm::vec3 value = vplMapValue(v.power, clampGeometryTerm(g, bound));
+    if (value.x <= 0.0f && value.y <= 0.0f && value.z <= 0.0f) continue;
+    if (!in.rayTracer.visibilityRay(x, n, v.position, v.normal, rays[count])) {
+      acc.add(value);  // closer than ε: visible
+      continue;
+    }
+    values[count++] = value;
+    if (count == kBatch) flush();
+  }
+  if (count) flush();
+}
+
 // Adds the VPLs [begin, end) seen from (x, n) into acc.
 void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin, size_t end,
                 KahanSum& acc) {
@@ -139,7 +170,9 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
         size_t b1 = std::min(numVpls, b0 + block);
         for (size_t a = 0; a < active.size(); ++a) {
           size_t s = active[a];
-          gatherVpls(in, bound, glm::vec3(ts.positionWeight[s]), glm::vec3(ts.normal[s]), b0, b1, acc[a]);
+          glm::vec3 x(ts.positionWeight[s]), n(ts.normal[s]);
+          if (options.packets) gatherVplsPackets(in, bound, x, n, b0, b1, acc[a]);
+          else gatherVpls(in, bound, x, n, b0, b1, acc[a]);
         }
       }
       for (size_t a = 0; a < active.size(); ++a) {

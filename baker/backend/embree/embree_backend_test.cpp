@@ -297,3 +297,27 @@ TEST(EmbreeBackend, ZeroThicknessPartitionDoesNotLeak) {
   EXPECT_GT(lit, 0.1);
   EXPECT_LT(darkMax, 1e-3 * lit);
 }
+
+// Packets of 8 shadow rays (rtcOccluded8) must give what single rays give, occluders included.
+TEST(EmbreeBackend, PacketShadowRaysMatchSingleRays) {
+  Scene s = samples::makeThinWall();
+  std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-2, 0, -1), glm::vec3(0, 0, 2), glm::vec3(4, 0, 0), 8, 16)};
+  RayTracer rt(s);
+  WalkOptions w;
+  w.paths = 512;
+  VplSet vpls = generateVpls(s, rt, w);
+  VplEvalOptions eval;
+  eval.clampBound = deriveClampBound(s, vpls);
+  BakeInputs in{s, rt, texels, vpls, eval, {}};
+  EmbreeOptions single, packets;
+  single.packets = false;
+  packets.packets = true;
+  std::vector<Lightmap> a = bakeEmbree(in, single), b = bakeEmbree(in, packets);
+  int lit = 0;
+  for (size_t i = 0; i < a[0].size(); ++i) {
+    EXPECT_NEAR(b[0].texels[i].x, a[0].texels[i].x, 1e-6f * std::max(1.0f, a[0].texels[i].x)) << "texel " << i;
+    lit += a[0].texels[i].x > 0.0f;
+  }
+  EXPECT_GT(lit, 32);                       // the lit room
+  EXPECT_LT(lit, int(a[0].size()) - 32);   // and the dark one
+}
