@@ -23,8 +23,13 @@ void throwOnGlError(const char* what) {
   }
 }
 
-GLuint compileShader(GLenum type, const std::string& file) {
-  const std::string src = shaderSource(file);
+// defines: lines inserted after the #version line of the file.
+GLuint compileShader(GLenum type, const std::string& file, const std::string& defines = "") {
+  std::string src = shaderSource(file);
+  if (!defines.empty()) {
+    size_t eol = src.find('\n');
+    src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
+  }
   GLuint s = glCreateShader(type);
   const char* p = src.c_str();
   glShaderSource(s, 1, &p, nullptr);
@@ -117,21 +122,52 @@ struct ViewRenderer::Impl {
     glm::vec2 lightmapSize{1.0f};
   };
   const Scene& scene;
-  GLuint program = 0;
+  GLuint program = 0;                      // the bound variant
+  std::map<int, GLuint> programs;          // (view mode, sRGB) variant → program
+  std::map<GLuint, std::map<std::string, GLint>> uniformsByProgram;
   std::map<int, GLuint> colorTextures;     // Scene::textures index → GL texture
   std::map<int, GLuint> textureLightmaps;  // Scene::textures index → float light map texture
   std::vector<GLuint> pageTextures;        // ViewerScene::pages index → GL texture
   std::vector<GpuPrimitive> prims;
   GLuint fbo = 0, colorRb = 0, depthRb = 0;
   int fboWidth = 0, fboHeight = 0;
-  std::map<std::string, GLint> uniforms;
 
   explicit Impl(const Scene& s) : scene(s) {}
 
   GLint u(const char* name) {
+    auto& uniforms = uniformsByProgram[program];
     auto it = uniforms.find(name);
     if (it != uniforms.end()) return it->second;
     return uniforms[name] = glGetUniformLocation(program, name);
+  }
+
+  // Binds the shader variant for a view mode (0..5) and output encoding, compiling it on first use.
+  void useProgram(int mode, bool srgb) {
+    const int key = mode * 2 + (srgb ? 1 : 0);
+    auto it = programs.find(key);
+    if (it == programs.end()) {
+      const std::string defines =
+          "#define VIEW_MODE " + std::to_string(mode) + "\n#define ENCODE_SRGB " + (srgb ? "1" : "0") + "\n";
+      GLuint vs = compileShader(GL_VERTEX_SHADER, "view_mesh.vert");
+      GLuint fs = compileShader(GL_FRAGMENT_SHADER, "view_mesh.frag", defines);
+      GLuint p = glCreateProgram();
+      glAttachShader(p, vs);
+      glAttachShader(p, fs);
+      glLinkProgram(p);
+      glDeleteShader(vs);
+      glDeleteShader(fs);
+      GLint ok = 0;
+      glGetProgramiv(p, GL_LINK_STATUS, &ok);
+      if (!ok) {
+        char log[4096] = {0};
+        glGetProgramInfoLog(p, sizeof log, nullptr, log);
+        glDeleteProgram(p);
+        throw Error(ErrorCode::Gl, "shaders/view_mesh.frag", std::string("link failed: ") + log);
+      }
+      it = programs.emplace(key, p).first;
+    }
+    program = it->second;
+    glUseProgram(program);
   }
 
   GLuint colorTexture(int index) {
@@ -167,21 +203,7 @@ struct ViewRenderer::Impl {
 
 ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(v.scene)) {
   Impl& I = *impl_;
-  GLuint vs = compileShader(GL_VERTEX_SHADER, "view_mesh.vert");
-  GLuint fs = compileShader(GL_FRAGMENT_SHADER, "view_mesh.frag");
-  I.program = glCreateProgram();
-  glAttachShader(I.program, vs);
-  glAttachShader(I.program, fs);
-  glLinkProgram(I.program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(I.program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {0};
-    glGetProgramInfoLog(I.program, sizeof log, nullptr, log);
-    throw Error(ErrorCode::Gl, "shaders/view_mesh.frag", std::string("link failed: ") + log);
-  }
+  I.useProgram(0, false);  // compile errors surface here, not at the first frame
 
   for (const Lightmap& page : v.pages)
     I.pageTextures.push_back(page.size() > 0 && page.texels.size() == page.size()
@@ -270,7 +292,7 @@ ViewRenderer::~ViewRenderer() {
     glDeleteRenderbuffers(1, &I.colorRb);
     glDeleteRenderbuffers(1, &I.depthRb);
   }
-  glDeleteProgram(I.program);
+  for (auto& [key, p] : I.programs) glDeleteProgram(p);
 }
 
 void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const DrawSettings& settings) {
@@ -283,19 +305,17 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);  // light maps cover both sides that matter; never hide a wall seen from behind
   glDisable(GL_BLEND);
-  glUseProgram(I.program);
   const float aspect = static_cast<float>(width) / std::max(height, 1);
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
-  glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
-  glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
-  glUniform1i(I.u("uEncodeSrgb"), settings.encodeSrgb ? 1 : 0);
-  glUniform1i(I.u("uBaseColorTex"), 0);
-  glUniform1i(I.u("uEmissiveTex"), 1);
-  glUniform1i(I.u("uLightmap"), 2);
-  glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
 
   auto drawAll = [&](int mode) {
-    glUniform1i(I.u("uMode"), mode);
+    I.useProgram(mode, settings.encodeSrgb);
+    glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
+    glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
+    glUniform1i(I.u("uBaseColorTex"), 0);
+    glUniform1i(I.u("uEmissiveTex"), 1);
+    glUniform1i(I.u("uLightmap"), 2);
+    glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
     for (const auto& g : I.prims) {
       const Material& m = I.scene.materials.at(g.material);
       glUniform4fv(I.u("uBaseColorFactor"), 1, &m.baseColorFactor[0]);

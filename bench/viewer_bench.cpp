@@ -1,0 +1,125 @@
+// irview frame time on this machine's GL (llvmpipe in CI): one frame = clear + one textured draw per
+// primitive into a 1280×720 RGBA8 framebuffer with the display shading (exposure + sRGB), then
+// glFinish, as the window does before a swap. Scenes: the baked Cornell box (Embree backend) and a
+// generated ~100k-triangle height field with a 1024² light-map page.
+// Run: viewer_bench --benchmark_repetitions=9 --benchmark_report_aggregates_only=true (quote medians).
+#include <sys/resource.h>
+
+#include <cmath>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+#include <epoxy/gl.h>
+
+#include "glcontext/gl_context.h"
+#include "pipeline/bake.h"
+#include "samples/sample_scenes.h"
+#include "view_renderer.h"
+
+using namespace irbake;
+using namespace irbake::view;
+
+namespace {
+
+constexpr int kWidth = 1280, kHeight = 720;
+
+// CPU seconds of the whole process (llvmpipe's rasteriser threads included): on a shared machine the
+// wall time follows the load, the CPU time per frame much less so.
+double processCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+GlContext& context() {
+  static GlContext gl;
+  return gl;
+}
+
+// A wavy n×n height field over 10 × 10 m: 2n² triangles, uv1 over one page with a smooth map.
+ViewerScene heightField(int n, int pageSize) {
+  Scene s;
+  s.materials.emplace_back();
+  s.materials[0].baseColorFactor = glm::vec4(0.7f, 0.7f, 0.7f, 1.0f);
+  Primitive p;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      float u = static_cast<float>(i) / n, v = static_cast<float>(j) / n;
+      float x = 10 * u - 5, z = 10 * v - 5;
+      p.positions.emplace_back(x, 0.3f * std::sin(3 * x) * std::cos(2 * z), z);
+      p.normals.emplace_back(0, 1, 0);
+      p.uv0.emplace_back(u, v);
+      p.uv1.emplace_back(u, v);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      p.indices.insert(p.indices.end(), {a, c, b, b, c, d});
+    }
+  p.lightmap = {0, pageSize, pageSize};
+  s.primitives.push_back(std::move(p));
+  Lightmap page;
+  page.width = page.height = pageSize;
+  for (int y = 0; y < pageSize; ++y)
+    for (int x = 0; x < pageSize; ++x)
+      page.texels.emplace_back(0.5f + 0.4f * std::sin(0.05f * x) * std::cos(0.03f * y));
+  page.valid.assign(page.size(), 1);
+  return makeViewerScene(std::move(s), {page});
+}
+
+ViewerScene bakedCornell() {
+  BakeOptions o;
+  o.backend = BackendKind::Embree;
+  o.walk.paths = 1024;
+  o.atlas.texelsPerUnit = 100.0f;  // 1 cm texels: a 56 × 56 texel wall
+  BakeResult r = bake(samples::makeCornellBox(), o);
+  return makeViewerScene(std::move(r.scene), std::move(r.maps));
+}
+
+void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam) {
+  context();
+  ViewRenderer renderer(v);
+  GLuint fbo = 0, color = 0, depth = 0;
+  glGenFramebuffers(1, &fbo);
+  glGenRenderbuffers(1, &color);
+  glGenRenderbuffers(1, &depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, color);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, kWidth, kHeight);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, kWidth, kHeight);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  DrawSettings settings;
+  settings.encodeSrgb = true;
+  renderer.draw(cam, kWidth, kHeight, settings);  // warm-up: shader compile, texture residency
+  glFinish();
+  const double cpu0 = processCpuSeconds();
+  for (auto _ : state) {
+    renderer.draw(cam, kWidth, kHeight, settings);
+    glFinish();
+  }
+  state.counters["cpu_ms_per_frame"] =
+      benchmark::Counter(1000.0 * (processCpuSeconds() - cpu0), benchmark::Counter::kAvgIterations);
+  state.counters["triangles"] = static_cast<double>(renderer.triangleCount());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteRenderbuffers(1, &color);
+  glDeleteRenderbuffers(1, &depth);
+}
+
+void BM_FrameCornellBox(benchmark::State& state) {
+  static ViewerScene v = bakedCornell();
+  frameLoop(state, v, fromGltfCamera(v.scene.cameras.at(0), v.scene.bounds()));
+}
+
+void BM_Frame100kTriangles(benchmark::State& state) {
+  static ViewerScene v = heightField(224, 1024);  // 2·224² = 100,352 triangles
+  frameLoop(state, v, lookAt({0, 4, 8}, {0, 0, 0}, 50.0f, v.scene.bounds()));
+}
+
+}  // namespace
+
+BENCHMARK(BM_FrameCornellBox)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(BM_Frame100kTriangles)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK_MAIN();
