@@ -93,6 +93,34 @@ void checkBuffers(const GltfSource& s) {
   }
 }
 
+// tinygltf hands image buffer views to the image callback without a bounds check: check every view
+// against its buffer's declared length (already known to be no longer than the real data).
+void checkBufferViews(const GltfSource& s) {
+  const auto& j = s.json;
+  if (!j.contains("bufferViews")) return;
+  if (!j["bufferViews"].is_array()) fail(ErrorCode::Parse, s, "'bufferViews' is not an array");
+  const size_t bufferCount = j.contains("buffers") ? j["buffers"].size() : 0;
+  const auto& views = j["bufferViews"];
+  for (size_t i = 0; i < views.size(); ++i) {
+    const auto& v = views[i];
+    std::string what = "buffer view " + std::to_string(i);
+    if (!v.is_object() || !v.contains("buffer") || !v["buffer"].is_number_integer())
+      fail(ErrorCode::Parse, s, what + " has no integer 'buffer'");
+    int64_t b = v["buffer"].get<int64_t>();
+    if (b < 0 || static_cast<size_t>(b) >= bufferCount)
+      fail(ErrorCode::InvalidData, s, what + " references buffer " + std::to_string(b) + ", out of range");
+    double offset = v.contains("byteOffset") && v["byteOffset"].is_number() ? v["byteOffset"].get<double>() : 0.0;
+    double length = v.contains("byteLength") && v["byteLength"].is_number() ? v["byteLength"].get<double>() : -1.0;
+    double bufferLength = j["buffers"][b]["byteLength"].get<double>();
+    if (offset < 0.0 || length < 0.0) fail(ErrorCode::InvalidData, s, what + " has a negative or missing byteOffset/byteLength");
+    if (offset + length > bufferLength)
+      fail(ErrorCode::InvalidData, s,
+           what + " is out of bounds: bytes " + std::to_string(static_cast<uint64_t>(offset)) + ".." +
+               std::to_string(static_cast<uint64_t>(offset + length)) + " of buffer " + std::to_string(b) + " (" +
+               std::to_string(static_cast<uint64_t>(bufferLength)) + " bytes)");
+  }
+}
+
 void checkImages(const GltfSource& s) {
   const auto& j = s.json;
   if (!j.contains("images") || !j["images"].is_array()) return;
@@ -219,6 +247,7 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
   if (!asset.contains("version") || !asset["version"].is_string() || asset["version"].get<std::string>().rfind("2.", 0) != 0)
     fail(ErrorCode::Parse, s, "not a glTF 2.0 file: asset.version is " + (asset.contains("version") ? asset["version"].dump() : std::string("missing")));
   checkBuffers(s);
+  checkBufferViews(s);
   checkImages(s);
   checkRootExtras(s);
   return s;
