@@ -31,15 +31,43 @@ float cubeDepth(sampler2DArray cubes, int cube, vec3 v, out float axisDistance) 
   return texelFetch(cubes, ivec3(texel, 6 * cube + face), 0).r;
 }
 
+// Fraction of a 2×2 texel neighbourhood (bilinear weights, percentage-closer filtering) that lets
+// the lookup point v see the cube's centre: shadow edges become fractional instead of one texel of
+// all-or-nothing, which halves the edge error against ray-traced visibility at the same map size.
+float cubeVisibilityPcf(sampler2DArray cubes, int cube, vec3 v, float nearPlane, float bias) {
+  vec3 a = abs(v);
+  bool xMajor = a.x >= a.y && a.x >= a.z;
+  bool yMajor = !xMajor && a.y >= a.z;
+  float axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
+  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
+  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
+                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  int size = textureSize(cubes, 0).x;
+  vec2 st = (sctc / axisDistance * 0.5 + 0.5) * float(size) - 0.5;
+  vec2 f = fract(st);
+  ivec2 t0 = clamp(ivec2(floor(st)), ivec2(0), ivec2(size - 1));
+  ivec2 t1 = min(t0 + 1, ivec2(size - 1));
+  int layer = 6 * cube + face;
+  vec4 d = vec4(texelFetch(cubes, ivec3(t0.x, t0.y, layer), 0).r, texelFetch(cubes, ivec3(t1.x, t0.y, layer), 0).r,
+                texelFetch(cubes, ivec3(t0.x, t1.y, layer), 0).r, texelFetch(cubes, ivec3(t1.x, t1.y, layer), 0).r);
+  // lit where axis·depth ≤ near + bias·depth (reversed-Z, no division)
+  vec4 lit = vec4(lessThanEqual(axisDistance * d, vec4(nearPlane) + bias * d));
+  return mix(mix(lit.x, lit.y, f.x), mix(lit.z, lit.w, f.x), f.y);
+}
+
 // Lit test against reversed-Z depth without a division: axis ≤ near/depth + bias.
 bool cubeLit(float depth, float axisDistance, float nearPlane, float bias) {
   return axisDistance * depth <= nearPlane + bias * depth;
 }
 
-// Depth bias for a shadow lookup: a constant (scene scale) plus the depth change across one shadow
-// texel of footprint `footprint` on a surface tilted by θ (tanθ = sinθ / cosθ, capped).
+// Depth bias for a shadow lookup: a constant (scene scale) plus the change of stored depth across
+// one shadow texel of angular footprint `footprint` (m at the receiver's distance). The stored depth is
+// the distance along the face axis, so it varies both with the receiver's tilt θ to the ray (tanθ) and
+// with the ray's angle to the face axis (≤ 54.7° in a cube face: tan ≤ √2, hence the + 1.5).
+float shadowBiasTan(float constantBias, float slopeScale, float footprint, float tanTheta) {
+  return constantBias + slopeScale * footprint * (min(tanTheta, 20.0) + 1.5);
+}
 float shadowBias(float constantBias, float slopeScale, float footprint, float cosTheta) {
   float c = clamp(cosTheta, 0.05, 1.0);
-  float tanTheta = sqrt(1.0 - c * c) / c;
-  return constantBias + slopeScale * footprint * tanTheta;
+  return shadowBiasTan(constantBias, slopeScale, footprint, sqrt(1.0 - c * c) / c);
 }

@@ -46,11 +46,14 @@ void main() {
       // Lookup point: pushed along the receiver normal, relative to the shadow origin (VPL + offset·ny).
       vec3 q = nx * (normalOffset * footprint) - d - ny * vpls[k].origin.w;
       vec3 local = vec3(dot(q, vpls[k].tangent.xyz), dot(q, vpls[k].bitangent.xyz), dot(q, ny));
+      float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cx * cx, 0.0)) / cx);
+#ifdef SHADOW_PCF
+      s += vpls[k].power.rgb * (g * cubeVisibilityPcf(vplDepth, k, local, nearPlane, bias));
+#else
       float axisDistance;
       float depth = cubeDepth(vplDepth, k, local, axisDistance);
-      float tanTheta = min(sqrt(max(r2 - cx * cx, 0.0)) / cx, 20.0);
-      float bias = constantBias + slopeBias * footprint * tanTheta;
       if (cubeLit(depth, axisDistance, nearPlane, bias)) s += vpls[k].power.rgb * g;
+#endif
     }
     sum += pw.w * s;
   }

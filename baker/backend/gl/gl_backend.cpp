@@ -302,6 +302,7 @@ void GlBaker::bakeDirect(const Light& light) {
   glBindVertexArray(geometry_->vao);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_SCISSOR_TEST);
+  glDisable(GL_BLEND);
   if (cube) {
     maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.pointFaceSize, kFaces);
     const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
@@ -329,6 +330,7 @@ void GlBaker::bakeDirect(const Light& light) {
 
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_SCISSOR_TEST);
+  glEnable(GL_BLEND);  // added to the VPL partial sums not yet folded
   directProgram_->use();
   const GlProgram& p = *directProgram_;
   glUniform1i(p.uniform("lightType"), light.type == LightType::Point ? 0 : light.type == LightType::Spot ? 1 : 2);
@@ -369,7 +371,8 @@ std::vector<Lightmap> GlBaker::run() {
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s));
 
   const int K = std::clamp(opt_.vplsPerPass, 1, 256);
-  const std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(K)};
+  std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(K)};
+  if (opt_.shadowPcf) defines.push_back("#define SHADOW_PCF 1");
   depthProgram_ = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   vplProgram_ = std::make_unique<GlProgram>(
@@ -430,9 +433,7 @@ std::vector<Lightmap> GlBaker::run() {
     }
   }
   for (size_t i = 0; i < lightCount; ++i) {
-    glDisable(GL_BLEND);
     bakeDirect(in_.scene.lights[i]);
-    glEnable(GL_BLEND);
     ++stats_.passes;
     if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * K) / std::max<size_t>(1, totalWork));
   }

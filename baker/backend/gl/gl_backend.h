@@ -37,8 +37,9 @@ struct GlBackendOptions {
   float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
   float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
   float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal
-  float slopeBias = 1.5f;        // depth bias in shadow texel footprints × tanθ
-  float normalOffset = 1.0f;     // lookup point pushed along the receiver normal, in texel footprints
+  float slopeBias = 3.0f;        // depth bias in shadow texel footprints × tanθ
+  float normalOffset = 0.0f;     // lookup point pushed along the receiver normal, in texel footprints
+  bool shadowPcf = true;         // VPL cubes: 2×2 percentage-closer filtering (fractional shadow edges)
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
   const GlContext* context = nullptr;  // an existing current context; null: bakeGl creates one
   GlBakeStats* stats = nullptr;  // out: timings and counts (may be null)

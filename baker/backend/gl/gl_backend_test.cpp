@@ -326,6 +326,31 @@ TEST(GlBackend, DirectionalLightIsExactWithOrthoShadowMap) {
   EXPECT_LE(mismatched, 8u);  // at most a few texels on the shadow edge
 }
 
+// A bake with VPLs and a punctual light equals the sum of the two bakes alone: the direct pass is
+// added to the VPL partial sums that are still on the GPU (none folded: one pass, no fold).
+TEST(GlBackend, DirectAndVplPassesAdd) {
+  Fixture f = floorScene(true);
+  Vpl v;
+  v.position = {0.3f, 0.2f, 0.9f};
+  v.normal = {0, 0, -1};
+  v.power = glm::vec3(1.0f);
+  f.vpls.vpls.push_back(v);
+  f.scene.lights.push_back(testing::pointLight({-0.2f, 0.1f, 1.1f}, 2.0f));
+  GlBackendOptions opt;
+  opt.foldEveryPasses = 100;
+  VplEvalOptions both, vplOnly, directOnly;
+  vplOnly.includeDirect = false;
+  directOnly.includeVpls = false;
+  const auto a = f.bake(both, opt), b = f.bake(vplOnly, opt), c = f.bake(directOnly, opt);
+  double sumA = 0, sumB = 0, sumC = 0;
+  for (size_t i = 0; i < a[0].size(); ++i) {
+    EXPECT_NEAR(a[0].texels[i].x, b[0].texels[i].x + c[0].texels[i].x, 1e-6 + 1e-5 * a[0].texels[i].x) << i;
+    sumA += a[0].texels[i].x, sumB += b[0].texels[i].x, sumC += c[0].texels[i].x;
+  }
+  EXPECT_GT(sumB, 0.1 * sumA);
+  EXPECT_GT(sumC, 0.1 * sumA);
+}
+
 TEST(GlBackend, EmptyInputsGiveZeroMaps) {
   Fixture f = floorScene(false);
   auto maps = f.bake();

@@ -1,0 +1,130 @@
+// The GL backend against the Embree backend on the same atlas, texel samples and VPL set (issue 5,
+// item 8): relative RMSE < 1% on the Cornell box and the corner scene, and the furnace within the
+// tolerance of the core issue. Small pages (≈ 64² … 128²) keep each test to seconds on llvmpipe.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "atlas/atlas.h"
+#include "backend/embree/embree_backend.h"
+#include "backend/embree/geometry_term.h"
+#include "backend/gl/gl_backend.h"
+#include "raytrace/ray_tracer.h"
+#include "samples/sample_scenes.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+namespace {
+
+struct Comparison {
+  double relativeRmse = 0.0;  // GL vs Embree over valid texels, all channels
+  double meanEmbree = 0.0, meanGl = 0.0;
+  size_t validTexels = 0;
+  GlBakeStats gl;
+};
+
+Comparison compareBackends(Scene scene, int pageSize, int paths, int supersample = 1, bool includeDirect = true) {
+  AtlasOptions atlas;
+  atlas.targetPageSize = pageSize;
+  atlas.maxPageSize = pageSize;
+  buildAtlas(scene, atlas);
+  RayTracer rt(scene);
+  TexelSampleOptions to;
+  to.supersample = supersample;
+  const std::vector<TexelSamples> texels = buildTexelSamples(scene, rt, to);
+  WalkOptions walk;
+  walk.paths = paths;
+  walk.seed = 7;
+  const VplSet vpls = generateVpls(scene, rt, walk);
+  VplEvalOptions eval;
+  eval.clampBound = deriveClampBound(scene, vpls);
+  eval.includeDirect = includeDirect;
+  BakeInputs in{scene, rt, texels, vpls, eval, {}};
+  const std::vector<Lightmap> ref = bakeEmbree(in);
+  Comparison c;
+  GlBackendOptions go;
+  go.stats = &c.gl;
+  const std::vector<Lightmap> gl = bakeGl(in, go);
+  EXPECT_EQ(gl.size(), ref.size());
+  double num = 0, den = 0;
+  for (size_t p = 0; p < std::min(gl.size(), ref.size()); ++p) {
+    EXPECT_EQ(gl[p].size(), ref[p].size());
+    for (size_t i = 0; i < ref[p].size(); ++i) {
+      if (!ref[p].valid[i]) continue;
+      EXPECT_EQ(gl[p].valid[i], 1);
+      ++c.validTexels;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double e = gl[p].texels[i][ch] - double(ref[p].texels[i][ch]);
+        num += e * e;
+        den += double(ref[p].texels[i][ch]) * ref[p].texels[i][ch];
+        c.meanEmbree += ref[p].texels[i][ch];
+        c.meanGl += gl[p].texels[i][ch];
+      }
+    }
+  }
+  c.relativeRmse = std::sqrt(num / std::max(den, 1e-300));
+  c.meanEmbree /= std::max<size_t>(1, 3 * c.validTexels);
+  c.meanGl /= std::max<size_t>(1, 3 * c.validTexels);
+  std::printf("texels %zu, VPLs %zu: relative RMSE %.4f%%, mean embree %.6g gl %.6g\n", c.validTexels, vpls.vpls.size(),
+              100.0 * c.relativeRmse, c.meanEmbree, c.meanGl);
+  return c;
+}
+
+TEST(GlVsEmbree, CornellBoxWithinOnePercent) {
+  const Comparison c = compareBackends(samples::makeCornellBox(), 128, 256);
+  EXPECT_GT(c.validTexels, 5000u);
+  EXPECT_GT(c.meanEmbree, 0.0);
+  EXPECT_LT(c.relativeRmse, 0.01);
+}
+
+TEST(GlVsEmbree, CornerSceneWithinOnePercent) {
+  // Spot light (2D perspective shadow map) plus bounce VPLs in a corner: the VPL singularity case.
+  const Comparison c = compareBackends(samples::makeCorner(), 128, 256);
+  EXPECT_GT(c.validTexels, 3000u);
+  EXPECT_LT(c.relativeRmse, 0.01);
+}
+
+TEST(GlVsEmbree, CornerBouncesOnlyWithinOnePercent) {
+  // Only the VPLs (no exact direct light), so the comparison is about the VPL cubes alone.
+  const Comparison c = compareBackends(samples::makeCorner(), 128, 256, 1, false);
+  EXPECT_GT(c.meanEmbree, 0.0);
+  EXPECT_LT(c.relativeRmse, 0.01);
+}
+
+TEST(GlVsEmbree, FurnaceMatchesClosedForm) {
+  // Closed box, ρ = 0.5, Le = 1 on every wall: the incident radiance is Le/(1−ρ) everywhere, so the
+  // map (irradiance/π) is exactly 2. The GL backend has no bias compensation, so the clamp is off and
+  // the estimate is the plain VPL sum: it must equal the Embree backend's on the same VPLs (0.1%).
+  // Against the exact answer the unclamped sum converges from below (rare near-corner VPLs carry the
+  // singular part): −1.6% / −1.2% / −1.0% at 1024 / 2048 / 4096 paths on this atlas, so 1.5% here.
+  Scene scene = samples::makeFurnace(0.5f, 1.0f);
+  AtlasOptions atlas;
+  atlas.targetPageSize = 64;
+  atlas.maxPageSize = 64;
+  buildAtlas(scene, atlas);
+  RayTracer rt(scene);
+  const std::vector<TexelSamples> texels = buildTexelSamples(scene, rt, {});
+  WalkOptions walk;
+  walk.paths = 2048;
+  const VplSet vpls = generateVpls(scene, rt, walk);
+  BakeInputs in{scene, rt, texels, vpls, VplEvalOptions{}, {}};
+  GlBackendOptions go;
+  go.cubeFaceSize = 64;  // a convex box: nothing to shadow, small cubes keep the test quick
+  go.vplsPerPass = 64;
+  const std::vector<Lightmap> gl = bakeGl(in, go);
+  const std::vector<Lightmap> em = bakeEmbree(in);
+  double sumGl = 0, sumEm = 0;
+  size_t n = 0;
+  for (size_t p = 0; p < gl.size(); ++p)
+    for (size_t i = 0; i < gl[p].size(); ++i)
+      if (gl[p].valid[i]) sumGl += gl[p].texels[i].x, sumEm += em[p].texels[i].x, ++n;
+  ASSERT_GT(n, 0u);
+  std::printf("furnace: mean gl %.5f embree %.5f (exact 2)\n", sumGl / n, sumEm / n);
+  EXPECT_NEAR(sumGl / n, sumEm / n, 0.001 * sumEm / n);
+  EXPECT_NEAR(sumGl / n, 2.0, 0.03);
+}
+
+}  // namespace
+}  // namespace irbake
