@@ -1,5 +1,6 @@
 #include "atlas/atlas_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -60,16 +61,17 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
     }
   }
   mesh.meanEdge = edgeCount ? edgeSum / double(edgeCount) : 0.0;
-  const double minArea = options.degenerateArea * mesh.meanEdge * mesh.meanEdge;
   for (size_t f = 0; f < faces; ++f) {
     const auto& v = mesh.faceVertex[f];
     const bool repeated = v[0] == v[1] || v[1] == v[2] || v[0] == v[2];
-    if (repeated || !(mesh.faceArea[f] > minArea)) {
+    const glm::dvec3 &a = mesh.vertexPos[v[0]], &b = mesh.vertexPos[v[1]], &c = mesh.vertexPos[v[2]];
+    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    // Thinner than the weld tolerance: such a face has no surface to give texels to.
+    if (repeated || !(mesh.faceArea[f] > options.weldTolerance * mesh.diagonal * longest)) {
       mesh.degenerate[f] = 1;
       ++mesh.degenerateFaces;
       continue;
     }
-    const glm::dvec3 &a = mesh.vertexPos[v[0]], &b = mesh.vertexPos[v[1]], &c = mesh.vertexPos[v[2]];
     mesh.faceNormal[f] = glm::normalize(glm::cross(b - a, c - a));
   }
 

@@ -14,9 +14,9 @@ namespace irbake::atlas {
 constexpr uint32_t kNone = 0xffffffffu;
 
 struct MeshOptions {
-  double weldTolerance = 1e-6;     // weld distance relative to the bounding-box diagonal
+  double weldTolerance = 1e-6;     // weld distance relative to the bounding-box diagonal; faces thinner
+                                   // than it (area < tolerance × diagonal × longest edge) are degenerate
   double hardNormalDegrees = 1.0;  // corner normals further apart than this make the edge a seam
-  double degenerateArea = 1e-10;   // faces below this × meanEdge² are degenerate
 };
 
 // Faces keep the primitive's triangle order. faceVertex ids index vertexPos (welded, then split

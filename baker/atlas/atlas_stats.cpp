@@ -52,6 +52,9 @@ void measureAtlas(const Scene& scene, const std::vector<AtlasPage>& pages, Atlas
       if (!added) parent[findRoot(parent, v)] = findRoot(parent, it->second);
     }
     std::vector<int32_t> islandOf(prim.positions.size(), -1);
+    Bounds3 bounds;
+    for (const glm::vec3& q : prim.positions) bounds.extend(q);
+    const double diagonal = bounds.diagonal();
     double meanEdge = 0.0;
     for (size_t t = 0; t < prim.triangleCount(); ++t)
       for (int k = 0; k < 3; ++k)
@@ -69,7 +72,8 @@ void measureAtlas(const Scene& scene, const std::vector<AtlasPage>& pages, Atlas
       }
       const double area3d = 0.5 * glm::length(glm::cross(q[1] - q[0], q[2] - q[0]));
       const double areaUv = 0.5 * cross2(uv[1] - uv[0], uv[2] - uv[0]);
-      const bool degenerate = !(area3d > 1e-10 * meanEdge * meanEdge);
+      const double longest = std::max({glm::length(q[1] - q[0]), glm::length(q[2] - q[1]), glm::length(q[0] - q[2])});
+      const bool degenerate = !(area3d > 1e-6 * diagonal * longest);  // as the atlas mesh decides
       if (!degenerate) {
         if (areaUv <= 0.0) ++flipped;
         ratios.push_back({areaUv / area3d, area3d});

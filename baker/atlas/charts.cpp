@@ -38,6 +38,7 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
   const double coneCos = std::cos(glm::radians(options.coneDegrees));
   const double creaseCos = std::cos(glm::radians(options.creaseDegrees));
   const double mergeCos = std::cos(glm::radians(options.mergeConeDegrees));
+  const double softCos = std::cos(glm::radians(options.softBendDegrees));
   constexpr uint32_t kFree = kNone;
 
   std::vector<uint32_t> order;
@@ -62,7 +63,7 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
 
   // Phase 1: planar regions (flood fill within a small angle of the seed's normal).
   std::vector<uint8_t> tried(n, 0);
-  std::vector<uint32_t> region;
+  std::vector<uint32_t> region, regionOf(n, kNone);
   for (uint32_t seed : order) {
     if (chartOf[seed] != kFree || tried[seed]) continue;
     region.assign(1, seed);
@@ -79,7 +80,22 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
         region.push_back(g);
       }
     }
+    // A flat strip of a finely faceted curved surface (a cylinder's side) is not a flat region:
+    // lock only regions whose boundary is mostly hard (seams, creases or a clear bend).
+    double softBoundary = 0.0, boundary = 0.0;
     if (region.size() >= 2 && area >= options.planarMinAreaFraction * totalArea) {
+      for (uint32_t f : region) regionOf[f] = seed;
+      for (uint32_t f : region)
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t g = mesh.faceNeighbour[f][k];
+          if (g != kNone && regionOf[g] == seed) continue;
+          const double len = edgeLength(mesh, f, k);
+          boundary += len;
+          const uint32_t h = crossable(mesh, f, k, creaseCos);
+          if (h != kNone && glm::dot(mesh.faceNormal[h], mesh.faceNormal[f]) > softCos) softBoundary += len;
+        }
+    }
+    if (region.size() >= 2 && area >= options.planarMinAreaFraction * totalArea && softBoundary <= 0.5 * boundary) {
       Work w;
       w.faces = region;
       w.area = area;

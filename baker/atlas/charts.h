@@ -10,6 +10,7 @@ namespace irbake::atlas {
 struct ChartOptions {
   double planarDegrees = 0.5;       // faces within this of a seed's normal form a planar region
   double planarMinAreaFraction = 0.002;  // a planar region of ≥ 2 faces and ≥ this × mesh area is locked as a chart
+  double softBendDegrees = 20.0;    // a planar region mostly bordered by bends below this is part of a curved surface
   double coneDegrees = 60.0;        // a curved chart's faces stay within this of its mean normal
   double creaseDegrees = 75.0;      // growth never crosses an edge whose dihedral exceeds this
   double mergeAreaFraction = 0.5;   // curved charts below this × the median curved chart area are merged

@@ -12,6 +12,8 @@ namespace {
 
 double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
 
+constexpr double kMargin = 1e-3;  // texels; far above float32 rounding of uv1 on a 16k page (~1e-3 × 1)
+
 // Convex hull (Andrew's monotone chain), counter-clockwise.
 std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> p) {
   std::sort(p.begin(), p.end(), [](const glm::dvec2& a, const glm::dvec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
@@ -45,7 +47,7 @@ void rotateToMinimumBox(ChartUv& chart) {
       lo1 = std::min(lo1, glm::dot(p, n)); hi1 = std::max(hi1, glm::dot(p, n));
     }
     const double area = (hi0 - lo0) * (hi1 - lo1);
-    if (area < bestArea * (1.0 - 1e-9)) { bestArea = area; bestAngle = std::atan2(d.y, d.x); }
+    if (area < bestArea * (1.0 - 1e-6)) { bestArea = area; bestAngle = std::atan2(d.y, d.x); }
   }
   const double c = std::cos(-bestAngle), s = std::sin(-bestAngle);
   for (glm::dvec2& p : chart.uv) p = {c * p.x - s * p.y, s * p.x + c * p.y};
@@ -80,19 +82,19 @@ Mask buildMask(const ChartUv& chart, int quarterTurns, int padding) {
     hi = glm::max(hi, r);
   }
   const glm::dvec2 size = hi - lo;
-  m.w = std::max(1, int(std::ceil(size.x - 1e-9)));
-  m.h = std::max(1, int(std::ceil(size.y - 1e-9)));
-  // Centre the chart in its whole-texel box so partial texels are shared evenly by both sides.
-  m.shift = -lo + (glm::dvec2(m.w, m.h) - size) * 0.5;
+  // kMargin keeps every chart a hair inside its texels, so float32 rounding of uv1 cannot reach a neighbour.
+  m.w = std::max(1, int(std::ceil(size.x + 2 * kMargin)));
+  m.h = std::max(1, int(std::ceil(size.y + 2 * kMargin)));
+  m.shift = -lo + glm::dvec2(kMargin);
   m.bits.assign(size_t(m.w) * m.h, 0);
   for (const auto& c : chart.corner) {
     const glm::dvec2 a = rotate90(chart.uv[c[0]], quarterTurns) + m.shift, b = rotate90(chart.uv[c[1]], quarterTurns) + m.shift,
                      d = rotate90(chart.uv[c[2]], quarterTurns) + m.shift;
-    const int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, d.x})))), x1 = std::min(m.w - 1, int(std::ceil(std::max({a.x, b.x, d.x}))) - 1);
-    const int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, d.y})))), y1 = std::min(m.h - 1, int(std::ceil(std::max({a.y, b.y, d.y}))) - 1);
+    const int x0 = std::max(0, int(std::floor(std::min({a.x, b.x, d.x}) - kMargin))), x1 = std::min(m.w - 1, int(std::ceil(std::max({a.x, b.x, d.x}) + kMargin)) - 1);
+    const int y0 = std::max(0, int(std::floor(std::min({a.y, b.y, d.y}) - kMargin))), y1 = std::min(m.h - 1, int(std::ceil(std::max({a.y, b.y, d.y}) + kMargin)) - 1);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x)
-        if (!m.bits[size_t(y) * m.w + x] && triangleOverlapsTexel(a, b, d, x, y)) m.bits[size_t(y) * m.w + x] = 1;
+        if (!m.bits[size_t(y) * m.w + x] && triangleOverlapsTexel(a, b, d, x, y, kMargin)) m.bits[size_t(y) * m.w + x] = 1;
   }
   m.texels = size_t(std::count(m.bits.begin(), m.bits.end(), uint8_t(1)));
   // Square dilation by the padding: horizontal then vertical, as runs per padded row.
@@ -305,8 +307,8 @@ double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<
 
 }  // namespace
 
-bool triangleOverlapsTexel(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int x, int y) {
-  const double x0 = x, x1 = x + 1.0, y0 = y, y1 = y + 1.0;
+bool triangleOverlapsTexel(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int x, int y, double margin) {
+  const double x0 = x - margin, x1 = x + 1.0 + margin, y0 = y - margin, y1 = y + 1.0 + margin;
   if (std::max({a.x, b.x, c.x}) <= x0 || std::min({a.x, b.x, c.x}) >= x1) return false;
   if (std::max({a.y, b.y, c.y}) <= y0 || std::min({a.y, b.y, c.y}) >= y1) return false;
   double area = cross2(b - a, c - a);

@@ -26,7 +26,7 @@ struct PackResult {
 // [x,x+1]×[y,y+1]); orientation is preserved (rotations only, never mirrored).
 PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options);
 
-// Conservative coverage: does the UV triangle overlap the open texel square (x,y)?
-bool triangleOverlapsTexel(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int x, int y);
+// Conservative coverage: does the UV triangle overlap the open texel square (x,y) grown by margin?
+bool triangleOverlapsTexel(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, int x, int y, double margin = 0.0);
 
 }  // namespace irbake::atlas
