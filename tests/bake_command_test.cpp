@@ -43,7 +43,13 @@ int runIrbake(const std::string& args, std::string* output = nullptr) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-std::string q(const fs::path& p) { return "\"" + p.string() + "\""; }
+// Quoted for the shell. (Built with append: GCC 12 warns falsely on "\"" + std::string.)
+std::string q(const fs::path& p) {
+  std::string s(1, '"');
+  s.append(p.string());
+  s.push_back('"');
+  return s;
+}
 
 fs::path samplesDir() {
   static fs::path dir = [] {
@@ -72,6 +78,11 @@ void expectFinite(const Lightmap& m) {
 TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
   ASSERT_FALSE(samplesDir().empty());
   fs::path out = scratch("point_over_plane");
+  // A page left by an earlier bake with more pages must not survive into this one.
+  Lightmap stale;
+  stale.width = stale.height = 2;
+  stale.texels.assign(4, glm::vec3(1.0f));
+  writeExr(stale, out / "lightmap_1.exr");
   std::string log;
   ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(out) +
                        " --backend embree --texels-per-unit 4 --vpls 64 --seed 3",
@@ -81,6 +92,7 @@ TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
   ASSERT_TRUE(fs::exists(out / "lightmap_0.exr")) << log;
   ASSERT_TRUE(fs::exists(out / "scene.gltf")) << log;
   ASSERT_TRUE(fs::exists(out / "report.json")) << log;
+  EXPECT_FALSE(fs::exists(out / "lightmap_1.exr"));
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << "temp file left: " << e.path();
 

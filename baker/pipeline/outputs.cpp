@@ -4,6 +4,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/log.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
@@ -32,6 +33,15 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   for (size_t i = 0; i < result.maps.size(); ++i) {
     if (!options.writeGltf || !fs::exists(exrs[i])) writeExr(result.maps[i], exrs[i]);
     written.push_back(exrs[i]);
+  }
+
+  // Pages of an earlier bake into the same folder that this bake does not have would be read as
+  // part of it (irbake diff, the viewer): remove them.
+  for (size_t page = result.maps.size();; ++page) {
+    fs::path stale = options.outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    if (!fs::exists(stale)) break;
+    fs::remove(stale, ec);
+    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
   }
 
   fs::path reportPath = options.reportPath.empty() ? options.outDir / "report.json" : options.reportPath;
