@@ -68,7 +68,10 @@ double meanReflectivity(const Scene& scene) {
       const glm::vec3& a = prim.positions[prim.indices[3 * t]];
       double A = 0.5 * glm::length(glm::cross(prim.positions[prim.indices[3 * t + 1]] - a, prim.positions[prim.indices[3 * t + 2]] - a));
       double rho = 0.0;
-      for (const glm::vec2& p : kPoints) rho += channelMean(glm::dvec3(glm::vec3(scene.baseColorAt(prim, t, p))));
+      for (const glm::vec2& p : kPoints) {
+        glm::vec3 a(scene.baseColorAt(prim, t, p));
+        rho += std::max(a.x, std::max(a.y, a.z));
+      }
       weighted += A * rho / 4.0;
       area += A;
     }
