@@ -13,6 +13,7 @@
 #include "atlas/atlas.h"
 #include "atlas/atlas_mesh.h"
 #include "common/error.h"
+#include "export/gltf_export.h"
 #include "scene/gltf_loader.h"
 
 namespace irbake {
@@ -427,6 +428,30 @@ TEST(Atlas, KeepUv1RepacksIslandsWithoutChangingTheirShape) {
     const glm::vec2 b = out.uv1[out.indices[3 * t + 1]] * glm::vec2(r.pages[0].width, r.pages[0].height);
     EXPECT_NEAR(glm::length(a - b), 20.0f, 1e-3f);
   }
+}
+
+TEST(Atlas, ExportedTexcoord1LoadsBackWithItsPage) {
+  Scene s = sceneOf({cylinder(0.5f, 1.0f, 24), cube(0.4f)});
+  const AtlasResult r = unwrap(s, 30);
+  const char* bin = std::getenv("IRBAKE_BINARY_DIR");
+  const std::filesystem::path out = std::filesystem::path(bin ? bin : ".") / "atlas_test_roundtrip.glb";
+  ExportOptions eo;
+  eo.output = out;
+  eo.writeExrPages = false;
+  exportGltf(s, {}, eo);
+  LoadOptions lo;
+  lo.decodeImages = false;
+  const Scene back = loadScene(out, lo);
+  size_t triangles = 0;
+  for (const Primitive& p : back.primitives) {
+    triangles += p.triangleCount();
+    ASSERT_EQ(p.uv1.size(), p.positions.size());
+    EXPECT_EQ(p.lightmap.page, 0);
+    EXPECT_EQ(p.lightmap.width, r.pages[0].width);
+    EXPECT_EQ(p.lightmap.height, r.pages[0].height);
+  }
+  EXPECT_EQ(triangles, s.triangleCount());
+  expectValid(back, r, 2);  // the reloaded UVs pass the same checker
 }
 
 TEST(Atlas, RejectsBadOptions) {
