@@ -1,0 +1,303 @@
+// Speed against error (issue 5, item 7): both VPL backends (GL on EGL, Embree) at N = 64 … 4096
+// light paths on the same atlas, texel samples and VPL sets, scored against a converged reference
+// bake (path tracer) of that atlas; time per stage. Plus the per-VPL cost of the GL backend's two
+// stages (shadow cube, accumulation) on a synthetic ~100k-triangle scene and a 1M-texel page.
+//
+//   speed_error_bench scene GLTF [--add GLB:scale:x,y,z]... [--page 256] [--ns 64,256,1024,4096]
+//                     [--spp 256] [--name NAME] [--csv OUT.csv]
+//   speed_error_bench stages [--tris-div 91] [--texels 1024] [--vpls 64] [--csv OUT.csv]
+//
+// Rows are appended to the CSV (header written when the file is new). Times are wall-clock seconds
+// on whatever machine runs it, plus process CPU seconds for the GL stages (load-independent).
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "atlas/atlas.h"
+#include "backend/embree/embree_backend.h"
+#include "backend/embree/geometry_term.h"
+#include "backend/gl/gl_backend.h"
+#include "backend/reference/reference_integrator.h"
+#include "common/error.h"
+#include "common/progress.h"
+#include "pipeline/diff.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/gltf_loader.h"
+#include "texels/texel_area.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
+
+using namespace irbake;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, sep);) out.push_back(item);
+  return out;
+}
+
+std::ofstream openCsv(const std::string& path, const std::string& header) {
+  const bool fresh = !std::filesystem::exists(path);
+  std::ofstream f(path, std::ios::app);
+  if (!f) throw Error(ErrorCode::Io, path, "cannot open CSV for appending");
+  if (fresh) f << header << "\n";
+  return f;
+}
+
+// Appends `extra` (a glTF/GLB, uniformly scaled then translated) to `scene`: materials and textures
+// are re-indexed, positions moved (normals are unchanged by a uniform scale and a translation).
+void addModel(Scene& scene, const std::string& spec) {
+  const auto parts = split(spec, ':');
+  if (parts.size() != 3) throw Error(ErrorCode::Usage, spec, "--add wants FILE:scale:x,y,z");
+  Scene extra = loadScene(parts[0]);
+  const float scale = std::stof(parts[1]);
+  const auto t = split(parts[2], ',');
+  if (t.size() != 3) throw Error(ErrorCode::Usage, spec, "--add offset wants x,y,z");
+  const glm::vec3 offset(std::stof(t[0]), std::stof(t[1]), std::stof(t[2]));
+  // Stand the model on y = offset.y: its lowest point goes there.
+  const Bounds3 b = extra.bounds();
+  const int materialBase = static_cast<int>(scene.materials.size());
+  const int textureBase = static_cast<int>(scene.textures.size());
+  for (Material m : extra.materials) {
+    if (m.baseColorTexture >= 0) m.baseColorTexture += textureBase;
+    if (m.emissiveTexture >= 0) m.emissiveTexture += textureBase;
+    if (m.lightmapTexture >= 0) m.lightmapTexture = -1;
+    scene.materials.push_back(m);
+  }
+  for (Texture& tex : extra.textures) scene.textures.push_back(std::move(tex));
+  for (Primitive p : extra.primitives) {
+    for (glm::vec3& v : p.positions) {
+      v = (v - glm::vec3(0.5f * (b.min.x + b.max.x), b.min.y, 0.5f * (b.min.z + b.max.z))) * scale + offset;
+    }
+    p.material += materialBase;
+    p.node = p.gltfMesh = p.gltfPrimitive = -1;
+    p.uv1.clear();
+    p.lightmap = {};
+    scene.primitives.push_back(std::move(p));
+  }
+  for (const Light& l : extra.lights) scene.lights.push_back(l);
+}
+
+int sceneBench(const std::vector<std::string>& args) {
+  std::string gltf, name, csv = "speed_error.csv";
+  std::vector<std::string> adds;
+  int page = 256, spp = 256;
+  std::vector<int> ns{64, 256, 1024, 4096};
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto next = [&] {
+      if (i + 1 >= args.size()) throw Error(ErrorCode::Usage, "", a + " needs a value");
+      return args[++i];
+    };
+    if (a == "--add") adds.push_back(next());
+    else if (a == "--page") page = std::stoi(next());
+    else if (a == "--spp") spp = std::stoi(next());
+    else if (a == "--name") name = next();
+    else if (a == "--csv") csv = next();
+    else if (a == "--ns") {
+      ns.clear();
+      for (const auto& n : split(next(), ',')) ns.push_back(std::stoi(n));
+    } else gltf = a;
+  }
+  if (gltf.empty()) throw Error(ErrorCode::Usage, "", "scene: no glTF given");
+  if (name.empty()) name = std::filesystem::path(gltf).stem().string();
+
+  Stopwatch sw;
+  Scene scene = loadScene(gltf);
+  for (const auto& spec : adds) addModel(scene, spec);
+  const double loadSeconds = sw.seconds();
+  sw.reset();
+  AtlasOptions atlas;
+  atlas.targetPageSize = page;
+  atlas.maxPageSize = std::max(page, 1024);
+  buildAtlas(scene, atlas);
+  const double atlasSeconds = sw.seconds();
+  sw.reset();
+  RayTracer rt(scene);
+  const double bvhSeconds = sw.seconds();
+  sw.reset();
+  const std::vector<TexelSamples> texels = buildTexelSamples(scene, rt, {});
+  const double texelSeconds = sw.seconds();
+  size_t validTexels = 0;
+  for (const auto& t : texels)
+    for (uint8_t v : t.valid) validTexels += v;
+  const auto areas = texelWorldAreas(scene);
+  std::printf("%s: %zu triangles, %zu pages, %zu valid texels; load %.2f s, atlas %.2f s, bvh %.2f s, texels %.2f s\n",
+              name.c_str(), scene.triangleCount(), texels.size(), validTexels, loadSeconds, atlasSeconds, bvhSeconds,
+              texelSeconds);
+
+  // The yardstick: the path tracer on the same texel samples.
+  sw.reset();
+  const VplSet none;
+  std::vector<Lightmap> refError;
+  BakeInputs refInputs{scene, rt, texels, none, {}, {}};
+  ReferenceOptions ro;
+  ro.spp = spp;
+  const std::vector<Lightmap> reference = bakeReference(refInputs, ro, &refError);
+  const double refSeconds = sw.seconds();
+  // Relative standard error of the reference itself (RMS of per-texel SE over RMS of the map).
+  double se2 = 0, v2 = 0;
+  for (size_t p = 0; p < reference.size(); ++p)
+    for (size_t i = 0; i < reference[p].size(); ++i)
+      if (reference[p].valid[i])
+        for (int c = 0; c < 3; ++c) se2 += refError[p].texels[i][c] * refError[p].texels[i][c],
+                                    v2 += reference[p].texels[i][c] * reference[p].texels[i][c];
+  const double refRelSe = std::sqrt(se2 / std::max(v2, 1e-300));
+  std::printf("reference: %d spp in %.1f s, relative standard error %.3f%%\n", spp, refSeconds, 100 * refRelSe);
+
+  std::ofstream out = openCsv(csv,
+                              "scene,triangles,texels,backend,paths,vpls,relative_rmse,relative_rmse_corrected,relative_bias,walk_s,backend_s,"
+                              "gl_setup_s,gl_shadow_s,gl_accumulate_s,gl_shadow_cpu_s,gl_accumulate_cpu_s,"
+                              "atlas_s,texels_s,reference_spp,reference_s,reference_rel_se,renderer");
+  for (int n : ns) {
+    sw.reset();
+    WalkOptions walk;
+    walk.paths = n;
+    walk.seed = 1;
+    const VplSet vpls = generateVpls(scene, rt, walk);
+    const double walkSeconds = sw.seconds();
+    VplEvalOptions eval;
+    eval.clampBound = deriveClampBound(scene, vpls);
+    BakeInputs in{scene, rt, texels, vpls, eval, {}};
+    for (const char* backend : {"gl", "embree"}) {
+      GlBakeStats st;
+      sw.reset();
+      std::vector<Lightmap> maps;
+      if (std::string(backend) == "gl") {
+        GlBackendOptions go;
+        go.stats = &st;
+        go.stageTimings = true;
+        maps = bakeGl(in, go);
+      } else {
+        maps = bakeEmbree(in);
+      }
+      const double backendSeconds = sw.seconds();
+      const MapDifference d = compareMaps(maps, reference, areas);
+      // The reference's own noise adds its variance to the squared error: remove it (area-weighted
+      // mean of SE², same weights as compareMaps) so the figure estimates the error against the truth.
+      double wse = 0, w = 0, wref = 0;
+      for (size_t p = 0; p < reference.size(); ++p)
+        for (size_t i = 0; i < reference[p].size(); ++i) {
+          if (!maps[p].valid[i] || !reference[p].valid[i]) continue;
+          const double a = areas.empty() ? 1.0 : areas[p][i];
+          if (!(a > 0)) continue;
+          const glm::vec3 e = refError[p].texels[i], r = reference[p].texels[i];
+          wse += a * glm::dot(e, e) / 3.0;
+          wref += a * glm::dot(r, r) / 3.0;
+          w += a;
+        }
+      const double rms = std::sqrt(wref / std::max(w, 1e-300));
+      const double mse = d.rmse * d.rmse - wse / std::max(w, 1e-300);
+      const double corrected = mse > 0 ? std::sqrt(mse) / rms : 0.0;
+      std::printf("  %-6s N=%5d (%6zu VPLs): rel RMSE %.4f (noise-corrected %.4f), bias %+.4f, walk %.2f s, backend %.2f s (shadow %.2f, accumulate %.2f)\n",
+                  backend, n, vpls.vpls.size(), d.relativeRmse, corrected, d.relativeBias, walkSeconds, backendSeconds,
+                  st.shadowSeconds, st.accumulateSeconds);
+      std::fflush(stdout);
+      out << name << "," << scene.triangleCount() << "," << validTexels << "," << backend << "," << n << ","
+          << vpls.vpls.size() << "," << d.relativeRmse << "," << corrected << "," << d.relativeBias << "," << walkSeconds << ","
+          << backendSeconds << "," << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << ","
+          << st.shadowCpuSeconds << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
+          << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"\n";
+      out.flush();
+    }
+  }
+  return 0;
+}
+
+// A closed room of `div`×`div`-cell walls (12 div² triangles) and one page of texels×texels samples on
+// its floor; VPLs on the ceiling facing down: every VPL sees the whole floor.
+int stagesBench(const std::vector<std::string>& args) {
+  int div = 91, tex = 1024, nv = 64;
+  std::string csv = "gl_stages.csv";
+  for (size_t i = 1; i + 1 < args.size(); i += 2) {
+    if (args[i] == "--tris-div") div = std::stoi(args[i + 1]);
+    else if (args[i] == "--texels") tex = std::stoi(args[i + 1]);
+    else if (args[i] == "--vpls") nv = std::stoi(args[i + 1]);
+    else if (args[i] == "--csv") csv = args[i + 1];
+    else throw Error(ErrorCode::Usage, "", "unknown option " + args[i]);
+  }
+  Scene s;
+  Material white;
+  white.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  s.materials.push_back(white);
+  const glm::vec3 lo(-1, -1, 0), hi(1, 1, 2);
+  const glm::vec3 d = hi - lo, X(d.x, 0, 0), Y(0, d.y, 0), Z(0, 0, d.z);
+  struct Face { glm::vec3 p0, e1, e2; };
+  const Face faces[6] = {{lo, X, Y}, {lo + Z, Y, X}, {lo, Z, X}, {lo + Y, X, Z}, {lo, Y, Z}, {lo + X, Z, Y}};
+  for (const Face& f : faces) {  // inward-facing walls
+    Primitive p;
+    const glm::vec3 n = glm::normalize(glm::cross(f.e1, f.e2));
+    for (int j = 0; j <= div; ++j)
+      for (int i = 0; i <= div; ++i) {
+        p.positions.push_back(f.p0 + f.e1 * (float(i) / div) + f.e2 * (float(j) / div));
+        p.normals.push_back(n);
+      }
+    for (int j = 0; j < div; ++j)
+      for (int i = 0; i < div; ++i) {
+        uint32_t a = j * (div + 1) + i, b = a + 1, c = a + div + 2, e = a + div + 1;
+        p.indices.insert(p.indices.end(), {a, b, c, a, c, e});
+      }
+    s.primitives.push_back(std::move(p));
+  }
+  RayTracer rt(s);
+  TexelSamples t;
+  t.width = t.height = tex;
+  for (int y = 0; y < tex; ++y)
+    for (int x = 0; x < tex; ++x) {
+      t.positionWeight.push_back(glm::vec4(-1 + 2 * (x + 0.5f) / tex, -1 + 2 * (y + 0.5f) / tex, 0, 1));
+      t.normal.push_back(glm::vec4(0, 0, 1, 0));
+    }
+  t.primitive.assign(t.slotCount(), 0);
+  t.triangle.assign(t.slotCount(), 0);
+  t.covered.assign(t.layerSize(), 1);
+  t.valid.assign(t.layerSize(), 1);
+  const std::vector<TexelSamples> pages{t};
+  VplSet vs;
+  for (int i = 0; i < nv; ++i) {
+    Vpl v;
+    v.position = glm::vec3(-0.9f + 1.8f * ((i * 37) % 101) / 101.0f, -0.9f + 1.8f * ((i * 53) % 97) / 97.0f, 1.999f);
+    v.normal = {0, 0, -1};
+    v.power = glm::vec3(0.01f);
+    vs.vpls.push_back(v);
+  }
+  std::ofstream out = openCsv(csv, "triangles,texels,vpls,k,face,shadow_ms_per_vpl,accumulate_ms_per_vpl,"
+                                   "shadow_cpu_ms_per_vpl,accumulate_cpu_ms_per_vpl,triangles_drawn_per_vpl,renderer");
+  for (int k : {1, 4, 16, 64}) {
+    GlBakeStats st;
+    GlBackendOptions o;
+    o.stats = &st;
+    o.stageTimings = true;
+    o.vplsPerPass = k;
+    BakeInputs in{s, rt, pages, vs, {}, {}};
+    bakeGl(in, o);
+    const double sv = 1e3 * st.shadowSeconds / nv, av = 1e3 * st.accumulateSeconds / nv;
+    const double sc = 1e3 * st.shadowCpuSeconds / nv, ac = 1e3 * st.accumulateCpuSeconds / nv;
+    std::printf("%zu triangles, %d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate %.2f ms/VPL "
+                "(CPU %.2f), %zu triangles drawn per VPL\n",
+                s.triangleCount(), tex * tex, k, o.cubeFaceSize, sv, sc, av, ac, st.trianglesDrawn / nv);
+    std::fflush(stdout);
+    out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << o.cubeFaceSize << "," << sv << ","
+        << av << "," << sc << "," << ac << "," << st.trianglesDrawn / nv << ",\"" << st.renderer << "\"\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  try {
+    if (!args.empty() && args[0] == "scene") return sceneBench(args);
+    if (!args.empty() && args[0] == "stages") return stagesBench(args);
+    std::fprintf(stderr, "usage: speed_error_bench scene GLTF [...] | stages [...]\n");
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "speed_error_bench: error: %s\n", e.what());
+    return 1;
+  }
+}
