@@ -86,9 +86,10 @@ glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n)
   return sum;
 }
 
-glm::vec3 vplSumAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n) {
+glm::vec3 vplSumAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, bool packets) {
   KahanSum acc;
-  gatherVpls(in, bound, x, n, 0, in.vpls.vpls.size(), acc);
+  if (packets) gatherVplsPackets(in, bound, x, n, 0, in.vpls.vpls.size(), acc);
+  else gatherVpls(in, bound, x, n, 0, in.vpls.vpls.size(), acc);
   return acc.sum;
 }
 
@@ -96,7 +97,8 @@ glm::vec3 vplSumAt(const BakeInputs& in, float bound, const glm::vec3& x, const 
 // where G(x, y) exceeds the bound B, the fraction w = 1 − B/G of the radiance leaving y towards x was
 // lost: L(y→x) = Le(y) + ρ(y) · (direct(y) + clampedVpl(y) + residual(y)) in map units. With cosine
 // sampling (pdf cosθ/π) the estimator of the lost irradiance / π is w · L(y→x).
-glm::vec3 residualAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, Rng& rng, int depth) {
+glm::vec3 residualAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, Rng& rng, int depth,
+                     bool packets) {
   if (depth <= 0 || bound <= 0.0f) return glm::vec3(0.0f);
   const RayTracer& rt = in.rayTracer;
   glm::vec3 dir = cosineHemisphere(n, rng.uniform(), rng.uniform());
@@ -115,8 +117,8 @@ glm::vec3 residualAt(const BakeInputs& in, float bound, const glm::vec3& x, cons
   glm::vec3 albedo = rt.albedoAt(hit);
   glm::vec3 reflected(0.0f);
   if (albedo != glm::vec3(0.0f))
-    reflected = directAt(in, hit.position, ny) + vplSumAt(in, bound, hit.position, ny) +
-                residualAt(in, bound, hit.position, ny, rng, depth - 1);
+    reflected = directAt(in, hit.position, ny) + vplSumAt(in, bound, hit.position, ny, packets) +
+                residualAt(in, bound, hit.position, ny, rng, depth - 1, packets);
   return w * (Le + albedo * reflected);
 }
 
@@ -130,10 +132,11 @@ PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const gl
   if (in.eval.includeDirect) s.direct = directAt(in, x, n);
   if (in.eval.includeVpls) {
     float bound = clampBoundFor(in);
-    s.vpl = vplSumAt(in, bound, x, n);
+    s.vpl = vplSumAt(in, bound, x, n, options.packets);
     if (in.eval.biasCompensation && bound > 0.0f) {
       int k = std::max(1, options.compensationRays);
-      for (int i = 0; i < k; ++i) s.compensation += residualAt(in, bound, x, n, rng, options.compensationDepth);
+      for (int i = 0; i < k; ++i)
+        s.compensation += residualAt(in, bound, x, n, rng, options.compensationDepth, options.packets);
       s.compensation /= static_cast<float>(k);
     }
   }
@@ -184,7 +187,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
           Rng rng(hashSeed(options.seed, static_cast<uint64_t>(ts.page), s));
           glm::vec3 c(0.0f);
           int k = std::max(1, options.compensationRays);
-          for (int i = 0; i < k; ++i) c += residualAt(in, bound, x, n, rng, options.compensationDepth);
+          for (int i = 0; i < k; ++i) c += residualAt(in, bound, x, n, rng, options.compensationDepth, options.packets);
           v += c / static_cast<float>(k);
         }
         slotValue[s] = v;

@@ -321,3 +321,50 @@ TEST(EmbreeBackend, PacketShadowRaysMatchSingleRays) {
   EXPECT_GT(lit, 32);                       // the lit room
   EXPECT_LT(lit, int(a[0].size()) - 32);   // and the dark one
 }
+
+// Punctual lights through the backend with shadows: a directional light (shadow ray to infinity) and a
+// spot light over a black floor with a black square occluder; lit texels exact, shadowed texels 0.
+TEST(EmbreeBackend, DirectionalAndSpotShadowsAreExact) {
+  Scene s;
+  int black = addMaterial(s, glm::vec3(0.0f));
+  addQuad(s, black, glm::vec3(-2, -2, 0), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0));
+  addQuad(s, black, glm::vec3(-0.25f, -0.25f, 1), glm::vec3(0.5f, 0, 0), glm::vec3(0, 0.5f, 0));  // occluder at z = 1
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = glm::normalize(glm::vec3(0.5f, 0.0f, -1.0f));
+  sun.intensity = 3.0f;
+  s.lights.push_back(sun);
+  Light spot;
+  spot.type = LightType::Spot;
+  spot.position = glm::vec3(0, 0, 3);
+  spot.direction = glm::vec3(0, 0, -1);
+  spot.intensity = 20.0f;
+  spot.innerConeAngle = 0.3f;
+  spot.outerConeAngle = 0.5f;
+  s.lights.push_back(spot);
+  std::vector<TexelSamples> t = {gridSamples(glm::vec3(-2, -2, 0), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0), 32, 32)};
+  WalkOptions w;
+  w.paths = 16;
+  Baked b = bakeWith(s, t, w, VplEvalOptions{}, true);
+  int shadowedSun = 0, shadowedSpot = 0;
+  for (size_t i = 0; i < b.maps[0].size(); ++i) {
+    glm::dvec3 x(glm::vec3(t[0].positionWeight[i]));
+    // Sun: the occluder's shadow is the square shifted by +0.5 in x (1 m above, direction 0.5 : −1).
+    bool sunBlocked = std::abs(x.x - 0.5) < 0.25 && std::abs(x.y) < 0.25;
+    double sunValue = sunBlocked ? 0.0 : 3.0 * (1.0 / std::sqrt(1.25)) / kPi;
+    // Spot from (0,0,3): the occluder at z = 1 shadows |x|,|y| < 0.375 on the floor.
+    bool spotBlocked = std::abs(x.x) < 0.375 && std::abs(x.y) < 0.375;
+    glm::dvec3 d = glm::dvec3(0, 0, 3) - x;
+    double r2 = glm::dot(d, d), c = d.z / std::sqrt(r2);
+    double cosO = std::cos(0.5), cosI = std::cos(0.3), tt = std::clamp((c - cosO) / (cosI - cosO), 0.0, 1.0);
+    double spotValue = spotBlocked ? 0.0 : 20.0 * tt * tt * c / r2 / kPi;
+    // Texels whose centre is within half a texel of a shadow edge are skipped (the edge crosses them).
+    auto nearEdge = [&](double a, double e) { return std::abs(std::abs(a) - e) < 0.07; };
+    if (nearEdge(x.x - 0.5, 0.25) || nearEdge(x.x, 0.375) || nearEdge(x.y, 0.25) || nearEdge(x.y, 0.375)) continue;
+    shadowedSun += sunBlocked;
+    shadowedSpot += spotBlocked;
+    EXPECT_NEAR(b.maps[0].texels[i].x, sunValue + spotValue, 1e-5 + 1e-5 * (sunValue + spotValue)) << "texel " << i;
+  }
+  EXPECT_GT(shadowedSun, 0);
+  EXPECT_GT(shadowedSpot, 0);
+}
