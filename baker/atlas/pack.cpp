@@ -217,13 +217,14 @@ class PageGrid {
     }
     return false;
   }
-  // Where to start looking: a chart at least as large (both box sides) as an earlier one found no room
-  // below that one's row, so it starts there (a heuristic for concave shapes; it only costs packing density).
+  // Where to start looking: an earlier chart about as large (both box sides ≥ 90% of it) found no room
+  // below its row, so this one starts there. A heuristic (shapes differ): it costs a little density
+  // (helmet 66.8% -> 64.5%) and halves the packing time of scenes with many similar charts.
   int searchStart(const Mask& m) const {
     const int lo = std::min(m.w, m.h), hi = std::max(m.w, m.h);
     int y = 0;
     for (const auto& r : placedRows_)
-      if (lo >= r[0] && hi >= r[1]) y = std::max(y, r[2]);
+      if (10 * lo >= 9 * r[0] && 10 * hi >= 9 * r[1]) y = std::max(y, r[2]);
     return y;
   }
   void place(const Mask& m, int x0, int y0) {
