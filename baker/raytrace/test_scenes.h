@@ -64,7 +64,8 @@ inline Light pointLight(glm::vec3 position, float intensity) {
 
 // A W×H grid of texel samples (supersample 1) over the rectangle p0 + [0,1]e1 + [0,1]e2, texel centres,
 // all valid, normal = normalize(e1 × e2). Texel (x, y) sits at p0 + (x+0.5)/W e1 + (y+0.5)/H e2.
-inline TexelSamples gridSamples(glm::vec3 p0, glm::vec3 e1, glm::vec3 e2, int W, int H, uint32_t primitive = 0) {
+// The samples name no triangle (primitive UINT32_MAX), so backends use the positions as given.
+inline TexelSamples gridSamples(glm::vec3 p0, glm::vec3 e1, glm::vec3 e2, int W, int H, uint32_t primitive = UINT32_MAX) {
   TexelSamples t;
   t.width = W;
   t.height = H;

@@ -124,6 +124,17 @@ glm::vec3 residualAt(const BakeInputs& in, float bound, const glm::vec3& x, cons
 
 float clampBoundFor(const BakeInputs& in) { return in.eval.includeVpls ? in.eval.clampBound : 0.0f; }
 
+// A texel sample's position moved ε into its triangle: samples snapped onto an edge (a texel centre
+// outside every triangle takes the nearest point) would otherwise start rays on the plane of the
+// neighbouring face at concave corners and see behind it.
+glm::vec3 samplePosition(const BakeInputs& in, const TexelSamples& ts, size_t s) {
+  glm::vec3 x(ts.positionWeight[s]);
+  if (s >= ts.primitive.size() || s >= ts.triangle.size()) return x;
+  uint32_t p = ts.primitive[s], t = ts.triangle[s];
+  if (p >= in.scene.primitives.size() || t >= in.scene.primitives[p].triangleCount()) return x;
+  return in.rayTracer.insetPoint(p, t, x);
+}
+
 }  // namespace
 
 PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Rng& rng,
@@ -173,14 +184,14 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
         size_t b1 = std::min(numVpls, b0 + block);
         for (size_t a = 0; a < active.size(); ++a) {
           size_t s = active[a];
-          glm::vec3 x(ts.positionWeight[s]), n(ts.normal[s]);
+          glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
           if (options.packets) gatherVplsPackets(in, bound, x, n, b0, b1, acc[a]);
           else gatherVpls(in, bound, x, n, b0, b1, acc[a]);
         }
       }
       for (size_t a = 0; a < active.size(); ++a) {
         size_t s = active[a];
-        glm::vec3 x(ts.positionWeight[s]), n(ts.normal[s]);
+        glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
         glm::vec3 v = acc[a].sum;
         if (in.eval.includeDirect) v += directAt(in, x, n);
         if (in.eval.includeVpls && in.eval.biasCompensation && bound > 0.0f) {

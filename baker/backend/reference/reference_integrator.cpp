@@ -114,6 +114,11 @@ std::vector<Lightmap> bakeReference(const BakeInputs& in, const ReferenceOptions
         if (!(ts.positionWeight[s].w > 0.0f)) continue;
         Rng rng(hashSeed(options.seed, static_cast<uint64_t>(ts.page), s));
         glm::vec3 x(ts.positionWeight[s]), n(ts.normal[s]);
+        // Moved ε into its triangle: a sample snapped onto an edge would start paths on the plane of the
+        // neighbouring face at concave corners.
+        if (s < ts.primitive.size() && s < ts.triangle.size() && ts.primitive[s] < in.scene.primitives.size() &&
+            ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
+          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
         glm::dvec3 sum(0.0), sum2(0.0);
         for (int k = 0; k < options.spp; ++k) {
           glm::dvec3 v(referencePathSample(in.scene, in.rayTracer, lights, x, n, rng, options));
