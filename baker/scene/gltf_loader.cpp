@@ -7,7 +7,7 @@
 #include <atomic>
 #include <cstring>
 #include <cmath>
-#include <future>
+#include <functional>
 #include <map>
 #include <thread>
 
@@ -31,6 +31,7 @@ using json = nlohmann::json;
 // out of bounds: the declared count cannot be a near miss.
 constexpr double kAbsurdFactor = 64.0;
 constexpr int kMaxNodeDepth = 1024;
+constexpr size_t kMaxNodeInstances = 1000000;
 
 // tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
 // material uses). EXR and unknown formats load too; they are simply recorded.
@@ -168,6 +169,7 @@ class Loader {
     for (size_t i = 0; i < model_.materials.size(); ++i) materialIndex(static_cast<int>(i), "scene");
     std::vector<int> roots = rootNodes();
     checkNodeGraph(roots);
+    checkInstanceCount(roots);
     for (int r : roots) visitNode(r, glm::mat4(1.0f), 0);
     if (scene_.triangleCount() == 0) {
       std::string why = std::to_string(scene_.stats.primitivesSkipped) + " point/line primitives skipped, " +
@@ -264,6 +266,23 @@ class Loader {
         }
       }
     }
+  }
+
+  // A node may have several parents (a DAG is not a cycle), so flattening can multiply instances:
+  // count them without expanding (memoised over the acyclic graph) and refuse absurd totals.
+  void checkInstanceCount(const std::vector<int>& roots) {
+    std::vector<double> count(model_.nodes.size(), -1.0);
+    std::function<double(int)> instances = [&](int n) {
+      if (count[n] >= 0.0) return count[n];
+      double c = 1.0;
+      for (int child : model_.nodes[n].children) c += instances(child);
+      return count[n] = c;
+    };
+    double total = 0.0;
+    for (int r : roots) total += instances(r);
+    if (total > static_cast<double>(kMaxNodeInstances))
+      invalid("absurd size: the node graph instantiates " + std::to_string(static_cast<unsigned long long>(std::min(total, 1e19))) + " nodes (more than " +
+              std::to_string(kMaxNodeInstances) + ")");
   }
 
   std::string nodeName(int n) const {

@@ -334,3 +334,26 @@ TEST(GltfLoader, DamagedHelmetCounts) {
   EXPECT_TRUE(s.materials[0].isEmissive());
   EXPECT_GE(s.materials[0].emissiveTexture, 0);
 }
+
+TEST(GltfLoader, SharedChildLatticeIsCappedNotExpanded) {
+  // 40 levels of two nodes, each the child of both nodes above: 2^40 paths, no cycle.
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  json nodes = json::array();
+  for (int level = 0; level < 40; ++level)
+    for (int k = 0; k < 2; ++k) {
+      json n = {{"mesh", 0}};
+      if (level + 1 < 40) n["children"] = {2 * (level + 1), 2 * (level + 1) + 1};
+      nodes.push_back(n);
+    }
+  doc.root["nodes"] = nodes;
+  doc.root["scenes"][0]["nodes"] = {0, 1};
+  auto dir = testFolder("loader_lattice");
+  writeDocument(doc, dir / "l.gltf");
+  try {
+    loadScene(dir / "l.gltf");
+    FAIL() << "expected InvalidData";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("absurd size"), std::string::npos) << e.what();
+  }
+}
