@@ -112,6 +112,11 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
         std::vector<ChartUv> done(work.size());
         std::vector<atlas::ChartCheck> checks(work.size());
         tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
+          if (work[i].faces.size() > 1 && !work[i].planarRegion &&
+              atlas::absoluteCurvature(mesh, work[i].faces) > paramOptions.maxAbsCurvature) {
+            checks[i] = atlas::ChartCheck::Stretched;  // hopeless: split without solving
+            return;
+          }
           checks[i] = atlas::parameterizeChart(mesh, work[i].faces, paramOptions, done[i]);
         });
         std::vector<atlas::ChartFaces> again;

@@ -270,6 +270,26 @@ ChartCheck checkChart(const AtlasMesh& mesh, const std::vector<std::array<uint32
 
 }  // namespace
 
+double absoluteCurvature(const AtlasMesh& mesh, const std::vector<uint32_t>& faces) {
+  std::unordered_map<uint32_t, double> angleSum;
+  std::unordered_map<uint32_t, uint8_t> onBoundary;
+  std::unordered_map<uint32_t, uint8_t> inChart;
+  for (uint32_t f : faces) inChart[f] = 1;
+  for (uint32_t f : faces) {
+    const auto& v = mesh.faceVertex[f];
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 a = mesh.vertexPos[v[k]], b = mesh.vertexPos[v[(k + 1) % 3]], c = mesh.vertexPos[v[(k + 2) % 3]];
+      angleSum[v[k]] += std::acos(std::clamp(glm::dot(glm::normalize(b - a), glm::normalize(c - a)), -1.0, 1.0));
+      const uint32_t g = mesh.faceNeighbour[f][k];
+      if (g == kNone || !inChart.count(g)) onBoundary[v[k]] = onBoundary[v[(k + 1) % 3]] = 1;
+    }
+  }
+  double total = 0.0;
+  for (const auto& [v, sum] : angleSum)
+    if (!onBoundary.count(v)) total += std::abs(2.0 * 3.14159265358979323846 - sum);
+  return total;
+}
+
 const char* toString(ChartCheck check) {
   switch (check) {
     case ChartCheck::Valid: return "valid";

@@ -17,6 +17,7 @@ struct ParamOptions {
   double stretchHigh = 1.12;    // ... and p95 ≤ this
   double minAreaRatio = 1e-3;   // a face whose relative UV area is below this counts as zero-area
   double arapHopeless = 10.0;   // skip ARAP when the conformal map's p95/p5 area ratio exceeds this (it will be split)
+  double maxAbsCurvature = 60.0;  // radians of Σ|angle deficit|; above it a chart is split unsolved (bunny: none above 53 passed)
   int arapIterations = 5;       // as-rigid-as-possible rounds after LSCM (0: conformal only)
 };
 
@@ -37,6 +38,10 @@ struct ChartUv {
 // Parameterises the faces (an edge-connected chart) and checks the result.
 ChartCheck parameterizeChart(const AtlasMesh& mesh, const std::vector<uint32_t>& faces,
                              const ParamOptions& options, ChartUv& out);
+
+// Σ |2π − angle sum| over the chart's interior vertices (radians): how far it is from developable.
+// Scale-free; charts far above what passes the checks are bisected before any solve.
+double absoluteCurvature(const AtlasMesh& mesh, const std::vector<uint32_t>& faces);
 
 // Signed UV area of a face of the chart (positive = same winding as in 3D).
 double uvArea(const ChartUv& chart, size_t face);
