@@ -1,5 +1,7 @@
 #include "atlas/pack.h"
 
+#include "common/error.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -294,6 +296,8 @@ double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<
           bestTurn = t;
         }
       }
+      if (bestTurn < 0 && pages[size_t(p)].usedHeight() == 0)  // cannot happen: charts are scaled to fit a page
+        throw Error(ErrorCode::InvalidData, "", "atlas: a chart does not fit an empty page");
       if (bestTurn >= 0) {
         pages[size_t(p)].place(masks[c][size_t(bestTurn)], bestX, bestY);
         placement[c] = {p, bestTurn, bestX, bestY};
