@@ -223,3 +223,28 @@ TEST(BakeCommand, DefaultBackendIsGlAndAgreesWithEmbree) {
               d["maxError"].get<double>());
   EXPECT_LT(d["relativeRmse"].get<double>(), 1e-3);  // direct light only: both exact up to shadow-map bias
 }
+
+TEST(BakeCommand, ReferenceBackendReportsItsSamplesAndMatchesTheClosedForm) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("reference");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir) +
+                          " --backend reference --spp 4 --texels-per-unit 2 --no-gltf",
+                      &log),
+            0)
+      << log;
+  nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "report.json"));
+  EXPECT_EQ(report["backend"], "reference");
+  EXPECT_EQ(report["reference"]["spp"].get<int>(), 4);
+  // Nothing faces the plane: every path's light is the exact next-event term, so no noise.
+  EXPECT_LT(report["reference"]["relativeStandardError"].get<double>(), 1e-4);
+  Lightmap m = readExr(dir / "lightmap_0.exr");
+  expectFinite(m);
+  double peak = 0.0;
+  for (const auto& t : m.texels) peak = std::max(peak, double(t.x));
+  // The brightest texel centre is within half a texel (s) of the foot of the light on each axis:
+  // between I·h/(π r³) at r = sqrt(1 + 2 s²) and the value right under the light, I/π.
+  double s = 0.5 / report["atlas"]["texelsPerUnit"].get<double>();
+  EXPECT_LE(peak, 10.0 / M_PI * 1.0001);
+  EXPECT_GE(peak, 10.0 / (M_PI * std::pow(1.0 + 2 * s * s, 1.5)) * 0.9999);
+}
