@@ -14,6 +14,11 @@
 int main(int argc, char** argv) {
   using namespace irbake;
   std::vector<std::string> args(argv + 1, argv + argc);
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") {
+      std::fputs(view::viewerUsage().c_str(), stdout);
+      return 0;
+    }
   try {
     view::ViewerOptions options = view::parseViewerOptions(args);
     view::ViewerScene scene = view::loadViewerScene(options.scene);
