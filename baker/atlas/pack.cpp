@@ -276,7 +276,7 @@ struct Placement {
 
 // Packs masks (in order) into pages of the given width; returns the total page area.
 double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<size_t>& order, int width, int maxPage,
-               int padding, std::vector<Placement>& placement, std::vector<PageGrid>& pages) {
+               int padding, double giveUpArea, std::vector<Placement>& placement, std::vector<PageGrid>& pages) {
   pages.clear();
   placement.assign(masks.size(), Placement{});
   for (size_t c : order) {
@@ -304,6 +304,10 @@ double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<
         break;
       }
     }
+    // Pages only grow: once this trial is larger than the best one so far it cannot win.
+    double partial = 0.0;
+    for (const PageGrid& g : pages) partial += double(roundUp4(g.usedWidth())) * roundUp4(g.usedHeight());
+    if (partial >= giveUpArea) return 1e300;
   }
   double area = 0.0;
   for (const PageGrid& g : pages) area += double(roundUp4(g.usedWidth())) * roundUp4(g.usedHeight());
@@ -377,7 +381,7 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
   std::vector<Placement> best, placement;
   std::vector<PageGrid> grids, bestGrids;
   for (int w : widths) {
-    const double area = packAll(masks, order, w, limit, pad, placement, grids);
+    const double area = packAll(masks, order, w, limit, pad, bestArea, placement, grids);
     if (area < bestArea) {
       bestArea = area;
       best = placement;
