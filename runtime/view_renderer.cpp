@@ -210,6 +210,7 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
                                  ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
                                  : 0);
 
+  uint32_t chartBase = 0, nextChartBase = 0;
   for (const Primitive& p : v.scene.primitives) {
     if (p.indices.empty()) continue;
     Impl::GpuPrimitive g;
@@ -237,6 +238,7 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
         if (p.lightmap.width > 0) g.lightmapSize = glm::vec2(p.lightmap.width, p.lightmap.height);
         break;
     }
+    // Chart ids run on across primitives so chart 0 of every primitive does not share one colour.
     const std::vector<uint32_t> charts = chartIds(p);
     std::vector<Vertex> verts(p.positions.size());
     for (size_t i = 0; i < verts.size(); ++i) {
@@ -244,8 +246,10 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
       verts[i].normal = i < p.normals.size() ? p.normals[i] : glm::vec3(0, 1, 0);
       verts[i].uv0 = i < p.uv0.size() ? p.uv0[i] : glm::vec2(0.0f);
       verts[i].uv1 = i < p.uv1.size() ? p.uv1[i] : glm::vec2(0.0f);
-      verts[i].chart = static_cast<float>(charts[i]);
+      verts[i].chart = static_cast<float>(chartBase + charts[i]);
     }
+    for (uint32_t c : charts) nextChartBase = std::max(nextChartBase, chartBase + c + 1);
+    chartBase = nextChartBase;
     glGenVertexArrays(1, &g.vao);
     glBindVertexArray(g.vao);
     glGenBuffers(1, &g.vbo);
