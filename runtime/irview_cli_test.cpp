@@ -7,6 +7,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -39,7 +41,8 @@ struct RunResult {
 
 RunResult run(const std::string& args, const std::string& prefix = "") {
   static int counter = 0;
-  fs::path log = workDir() / ("run_" + std::to_string(counter++) + ".log");
+  // One log per process and call: ctest runs the tests of this file as parallel processes.
+  fs::path log = workDir() / ("run_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".log");
   std::string cmd = prefix + "\"" IRVIEW_EXE "\" " + args + " > \"" + log.string() + "\" 2>&1";
   int raw = std::system(cmd.c_str());
   RunResult r;
