@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include "export/gltf_export.h"
@@ -130,6 +131,42 @@ TEST(BakedView, ExportedGltfShowsTheSameLightAsTheBake) {
   EXPECT_LT(exrDiff, 1e-4f);  // float pages: the same numbers
   EXPECT_LT(pngDiff, 0.03f);  // 8-bit PNG × intensity
   RecordProperty("pngMaxDifference", std::to_string(pngDiff));
+}
+
+// The whole path a user takes: bake, export, `irview --camera 0 --screenshot` (headless), read the PNG.
+TEST(BakedView, IrviewScreenshotOfExportedCornellBox) {
+  BakeResult baked = bake(samples::makeCornellBox(), smallBake(512, 16.0f));
+  const char* dir = std::getenv("IRBAKE_BINARY_DIR");
+  const std::filesystem::path out = std::filesystem::path(dir ? dir : ".") / "runtime_bake_test" / "cornell";
+  ExportOptions ex;
+  ex.output = out / "cornell_box.gltf";
+  exportGltf(baked.scene, baked.maps, ex);
+  const std::filesystem::path png = out / "cornell_camera0.png";
+  std::filesystem::remove(png);
+  const std::string cmd = "\"" IRVIEW_EXE "\" \"" + ex.output.string() + "\" --camera 0 --width 128 --height 128 --screenshot \"" +
+                          png.string() + "\" > \"" + (out / "irview.log").string() + "\" 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  auto in = OIIO::ImageInput::open(png.string());
+  ASSERT_TRUE(in) << png;
+  const int w = in->spec().width, h = in->spec().height, nc = in->spec().nchannels;
+  ASSERT_EQ(w, 128);
+  ASSERT_EQ(h, 128);
+  std::vector<unsigned char> px(static_cast<size_t>(w) * h * nc);
+  ASSERT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()));
+  auto band = [&](int x0, int x1) {
+    glm::dvec3 s(0.0);
+    int n = 0;
+    for (int y = h * 2 / 5; y < h * 3 / 5; ++y)
+      for (int x = x0; x < x1; ++x, ++n)
+        for (int c = 0; c < 3; ++c) s[c] += px[(static_cast<size_t>(y) * w + x) * nc + c];
+    return s / double(n);
+  };
+  double mean = 0.0;
+  for (unsigned char v : px) mean += v;
+  EXPECT_GT(mean / px.size(), 20.0) << "screenshot is black";
+  glm::dvec3 left = band(w / 20, w / 8), right = band(w - w / 8, w - w / 20);
+  EXPECT_GT(left.r, 1.5 * left.g) << "left wall not red";   // sRGB-encoded: ratios are smaller than in linear
+  EXPECT_GT(right.g, 1.3 * right.r) << "right wall not green";
 }
 
 }  // namespace
