@@ -194,7 +194,8 @@ int sceneBench(const std::vector<std::string>& args) {
   BakeInputs refInputs{scene, rt, texels, none, {}, {}};
   ReferenceOptions ro;
   ro.spp = spp;
-  const std::vector<Lightmap> reference = bakeReference(refInputs, ro, &refError);
+  // --spp 0: timings only (no reference, error columns empty), for texel counts a reference cannot reach here.
+  const std::vector<Lightmap> reference = spp > 0 ? bakeReference(refInputs, ro, &refError) : std::vector<Lightmap>{};
   const double refSeconds = sw.seconds();
   // Relative standard error of the reference itself (RMS of per-texel SE over RMS of the map).
   double se2 = 0, v2 = 0;
@@ -237,6 +238,17 @@ int sceneBench(const std::vector<std::string>& args) {
       double glVsEmbree = 0.0;
       if (std::string(backend) == "gl") glMaps = maps;
       else glVsEmbree = compareMaps(glMaps, maps, areas).relativeRmse;
+      if (reference.empty()) {
+        std::printf("  %-6s N=%5d (%6zu VPLs): backend %.2f s (shadow %.2f, accumulate %.2f), GL vs Embree %.4f\n", backend,
+                    n, vpls.vpls.size(), backendSeconds, st.shadowSeconds, st.accumulateSeconds, glVsEmbree);
+        std::fflush(stdout);
+        out << name << "," << scene.triangleCount() << "," << validTexels << "," << backend << "," << n << ","
+            << vpls.vpls.size() << ",,,," << walkSeconds << "," << backendSeconds << "," << glVsEmbree << ","
+            << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << "," << st.shadowCpuSeconds
+            << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << st.renderer
+            << "\"\n";
+        continue;
+      }
       const MapDifference d = compareMaps(maps, reference, areas);
       // The reference's own noise adds its variance to the squared error: remove it (area-weighted
       // mean of SE², same weights as compareMaps) so the figure estimates the error against the truth.

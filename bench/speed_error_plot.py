@@ -18,6 +18,8 @@ def main(src, dst):
     rows = list(csv.DictReader(open(src)))
     series = {}
     for r in rows:
+        if not r["relative_rmse_corrected"]:
+            continue  # timing-only rows (no reference)
         series.setdefault((r["scene"], r["backend"]), []).append(r)
     fig, ax = plt.subplots(figsize=(7, 5))
     markers = {"gl": "o", "embree": "s"}
