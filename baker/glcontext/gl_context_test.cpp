@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <vector>
 
 #include "common/error.h"
@@ -98,6 +99,22 @@ TEST(GlContext, RoutesKhrDebugMessages) {
   glEnable(GLenum(0xDEAD));
   EXPECT_THROW(checkGlError("glEnable(bad)"), Error);
   EXPECT_EQ(ctx.debugErrorCount(), errorsBefore + 1);
+}
+
+// The fallback path on its own: the EGL device platform (a GPU without a display; Mesa lists its
+// software device too). Skipped where the EGL has no device enumeration.
+TEST(GlContext, DevicePlatformAlone) {
+  GlContextOptions opt;
+  opt.platforms = {EglPlatform::Device};
+  std::unique_ptr<GlContext> ctx;
+  try {
+    ctx = std::make_unique<GlContext>(opt);
+  } catch (const Error& e) {
+    GTEST_SKIP() << "no EGL device platform here: " << e.what();
+  }
+  EXPECT_EQ(ctx->platform(), EglPlatform::Device);
+  EXPECT_GE(epoxy_gl_version(), 45);
+  std::printf("device renderer: %s\n", ctx->description().c_str());
 }
 
 TEST(GlContext, FailsWithBackendHintWhenNoPlatform) {
