@@ -31,7 +31,9 @@ BakeOptions smallBake(int paths, float texelsPerUnit) {
 
 // ρ = 0.5, Le = 0.5: the converged radiance is Le/(1−ρ) = 1 and every pixel shows ρ·map + Le = 1.
 TEST(BakedView, FurnaceSeenFromInsideIsOne) {
-  BakeResult baked = bake(samples::makeFurnace(0.5f, 0.5f), smallBake(4096, 4.0f));
+  BakeOptions options = smallBake(4096, 4.0f);
+  options.eval.biasCompensation = true;  // the clamp's lost energy sits along the cube's edges
+  BakeResult baked = bake(samples::makeFurnace(0.5f, 0.5f), options);
   ViewerScene v = makeViewerScene(std::move(baked.scene), std::move(baked.maps));
   EXPECT_TRUE(v.warnings.empty());
   GlContext gl;
