@@ -68,14 +68,15 @@ GLuint uploadColorTexture(const Texture& t) {
   return tex;
 }
 
-// Light maps: full-range float, bilinear, no mipmaps (a coarser level would mix in the padding
-// between charts), clamped at the page edge.
+// Light maps: half float (range to 65504, 11-bit mantissa: 0.05% relative, far below what a display
+// shows) — llvmpipe filters RGBA16F markedly faster than RGB32F (Cornell frame 19.9 → 16.1 ms);
+// bilinear, no mipmaps (a coarser level would mix in the padding between charts), clamped at the page edge.
 GLuint uploadLightmap(int width, int height, GLenum format, const void* data) {
   GLuint tex = 0;
   glGenTextures(1, &tex);
   glBindTexture(GL_TEXTURE_2D, tex);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  GLenum internal = format == GL_RGB ? GL_RGB32F : GL_RGBA32F;
+  GLenum internal = GL_RGBA16F;
   glTexImage2D(GL_TEXTURE_2D, 0, internal, width, height, 0, format, GL_FLOAT, data);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
