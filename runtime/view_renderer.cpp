@@ -4,11 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 
 #include <epoxy/gl.h>
 
 #include "common/error.h"
-#include "shaders.h"
+#include "glcontext/gl_program.h"
 
 namespace irbake::view {
 namespace {
@@ -21,28 +22,6 @@ void throwOnGlError(const char* what) {
     std::snprintf(buf, sizeof buf, "0x%04x", first);
     throw Error(ErrorCode::Gl, "", std::string(what) + ": GL error " + buf);
   }
-}
-
-// defines: lines inserted after the #version line of the file.
-GLuint compileShader(GLenum type, const std::string& file, const std::string& defines = "") {
-  std::string src = shaderSource(file);
-  if (!defines.empty()) {
-    size_t eol = src.find('\n');
-    src.insert(eol == std::string::npos ? src.size() : eol + 1, defines);
-  }
-  GLuint s = glCreateShader(type);
-  const char* p = src.c_str();
-  glShaderSource(s, 1, &p, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {0};
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    glDeleteShader(s);
-    throw Error(ErrorCode::Gl, "shaders/" + file, std::string("compile failed: ") + log);
-  }
-  return s;
 }
 
 GLenum glWrap(WrapMode m) {
@@ -124,7 +103,7 @@ struct ViewRenderer::Impl {
   };
   const Scene& scene;
   GLuint program = 0;                      // the bound variant
-  std::map<int, GLuint> programs;          // (view mode, sRGB) variant → program
+  std::map<int, std::unique_ptr<GlProgram>> programs;  // (view mode, sRGB) variant → program
   std::map<GLuint, std::map<std::string, GLint>> uniformsByProgram;
   std::map<int, GLuint> colorTextures;     // Scene::textures index → GL texture
   std::map<int, GLuint> textureLightmaps;  // Scene::textures index → float light map texture
@@ -147,27 +126,16 @@ struct ViewRenderer::Impl {
     const int key = mode * 2 + (srgb ? 1 : 0);
     auto it = programs.find(key);
     if (it == programs.end()) {
-      const std::string defines =
-          "#define VIEW_MODE " + std::to_string(mode) + "\n#define ENCODE_SRGB " + (srgb ? "1" : "0") + "\n";
-      GLuint vs = compileShader(GL_VERTEX_SHADER, "view_mesh.vert");
-      GLuint fs = compileShader(GL_FRAGMENT_SHADER, "view_mesh.frag", defines);
-      GLuint p = glCreateProgram();
-      glAttachShader(p, vs);
-      glAttachShader(p, fs);
-      glLinkProgram(p);
-      glDeleteShader(vs);
-      glDeleteShader(fs);
-      GLint ok = 0;
-      glGetProgramiv(p, GL_LINK_STATUS, &ok);
-      if (!ok) {
-        char log[4096] = {0};
-        glGetProgramInfoLog(p, sizeof log, nullptr, log);
-        glDeleteProgram(p);
-        throw Error(ErrorCode::Gl, "shaders/view_mesh.frag", std::string("link failed: ") + log);
-      }
-      it = programs.emplace(key, p).first;
+      const std::vector<std::string> defines = {"#define VIEW_MODE " + std::to_string(mode),
+                                                std::string("#define ENCODE_SRGB ") + (srgb ? "1" : "0")};
+      it = programs
+               .emplace(key, std::make_unique<GlProgram>(
+                                 std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
+                                                          {GL_FRAGMENT_SHADER, {"view_mesh.frag"}}},
+                                 defines, "330 core"))
+               .first;
     }
-    program = it->second;
+    program = it->second->id();
     glUseProgram(program);
   }
 
@@ -297,7 +265,7 @@ ViewRenderer::~ViewRenderer() {
     glDeleteRenderbuffers(1, &I.colorRb);
     glDeleteRenderbuffers(1, &I.depthRb);
   }
-  for (auto& [key, p] : I.programs) glDeleteProgram(p);
+  I.programs.clear();
 }
 
 void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const DrawSettings& settings) {

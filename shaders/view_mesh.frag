@@ -1,4 +1,3 @@
-#version 330 core
 // irview shading: baseColor × lightmap + emissive, in linear radiance. The light map stores
 // irradiance/π, so a Lambertian surface of albedo ρ shows ρ·map (docs/units.md).
 // Compiled once per view (VIEW_MODE) and output (ENCODE_SRGB), both defined by the renderer: a

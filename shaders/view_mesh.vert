@@ -1,4 +1,3 @@
-#version 330 core
 // irview: world-space triangles (positions are already transformed by the loader).
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;

@@ -15,14 +15,15 @@ std::string joinNames(const std::vector<std::string>& files) {
 
 }  // namespace
 
-GlProgram::GlProgram(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines) {
+GlProgram::GlProgram(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines,
+                     const std::string& version) {
   std::vector<GLuint> shaders;
   auto cleanup = [&] {
     for (GLuint s : shaders) glDeleteShader(s);
   };
   program_ = glCreateProgram();
   for (const ShaderStage& stage : stages) {
-    std::string source = "#version 450 core\n";
+    std::string source = "#version " + version + "\n";
     for (const auto& d : defines) source += d + "\n";
     std::string names = joinNames(stage.files);
     try {

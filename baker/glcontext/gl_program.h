@@ -14,8 +14,10 @@ struct ShaderStage {
 
 class GlProgram {
  public:
-  // defines: lines placed after "#version 450 core" ("#define MAX_BATCH 16").
-  GlProgram(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines = {});
+  // defines: lines placed after the #version line ("#define MAX_BATCH 16"). version: the GLSL
+  // version line's argument; the viewer's window asks for a 3.3 core context, hence "330 core".
+  GlProgram(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines = {},
+            const std::string& version = "450 core");
   ~GlProgram();
   GlProgram(const GlProgram&) = delete;
   GlProgram& operator=(const GlProgram&) = delete;
