@@ -79,6 +79,7 @@ std::vector<ChartUv> chartsFromUv1(const Primitive& prim, const AtlasMesh& mesh)
 
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.padding < 0) throw Error(ErrorCode::Usage, "", "atlas padding must be ≥ 0");
+  if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
   if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
   AtlasResult result;
   AtlasStats& stats = result.stats;
@@ -108,6 +109,10 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
       stats.secondsCharts += clock.seconds();
       clock.reset();
       // Parameterise every chart; a chart that fails a check is bisected and both halves redone.
+      // Bounded: a chart bisected maxSplitDepth times and still failing falls back to one planar
+      // chart per face (a single triangle always projects validly), with a warning.
+      std::vector<int> depth(work.size(), 0);
+      size_t fallbackFaces = 0;
       while (!work.empty()) {
         std::vector<ChartUv> done(work.size());
         std::vector<atlas::ChartCheck> checks(work.size());
@@ -120,9 +125,20 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
           checks[i] = atlas::parameterizeChart(mesh, work[i].faces, paramOptions, done[i]);
         });
         std::vector<atlas::ChartFaces> again;
+        std::vector<int> againDepth;
         for (size_t i = 0; i < work.size(); ++i) {
           if (checks[i] == atlas::ChartCheck::Valid) {
             charts.push_back(std::move(done[i]));
+            continue;
+          }
+          if (work[i].faces.size() > 1 && depth[i] >= std::max(0, options.maxSplitDepth)) {
+            // Safe fallback: every face its own planar chart, solved right here (no further rounds).
+            for (uint32_t f : work[i].faces) {
+              ChartUv single;
+              atlas::parameterizeChart(mesh, {f}, paramOptions, single);
+              charts.push_back(std::move(single));
+            }
+            fallbackFaces += work[i].faces.size();
             continue;
           }
           auto halves = atlas::bisectChart(mesh, work[i]);
@@ -131,11 +147,21 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
             continue;
           }
           ++stats.chartsSplit;
-          for (auto& h : halves) again.push_back(std::move(h));
+          for (auto& h : halves) {
+            again.push_back(std::move(h));
+            againDepth.push_back(depth[i] + 1);
+          }
         }
         work = std::move(again);
+        depth = std::move(againDepth);
       }
       stats.secondsParam += clock.seconds();
+      if (fallbackFaces) {
+        const std::string w = std::to_string(fallbackFaces) + " faces of \"" + prim.name + "\" still failed the chart checks after " +
+                              std::to_string(options.maxSplitDepth) + " bisections: mapped as one planar chart per face";
+        log::warn("atlas: " + w);
+        stats.warnings.push_back(w);
+      }
     }
     prims[p].chartCount = charts.size() - prims[p].firstChart;
     progress(0.6 * double(p + 1) / double(scene.primitives.size()));

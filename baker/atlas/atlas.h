@@ -14,6 +14,7 @@ struct AtlasOptions {
   int padding = 2;             // empty texels kept around every chart (bilinear-safe)
   int maxPageSize = 2048;      // largest page edge; more pages are opened when one is full
   bool keepUv1 = false;        // keep an input TEXCOORD_1 and only repack its islands
+  int maxSplitDepth = 24;      // bisections of one segmented chart before its faces become one planar chart each
   ProgressCallback progress;   // optional
 };
 

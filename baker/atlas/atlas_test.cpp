@@ -454,6 +454,56 @@ TEST(Atlas, ExportedTexcoord1LoadsBackWithItsPage) {
   expectValid(back, r, 2);  // the reloaded UVs pass the same checker
 }
 
+// A crumpled sheet (pseudo-random heights, fixed seed): its charts fail the checks and are bisected.
+Primitive crumpledSheet(int n) {
+  uint32_t state = 12345u;
+  auto next = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24);
+  };
+  std::vector<float> height(size_t(n + 1) * (n + 1));
+  for (float& h : height) h = 4.0f * next() / float(n);
+  return gridSurface("crumpled", n, n, false, false, [&](float u, float v) {
+    const int i = int(std::lround(u * n)), j = int(std::lround(v * n));
+    return glm::vec3(u, height[size_t(j) * (n + 1) + i] + 0.3f * std::sin(6.0f * u) * std::sin(5.0f * v), v);
+  });
+}
+
+TEST(Atlas, SplitDepthIsBoundedWithAPlanarPerFaceFallback) {
+  Scene a = sceneOf({crumpledSheet(24)});
+  const size_t triangles = a.triangleCount();
+  const AtlasResult free = unwrap(a, 256);
+  ASSERT_GT(free.stats.chartsSplit, 0u) << "the sheet must exercise the split loop";
+  expectValid(a, free, 2);
+
+  Scene b = sceneOf({crumpledSheet(24)});
+  AtlasOptions o;
+  o.texelsPerUnit = 256;
+  o.maxSplitDepth = 0;  // no bisection allowed: every failing chart takes the fallback
+  const AtlasResult capped = buildAtlas(b, o);
+  EXPECT_EQ(capped.stats.chartsSplit, 0u);
+  ASSERT_FALSE(capped.stats.warnings.empty());
+  EXPECT_NE(capped.stats.warnings.front().find("planar chart per face"), std::string::npos);
+  EXPECT_EQ(b.triangleCount(), triangles);
+  expectValid(b, capped, 2);
+}
+
+TEST(Atlas, SameInputGivesIdenticalUv1) {
+  std::vector<std::vector<glm::vec2>> runs;
+  for (int run = 0; run < 3; ++run) {
+    Scene s = sceneOf({crumpledSheet(24), uvSphere(0.5f, 48, 24), torus(1.0f, 0.3f, 48, 16)});
+    unwrap(s, 128);
+    std::vector<glm::vec2> uv;
+    for (const Primitive& p : s.primitives) uv.insert(uv.end(), p.uv1.begin(), p.uv1.end());
+    runs.push_back(std::move(uv));
+  }
+  ASSERT_FALSE(runs[0].empty());
+  for (int run = 1; run < 3; ++run) {
+    ASSERT_EQ(runs[run].size(), runs[0].size());
+    EXPECT_TRUE(std::equal(runs[run].begin(), runs[run].end(), runs[0].begin())) << "run " << run << " differs";
+  }
+}
+
 TEST(Atlas, RejectsBadOptions) {
   Scene s = sceneOf({cube(1.0f)});
   AtlasOptions o;
