@@ -134,6 +134,22 @@ bool leaks(const RayTracer& rt, const Scene& scene, const SurfacePoint& s, float
   return 2 * backHits > kLeakRays;
 }
 
+// A nearest point lies on the triangle's border, and on a concave edge (floor meeting wall) the VPL
+// geometry term is singular there: the clamp loses up to half the wall's light and compensation
+// recovers it with high variance. Pull the point kEdgePull texels (in uv1 space) towards the
+// centroid, never past it, so it stays on the triangle but off the edge.
+constexpr float kEdgePull = 0.5f;
+glm::vec2 pullInside(const RasterTriangle& t, glm::vec2 b) {
+  glm::vec2 p = t.t0 * (1.0f - b.x - b.y) + t.t1 * b.x + t.t2 * b.y;
+  glm::vec2 c = (t.t0 + t.t1 + t.t2) / 3.0f;
+  glm::vec2 toC = c - p;
+  float len = glm::length(toC);
+  if (!(len > 1e-6f)) return b;
+  float step = std::min(kEdgePull, len);
+  glm::vec2 q = p + toC * (step / len);
+  return barycentric(t, q);
+}
+
 TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, int S) {
   TexelSamples ts;
   ts.page = page;
@@ -186,6 +202,7 @@ TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, 
             }
           float d;
           glm::vec2 b = nearestBarycentric(t, glm::vec2(x + 0.5f, y + 0.5f), d);
+          b = pullInside(t, b);
           if (d < nearestDistance[texel]) {
             nearestDistance[texel] = d;
             nearestPrim[texel] = pi;

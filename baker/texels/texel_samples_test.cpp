@@ -101,9 +101,14 @@ TEST(TexelSamples, ConservativeCoverageUsesTheNearestPointOnTheTriangle) {
     for (int x = 0; x < 16; ++x) {
       size_t i = y * 16 + x;
       EXPECT_EQ(ts.covered[i], x + y <= 15 ? 1 : 0) << x << "," << y;
-      if (x + y == 15) {  // centre sum 16 → moved by (−0.1, −0.1) texels onto x + y = 15.8
-        EXPECT_NEAR(ts.positionWeight[i].x * 16.0f, x + 0.4f, 1e-4f);
-        EXPECT_NEAR(ts.positionWeight[i].y * 16.0f, y + 0.4f, 1e-4f);
+      if (x + y == 15) {
+        // Centre sum 16 → nearest point (x + 0.4, y + 0.4) on x + y = 15.8, then pulled half a texel
+        // towards the centroid (15.8/3, 15.8/3), off the edge.
+        const glm::vec2 nearest(x + 0.4f, y + 0.4f), centroid(15.8f / 3.0f);
+        const glm::vec2 expected = nearest + 0.5f * glm::normalize(centroid - nearest);
+        EXPECT_NEAR(ts.positionWeight[i].x * 16.0f, expected.x, 1e-3f);
+        EXPECT_NEAR(ts.positionWeight[i].y * 16.0f, expected.y, 1e-3f);
+        EXPECT_LT(ts.positionWeight[i].x * 16.0f + ts.positionWeight[i].y * 16.0f, 15.8f - 0.2f);  // off the edge
       } else if (x + y < 15) {
         EXPECT_NEAR(ts.positionWeight[i].x * 16.0f, x + 0.5f, 1e-4f);
       } else {
