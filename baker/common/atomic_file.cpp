@@ -41,6 +41,9 @@ void writeAllAtomically(const std::vector<PendingFile>& files) {
     std::error_code ec;
     std::filesystem::rename(temps[i], files[i].finalPath, ec);
     if (ec) {
+      // The set is all or nothing: the files already renamed go too, with the remaining temps.
+      std::error_code ignored;
+      for (size_t j = 0; j < i; ++j) std::filesystem::remove(files[j].finalPath, ignored);
       cleanup();
       throw Error(ErrorCode::Io, files[i].finalPath.string(), "cannot rename temp file: " + ec.message());
     }

@@ -93,3 +93,17 @@ TEST(Error, MessageNamesFileAndExitCodesDiffer) {
   }
   EXPECT_EQ(codes.size(), 8u);
 }
+
+TEST(AtomicFile, RenameFailingHalfWayLeavesNoFile) {
+  fs::path dir = scratch("rename").parent_path() / "rename";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "blocker");  // a non-empty folder where the second file should go
+  std::ofstream(dir / "blocker" / "keep") << "x";
+  std::vector<PendingFile> files = {
+      {dir / "a.bin", [](const fs::path& t) { std::ofstream(t) << "a"; }},
+      {dir / "blocker", [](const fs::path& t) { std::ofstream(t) << "b"; }},
+  };
+  EXPECT_THROW(writeAllAtomically(files), Error);
+  EXPECT_FALSE(fs::exists(dir / "a.bin")) << "first file of a failed set left behind";
+  EXPECT_EQ(filesIn(dir), 1u) << "temp files left behind";  // only the blocker folder
+}
