@@ -26,6 +26,15 @@ struct KahanSum {
   }
 };
 
+// The clamped map value of VPL v at (x, n) before visibility; false when it cannot contribute
+// (behind either surface, or no power). Shared by the packet and single-ray gathers.
+bool unshadowedVplValue(const Vpl& v, float bound, const glm::vec3& x, const glm::vec3& n, glm::vec3& value) {
+  float g = vplGeometryTerm(x, n, v.position, v.normal);
+  if (g <= 0.0f) return false;
+  value = vplMapValue(v.power, clampGeometryTerm(g, bound));
+  return value.x > 0.0f || value.y > 0.0f || value.z > 0.0f;
+}
+
 // Adds the VPLs [begin, end) seen from (x, n) into acc, tracing the shadow rays in packets of 8.
 void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
                        size_t end, KahanSum& acc) {
@@ -43,10 +52,8 @@ void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, co
   };
   for (size_t k = begin; k < end; ++k) {
     const Vpl& v = vpls[k];
-    float g = vplGeometryTerm(x, n, v.position, v.normal);
-    if (g <= 0.0f) continue;
-    glm::vec3 value = vplMapValue(v.power, clampGeometryTerm(g, bound));
-    if (value.x <= 0.0f && value.y <= 0.0f && value.z <= 0.0f) continue;
+    glm::vec3 value;
+    if (!unshadowedVplValue(v, bound, x, n, value)) continue;
     if (!in.rayTracer.visibilityRay(x, n, v.position, v.normal, rays[count])) {
       acc.add(value);  // closer than ε: visible
       continue;
@@ -63,10 +70,8 @@ void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm
   const auto& vpls = in.vpls.vpls;
   for (size_t k = begin; k < end; ++k) {
     const Vpl& v = vpls[k];
-    float g = vplGeometryTerm(x, n, v.position, v.normal);
-    if (g <= 0.0f) continue;
-    glm::vec3 value = vplMapValue(v.power, clampGeometryTerm(g, bound));
-    if (value.x <= 0.0f && value.y <= 0.0f && value.z <= 0.0f) continue;
+    glm::vec3 value;
+    if (!unshadowedVplValue(v, bound, x, n, value)) continue;
     if (!in.rayTracer.visible(x, n, v.position, v.normal)) continue;
     acc.add(value);
   }
