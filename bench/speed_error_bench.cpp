@@ -4,12 +4,17 @@
 // stages (shadow cube, accumulation) on a synthetic ~100k-triangle scene and a 1M-texel page.
 //
 //   speed_error_bench scene GLTF [--add GLB:scale:x,y,z]... [--page 256] [--ns 64,256,1024,4096]
-//                     [--spp 256] [--name NAME] [--csv OUT.csv]
+//                     [--spp 256] [--name NAME] [--csv OUT.csv] [--clamp-k 16] [--compensate]
+//                     [--backends gl,embree] [--ref-cache FILE]
+//     --clamp-k: k of deriveClampBound (larger = tighter clamp); --compensate: add the clamp residual
+//     (backend/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
+//     reference maps in FILE (raw floats) and reuse them when FILE matches the texel layout.
 //   speed_error_bench stages [--tris-div 91] [--texels 1024] [--vpls 64] [--csv OUT.csv]
 //
 // Rows are appended to the CSV (header written when the file is new). Times are wall-clock seconds
 // on whatever machine runs it, plus process CPU seconds for the GL stages (load-independent).
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,6 +22,7 @@
 #include <vector>
 
 #include "atlas/atlas.h"
+#include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/gl/gl_backend.h"
@@ -133,12 +139,58 @@ Scene furnishedRoom(int div, std::vector<TexelSamples>& texels, int grid) {
   return s;
 }
 
+// Reference cache: spp, page count, then per page width, height, valid[], value[], error[] (raw floats).
+void writeReferenceCache(const std::string& path, int spp, const std::vector<Lightmap>& ref,
+                         const std::vector<Lightmap>& err) {
+  std::ofstream f(path, std::ios::binary);
+  const int pages = static_cast<int>(ref.size());
+  f.write(reinterpret_cast<const char*>(&spp), sizeof spp);
+  f.write(reinterpret_cast<const char*>(&pages), sizeof pages);
+  for (int p = 0; p < pages; ++p) {
+    f.write(reinterpret_cast<const char*>(&ref[p].width), sizeof(int));
+    f.write(reinterpret_cast<const char*>(&ref[p].height), sizeof(int));
+    f.write(reinterpret_cast<const char*>(ref[p].valid.data()), ref[p].valid.size());
+    f.write(reinterpret_cast<const char*>(ref[p].texels.data()), ref[p].texels.size() * sizeof(glm::vec3));
+    f.write(reinterpret_cast<const char*>(err[p].texels.data()), err[p].texels.size() * sizeof(glm::vec3));
+  }
+}
+
+bool readReferenceCache(const std::string& path, const std::vector<TexelSamples>& texels, int spp,
+                        std::vector<Lightmap>& ref, std::vector<Lightmap>& err) {
+  std::ifstream f(path, std::ios::binary);
+  int fileSpp = 0, pages = 0;
+  if (!f.read(reinterpret_cast<char*>(&fileSpp), sizeof fileSpp) || !f.read(reinterpret_cast<char*>(&pages), sizeof pages))
+    return false;
+  if (fileSpp != spp || pages != static_cast<int>(texels.size())) return false;
+  ref.assign(pages, {});
+  err.assign(pages, {});
+  for (int p = 0; p < pages; ++p) {
+    int w = 0, h = 0;
+    f.read(reinterpret_cast<char*>(&w), sizeof w);
+    f.read(reinterpret_cast<char*>(&h), sizeof h);
+    if (w != texels[p].width || h != texels[p].height) return false;
+    for (Lightmap* m : {&ref[p], &err[p]}) m->page = p, m->width = w, m->height = h;
+    ref[p].valid.resize(static_cast<size_t>(w) * h);
+    ref[p].texels.resize(ref[p].valid.size());
+    err[p].texels.resize(ref[p].valid.size());
+    f.read(reinterpret_cast<char*>(ref[p].valid.data()), ref[p].valid.size());
+    f.read(reinterpret_cast<char*>(ref[p].texels.data()), ref[p].texels.size() * sizeof(glm::vec3));
+    f.read(reinterpret_cast<char*>(err[p].texels.data()), err[p].texels.size() * sizeof(glm::vec3));
+    err[p].valid = ref[p].valid;
+  }
+  return static_cast<bool>(f);
+}
+
 int sceneBench(const std::vector<std::string>& args) {
   std::string gltf, name, csv = "speed_error.csv";
   std::vector<std::string> adds;
   int page = 256, spp = 256;
   std::vector<int> ns{64, 256, 1024, 4096};
   int roomDiv = 0;  // > 0: the furnished room instead of a glTF
+  double clampK = kClampVplsPerMean;
+  bool compensate = false;
+  std::vector<std::string> backends{"gl", "embree"};
+  std::string refCache;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto next = [&] {
@@ -151,6 +203,10 @@ int sceneBench(const std::vector<std::string>& args) {
     else if (a == "--name") name = next();
     else if (a == "--room") roomDiv = std::stoi(next());
     else if (a == "--csv") csv = next();
+    else if (a == "--clamp-k") clampK = std::stod(next());
+    else if (a == "--compensate") compensate = true;
+    else if (a == "--backends") backends = split(next(), ',');
+    else if (a == "--ref-cache") refCache = next();
     else if (a == "--ns") {
       ns.clear();
       for (const auto& n : split(next(), ',')) ns.push_back(std::stoi(n));
@@ -195,7 +251,13 @@ int sceneBench(const std::vector<std::string>& args) {
   ReferenceOptions ro;
   ro.spp = spp;
   // --spp 0: timings only (no reference, error columns empty), for texel counts a reference cannot reach here.
-  const std::vector<Lightmap> reference = spp > 0 ? bakeReference(refInputs, ro, &refError) : std::vector<Lightmap>{};
+  std::vector<Lightmap> reference;
+  if (spp > 0 && !refCache.empty() && readReferenceCache(refCache, texels, spp, reference, refError)) {
+    std::printf("reference read from %s\n", refCache.c_str());
+  } else if (spp > 0) {
+    reference = bakeReference(refInputs, ro, &refError);
+    if (!refCache.empty()) writeReferenceCache(refCache, spp, reference, refError);
+  }
   const double refSeconds = sw.seconds();
   // Relative standard error of the reference itself (RMS of per-texel SE over RMS of the map).
   double se2 = 0, v2 = 0;
@@ -210,19 +272,20 @@ int sceneBench(const std::vector<std::string>& args) {
   std::ofstream out = openCsv(csv,
                               "scene,triangles,texels,backend,paths,vpls,relative_rmse,relative_rmse_corrected,relative_bias,walk_s,backend_s,"
                               "gl_vs_embree,gl_setup_s,gl_shadow_s,gl_accumulate_s,gl_shadow_cpu_s,gl_accumulate_cpu_s,"
-                              "atlas_s,texels_s,reference_spp,reference_s,reference_rel_se,renderer");
+                              "atlas_s,texels_s,reference_spp,reference_s,reference_rel_se,renderer,clamp_k,compensation_s");
   for (int n : ns) {
     sw.reset();
     WalkOptions walk;
     walk.paths = n;
-    walk.seed = 1;
+    walk.seed = std::getenv("WALK_SEED") ? static_cast<uint32_t>(std::atoi(std::getenv("WALK_SEED"))) : 1u;
     const VplSet vpls = generateVpls(scene, rt, walk);
     const double walkSeconds = sw.seconds();
     VplEvalOptions eval;
-    eval.clampBound = deriveClampBound(scene, vpls);
+    eval.clampBound = deriveClampBound(scene, vpls, clampK);
     BakeInputs in{scene, rt, texels, vpls, eval, {}};
     std::vector<Lightmap> glMaps;  // kept to score GL against Embree on the same VPLs
-    for (const char* backend : {"gl", "embree"}) {
+    for (const std::string& backendName : backends) {
+      const char* backend = backendName.c_str();
       GlBakeStats st;
       sw.reset();
       std::vector<Lightmap> maps;
@@ -234,10 +297,22 @@ int sceneBench(const std::vector<std::string>& args) {
       } else {
         maps = bakeEmbree(in);
       }
+      double compensationSeconds = 0.0;
+      if (compensate) {
+        Stopwatch cw;
+        ClampCompensationOptions co;
+        co.seed = 1;
+        if (const char* e = std::getenv("COMP_RAYS")) co.rays = std::atoi(e);
+        if (const char* e = std::getenv("COMP_REFINE")) co.refineRays = std::atoi(e);
+        if (const char* e = std::getenv("COMP_FILTER")) co.filterRadius = std::atoi(e);
+        if (const char* e = std::getenv("COMP_FRACTION")) co.refineFraction = std::atof(e);
+        compensateClamp(in, maps, co);
+        compensationSeconds = cw.seconds();
+      }
       const double backendSeconds = sw.seconds();
       double glVsEmbree = 0.0;
       if (std::string(backend) == "gl") glMaps = maps;
-      else glVsEmbree = compareMaps(glMaps, maps, areas).relativeRmse;
+      else if (!glMaps.empty()) glVsEmbree = compareMaps(glMaps, maps, areas).relativeRmse;
       if (reference.empty()) {
         std::printf("  %-6s N=%5d (%6zu VPLs): backend %.2f s (shadow %.2f, accumulate %.2f), GL vs Embree %.4f\n", backend,
                     n, vpls.vpls.size(), backendSeconds, st.shadowSeconds, st.accumulateSeconds, glVsEmbree);
@@ -246,7 +321,7 @@ int sceneBench(const std::vector<std::string>& args) {
             << vpls.vpls.size() << ",,,," << walkSeconds << "," << backendSeconds << "," << glVsEmbree << ","
             << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << "," << st.shadowCpuSeconds
             << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << st.renderer
-            << "\"\n";
+            << "\"," << clampK << "," << compensationSeconds << "\n";
         continue;
       }
       const MapDifference d = compareMaps(maps, reference, areas);
@@ -267,15 +342,16 @@ int sceneBench(const std::vector<std::string>& args) {
       const double mse = d.rmse * d.rmse - wse / std::max(w, 1e-300);
       const double corrected = mse > 0 ? std::sqrt(mse) / rms : 0.0;
       if (glVsEmbree > 0) std::printf("  GL vs Embree on these VPLs: relative RMSE %.4f\n", glVsEmbree);
-      std::printf("  %-6s N=%5d (%6zu VPLs): rel RMSE %.4f (noise-corrected %.4f), bias %+.4f, walk %.2f s, backend %.2f s (shadow %.2f, accumulate %.2f)\n",
+      std::printf("  %-6s N=%5d (%6zu VPLs): rel RMSE %.4f (noise-corrected %.4f), bias %+.4f, walk %.2f s, backend %.2f s (shadow %.2f, accumulate %.2f, compensation %.2f)\n",
                   backend, n, vpls.vpls.size(), d.relativeRmse, corrected, d.relativeBias, walkSeconds, backendSeconds,
-                  st.shadowSeconds, st.accumulateSeconds);
+                  st.shadowSeconds, st.accumulateSeconds, compensationSeconds);
       std::fflush(stdout);
       out << name << "," << scene.triangleCount() << "," << validTexels << "," << backend << "," << n << ","
           << vpls.vpls.size() << "," << d.relativeRmse << "," << corrected << "," << d.relativeBias << "," << walkSeconds << ","
           << backendSeconds << "," << glVsEmbree << "," << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << ","
           << st.shadowCpuSeconds << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
-          << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"\n";
+          << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"," << clampK << ","
+          << compensationSeconds << "\n";
       out.flush();
     }
   }

@@ -20,7 +20,10 @@ const char* kBakeHelp =
     "  --texels-per-unit T      texels per metre (default: fit about one 1024 page)\n"
     "  --supersample S          S×S samples per texel (default 1)\n"
     "  --clamp B                geometry-term bound (1/m²); 0 = no clamp (default: derived from the scene)\n"
-    "  --bias-compensation      recover the clamped energy (Kollig & Keller 2004)\n"
+    "  --clamp-k K              derived clamp: no VPL adds more than 1/K of the mean (default 256 with\n"
+    "                           bias compensation, 16 without)\n"
+    "  --no-bias-compensation   keep the clamp's bias (default: recovered by a gather into the map,\n"
+    "                           after Kollig & Keller 2004; --comp-rays N, --comp-refine N rays per sample)\n"
     "  --seed K                 walk seed (default 0)\n"
     "  --spp N                  reference backend: paths per texel sample (default 256)\n"
     "  --sun DX,DY,DZ,E         add a directional light travelling along D with irradiance E (W/m²)\n"
@@ -42,8 +45,8 @@ int positiveInt(const ArgParser& a, const std::string& name, int fallback, int l
 int runBake(const Args& args) {
   ArgParser a(args,
               {"-o", "--output", "--backend", "--vpls", "--bounces", "--texels-per-unit", "--supersample", "--clamp",
-               "--seed", "--spp", "--report", "--sun"},
-              {"--help", "-h", "--bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
+               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine"},
+              {"--help", "-h", "--bias-compensation", "--no-bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
                "--quiet"});
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(kBakeHelp, stdout);
@@ -73,7 +76,12 @@ int runBake(const Args& args) {
     o.eval.clampBound = static_cast<float>(clamp);
     o.autoClamp = false;
   }
-  o.eval.biasCompensation = a.flag("--bias-compensation");
+  o.eval.biasCompensation = !a.flag("--no-bias-compensation");  // on by default; --bias-compensation kept
+  o.clampVplsPerMean = a.doubleOr("--clamp-k", 0.0);
+  if (o.clampVplsPerMean < 0.0 || o.clampVplsPerMean > 1e6)
+    throw Error(ErrorCode::Usage, "", "option --clamp-k must be in [0, 1e6] (0 = automatic)");
+  o.compensation.rays = positiveInt(a, "--comp-rays", o.compensation.rays, 1, 4096);
+  o.compensation.refineRays = positiveInt(a, "--comp-refine", o.compensation.refineRays, 0, 65536);
   o.referenceSpp = positiveInt(a, "--spp", o.referenceSpp, 1, 1 << 20);
   o.postDilate = !a.flag("--no-dilate");
   o.postSeams = !a.flag("--no-seams");

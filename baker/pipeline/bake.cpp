@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 
+#include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/gl/gl_backend.h"
@@ -132,13 +133,22 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
 
   VplEvalOptions eval = options.eval;
   bool clampDerived = false;
+  double clampK = 0.0;
   if (options.autoClamp && eval.clampBound == 0.0f) {
-    eval.clampBound = deriveClampBound(s, r.vpls);
+    clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
+             : eval.biasCompensation     ? kCompensatedClampVplsPerMean
+                                         : kClampVplsPerMean;
+    eval.clampBound = deriveClampBound(s, r.vpls, clampK);
     clampDerived = true;
   }
 
   stage.reset();
-  BakeInputs inputs{s, rt, texels, r.vpls, eval, options.progress};
+  // Bias compensation is its own stage after either VPL backend (backend/compensation), so the backends
+  // evaluate the clamped sum only.
+  const bool compensate = eval.biasCompensation && options.backend != BackendKind::Reference;
+  VplEvalOptions backendEval = eval;
+  if (compensate) backendEval.biasCompensation = false;
+  BakeInputs inputs{s, rt, texels, r.vpls, backendEval, options.progress};
   r.maps = runBackend(options, inputs, report);
   if (r.maps.size() != texels.size())
     throw Error(ErrorCode::InvalidData, s.sourcePath, "the backend returned " + std::to_string(r.maps.size()) +
@@ -148,6 +158,22 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
     if (r.maps[p].valid.size() != r.maps[p].size()) r.maps[p].valid = texels[p].valid;
   }
   seconds["backend"] = stage.seconds();
+
+  if (compensate) {
+    stage.reset();
+    ClampCompensationStats cs;
+    ClampCompensationOptions co = options.compensation;
+    co.seed = options.walk.seed;
+    compensateClamp(inputs, r.maps, co, &cs);
+    seconds["compensation"] = stage.seconds();
+    report["compensation"] = {{"rays", cs.raysTraced},
+                              {"samplesRefined", cs.samplesRefined},
+                              {"hitsKept", cs.hitsKept},
+                              {"addedFraction", cs.addedFraction},
+                              {"raysPerSample", cs.raysPerSample},
+                              {"filterRadius", cs.filterRadius},
+                              {"sweeps", co.sweeps}};
+  }
 
   stage.reset();
   PostOptions post;
@@ -196,6 +222,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
                     {"perBounce", perBounce},
                     {"seed", options.walk.seed}};
   report["eval"] = {{"clampBound", eval.clampBound},
+                    {"clampVplsPerMean", clampK},
                     {"clampDerived", clampDerived},
                     {"biasCompensation", eval.biasCompensation}};
   if (options.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;

@@ -8,6 +8,8 @@
 
 #include "atlas/atlas.h"
 #include "backend/bake_inputs.h"
+#include "backend/compensation/clamp_compensation.h"
+#include "backend/embree/geometry_term.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
@@ -17,13 +19,23 @@ namespace irbake {
 
 enum class BackendKind { Gl, Embree, Reference };
 
+// The default evaluation: derived clamp, bias compensation on, direct and VPLs.
+inline VplEvalOptions compensatedEval() {
+  VplEvalOptions e;
+  e.biasCompensation = true;
+  return e;
+}
+
 struct BakeOptions {
   BackendKind backend = BackendKind::Gl;  // gl (default), embree, reference
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
-  VplEvalOptions eval;                    // clamp (0 = derived from the scene), bias compensation
+  VplEvalOptions eval = compensatedEval();  // clamp (0 = derived from the scene), bias compensation (on)
+  ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
+  double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
+                                          // bias compensation, 16 without (docs/accuracy.md)
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams

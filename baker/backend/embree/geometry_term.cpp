@@ -29,7 +29,7 @@ PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, cons
   return c;
 }
 
-float deriveClampBound(const Scene& scene, const VplSet& vpls) {
+float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMean) {
   size_t n = 0;
   for (const Vpl& v : vpls.vpls)
     if (v.power.x > 0.0f || v.power.y > 0.0f || v.power.z > 0.0f) ++n;
@@ -40,7 +40,7 @@ float deriveClampBound(const Scene& scene, const VplSet& vpls) {
       area += 0.5 * glm::length(glm::cross(p.positions[p.indices[3 * t + 1]] - a, p.positions[p.indices[3 * t + 2]] - a));
     }
   if (n == 0 || area <= 0.0) return 0.0f;
-  return static_cast<float>(3.14159265358979323846 * static_cast<double>(n) / (kClampVplsPerMean * area));
+  return static_cast<float>(3.14159265358979323846 * static_cast<double>(n) / (vplsPerMean * area));
 }
 
 }  // namespace irbake

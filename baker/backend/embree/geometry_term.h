@@ -61,6 +61,6 @@ PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, cons
 // r_c = sqrt(k A / (π N)) ≈ 2.3 VPL spacings. The energy removed inside r_c (corners, contacts) is what
 // bias compensation recovers. Returns 0 (no clamp) without VPLs.
 constexpr double kClampVplsPerMean = 16.0;  // k above
-float deriveClampBound(const Scene& scene, const VplSet& vpls);
+float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMean = kClampVplsPerMean);
 
 }  // namespace irbake

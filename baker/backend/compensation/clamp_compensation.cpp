@@ -1,0 +1,288 @@
+#include "backend/compensation/clamp_compensation.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "common/progress.h"
+#include "texels/texel_filter.h"
+#include "vpl/sampling.h"
+
+namespace irbake {
+namespace {
+
+constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
+
+// A hit inside the clamp radius, kept for the sweeps: residual(slot) += Le + albedo ⊙ M(page, texel).
+// Le and albedo are already multiplied by w / (rays of the slot).
+struct KeptHit {
+  uint32_t slot = 0;
+  int32_t map = -1;          // index into maps; -1: the hit surface has no light map (Le only)
+  glm::vec2 texel{0.0f};     // continuous texel coordinates (u·W − ½, v·H − ½)
+  glm::vec3 emitted{0.0f};
+  glm::vec3 albedo{0.0f};
+};
+
+// Bilinear read of irradiance/π over the valid texels of a map; the nearest valid texel of the 3×3
+// neighbourhood when none of the four is valid (chart borders); 0 when none at all.
+glm::vec3 lookup(const Lightmap& m, const std::vector<glm::vec3>& value, glm::vec2 t) {
+  int x0 = static_cast<int>(std::floor(t.x)), y0 = static_cast<int>(std::floor(t.y));
+  float fx = t.x - x0, fy = t.y - y0;
+  glm::vec3 sum(0.0f);
+  float weight = 0.0f;
+  for (int dy = 0; dy < 2; ++dy)
+    for (int dx = 0; dx < 2; ++dx) {
+      int x = x0 + dx, y = y0 + dy;
+      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
+      size_t i = static_cast<size_t>(y) * m.width + x;
+      if (!m.valid[i]) continue;
+      float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) + 1e-6f;
+      sum += w * value[i];
+      weight += w;
+    }
+  if (weight > 0.0f) return sum / weight;
+  int cx = static_cast<int>(std::lround(t.x)), cy = static_cast<int>(std::lround(t.y));
+  float best = 1e30f;
+  glm::vec3 nearest(0.0f);
+  for (int y = cy - 1; y <= cy + 1; ++y)
+    for (int x = cx - 1; x <= cx + 1; ++x) {
+      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
+      size_t i = static_cast<size_t>(y) * m.width + x;
+      if (!m.valid[i]) continue;
+      float d = (x - t.x) * (x - t.x) + (y - t.y) * (y - t.y);
+      if (d < best) best = d, nearest = value[i];
+    }
+  return nearest;
+}
+
+}  // namespace
+
+void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options,
+                     ClampCompensationStats* stats) {
+  Stopwatch clock;
+  const float bound = in.eval.clampBound;
+  if (!in.eval.includeVpls || !(bound > 0.0f) || maps.size() != in.texels.size()) return;
+  const Scene& scene = in.scene;
+  const RayTracer& rt = in.rayTracer;
+
+  // Light-map page number → index into maps.
+  std::vector<int32_t> mapOfPage;
+  for (size_t i = 0; i < maps.size(); ++i) {
+    int page = maps[i].page;
+    if (page < 0) continue;
+    if (static_cast<size_t>(page) >= mapOfPage.size()) mapOfPage.resize(page + 1, -1);
+    mapOfPage[page] = static_cast<int32_t>(i);
+  }
+
+  // Round 1: trace, keep hits with w > 0. Per page, per tile of slots, one list (tiles own their slots).
+  struct Tile {
+    size_t page = 0, begin = 0, end = 0;
+    std::vector<KeptHit> hits;
+  };
+  std::vector<Tile> tiles;
+  constexpr size_t kTile = 256;
+  for (size_t p = 0; p < in.texels.size(); ++p)
+    for (size_t b = 0; b < in.texels[p].slotCount(); b += kTile)
+      tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}});
+
+  std::atomic<size_t> rays{0}, refined{0};
+  size_t activeSamples = 0;
+  for (const TexelSamples& ts : in.texels)
+    for (size_t s = 0; s < ts.slotCount(); ++s) activeSamples += ts.positionWeight[s].w > 0.0f;
+  int baseRays = std::max(1, options.rays);
+  if (options.rayBudget > 0 && activeSamples > 0)
+    baseRays = static_cast<int>(std::clamp<size_t>(options.rayBudget / activeSamples,
+                                                   static_cast<size_t>(std::max(1, options.minRays)),
+                                                   static_cast<size_t>(baseRays)));
+  const double rayScale = static_cast<double>(baseRays) / std::max(1, options.rays);
+  const int extraRays = static_cast<int>(std::lround(std::max(0, options.refineRays) * rayScale));
+  const int refineHits = static_cast<int>(std::ceil(options.refineFraction * baseRays));
+  // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
+  // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
+  // per-sample ray count is low.
+  const float clampRadius = 1.0f / std::sqrt(bound);
+  auto filterRadiusFor = [&](const TexelSamples& ts) {
+    if (options.filterRadius >= 0) return options.filterRadius;
+    if (baseRays >= 32) return 0;
+    const float h = texelSpacing(ts);
+    if (!(h > 0.0f)) return 0;
+    return static_cast<int>(std::min(2.0f, std::floor(0.05f * clampRadius / h)));
+  };
+  int filterRadius = 0;
+  // Traces `count` cosine rays from slot s of page p (a rotated Fibonacci lattice: well stratified over
+  // the hemisphere for any count) and appends the hits inside the clamp radius, not yet divided by the
+  // slot's ray count.
+  auto traceSlot = [&](size_t p, size_t s, int count, uint64_t round, std::vector<KeptHit>& out) {
+    const TexelSamples& ts = in.texels[p];
+    glm::vec3 n(ts.normal[s]);
+    glm::vec3 x(ts.positionWeight[s]);
+    if (s < ts.primitive.size() && ts.primitive[s] < scene.primitives.size())
+      x = rt.insetPoint(ts.primitive[s], ts.triangle[s], x);
+    const glm::vec3 origin = x + n * rt.epsilon();
+    Rng rng(hashSeed(options.seed, (static_cast<uint64_t>(ts.page) << 8) | round, s));
+    const double r1 = rng.uniform(), r2 = rng.uniform();
+    int kept = 0;
+    for (int i = 0; i < count; ++i) {
+      double u = std::fmod((i + 0.5) / count + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
+      glm::vec3 dir = cosineHemisphere(n, u, v);
+      RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
+      if (!hit.hit || hit.backFace) continue;
+      float cosX = glm::dot(n, dir), cosY = -glm::dot(hit.geometricNormal, dir);
+      glm::vec3 d = hit.position - x;
+      float r2 = glm::dot(d, d);
+      if (!(r2 > 0.0f) || cosX <= 0.0f || cosY <= 0.0f) continue;
+      float g = cosX * cosY / r2;
+      if (g <= bound) continue;
+      KeptHit k;
+      k.slot = static_cast<uint32_t>(s);
+      float w = 1.0f - bound / g;
+      const Primitive& prim = scene.primitives[hit.primitive];
+      k.emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
+      k.albedo = w * rt.albedoAt(hit);
+      int page = prim.lightmap.page;
+      if (page >= 0 && static_cast<size_t>(page) < mapOfPage.size() && mapOfPage[page] >= 0 &&
+          prim.uv1.size() == prim.positions.size()) {
+        const uint32_t* idx = &prim.indices[3 * static_cast<size_t>(hit.triangle)];
+        float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
+        glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
+        const Lightmap& m = maps[mapOfPage[page]];
+        k.map = mapOfPage[page];
+        k.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
+      }
+      out.push_back(k);
+      ++kept;
+    }
+    return kept;
+  };
+
+  // Round 1: every sample, baseRays each. raysOf = rays traced per slot (0: empty slot).
+  std::vector<std::vector<uint16_t>> raysOf(in.texels.size()), firstHits(in.texels.size());
+  for (size_t p = 0; p < in.texels.size(); ++p) {
+    raysOf[p].assign(in.texels[p].slotCount(), 0);
+    firstHits[p].assign(in.texels[p].slotCount(), 0);
+  }
+  tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+    Tile& tile = tiles[ti];
+    const TexelSamples& ts = in.texels[tile.page];
+    size_t traced = 0;
+    for (size_t s = tile.begin; s < tile.end; ++s) {
+      if (!(ts.positionWeight[s].w > 0.0f)) continue;
+      int k = traceSlot(tile.page, s, baseRays, 0, tile.hits);
+      traced += baseRays;
+      raysOf[tile.page][s] = static_cast<uint16_t>(baseRays);
+      firstHits[tile.page][s] = static_cast<uint16_t>(std::min(k, 65535));
+    }
+    rays += traced;
+  });
+
+  // Round 2: more rays where many first rays found clamped transport, within the same budget again.
+  size_t candidates = 0;
+  for (size_t p = 0; p < in.texels.size(); ++p)
+    for (size_t s = 0; s < firstHits[p].size(); ++s) candidates += firstHits[p][s] > 0 && firstHits[p][s] >= refineHits;
+  int extra = std::min(extraRays, 65535 - baseRays);
+  if (options.rayBudget > 0 && candidates > 0)
+    extra = static_cast<int>(std::min<size_t>(static_cast<size_t>(std::max(extra, 0)), options.rayBudget / candidates));
+  if (extra > 0 && candidates > 0) {
+    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+      Tile& tile = tiles[ti];
+      size_t traced = 0, refinedHere = 0;
+      for (size_t s = tile.begin; s < tile.end; ++s) {
+        const uint16_t h = firstHits[tile.page][s];
+        if (h == 0 || h < refineHits) continue;
+        traceSlot(tile.page, s, extra, 1, tile.hits);
+        traced += extra;
+        raysOf[tile.page][s] = static_cast<uint16_t>(raysOf[tile.page][s] + extra);
+        ++refinedHere;
+      }
+      rays += traced;
+      refined += refinedHere;
+    });
+  }
+  // Each hit stands for 1 / (rays of its slot) of the hemisphere.
+  tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+    Tile& tile = tiles[ti];
+    for (KeptHit& k : tile.hits) {
+      const float inv = 1.0f / static_cast<float>(std::max<uint16_t>(1, raysOf[tile.page][k.slot]));
+      k.emitted *= inv;
+      k.albedo *= inv;
+    }
+  });
+
+  // Sweeps: residual per slot from the current maps, folded into texels; the next sweep reads base + residual.
+  std::vector<std::vector<glm::vec3>> base(maps.size()), current(maps.size());
+  for (size_t p = 0; p < maps.size(); ++p) base[p] = current[p] = maps[p].texels;
+  std::vector<std::vector<glm::vec3>> slotResidual(maps.size());
+  for (size_t p = 0; p < maps.size(); ++p) slotResidual[p].assign(in.texels[p].slotCount(), glm::vec3(0.0f));
+  size_t kept = 0;
+  for (const Tile& t : tiles) kept += t.hits.size();
+
+  for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
+    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+      const Tile& tile = tiles[ti];
+      auto& res = slotResidual[tile.page];
+      for (size_t s = tile.begin; s < tile.end; ++s) res[s] = glm::vec3(0.0f);
+      for (const KeptHit& k : tile.hits) {
+        glm::vec3 L = k.emitted;
+        if (k.map >= 0) L += k.albedo * lookup(maps[k.map], current[k.map], k.texel);
+        res[k.slot] += L;
+      }
+    });
+    std::vector<std::vector<glm::vec3>> next = base;
+    for (size_t p = 0; p < maps.size(); ++p) {
+      const TexelSamples& ts = in.texels[p];
+      const Lightmap& m = maps[p];
+      const size_t layer = ts.layerSize();
+      const int layers = ts.supersample * ts.supersample;
+      std::vector<glm::vec3> residual(layer, glm::vec3(0.0f));
+      tbb::parallel_for(size_t(0), layer, [&](size_t t) {
+        if (t >= m.valid.size() || !m.valid[t]) return;
+        glm::vec3 sum(0.0f);
+        float weight = 0.0f;
+        for (int l = 0; l < layers; ++l) {
+          size_t s = static_cast<size_t>(l) * layer + t;
+          float w = ts.positionWeight[s].w;
+          if (!(w > 0.0f)) continue;
+          sum += w * slotResidual[p][s];
+          weight += w;
+        }
+        if (weight > 0.0f) residual[t] = sum / weight;
+      });
+      const int radius = filterRadiusFor(ts);
+      filterRadius = std::max(filterRadius, radius);
+      if (radius > 0) {
+        TexelFilterOptions fo;
+        fo.radius = radius;
+        residual = filterOnSurface(ts, residual, m.valid, fo);
+      }
+      for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
+        if (m.valid[t]) next[p][t] += residual[t];
+    }
+    current.swap(next);
+  }
+
+  double before = 0.0, added = 0.0;
+  for (size_t p = 0; p < maps.size(); ++p) {
+    for (size_t t = 0; t < maps[p].size(); ++t) {
+      if (!maps[p].valid[t]) continue;
+      glm::vec3 c = current[p][t];
+      if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;  // post's finite check reports
+      before += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
+      added += ((c - base[p][t]).x + (c - base[p][t]).y + (c - base[p][t]).z) / 3.0;
+      maps[p].texels[t] = c;
+    }
+  }
+  if (stats) {
+    stats->raysTraced = rays;
+    stats->samplesRefined = refined;
+    stats->hitsKept = kept;
+    stats->raysPerSample = baseRays;
+    stats->filterRadius = filterRadius;
+    stats->addedFraction = before > 0.0 ? added / before : 0.0;
+    stats->seconds = clock.seconds();
+  }
+}
+
+}  // namespace irbake

@@ -1,0 +1,30 @@
+// A geometry-aware box filter over a page's texels: smooths a per-texel estimate that is noisy but
+// spatially smooth on each surface (the clamp residual, interleaved VPL subsets) without mixing light
+// across surfaces: a neighbour counts only if it is valid, on a surface facing the same way and close
+// in world space (not just in the atlas, where unrelated charts can touch).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "texels/texel_samples.h"
+
+namespace irbake {
+
+struct TexelFilterOptions {
+  int radius = 1;               // window (2r+1)² texels
+  float minNormalCos = 0.95f;   // neighbour's normal within ≈ 18° of the centre's
+  float maxSpacings = 1.5f;     // neighbour at most (offset in texels) × this × texel spacing away in space
+};
+
+// World-space distance between horizontally or vertically adjacent valid texels of a page (median over
+// pairs on the same surface); 0 when the page has no such pair.
+float texelSpacing(const TexelSamples& ts);
+
+// values and valid: one per texel of the page (layer 0 positions/normals describe the texel). Invalid
+// texels are returned unchanged.
+std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector<glm::vec3>& values,
+                                       const std::vector<uint8_t>& valid, const TexelFilterOptions& options = {});
+
+}  // namespace irbake
