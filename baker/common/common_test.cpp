@@ -20,6 +20,13 @@ fs::path scratch(const std::string& name) {
   fs::remove(p);
   return p;
 }
+// An empty folder of its own (scratch() would try to remove a non-empty one left by an earlier run).
+fs::path scratchDir(const std::string& name) {
+  fs::path dir = fs::current_path() / "test_scratch" / "common" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
 size_t filesIn(const fs::path& dir) {
   size_t n = 0;
   for (auto& e : fs::directory_iterator(dir)) (void)e, ++n;
@@ -68,7 +75,7 @@ TEST(AtomicFile, WritesFinalNameOnlyOnSuccess) {
 }
 
 TEST(AtomicFile, FailureHalfWayLeavesNoFile) {
-  fs::path dir = scratch("set").parent_path() / "set";
+  fs::path dir = scratchDir("set");
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::vector<PendingFile> files = {
@@ -95,8 +102,7 @@ TEST(Error, MessageNamesFileAndExitCodesDiffer) {
 }
 
 TEST(AtomicFile, RenameFailingHalfWayLeavesNoFile) {
-  fs::path dir = scratch("rename").parent_path() / "rename";
-  fs::remove_all(dir);
+  fs::path dir = scratchDir("rename");
   fs::create_directories(dir / "blocker");  // a non-empty folder where the second file should go
   std::ofstream(dir / "blocker" / "keep") << "x";
   std::vector<PendingFile> files = {
