@@ -5,7 +5,7 @@
 //
 //   speed_error_bench scene GLTF [--add GLB:scale:x,y,z]... [--page 256] [--ns 64,256,1024,4096]
 //                     [--spp 256] [--name NAME] [--csv OUT.csv] [--clamp-k 16] [--compensate]
-//                     [--backends gl,embree] [--ref-cache FILE]
+//                     [--backends gl,embree] [--ref-cache FILE] [--interleave N]
 //     --clamp-k: k of deriveClampBound (larger = tighter clamp); --compensate: add the clamp residual
 //     (backend/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
 //     reference maps in FILE (raw floats) and reuse them when FILE matches the texel layout.
@@ -24,6 +24,7 @@
 #include "atlas/atlas.h"
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
+#include "backend/interleave/interleaved_sampling.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/gl/gl_backend.h"
 #include "backend/reference/reference_integrator.h"
@@ -191,6 +192,7 @@ int sceneBench(const std::vector<std::string>& args) {
   bool compensate = false;
   std::vector<std::string> backends{"gl", "embree"};
   std::string refCache;
+  int interleave = 1;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto next = [&] {
@@ -207,6 +209,7 @@ int sceneBench(const std::vector<std::string>& args) {
     else if (a == "--compensate") compensate = true;
     else if (a == "--backends") backends = split(next(), ',');
     else if (a == "--ref-cache") refCache = next();
+    else if (a == "--interleave") interleave = std::stoi(next());
     else if (a == "--ns") {
       ns.clear();
       for (const auto& n : split(next(), ',')) ns.push_back(std::stoi(n));
@@ -272,7 +275,7 @@ int sceneBench(const std::vector<std::string>& args) {
   std::ofstream out = openCsv(csv,
                               "scene,triangles,texels,backend,paths,vpls,relative_rmse,relative_rmse_corrected,relative_bias,walk_s,backend_s,"
                               "gl_vs_embree,gl_setup_s,gl_shadow_s,gl_accumulate_s,gl_shadow_cpu_s,gl_accumulate_cpu_s,"
-                              "atlas_s,texels_s,reference_spp,reference_s,reference_rel_se,renderer,clamp_k,compensation_s");
+                              "atlas_s,texels_s,reference_spp,reference_s,reference_rel_se,renderer,clamp_k,compensation_s,interleave");
   for (int n : ns) {
     sw.reset();
     WalkOptions walk;
@@ -290,12 +293,22 @@ int sceneBench(const std::vector<std::string>& args) {
       sw.reset();
       std::vector<Lightmap> maps;
       if (std::string(backend) == "gl") {
-        GlBackendOptions go;
-        go.stats = &st;
-        go.stageTimings = true;
-        maps = bakeGl(in, go);
+        maps = bakeInterleaved(in, interleave, [&](const BakeInputs& i) {
+          GlBakeStats one;
+          GlBackendOptions go;
+          go.stats = &one;
+          go.stageTimings = true;
+          auto m = bakeGl(i, go);
+          st.renderer = one.renderer;
+          st.setupSeconds += one.setupSeconds;
+          st.shadowSeconds += one.shadowSeconds;
+          st.accumulateSeconds += one.accumulateSeconds;
+          st.shadowCpuSeconds += one.shadowCpuSeconds;
+          st.accumulateCpuSeconds += one.accumulateCpuSeconds;
+          return m;
+        });
       } else {
-        maps = bakeEmbree(in);
+        maps = bakeInterleaved(in, interleave, [](const BakeInputs& i) { return bakeEmbree(i); });
       }
       double compensationSeconds = 0.0;
       if (compensate) {
@@ -321,7 +334,7 @@ int sceneBench(const std::vector<std::string>& args) {
             << vpls.vpls.size() << ",,,," << walkSeconds << "," << backendSeconds << "," << glVsEmbree << ","
             << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << "," << st.shadowCpuSeconds
             << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << st.renderer
-            << "\"," << clampK << "," << compensationSeconds << "\n";
+            << "\"," << clampK << "," << compensationSeconds << "," << interleave << "\n";
         continue;
       }
       const MapDifference d = compareMaps(maps, reference, areas);
@@ -351,7 +364,7 @@ int sceneBench(const std::vector<std::string>& args) {
           << backendSeconds << "," << glVsEmbree << "," << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << ","
           << st.shadowCpuSeconds << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
           << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"," << clampK << ","
-          << compensationSeconds << "\n";
+          << compensationSeconds << "," << interleave << "\n";
       out.flush();
     }
   }

@@ -24,6 +24,9 @@ const char* kBakeHelp =
     "                           bias compensation, 16 without)\n"
     "  --no-bias-compensation   keep the clamp's bias (default: recovered by a gather into the map,\n"
     "                           after Kollig & Keller 2004; --comp-rays N, --comp-refine N rays per sample)\n"
+    "  --interleave N|auto      interleaved sampling: each texel of an N×N block sees 1/N² of the VPLs,\n"
+    "                           then a filter on the surface mixes them (default auto: 1..4 from the texel\n"
+    "                           size and the clamp radius; 1 = every VPL everywhere)\n"
     "  --seed K                 walk seed (default 0)\n"
     "  --spp N                  reference backend: paths per texel sample (default 256)\n"
     "  --sun DX,DY,DZ,E         add a directional light travelling along D with irradiance E (W/m²)\n"
@@ -45,7 +48,7 @@ int positiveInt(const ArgParser& a, const std::string& name, int fallback, int l
 int runBake(const Args& args) {
   ArgParser a(args,
               {"-o", "--output", "--backend", "--vpls", "--bounces", "--texels-per-unit", "--supersample", "--clamp",
-               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine"},
+               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine", "--interleave"},
               {"--help", "-h", "--bias-compensation", "--no-bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
                "--quiet"});
   if (a.flag("--help") || a.flag("-h")) {
@@ -83,6 +86,7 @@ int runBake(const Args& args) {
   o.compensation.rays = positiveInt(a, "--comp-rays", o.compensation.rays, 1, 4096);
   o.compensation.refineRays = positiveInt(a, "--comp-refine", o.compensation.refineRays, 0, 65536);
   o.referenceSpp = positiveInt(a, "--spp", o.referenceSpp, 1, 1 << 20);
+  o.interleave = a.valueOr("--interleave", "auto") == "auto" ? 0 : positiveInt(a, "--interleave", 0, 1, 8);
   o.postDilate = !a.flag("--no-dilate");
   o.postSeams = !a.flag("--no-seams");
 

@@ -10,6 +10,8 @@
 #include "backend/embree/embree_backend.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/gl/gl_backend.h"
+#include "backend/interleave/interleaved_sampling.h"
+#include "glcontext/gl_context.h"
 #include "backend/reference/reference_integrator.h"
 #include "common/error.h"
 #include "common/log.h"
@@ -25,21 +27,47 @@ nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y
 // The backend stage. The GL engineer owns the GL line (options, stats); every backend returns one
 // Lightmap per texel page.
 std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& inputs, nlohmann::json& report) {
+  const int interleave =
+      options.interleave > 0 ? options.interleave : chooseInterleave(inputs.texels, inputs.eval.clampBound);
   switch (options.backend) {
     case BackendKind::Gl: {
-      GlBakeStats stats;
-      GlBackendOptions gl;
-      gl.stats = &stats;
-      std::vector<Lightmap> maps = bakeGl(inputs, gl);
-      report["renderer"] = stats.renderer;
-      report["gl"] = {{"setupSeconds", stats.setupSeconds},   {"shadowSeconds", stats.shadowSeconds},
-                      {"accumulateSeconds", stats.accumulateSeconds}, {"foldSeconds", stats.foldSeconds},
-                      {"passes", stats.passes},               {"facesRendered", stats.facesRendered},
-                      {"trianglesDrawn", stats.trianglesDrawn}};
+      // One context for every call (interleaved sampling makes n² + 1 of them).
+      GlContext context;
+      log::info("GL backend: " + context.description());
+      GlBakeStats total;
+      VplBackend gl = [&](const BakeInputs& in) {
+        GlBakeStats st;
+        GlBackendOptions go;
+        go.stats = &st;
+        go.context = &context;
+        std::vector<Lightmap> maps = bakeGl(in, go);
+        total.renderer = st.renderer;
+        total.setupSeconds += st.setupSeconds;
+        total.shadowSeconds += st.shadowSeconds;
+        total.accumulateSeconds += st.accumulateSeconds;
+        total.foldSeconds += st.foldSeconds;
+        total.passes += st.passes;
+        total.facesRendered += st.facesRendered;
+        total.trianglesDrawn += st.trianglesDrawn;
+        return maps;
+      };
+      InterleaveStats is;
+      std::vector<Lightmap> maps = bakeInterleaved(inputs, interleave, gl, &is);
+      report["renderer"] = total.renderer;
+      report["gl"] = {{"setupSeconds", total.setupSeconds},   {"shadowSeconds", total.shadowSeconds},
+                      {"accumulateSeconds", total.accumulateSeconds}, {"foldSeconds", total.foldSeconds},
+                      {"passes", total.passes},               {"facesRendered", total.facesRendered},
+                      {"trianglesDrawn", total.trianglesDrawn}};
+      report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
       return maps;
     }
-    case BackendKind::Embree:
-      return bakeEmbree(inputs);
+    case BackendKind::Embree: {
+      InterleaveStats is;
+      std::vector<Lightmap> maps =
+          bakeInterleaved(inputs, interleave, [](const BakeInputs& in) { return bakeEmbree(in); }, &is);
+      report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
+      return maps;
+    }
     case BackendKind::Reference: {
       ReferenceOptions ref;
       ref.spp = options.referenceSpp;

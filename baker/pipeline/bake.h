@@ -36,6 +36,8 @@ struct BakeOptions {
   bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)
+  int interleave = 0;                     // n: VPLs split over n×n texel classes (Keller & Heidrich 2001);
+                                          // 1 = off, 0 = automatic (chooseInterleave: 1…4)
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams

@@ -89,8 +89,9 @@ std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector
             const glm::vec3 d = glm::vec3(g.position[j]) - p;
             if (glm::dot(d, d) > reach * reach) continue;
           }
-          sum += values[j];
-          count += 1.0f;
+          const float w = options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
+          sum += w * values[j];
+          count += w;
         }
       }
       out[i] = sum / count;

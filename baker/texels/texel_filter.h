@@ -16,6 +16,8 @@ struct TexelFilterOptions {
   int radius = 1;               // window (2r+1)² texels
   float minNormalCos = 0.95f;   // neighbour's normal within ≈ 18° of the centre's
   float maxSpacings = 1.5f;     // neighbour at most (offset in texels) × this × texel spacing away in space
+  bool tent = false;            // weights (r+1−|dx|)(r+1−|dy|) instead of a box: with r = n−1 every
+                                // texel class (x mod n, y mod n) gets the same total weight
 };
 
 // World-space distance between horizontally or vertically adjacent valid texels of a page (median over

@@ -483,7 +483,7 @@ std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& o
     ctx = (owned = std::make_unique<GlContext>()).get();
   const double contextSeconds = contextTime.seconds();
   stats.renderer = ctx->description();
-  log::info("GL backend: " + stats.renderer);
+  if (!options.context) log::info("GL backend: " + stats.renderer);  // a caller passing a context logs it once
   std::vector<Lightmap> maps;
   {
     GlBaker baker(inputs, options, stats);

@@ -1,0 +1,41 @@
+// Interleaved sampling (Keller & Heidrich 2001) in light-map space, around any VPL backend.
+//
+// The texels of a page are split into n×n classes by (x mod n, y mod n); the VPLs into n² subsets
+// (per bounce, n² contiguous chunks in path order, power × bounce count / chunk count: each subset alone
+// is an unbiased estimate of the full sum, and a chunk of consecutive Halton paths stays stratified).
+// Class c evaluates only subset c, so every texel·VPL pair is evaluated once instead of n² times —
+// the accumulation cost per VPL drops by n² while every VPL still gets its shadow map once. A tent
+// filter of half-width n over the page then mixes the classes in equal parts (weights (n − |d|) per
+// axis give each class the same total weight), keeping only neighbours on the same surface
+// (texels/texel_filter.h): on a smooth VPL sum this recovers most of the full set's smoothness.
+// Only the VPL part is interleaved: punctual lights (exact, one shadow map) are evaluated on every
+// texel by a separate call and never filtered, so their shadows stay sharp.
+#pragma once
+#include <functional>
+#include <vector>
+
+#include "backend/bake_inputs.h"
+#include "backend/lightmap.h"
+
+namespace irbake {
+
+using VplBackend = std::function<std::vector<Lightmap>(const BakeInputs&)>;
+
+struct InterleaveStats {
+  int classes = 1;        // n²
+  int backendCalls = 0;   // n² VPL calls + 1 when there are punctual lights
+};
+
+// The texels of class (cx, cy) as their own pages ((W − cx)/n × (H − cy)/n, rounded up), same page ids.
+std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages, int n, int cx, int cy);
+
+// The automatic n: the class filter (half-width n texels) must stay well inside the scale on which the
+// clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (8 h)⌋, 1, maxN), h the median
+// texel spacing over the pages. Cornell box: 9.7k texels (h = 14 mm) → 2; 251k texels (2.8 mm) → 4.
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 4);
+
+// n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
+std::vector<Lightmap> bakeInterleaved(const BakeInputs& inputs, int n, const VplBackend& backend,
+                                      InterleaveStats* stats = nullptr);
+
+}  // namespace irbake
