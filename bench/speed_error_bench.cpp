@@ -5,7 +5,8 @@
 //
 //   speed_error_bench scene GLTF [--add GLB:scale:x,y,z]... [--page 256] [--ns 64,256,1024,4096]
 //                     [--spp 256] [--name NAME] [--csv OUT.csv] [--clamp-k 16] [--compensate]
-//                     [--backends gl,embree] [--ref-cache FILE] [--interleave N]
+//                     [--backends gl,embree] [--ref-cache FILE] [--interleave N|auto]
+//   speed_error_bench scene --room DIV [--room-grids] ...   the generated furnished room (atlas, or grids)
 //     --clamp-k: k of deriveClampBound (larger = tighter clamp); --compensate: add the clamp residual
 //     (backend/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
 //     reference maps in FILE (raw floats) and reuse them when FILE matches the texel layout.
@@ -91,11 +92,10 @@ void addModel(Scene& scene, const std::string& spec) {
   for (const Light& l : extra.lights) scene.lights.push_back(l);
 }
 
-// A furnished room (≥ 50k triangles) built here, with hand-made texel grids on the textured floor and
-// the back wall instead of an atlas (the atlas of a 50k-triangle scene takes minutes on 2 cores):
-// 4 × 3 × 4 m room of div×div-cell walls, a checker-textured floor, three boxes as furniture, an
-// emissive ceiling panel and a point light. Transport involves the whole scene; the error is scored
-// on the two grids.
+// A furnished room (≥ 50k triangles) built here: 4 × 3 × 4 m room of div×div-cell walls, a
+// checker-textured floor, three boxes as furniture, an emissive ceiling panel and a point light. By
+// default it goes through the atlas like any scene; --room-grids scores hand-made texel grids on the
+// floor and the back wall instead (the session-1 rows).
 Scene furnishedRoom(int div, std::vector<TexelSamples>& texels, int grid) {
   using namespace irbake::testing;
   Scene s;
@@ -188,6 +188,7 @@ int sceneBench(const std::vector<std::string>& args) {
   int page = 256, spp = 256;
   std::vector<int> ns{64, 256, 1024, 4096};
   int roomDiv = 0;  // > 0: the furnished room instead of a glTF
+  bool roomGrids = false;  // the room scored on hand-made grids (floor, back wall) instead of its atlas
   double clampK = kClampVplsPerMean;
   bool compensate = false;
   std::vector<std::string> backends{"gl", "embree"};
@@ -204,12 +205,16 @@ int sceneBench(const std::vector<std::string>& args) {
     else if (a == "--spp") spp = std::stoi(next());
     else if (a == "--name") name = next();
     else if (a == "--room") roomDiv = std::stoi(next());
+    else if (a == "--room-grids") roomGrids = true;
     else if (a == "--csv") csv = next();
     else if (a == "--clamp-k") clampK = std::stod(next());
     else if (a == "--compensate") compensate = true;
     else if (a == "--backends") backends = split(next(), ',');
     else if (a == "--ref-cache") refCache = next();
-    else if (a == "--interleave") interleave = std::stoi(next());
+    else if (a == "--interleave") {
+      const std::string v = next();
+      interleave = v == "auto" ? 0 : std::stoi(v);
+    }
     else if (a == "--ns") {
       ns.clear();
       for (const auto& n : split(next(), ',')) ns.push_back(std::stoi(n));
@@ -224,7 +229,8 @@ int sceneBench(const std::vector<std::string>& args) {
   for (const auto& spec : adds) addModel(scene, spec);
   const double loadSeconds = sw.seconds();
   sw.reset();
-  if (roomDiv <= 0) {
+  const bool grids = roomDiv > 0 && roomGrids;
+  if (!grids) {
     AtlasOptions atlas;
     atlas.targetPageSize = page;
     atlas.maxPageSize = std::max(page, 1024);
@@ -235,13 +241,13 @@ int sceneBench(const std::vector<std::string>& args) {
   RayTracer rt(scene);
   const double bvhSeconds = sw.seconds();
   sw.reset();
-  const std::vector<TexelSamples> texels = roomDiv > 0 ? gridTexels : buildTexelSamples(scene, rt, {});
+  const std::vector<TexelSamples> texels = grids ? gridTexels : buildTexelSamples(scene, rt, {});
   const double texelSeconds = sw.seconds();
   size_t validTexels = 0;
   for (const auto& t : texels)
     for (uint8_t v : t.valid) validTexels += v;
   // Area weights from the atlas; the room's grids are uniform (equal weights).
-  const auto areas = roomDiv > 0 ? std::vector<std::vector<float>>{} : texelWorldAreas(scene);
+  const auto areas = grids ? std::vector<std::vector<float>>{} : texelWorldAreas(scene);
   std::printf("%s: %zu triangles, %zu pages, %zu valid texels; load %.2f s, atlas %.2f s, bvh %.2f s, texels %.2f s\n",
               name.c_str(), scene.triangleCount(), texels.size(), validTexels, loadSeconds, atlasSeconds, bvhSeconds,
               texelSeconds);
@@ -286,6 +292,7 @@ int sceneBench(const std::vector<std::string>& args) {
     VplEvalOptions eval;
     eval.clampBound = deriveClampBound(scene, vpls, clampK);
     BakeInputs in{scene, rt, texels, vpls, eval, {}};
+    const int classes = interleave > 0 ? interleave : chooseInterleave(texels, eval.clampBound);
     std::vector<Lightmap> glMaps;  // kept to score GL against Embree on the same VPLs
     for (const std::string& backendName : backends) {
       const char* backend = backendName.c_str();
@@ -293,7 +300,7 @@ int sceneBench(const std::vector<std::string>& args) {
       sw.reset();
       std::vector<Lightmap> maps;
       if (std::string(backend) == "gl") {
-        maps = bakeInterleaved(in, interleave, [&](const BakeInputs& i) {
+        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) {
           GlBakeStats one;
           GlBackendOptions go;
           go.stats = &one;
@@ -308,7 +315,7 @@ int sceneBench(const std::vector<std::string>& args) {
           return m;
         });
       } else {
-        maps = bakeInterleaved(in, interleave, [](const BakeInputs& i) { return bakeEmbree(i); });
+        maps = bakeInterleaved(in, classes, [](const BakeInputs& i) { return bakeEmbree(i); });
       }
       double compensationSeconds = 0.0;
       if (compensate) {
@@ -334,7 +341,7 @@ int sceneBench(const std::vector<std::string>& args) {
             << vpls.vpls.size() << ",,,," << walkSeconds << "," << backendSeconds << "," << glVsEmbree << ","
             << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << "," << st.shadowCpuSeconds
             << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << st.renderer
-            << "\"," << clampK << "," << compensationSeconds << "," << interleave << "\n";
+            << "\"," << clampK << "," << compensationSeconds << "," << classes << "\n";
         continue;
       }
       const MapDifference d = compareMaps(maps, reference, areas);
@@ -364,7 +371,7 @@ int sceneBench(const std::vector<std::string>& args) {
           << backendSeconds << "," << glVsEmbree << "," << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << ","
           << st.shadowCpuSeconds << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
           << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"," << clampK << ","
-          << compensationSeconds << "," << interleave << "\n";
+          << compensationSeconds << "," << classes << "\n";
       out.flush();
     }
   }

@@ -30,8 +30,8 @@ struct InterleaveStats {
 std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages, int n, int cx, int cy);
 
 // The automatic n: the class filter (half-width n texels) must stay well inside the scale on which the
-// clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (8 h)⌋, 1, maxN), h the median
-// texel spacing over the pages. Cornell box: 9.7k texels (h = 14 mm) → 2; 251k texels (2.8 mm) → 4.
+// clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (16 h)⌋, 1, maxN), h the median
+// texel spacing over the pages. Cornell box, 1024 paths: 9.7k texels (h = 14 mm) → 1; 251k (2.8 mm) → 4.
 int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 4);
 
 // n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
