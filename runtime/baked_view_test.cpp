@@ -30,9 +30,12 @@ BakeOptions smallBake(int paths, float texelsPerUnit) {
 }
 
 // ρ = 0.5, Le = 0.5: the converged radiance is Le/(1−ρ) = 1 and every pixel shows ρ·map + Le = 1.
-TEST(BakedView, FurnaceSeenFromInsideIsOne) {
-  BakeOptions options = smallBake(4096, 4.0f);
-  options.eval.biasCompensation = true;  // the clamp's lost energy sits along the cube's edges
+// Pixel errors over seven views from inside the furnace baked with `options`.
+struct FurnaceView {
+  double mean = 0, meanAbs = 0;
+  float p95 = 0, worst = 0;
+};
+FurnaceView viewBakedFurnace(const BakeOptions& options) {
   BakeResult baked = bake(samples::makeFurnace(0.5f, 0.5f), options);
   ViewerScene v = makeViewerScene(std::move(baked.scene), std::move(baked.maps));
   EXPECT_TRUE(v.warnings.empty());
@@ -42,27 +45,49 @@ TEST(BakedView, FurnaceSeenFromInsideIsOne) {
   const glm::vec3 eye = 0.5f * (b.min + b.max) + glm::vec3(0.05f, -0.1f, 0.08f);
   const glm::vec3 dirs[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0.6f, 0.5f, -0.7f}};
   double sum = 0.0, absError = 0.0;
-  float worst = 0.0f;
-  size_t n = 0;
   std::vector<float> errors;
   for (const auto& d : dirs) {
     RgbaImage img = r.render(lookAt(eye, eye + d, 100.0f, b), 96, 64, {});
     for (const auto& p : img.pixels)
-      for (int c = 0; c < 3; ++c, ++n) {
+      for (int c = 0; c < 3; ++c) {
         sum += p[c];
         absError += std::abs(p[c] - 1.0f);
-        worst = std::max(worst, std::abs(p[c] - 1.0f));
         errors.push_back(std::abs(p[c] - 1.0f));
       }
   }
   std::sort(errors.begin(), errors.end());
-  const float p95 = errors[errors.size() * 95 / 100];
-  EXPECT_NEAR(sum / n, 1.0, 0.01);       // unbiased: the mean over every view is 1
-  EXPECT_LT(absError / n, 0.02);         // mean absolute error within 2%
-  EXPECT_LT(p95, 0.03f);                 // 95% of pixels within 3%: the rest is bake error along cube edges
-  RecordProperty("meanAbsoluteError", std::to_string(absError / n));
-  RecordProperty("p95AbsoluteError", std::to_string(p95));
-  RecordProperty("worstAbsoluteError", std::to_string(worst));
+  FurnaceView f;
+  f.mean = sum / errors.size();
+  f.meanAbs = absError / errors.size();
+  f.p95 = errors[errors.size() * 95 / 100];
+  f.worst = errors.back();
+  return f;
+}
+
+// Issue 6: every pixel 1.0 within 2%. The bake is converged for this purpose: a tight clamp (k = 4096,
+// clamp radius ≈ the box) leaves nearly all transport to the compensation gather, which in a furnace reads
+// a uniform map and is almost noise-free. Measured: worst pixel 1.4%, p95 0.7%, mean |error| 0.26%.
+TEST(BakedView, FurnaceSeenFromInsideIsOne) {
+  BakeOptions options = smallBake(4096, 4.0f);
+  options.clampVplsPerMean = 4096.0;
+  const FurnaceView f = viewBakedFurnace(options);
+  EXPECT_NEAR(f.mean, 1.0, 0.01);
+  EXPECT_LT(f.worst, 0.02f) << "p95 " << f.p95 << ", mean |error| " << f.meanAbs;
+  RecordProperty("worstAbsoluteError", std::to_string(f.worst));
+}
+
+// The same with the default estimator (k = 256 + gather, 4096 paths): VPL noise at the clamp-radius scale
+// remains. Measured: mean |error| 0.49%, p95 1.4%, worst 4.2% (session 1, k = 16 + Kollig–Keller: 0.68%,
+// 2.3%, 6.1%).
+TEST(BakedView, FurnaceWithDefaultEstimatorIsOneOnAverage) {
+  const FurnaceView f = viewBakedFurnace(smallBake(4096, 4.0f));
+  EXPECT_NEAR(f.mean, 1.0, 0.01);  // unbiased: the mean over every view is 1
+  EXPECT_LT(f.meanAbs, 0.01);      // mean absolute error within 1%
+  EXPECT_LT(f.p95, 0.02f);         // 95% of pixels within 2%
+  EXPECT_LT(f.worst, 0.06f);
+  RecordProperty("meanAbsoluteError", std::to_string(f.meanAbs));
+  RecordProperty("p95AbsoluteError", std::to_string(f.p95));
+  RecordProperty("worstAbsoluteError", std::to_string(f.worst));
 }
 
 TEST(BakedView, CornellBoxFromSampleCameraHasRedLeftAndGreenRightWalls) {
