@@ -259,6 +259,7 @@ int sceneBench(const std::vector<std::string>& args) {
   BakeInputs refInputs{scene, rt, texels, none, {}, {}};
   ReferenceOptions ro;
   ro.spp = spp;
+  if (const char* e = std::getenv("REF_DEPTH")) ro.maxDepth = std::atoi(e);  // diagnostics: truncated transport
   // --spp 0: timings only (no reference, error columns empty), for texel counts a reference cannot reach here.
   std::vector<Lightmap> reference;
   if (spp > 0 && !refCache.empty() && readReferenceCache(refCache, texels, spp, reference, refError)) {
@@ -286,6 +287,7 @@ int sceneBench(const std::vector<std::string>& args) {
     sw.reset();
     WalkOptions walk;
     walk.paths = n;
+    if (const char* e = std::getenv("WALK_BOUNCES")) walk.maxBounces = std::atoi(e);  // diagnostics
     walk.seed = std::getenv("WALK_SEED") ? static_cast<uint32_t>(std::atoi(std::getenv("WALK_SEED"))) : 1u;
     const VplSet vpls = generateVpls(scene, rt, walk);
     const double walkSeconds = sw.seconds();

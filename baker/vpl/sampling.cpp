@@ -65,6 +65,14 @@ Halton::Halton(int dimensions, uint32_t seed) : primes_(firstPrimes(std::max(dim
     shift_[0] = rng.uniform();
     shift_[1] = rng.uniform();
   }
+  // Dimensions ≥ 2 are also rotated (for every seed): with digit 0 fixed by the permutations, point 0
+  // would otherwise be 0 in every direction dimension for every seed — a path leaving along the normal
+  // at each bounce. Keller's fractional absorption keeps the *first* paths longest, so that one path
+  // carried the deepest bounces: in the Cornell box it ping-ponged between the floor and the light
+  // (albedo 0.78 > ρ̄) and biased the bake by +1.8% at 1024 paths (+3.5% at 512).
+  highShift_.assign(primes_.size(), 0.0);
+  Rng rng(hashSeed(seed, 0xD1CE));
+  for (size_t d = 2; d < primes_.size(); ++d) highShift_[d] = rng.uniform();
 }
 
 double Halton::sample(int dim, uint64_t index) const {
@@ -82,7 +90,9 @@ double Halton::sample(int dim, uint64_t index) const {
     index /= base;
     f *= inv;
   }
-  return r;
+  r += highShift_[dim];
+  r -= std::floor(r);
+  return std::min(r, 0.99999999999999989);
 }
 
 AliasTable::AliasTable(const std::vector<double>& weights) {

@@ -11,7 +11,8 @@ namespace irbake {
 // Halton sequence: dimension d uses the d-th prime as base (2, 3, 5, ...). Dimensions 0 and 1 are the
 // plain radical inverses Φ2, Φ3 (seed 0, as in Keller 1997) or Cranley–Patterson rotated by the seed;
 // dimensions ≥ 2 use seeded random digit permutations (0 kept fixed), which removes the strong
-// correlations between high prime bases at small N while keeping the low discrepancy.
+// correlations between high prime bases at small N while keeping the low discrepancy, and are then
+// Cranley–Patterson rotated (for every seed, so point 0 is not the origin of the direction dimensions).
 class Halton {
  public:
   Halton(int dimensions, uint32_t seed);
@@ -23,6 +24,7 @@ class Halton {
   std::vector<uint32_t> primes_;
   std::vector<std::vector<uint16_t>> permutations_;  // per dimension, digit → digit (empty: identity)
   double shift_[2] = {0.0, 0.0};
+  std::vector<double> highShift_;  // Cranley–Patterson rotation of dimensions ≥ 2 (always seeded)
 };
 
 // Plain radical inverse in base b (Φ_b).

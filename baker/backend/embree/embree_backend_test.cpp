@@ -203,13 +203,13 @@ void runFurnace(float rho, int paths, int grid, float fixedBound = 0.0f) {
 }  // namespace
 
 // Issue item 9: furnace, mean within 1% of Le/(1−ρ) with bias compensation; clamped-only bias printed.
-TEST(EmbreeBackend, FurnaceHalfAlbedo) { runFurnace(0.5f, 1024, 16); }
+TEST(EmbreeBackend, FurnaceHalfAlbedo) { runFurnace(0.5f, 4096, 16); }
 TEST(EmbreeBackend, FurnaceHighAlbedo) { runFurnace(0.9f, 1024, 12); }
 // A deliberately coarse clamp (B = 25/m², r_c = 0.2 m: a fifth of the room) removes a large part of the
 // light; compensation must give it back.
 TEST(EmbreeBackend, FurnaceCoarseClampIsCompensated) {
-  runFurnace(0.5f, 1024, 12, 25.0f);
-  runFurnace(0.9f, 1024, 12, 25.0f);
+  runFurnace(0.5f, 4096, 12, 25.0f);
+  runFurnace(0.9f, 4096, 12, 25.0f);
 }
 
 // Issue item 9: thin wall. Light on one side; the floor on the other side, right against the wall,
