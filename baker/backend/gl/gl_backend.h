@@ -40,6 +40,8 @@ struct GlBackendOptions {
   float slopeBias = 3.0f;        // depth bias in shadow texel footprints × tanθ
   float normalOffset = 0.0f;     // lookup point pushed along the receiver normal, in texel footprints
   bool shadowPcf = true;         // VPL cubes: 2×2 percentage-closer filtering (fractional shadow edges)
+  bool shadowCompare = true;     // PCF by the sampler's depth comparison (GL_LINEAR, one lookup) instead of 4 fetches
+  bool skipInvalidTexels = true; // early depth test against a per-page validity mask: invalid texels are not shaded
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
   const GlContext* context = nullptr;  // an existing current context; null: bakeGl creates one
   GlBakeStats* stats = nullptr;  // out: timings and counts (may be null)
