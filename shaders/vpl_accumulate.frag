@@ -20,14 +20,23 @@ layout(binding = 2) uniform sampler2DArrayShadow vplDepth;  // 6 layers per VPL 
 layout(binding = 2) uniform sampler2DArray vplDepth;        // 6 layers per VPL cube
 #endif
 
-struct VplGpu {
-  vec4 origin;     // xyz: VPL position (geometry term)
-  vec4 normal;     // xyz: unit normal = local +Z; w: shadow-origin offset along it (m)
-  vec4 power;      // rgb: Φ (W)
-  vec4 tangent;    // xyz: local +X
-  vec4 bitangent;  // xyz: local +Y
+// The batch's VPLs: 4 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
+// block: the loop index is not known to be uniform, so a block read is a per-lane gather of every
+// component (8 scalar loads each), while a texelFetch loads the 4 components of a lane at once.
+layout(binding = 3) uniform samplerBuffer vplTable;
+struct Vpl {
+  vec3 position;   // geometry term
+  float offset;    // shadow origin = position + offset·normal (m)
+  vec3 normal;     // unit normal = local +Z of its cube
+  vec3 power;      // Φ (W)
+  vec3 tangent;    // local +X
+  vec3 bitangent;  // local +Y
 };
-layout(std140, binding = 0) uniform VplBatch { VplGpu vpls[MAX_BATCH]; };
+Vpl loadVpl(int k) {
+  vec4 a = texelFetch(vplTable, 4 * k), b = texelFetch(vplTable, 4 * k + 1);
+  vec4 c = texelFetch(vplTable, 4 * k + 2), e = texelFetch(vplTable, 4 * k + 3);
+  return Vpl(a.xyz, a.w, b.xyz, vec3(b.w, c.w, e.w), c.xyz, e.xyz);
+}
 
 uniform int vplCount;          // VPLs in this batch
 uniform int layers;            // S×S supersample layers (when LAYERS is not defined)
@@ -65,24 +74,24 @@ float vplVisibility(int cube, vec3 v, float bias) {
 }
 
 // One VPL's unweighted contribution (Φ G V, before 1/π²) at receiver x with normal nx.
-vec3 vplTerm(VplGpu v, int cube, vec3 x, vec3 nx, float noClamp) {
-  vec3 d = v.origin.xyz - x;  // receiver → VPL
-  float cx = dot(nx, d), cy = -dot(v.normal.xyz, d);
+vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
+  vec3 d = v.position - x;  // receiver → VPL
+  float cx = dot(nx, d), cy = -dot(v.normal, d);
   float r2 = dot(d, d);
   float g = min(cx * cy / (r2 * r2), noClamp);  // vplGeometryTerm, inlined
   float r = sqrt(r2);
   float footprint = r * texelAngle;
   // Lookup point in the cube's frame, relative to the shadow origin (VPL + w·normal): −d − w·ny, whose
   // z is cy − w; optionally pushed along the receiver normal.
-  vec3 local = vec3(-dot(d, v.tangent.xyz), -dot(d, v.bitangent.xyz), cy - v.normal.w);
+  vec3 local = vec3(-dot(d, v.tangent), -dot(d, v.bitangent), cy - v.offset);
 #ifdef NORMAL_OFFSET
   vec3 o = nx * (normalOffset * footprint);
-  local += vec3(dot(o, v.tangent.xyz), dot(o, v.bitangent.xyz), dot(o, v.normal.xyz));
+  local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));
 #endif
   float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cx * cx, 0.0)) / cx);
   float visibility = vplVisibility(cube, local, bias);
   // Selected, not multiplied: behind either surface the lookup may be meaningless (even NaN).
-  return (cx > 0.0 && cy > 0.0) ? v.power.rgb * (g * visibility) : vec3(0.0);
+  return (cx > 0.0 && cy > 0.0) ? v.power * (g * visibility) : vec3(0.0);
 }
 
 void main() {
@@ -99,7 +108,7 @@ void main() {
     vec3 x = pw.xyz;
     vec3 nx = texelFetch(gNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
-    for (int k = 0; k < vplCount; ++k) s += vplTerm(vpls[k], k, x, nx, noClamp);
+    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, noClamp);
     sum += pw.w > 0.0 ? pw.w * s : vec3(0.0);
   }
   result = vec4(sum * kInvPi2, 0.0);

@@ -40,13 +40,12 @@ struct StageClock {
   }
 };
 
-// std140 layout of one VPL in the VplBatch uniform block (shaders/vpl_accumulate.frag).
-struct VplGpu {
-  glm::vec4 origin;     // xyz VPL position
-  glm::vec4 normal;     // xyz unit normal (local +Z), w shadow-origin offset along it
-  glm::vec4 power;      // rgb Φ
-  glm::vec4 tangent;    // xyz local +X
-  glm::vec4 bitangent;  // xyz local +Y
+// One VPL as 4 RGBA32F texels of the buffer texture vplTable (shaders/vpl_accumulate.frag, loadVpl).
+struct VplTexels {
+  glm::vec4 position;   // xyz VPL position, w shadow-origin offset along the normal
+  glm::vec4 normal;     // xyz unit normal (local +Z), w Φ.r
+  glm::vec4 tangent;    // xyz local +X, w Φ.g
+  glm::vec4 bitangent;  // xyz local +Y, w Φ.b
 };
 
 // Scene triangles on the GPU (world positions, one index buffer) with culling clusters.
@@ -231,8 +230,7 @@ class GlBaker {
   std::vector<std::unique_ptr<GpuPage>> pages_;
   std::unique_ptr<GlProgram> depthProgram_, directProgram_;
   std::map<int, std::unique_ptr<GlProgram>> vplPrograms_;  // by supersample layer count
-  int batchSize_ = 16;  // K
-  GLuint vplUbo_ = 0, emptyVao_ = 0;
+  GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
 };
@@ -304,15 +302,15 @@ void GlBaker::bindGBuffer(const GpuPage& page) const {
 }
 
 void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes) {
-  std::vector<VplGpu> batch(batchSize_, VplGpu{});
+  std::vector<VplTexels> batch(count);
   for (size_t k = 0; k < count; ++k) {
     const Vpl& v = in_.vpls.vpls[first + k];
     const VplFrame f = vplFrame(v.normal);
-    batch[k] = {glm::vec4(v.position, 0), glm::vec4(f.normal, scale_.originOffset), glm::vec4(v.power, 0),
-                glm::vec4(f.tangent, 0), glm::vec4(f.bitangent, 0)};
+    batch[k] = {glm::vec4(v.position, scale_.originOffset), glm::vec4(f.normal, v.power.r),
+                glm::vec4(f.tangent, v.power.g), glm::vec4(f.bitangent, v.power.b)};
   }
-  glNamedBufferSubData(vplUbo_, 0, batch.size() * sizeof(VplGpu), batch.data());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, vplUbo_);
+  glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
+  glBindTextureUnit(3, vplTable_);
   glBindTextureUnit(2, cubes.texture);
   glBindVertexArray(emptyVao_);
   for (auto& page : pages_) {
@@ -330,8 +328,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets&
 const GlProgram& GlBaker::vplProgram(int layers) {
   std::unique_ptr<GlProgram>& p = vplPrograms_[layers];
   if (p) return *p;
-  std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(batchSize_),
-                                   "#define LAYERS " + std::to_string(layers)};
+  std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
   if (opt_.normalOffset != 0.0f) defines.push_back("#define NORMAL_OFFSET 1");
   p = std::make_unique<GlProgram>(
@@ -426,14 +423,12 @@ std::vector<Lightmap> GlBaker::run() {
   uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, opt_.skipInvalidTexels));
 
-  const int K = batchSize_ = std::clamp(opt_.vplsPerPass, 1, 256);
-  std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(K)};
+  const int K = std::clamp(opt_.vplsPerPass, 1, 256);
   depthProgram_ = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   directProgram_ = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}},
-      defines);
+                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}});
   {
     const GlProgram* p = directProgram_.get();
     p->use();
@@ -445,8 +440,10 @@ std::vector<Lightmap> GlBaker::run() {
   }
   if (in_.eval.includeVpls && !in_.vpls.vpls.empty())
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
-  glCreateBuffers(1, &vplUbo_);
-  glNamedBufferStorage(vplUbo_, K * sizeof(VplGpu), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateBuffers(1, &vplBuffer_);
+  glNamedBufferStorage(vplBuffer_, K * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateTextures(GL_TEXTURE_BUFFER, 1, &vplTable_);
+  glTextureBuffer(vplTable_, GL_RGBA32F, vplBuffer_);
   glCreateVertexArrays(1, &emptyVao_);
   // Reversed-Z with [0,1] clip depth: depth = near / distance keeps float precision at every range.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -517,7 +514,8 @@ std::vector<Lightmap> GlBaker::run() {
     }
     maps.push_back(std::move(m));
   }
-  glDeleteBuffers(1, &vplUbo_);
+  glDeleteTextures(1, &vplTable_);
+  glDeleteBuffers(1, &vplBuffer_);
   glDeleteVertexArrays(1, &emptyVao_);
   if (in_.progress) in_.progress("gl", 1.0);
   return maps;
