@@ -20,22 +20,20 @@ layout(binding = 2) uniform sampler2DArrayShadow vplDepth;  // 6 layers per VPL 
 layout(binding = 2) uniform sampler2DArray vplDepth;        // 6 layers per VPL cube
 #endif
 
-// The batch's VPLs: 4 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
+// The batch's VPLs: 3 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
 // block: the loop index is not known to be uniform, so a block read is a per-lane gather of every
 // component (8 scalar loads each), while a texelFetch loads the 4 components of a lane at once.
 layout(binding = 3) uniform samplerBuffer vplTable;
 struct Vpl {
   vec3 position;   // geometry term
-  float offset;    // shadow origin = position + offset·normal (m)
   vec3 normal;     // unit normal = local +Z of its cube
   vec3 power;      // Φ (W)
   vec3 tangent;    // local +X
-  vec3 bitangent;  // local +Y
+  vec3 bitangent;  // local +Y = normal × tangent (as vplFrame builds it)
 };
 Vpl loadVpl(int k) {
-  vec4 a = texelFetch(vplTable, 4 * k), b = texelFetch(vplTable, 4 * k + 1);
-  vec4 c = texelFetch(vplTable, 4 * k + 2), e = texelFetch(vplTable, 4 * k + 3);
-  return Vpl(a.xyz, a.w, b.xyz, vec3(b.w, c.w, e.w), c.xyz, e.xyz);
+  vec4 a = texelFetch(vplTable, 3 * k), b = texelFetch(vplTable, 3 * k + 1), c = texelFetch(vplTable, 3 * k + 2);
+  return Vpl(a.xyz, b.xyz, vec3(a.w, b.w, c.w), c.xyz, cross(b.xyz, c.xyz));
 }
 
 uniform int vplCount;          // VPLs in this batch
@@ -46,6 +44,7 @@ uniform float constantBias;    // m
 uniform float slopeBias;       // in shadow texels
 uniform float normalOffset;    // in shadow texels
 uniform float texelAngle;      // angular size of one cube texel at the face centre (2 / faceSize)
+uniform float originOffset;    // VPL shadow origin = position + originOffset·normal (m)
 
 layout(location = 0) out vec4 result;
 
@@ -61,9 +60,12 @@ float vplVisibility(int cube, vec3 v, float bias) {
                      : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
 #ifdef SHADOW_COMPARE
   // lit where stored ≤ near / (axis − bias) (reversed-Z); axis ≤ bias: always lit (reference 1 ≥ any depth).
+  // One division for both 1/axis and 1/(axis − bias); where axis − bias ≤ near the reference is 1 and
+  // the coordinates do not matter.
   float ax = axisDistance - bias;
-  float reference = ax > nearPlane ? nearPlane / ax : 1.0;
-  return texture(vplDepth, vec4(sctc * (0.5 / axisDistance) + 0.5, float(6 * cube + face), reference));
+  float inv = 1.0 / (axisDistance * ax);
+  float reference = ax > nearPlane ? nearPlane * axisDistance * inv : 1.0;
+  return texture(vplDepth, vec4(sctc * (0.5 * ax * inv) + 0.5, float(6 * cube + face), reference));
 #elif defined(SHADOW_PCF)
   return cubeVisibilityPcf(vplDepth, cube, v, nearPlane, bias);
 #else
@@ -83,7 +85,7 @@ vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
   float footprint = r * texelAngle;
   // Lookup point in the cube's frame, relative to the shadow origin (VPL + w·normal): −d − w·ny, whose
   // z is cy − w; optionally pushed along the receiver normal.
-  vec3 local = vec3(-dot(d, v.tangent), -dot(d, v.bitangent), cy - v.offset);
+  vec3 local = vec3(-dot(d, v.tangent), -dot(d, v.bitangent), cy - originOffset);
 #ifdef NORMAL_OFFSET
   vec3 o = nx * (normalOffset * footprint);
   local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));

@@ -40,12 +40,12 @@ struct StageClock {
   }
 };
 
-// One VPL as 4 RGBA32F texels of the buffer texture vplTable (shaders/vpl_accumulate.frag, loadVpl).
+// One VPL as 3 RGBA32F texels of the buffer texture vplTable (shaders/vpl_accumulate.frag, loadVpl);
+// the shader rebuilds the bitangent as normal × tangent, as vplFrame does.
 struct VplTexels {
-  glm::vec4 position;   // xyz VPL position, w shadow-origin offset along the normal
-  glm::vec4 normal;     // xyz unit normal (local +Z), w Φ.r
-  glm::vec4 tangent;    // xyz local +X, w Φ.g
-  glm::vec4 bitangent;  // xyz local +Y, w Φ.b
+  glm::vec4 position;   // xyz VPL position, w Φ.r
+  glm::vec4 normal;     // xyz unit normal (local +Z), w Φ.g
+  glm::vec4 tangent;    // xyz local +X, w Φ.b
 };
 
 // Scene triangles on the GPU (world positions, one index buffer) with culling clusters.
@@ -306,8 +306,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets&
   for (size_t k = 0; k < count; ++k) {
     const Vpl& v = in_.vpls.vpls[first + k];
     const VplFrame f = vplFrame(v.normal);
-    batch[k] = {glm::vec4(v.position, scale_.originOffset), glm::vec4(f.normal, v.power.r),
-                glm::vec4(f.tangent, v.power.g), glm::vec4(f.bitangent, v.power.b)};
+    batch[k] = {glm::vec4(v.position, v.power.r), glm::vec4(f.normal, v.power.g), glm::vec4(f.tangent, v.power.b)};
   }
   glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
   glBindTextureUnit(3, vplTable_);
@@ -342,6 +341,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   glUniform1f(p->uniform("slopeBias"), opt_.slopeBias);
   glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   glUniform1f(p->uniform("texelAngle"), 2.0f / opt_.cubeFaceSize);
+  glUniform1f(p->uniform("originOffset"), scale_.originOffset);
   return *p;
 }
 
