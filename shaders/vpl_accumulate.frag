@@ -38,13 +38,15 @@ Vpl loadVpl(int k) {
 
 uniform int vplCount;          // VPLs in this batch
 uniform int layers;            // S×S supersample layers (when LAYERS is not defined)
-uniform float clampBound;      // geometry-term clamp (1/m²), ≤ 0: none
-uniform float nearPlane;       // cube near plane (m)
-uniform float constantBias;    // m
-uniform float slopeBias;       // in shadow texels
-uniform float normalOffset;    // in shadow texels
-uniform float texelAngle;      // angular size of one cube texel at the face centre (2 / faceSize)
-uniform float originOffset;    // VPL shadow origin = position + originOffset·normal (m)
+// Per-bake constants, compiled in (exact float literals from the host): a uniform read inside the VPL
+// loop costs llvmpipe a per-lane gather, a constant costs nothing and folds.
+const float clampBound = CLAMP_BOUND;       // geometry-term clamp (1/m²), ≤ 0: none
+const float nearPlane = NEAR_PLANE;         // cube near plane (m)
+const float constantBias = CONSTANT_BIAS;   // m
+const float slopeBias = SLOPE_BIAS;         // in shadow texels
+const float normalOffset = NORMAL_OFFSET;   // in shadow texels
+const float texelAngle = TEXEL_ANGLE;       // angular size of one cube texel at the face centre (2 / faceSize)
+const float originOffset = ORIGIN_OFFSET;   // VPL shadow origin = position + originOffset·normal (m)
 
 layout(location = 0) out vec4 result;
 
@@ -86,7 +88,7 @@ vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
   // Lookup point in the cube's frame, relative to the shadow origin (VPL + w·normal): −d − w·ny, whose
   // z is cy − w; optionally pushed along the receiver normal.
   vec3 local = vec3(-dot(d, v.tangent), -dot(d, v.bitangent), cy - originOffset);
-#ifdef NORMAL_OFFSET
+#ifdef HAS_NORMAL_OFFSET
   vec3 o = nx * (normalOffset * footprint);
   local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));
 #endif

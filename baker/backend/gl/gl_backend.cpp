@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <optional>
@@ -329,19 +330,23 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   if (p) return *p;
   std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
-  if (opt_.normalOffset != 0.0f) defines.push_back("#define NORMAL_OFFSET 1");
+  auto constant = [&](const char* name, float value) {
+    char text[64];
+    std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
+    defines.push_back(text);
+  };
+  constant("CLAMP_BOUND", in_.eval.clampBound);
+  constant("NEAR_PLANE", scale_.nearPlane);
+  constant("CONSTANT_BIAS", scale_.constantBias);
+  constant("SLOPE_BIAS", opt_.slopeBias);
+  constant("NORMAL_OFFSET", opt_.normalOffset);
+  constant("TEXEL_ANGLE", 2.0f / opt_.cubeFaceSize);
+  constant("ORIGIN_OFFSET", scale_.originOffset);
+  if (opt_.normalOffset != 0.0f) defines.push_back("#define HAS_NORMAL_OFFSET 1");
   p = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
                                {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
       defines);
-  p->use();
-  glUniform1f(p->uniform("clampBound"), in_.eval.clampBound);
-  glUniform1f(p->uniform("nearPlane"), scale_.nearPlane);
-  glUniform1f(p->uniform("constantBias"), scale_.constantBias);
-  glUniform1f(p->uniform("slopeBias"), opt_.slopeBias);
-  glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
-  glUniform1f(p->uniform("texelAngle"), 2.0f / opt_.cubeFaceSize);
-  glUniform1f(p->uniform("originOffset"), scale_.originOffset);
   return *p;
 }
 
