@@ -309,7 +309,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets&
     const VplFrame f = vplFrame(v.normal);
     batch[k] = {glm::vec4(v.position, v.power.r), glm::vec4(f.normal, v.power.g), glm::vec4(f.tangent, v.power.b)};
   }
-  glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
+  if (count > 0) glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
   glBindTextureUnit(3, vplTable_);
   glBindTextureUnit(2, cubes.texture);
   glBindVertexArray(emptyVao_);
@@ -454,22 +454,31 @@ std::vector<Lightmap> GlBaker::run() {
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glBlendFunc(GL_ONE, GL_ONE);
   glBlendEquation(GL_FUNC_ADD);
-  checkGlError("GL backend setup");
-  finishStage(stats_.setupSeconds, sw);
 
   const auto& vpls = in_.vpls.vpls;
   const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
   const size_t totalWork = vplCount + lightCount * K;
+  std::unique_ptr<DepthTargets> cubeTargets;
   if (vplCount > 0) {
-    DepthTargets cubes(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
+    cubeTargets = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
     if (opt_.shadowPcf && opt_.shadowCompare) {
       // Sampled through sampler2DArrayShadow: lit (1) where the stored depth ≤ the reference.
-      glTextureParameteri(cubes.texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-      glTextureParameteri(cubes.texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
-      glTextureParameteri(cubes.texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(cubes.texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     }
+    // A pass over zero VPLs (adds 0): llvmpipe compiles the accumulation shader for this state at its
+    // first draw, which then counts as setup, not as the first batch's accumulation.
+    lightMapPassState();
+    accumulateVplBatch(0, 0, *cubeTargets);
+  }
+  checkGlError("GL backend setup");
+  finishStage(stats_.setupSeconds, sw);
+
+  if (vplCount > 0) {
+    DepthTargets& cubes = *cubeTargets;
     int passesSinceFold = 0;
     for (size_t first = 0; first < vplCount; first += K) {
       const size_t count = std::min<size_t>(K, vplCount - first);
