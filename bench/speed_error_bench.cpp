@@ -362,7 +362,7 @@ int stagesBench(const std::vector<std::string>& args) {
   size_t validTexels = 0;
   for (uint8_t v : t.valid) validTexels += v;
   // Variants, for back-to-back A/B: default (the shipped options), fetch4 (PCF by 4 texelFetch and
-  // compares in the shader), nomask (invalid texels shaded too), cluster64/cluster128 (culling clusters).
+  // compares in the shader), nomask (invalid texels shaded too), cluster128/cluster256 (culling clusters).
   for (int rep = 0; rep < repeat; ++rep)
     for (const std::string& variant : variants)
       for (int k : ks) {
@@ -373,7 +373,7 @@ int stagesBench(const std::vector<std::string>& args) {
         o.vplsPerPass = k;
         if (variant == "fetch4") o.shadowCompare = false;
         else if (variant == "nomask") o.skipInvalidTexels = false;
-        else if (variant == "cluster64") o.clusterTriangles = 64;
+        else if (variant == "cluster256") o.clusterTriangles = 256;
         else if (variant == "cluster128") o.clusterTriangles = 128;
         else if (variant != "default") throw Error(ErrorCode::Usage, "", "unknown variant " + variant);
         BakeInputs in{s, rt, pages, vs, {}, {}};

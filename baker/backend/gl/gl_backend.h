@@ -33,7 +33,7 @@ struct GlBackendOptions {
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
   int lightMapSize = 2048;       // spot / directional shadow map size (texels)
   int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
-  int clusterTriangles = 256;    // triangles per culling cluster (CPU per-face culling)
+  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling; 64: −20% drawn vs 256)
   float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
   float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
   float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal
