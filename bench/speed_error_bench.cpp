@@ -11,6 +11,7 @@
 // Rows are appended to the CSV (header written when the file is new). Times are wall-clock seconds
 // on whatever machine runs it, plus process CPU seconds for the GL stages (load-independent).
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -283,6 +284,12 @@ int sceneBench(const std::vector<std::string>& args) {
   return 0;
 }
 
+// One-minute load average (other processes on the same cores inflate wall-clock times), or -1.
+double loadAverage() {
+  double load[1] = {-1.0};
+  return getloadavg(load, 1) == 1 ? load[0] : -1.0;
+}
+
 // A closed room of `div`×`div`-cell walls (12 div² triangles) and one page of texels×texels samples on
 // its floor; VPLs on the ceiling facing down: every VPL sees the whole floor.
 int stagesBench(const std::vector<std::string>& args) {
@@ -358,7 +365,7 @@ int stagesBench(const std::vector<std::string>& args) {
   }
   std::ofstream out = openCsv(csv, "triangles,texels,vpls,k,face,shadow_ms_per_vpl,accumulate_ms_per_vpl,"
                                    "shadow_cpu_ms_per_vpl,accumulate_cpu_ms_per_vpl,triangles_drawn_per_vpl,renderer,"
-                                   "variant,valid_texels");
+                                   "variant,valid_texels,load1");
   size_t validTexels = 0;
   for (uint8_t v : t.valid) validTexels += v;
   // Variants, for back-to-back A/B: default (the shipped options), fetch4 (PCF by 4 texelFetch and
@@ -387,7 +394,7 @@ int stagesBench(const std::vector<std::string>& args) {
         std::fflush(stdout);
         out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << o.cubeFaceSize << "," << sv
             << "," << av << "," << sc << "," << ac << "," << st.trianglesDrawn / nv << ",\"" << st.renderer << "\","
-            << variant << "," << validTexels << "\n";
+            << variant << "," << validTexels << "," << loadAverage() << "\n";
       }
   return 0;
 }
