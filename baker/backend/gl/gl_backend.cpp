@@ -335,7 +335,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
     std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
     defines.push_back(text);
   };
-  constant("CLAMP_BOUND", in_.eval.clampBound);
+  constant("CLAMP_BOUND", std::isfinite(in_.eval.clampBound) ? in_.eval.clampBound : 0.0f);  // ≤ 0: no clamp
   constant("NEAR_PLANE", scale_.nearPlane);
   constant("CONSTANT_BIAS", scale_.constantBias);
   constant("SLOPE_BIAS", opt_.slopeBias);
