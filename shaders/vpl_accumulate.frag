@@ -10,8 +10,9 @@
 // - Branch-free body: the hemisphere test selects the result instead of masking a `continue`.
 // - LAYERS: the S×S supersample count as a constant (1: no layer loop). Invalid texels never run: the
 //   pass is depth-tested against the page's validity mask (gl_backend.cpp).
-// Measured and dropped: unrolling the batch (constant VPL indices: slower, code size), a cube-map-array
-// sampler doing the face selection (no faster).
+// - The VPLs come from a buffer texture and the per-bake constants are compiled in (see below).
+// Measured and dropped: unrolling the batch (constant VPL indices from a uniform block: 2× slower), a
+// cube-map-array sampler doing the face selection (no faster).
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
 #if defined(SHADOW_COMPARE)
