@@ -10,7 +10,8 @@
 //     --clamp-k: k of deriveClampBound (larger = tighter clamp); --compensate: add the clamp residual
 //     (backend/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
 //     reference maps in FILE (raw floats) and reuse them when FILE matches the texel layout.
-//   speed_error_bench stages [--tris-div 91] [--texels 1024] [--vpls 64] [--csv OUT.csv]
+//   speed_error_bench stages [--tris-div 91] [--texels 1024] [--vpls 64] [--k 1,4,16,64]
+//                     [--variants default] [--repeat 1] [--covered 1.0] [--csv OUT.csv]
 //
 // Rows are appended to the CSV (header written when the file is new). Times are wall-clock seconds
 // on whatever machine runs it, plus process CPU seconds for the GL stages (load-independent).
@@ -380,16 +381,31 @@ int sceneBench(const std::vector<std::string>& args) {
   return 0;
 }
 
+// One-minute load average (other processes on the same cores inflate wall-clock times), or -1.
+double loadAverage() {
+  double load[1] = {-1.0};
+  return getloadavg(load, 1) == 1 ? load[0] : -1.0;
+}
+
 // A closed room of `div`×`div`-cell walls (12 div² triangles) and one page of texels×texels samples on
 // its floor; VPLs on the ceiling facing down: every VPL sees the whole floor.
 int stagesBench(const std::vector<std::string>& args) {
-  int div = 91, tex = 1024, nv = 64;
+  int div = 91, tex = 1024, nv = 64, repeat = 1;
+  float coveredFraction = 1.0f;
   std::string csv = "gl_stages.csv";
+  std::vector<int> ks{1, 4, 16, 64};
+  std::vector<std::string> variants{"default"};
   for (size_t i = 1; i + 1 < args.size(); i += 2) {
     if (args[i] == "--tris-div") div = std::stoi(args[i + 1]);
     else if (args[i] == "--texels") tex = std::stoi(args[i + 1]);
     else if (args[i] == "--vpls") nv = std::stoi(args[i + 1]);
+    else if (args[i] == "--repeat") repeat = std::stoi(args[i + 1]);
+    else if (args[i] == "--covered") coveredFraction = std::stof(args[i + 1]);
     else if (args[i] == "--csv") csv = args[i + 1];
+    else if (args[i] == "--k") {
+      ks.clear();
+      for (const auto& k : split(args[i + 1], ',')) ks.push_back(std::stoi(k));
+    } else if (args[i] == "--variants") variants = split(args[i + 1], ',');
     else throw Error(ErrorCode::Usage, "", "unknown option " + args[i]);
   }
   Scene s;
@@ -425,8 +441,16 @@ int stagesBench(const std::vector<std::string>& args) {
     }
   t.primitive.assign(t.slotCount(), 0);
   t.triangle.assign(t.slotCount(), 0);
+  // --covered f < 1: only a disc of that fraction of the page is valid (atlas pages are 60–85% covered).
   t.covered.assign(t.layerSize(), 1);
   t.valid.assign(t.layerSize(), 1);
+  if (coveredFraction < 1.0f) {
+    const float r2 = coveredFraction * 4.0f / 3.14159265f;  // disc of that area in [-1,1]²
+    for (size_t i = 0; i < t.layerSize(); ++i) {
+      const glm::vec4 p = t.positionWeight[i];
+      if (p.x * p.x + p.y * p.y > r2) t.valid[i] = t.covered[i] = 0, t.positionWeight[i].w = 0.0f;
+    }
+  }
   const std::vector<TexelSamples> pages{t};
   VplSet vs;
   for (int i = 0; i < nv; ++i) {
@@ -437,24 +461,38 @@ int stagesBench(const std::vector<std::string>& args) {
     vs.vpls.push_back(v);
   }
   std::ofstream out = openCsv(csv, "triangles,texels,vpls,k,face,shadow_ms_per_vpl,accumulate_ms_per_vpl,"
-                                   "shadow_cpu_ms_per_vpl,accumulate_cpu_ms_per_vpl,triangles_drawn_per_vpl,renderer");
-  for (int k : {1, 4, 16, 64}) {
-    GlBakeStats st;
-    GlBackendOptions o;
-    o.stats = &st;
-    o.stageTimings = true;
-    o.vplsPerPass = k;
-    BakeInputs in{s, rt, pages, vs, {}, {}};
-    bakeGl(in, o);
-    const double sv = 1e3 * st.shadowSeconds / nv, av = 1e3 * st.accumulateSeconds / nv;
-    const double sc = 1e3 * st.shadowCpuSeconds / nv, ac = 1e3 * st.accumulateCpuSeconds / nv;
-    std::printf("%zu triangles, %d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate %.2f ms/VPL "
-                "(CPU %.2f), %zu triangles drawn per VPL\n",
-                s.triangleCount(), tex * tex, k, o.cubeFaceSize, sv, sc, av, ac, st.trianglesDrawn / nv);
-    std::fflush(stdout);
-    out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << o.cubeFaceSize << "," << sv << ","
-        << av << "," << sc << "," << ac << "," << st.trianglesDrawn / nv << ",\"" << st.renderer << "\"\n";
-  }
+                                   "shadow_cpu_ms_per_vpl,accumulate_cpu_ms_per_vpl,triangles_drawn_per_vpl,renderer,"
+                                   "variant,valid_texels,load1");
+  size_t validTexels = 0;
+  for (uint8_t v : t.valid) validTexels += v;
+  // Variants, for back-to-back A/B: default (the shipped options), fetch4 (PCF by 4 texelFetch and
+  // compares in the shader), nomask (invalid texels shaded too), cluster128/cluster256 (culling clusters).
+  for (int rep = 0; rep < repeat; ++rep)
+    for (const std::string& variant : variants)
+      for (int k : ks) {
+        GlBakeStats st;
+        GlBackendOptions o;
+        o.stats = &st;
+        o.stageTimings = true;
+        o.vplsPerPass = k;
+        if (variant == "fetch4") o.shadowCompare = false;
+        else if (variant == "nomask") o.skipInvalidTexels = false;
+        else if (variant == "cluster256") o.clusterTriangles = 256;
+        else if (variant == "cluster128") o.clusterTriangles = 128;
+        else if (variant != "default") throw Error(ErrorCode::Usage, "", "unknown variant " + variant);
+        BakeInputs in{s, rt, pages, vs, {}, {}};
+        bakeGl(in, o);
+        const double sv = 1e3 * st.shadowSeconds / nv, av = 1e3 * st.accumulateSeconds / nv;
+        const double sc = 1e3 * st.shadowCpuSeconds / nv, ac = 1e3 * st.accumulateCpuSeconds / nv;
+        std::printf("%-10s %zu triangles, %zu/%d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate "
+                    "%.2f ms/VPL (CPU %.2f), %zu triangles drawn per VPL\n",
+                    variant.c_str(), s.triangleCount(), validTexels, tex * tex, k, o.cubeFaceSize, sv, sc, av, ac,
+                    st.trianglesDrawn / nv);
+        std::fflush(stdout);
+        out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << o.cubeFaceSize << "," << sv
+            << "," << av << "," << sc << "," << ac << "," << st.trianglesDrawn / nv << ",\"" << st.renderer << "\","
+            << variant << "," << validTexels << "," << loadAverage() << "\n";
+      }
   return 0;
 }
 

@@ -1,61 +1,120 @@
 // Accumulation: every texel sample of a page against a batch of VPLs, each with its depth cube
 // (layers 6k..6k+5 of a 2D array: a cube in the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance).
 // Output: the batch's contribution to irradiance/π, summed by additive blending.
+//
+// Cost on llvmpipe (8 fragments per SIMD vector, 2 threads) is everything inside the per-VPL loop, so
+// (docs/performance.md, "What limits the per-VPL cost"):
+// - SHADOW_COMPARE: hardware depth comparison with bilinear filtering (sampler2DArrayShadow, GL_LINEAR,
+//   GL_GEQUAL) gives the 2×2 percentage-closer filter in one lookup instead of 4 texelFetch + compares.
+// - The lookup point in the cube frame comes from d (receiver → VPL) and cy; no second position.
+// - Branch-free body: the hemisphere test selects the result instead of masking a `continue`.
+// - LAYERS: the S×S supersample count as a constant (1: no layer loop). Invalid texels never run: the
+//   pass is depth-tested against the page's validity mask (gl_backend.cpp).
+// - The VPLs come from a buffer texture and the per-bake constants are compiled in (see below).
+// Measured and dropped: unrolling the batch (constant VPL indices from a uniform block: 2× slower), a
+// cube-map-array sampler doing the face selection (no faster).
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
-layout(binding = 2) uniform sampler2DArray vplDepth;     // 6 layers per VPL cube
+#if defined(SHADOW_COMPARE)
+layout(binding = 2) uniform sampler2DArrayShadow vplDepth;  // 6 layers per VPL cube, compare GL_GEQUAL
+#else
+layout(binding = 2) uniform sampler2DArray vplDepth;        // 6 layers per VPL cube
+#endif
 
-struct VplGpu {
-  vec4 origin;     // xyz: shadow origin (VPL offset along its normal)
-  vec4 normal;     // xyz: unit normal = local +Z
-  vec4 power;      // rgb: Φ (W)
-  vec4 tangent;    // xyz: local +X
-  vec4 bitangent;  // xyz: local +Y
+// The batch's VPLs: 3 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
+// block: the loop index is not known to be uniform, so a block read is a per-lane gather of every
+// component (8 scalar loads each), while a texelFetch loads the 4 components of a lane at once.
+layout(binding = 3) uniform samplerBuffer vplTable;
+struct Vpl {
+  vec3 position;   // geometry term
+  vec3 normal;     // unit normal = local +Z of its cube
+  vec3 power;      // Φ (W)
+  vec3 tangent;    // local +X
+  vec3 bitangent;  // local +Y = normal × tangent (as vplFrame builds it)
 };
-layout(std140, binding = 0) uniform VplBatch { VplGpu vpls[MAX_BATCH]; };
+Vpl loadVpl(int k) {
+  vec4 a = texelFetch(vplTable, 3 * k), b = texelFetch(vplTable, 3 * k + 1), c = texelFetch(vplTable, 3 * k + 2);
+  return Vpl(a.xyz, b.xyz, vec3(a.w, b.w, c.w), c.xyz, cross(b.xyz, c.xyz));
+}
 
-uniform int vplCount;
-uniform int layers;            // S×S supersample layers
-uniform float clampBound;      // geometry-term clamp (1/m²), ≤ 0: none
-uniform float nearPlane;       // cube near plane (m)
-uniform float constantBias;    // m
-uniform float slopeBias;       // in shadow texels
-uniform float normalOffset;    // in shadow texels
-uniform float texelAngle;      // angular size of one cube texel at the face centre (2 / faceSize)
+uniform int vplCount;          // VPLs in this batch
+uniform int layers;            // S×S supersample layers (when LAYERS is not defined)
+// Per-bake constants, compiled in (exact float literals from the host): a uniform read inside the VPL
+// loop costs llvmpipe a per-lane gather, a constant costs nothing and folds.
+const float clampBound = CLAMP_BOUND;       // geometry-term clamp (1/m²), ≤ 0: none
+const float nearPlane = NEAR_PLANE;         // cube near plane (m)
+const float constantBias = CONSTANT_BIAS;   // m
+const float slopeBias = SLOPE_BIAS;         // in shadow texels
+const float normalOffset = NORMAL_OFFSET;   // in shadow texels
+const float texelAngle = TEXEL_ANGLE;       // angular size of one cube texel at the face centre (2 / faceSize)
+const float originOffset = ORIGIN_OFFSET;   // VPL shadow origin = position + originOffset·normal (m)
 
 layout(location = 0) out vec4 result;
+
+// Fraction of the lookup point (local: relative to the cube's origin, in its frame) that sees the
+// cube's centre, 2×2 percentage-closer filtered (or a single texel without SHADOW_PCF).
+float vplVisibility(int cube, vec3 v, float bias) {
+  vec3 a = abs(v);
+  bool xMajor = a.x >= a.y && a.x >= a.z;
+  bool yMajor = !xMajor && a.y >= a.z;
+  float axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
+  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
+  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
+                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+#ifdef SHADOW_COMPARE
+  // lit where stored ≤ near / (axis − bias) (reversed-Z); axis ≤ bias: always lit (reference 1 ≥ any depth).
+  // One division for both 1/axis and 1/(axis − bias); where axis − bias ≤ near the reference is 1 and
+  // the coordinates do not matter.
+  float ax = axisDistance - bias;
+  float inv = 1.0 / (axisDistance * ax);
+  float reference = ax > nearPlane ? nearPlane * axisDistance * inv : 1.0;
+  return texture(vplDepth, vec4(sctc * (0.5 * ax * inv) + 0.5, float(6 * cube + face), reference));
+#elif defined(SHADOW_PCF)
+  return cubeVisibilityPcf(vplDepth, cube, v, nearPlane, bias);
+#else
+  float axis;
+  float depth = cubeDepth(vplDepth, cube, v, axis);
+  return cubeLit(depth, axis, nearPlane, bias) ? 1.0 : 0.0;
+#endif
+}
+
+// One VPL's unweighted contribution (Φ G V, before 1/π²) at receiver x with normal nx.
+vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
+  vec3 d = v.position - x;  // receiver → VPL
+  float cx = dot(nx, d), cy = -dot(v.normal, d);
+  float r2 = dot(d, d);
+  float g = min(cx * cy / (r2 * r2), noClamp);  // vplGeometryTerm, inlined
+  float r = sqrt(r2);
+  float footprint = r * texelAngle;
+  // Lookup point in the cube's frame, relative to the shadow origin (VPL + w·normal): −d − w·ny, whose
+  // z is cy − w; optionally pushed along the receiver normal.
+  vec3 local = vec3(-dot(d, v.tangent), -dot(d, v.bitangent), cy - originOffset);
+#ifdef HAS_NORMAL_OFFSET
+  vec3 o = nx * (normalOffset * footprint);
+  local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));
+#endif
+  float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cx * cx, 0.0)) / cx);
+  float visibility = vplVisibility(cube, local, bias);
+  // Selected, not multiplied: behind either surface the lookup may be meaningless (even NaN).
+  return (cx > 0.0 && cy > 0.0) ? v.power * (g * visibility) : vec3(0.0);
+}
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
   float noClamp = clampBound > 0.0 ? clampBound : 3.0e38;
-  for (int l = 0; l < layers; ++l) {
+#ifdef LAYERS
+  const int layerCount = LAYERS;
+#else
+  int layerCount = layers;
+#endif
+  for (int l = 0; l < layerCount; ++l) {
     vec4 pw = texelFetch(gPositionWeight, ivec3(p, l), 0);
-    if (pw.w <= 0.0) continue;
+    vec3 x = pw.xyz;
     vec3 nx = texelFetch(gNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
-    for (int k = 0; k < vplCount; ++k) {
-      vec3 ny = vpls[k].normal.xyz;
-      vec3 d = vpls[k].origin.xyz - pw.xyz;  // receiver → VPL
-      float cx = dot(nx, d), cy = -dot(ny, d);
-      if (cx <= 0.0 || cy <= 0.0) continue;
-      float r2 = dot(d, d);
-      float g = min(cx * cy / (r2 * r2), noClamp);  // vplGeometryTerm, inlined
-      float r = sqrt(r2);
-      float footprint = r * texelAngle;
-      // Lookup point: pushed along the receiver normal, relative to the shadow origin (VPL + offset·ny).
-      vec3 q = nx * (normalOffset * footprint) - d - ny * vpls[k].origin.w;
-      vec3 local = vec3(dot(q, vpls[k].tangent.xyz), dot(q, vpls[k].bitangent.xyz), dot(q, ny));
-      float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cx * cx, 0.0)) / cx);
-#ifdef SHADOW_PCF
-      s += vpls[k].power.rgb * (g * cubeVisibilityPcf(vplDepth, k, local, nearPlane, bias));
-#else
-      float axisDistance;
-      float depth = cubeDepth(vplDepth, k, local, axisDistance);
-      if (cubeLit(depth, axisDistance, nearPlane, bias)) s += vpls[k].power.rgb * g;
-#endif
-    }
-    sum += pw.w * s;
+    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, noClamp);
+    sum += pw.w > 0.0 ? pw.w * s : vec3(0.0);
   }
   result = vec4(sum * kInvPi2, 0.0);
 }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -39,13 +41,12 @@ struct StageClock {
   }
 };
 
-// std140 layout of one VPL in the VplBatch uniform block (shaders/vpl_accumulate.frag).
-struct VplGpu {
-  glm::vec4 origin;     // xyz position, w: shadow-origin offset along the normal
-  glm::vec4 normal;
-  glm::vec4 power;
-  glm::vec4 tangent;
-  glm::vec4 bitangent;
+// One VPL as 3 RGBA32F texels of the buffer texture vplTable (shaders/vpl_accumulate.frag, loadVpl);
+// the shader rebuilds the bitangent as normal × tangent, as vplFrame does.
+struct VplTexels {
+  glm::vec4 position;   // xyz VPL position, w Φ.r
+  glm::vec4 normal;     // xyz unit normal (local +Z), w Φ.g
+  glm::vec4 tangent;    // xyz local +X, w Φ.b
 };
 
 // Scene triangles on the GPU (world positions, one index buffer) with culling clusters.
@@ -148,13 +149,15 @@ struct DepthTargets {
   }
 };
 
-// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator.
+// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a
+// validity mask as depth (1 valid, 0 not): the light-map passes draw at depth 0 with GL_LESS, so
+// llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
 struct GpuPage {
   const TexelSamples* samples = nullptr;
-  GLuint positionWeight = 0, normal = 0, accum = 0, fbo = 0;
+  GLuint positionWeight = 0, normal = 0, accum = 0, validDepth = 0, fbo = 0;
   std::vector<glm::dvec3> sum;
   std::vector<glm::vec4> readback;
-  explicit GpuPage(const TexelSamples& s) : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
+  GpuPage(const TexelSamples& s, bool validityMask) : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
     const int layers = s.supersample * s.supersample;
     if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
       throw Error(ErrorCode::InvalidData, "", "texel samples of page " + std::to_string(s.page) + " are incomplete");
@@ -171,14 +174,22 @@ struct GpuPage {
     glTextureStorage2D(accum, 1, GL_RGBA32F, s.width, s.height);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, accum, 0);
+    if (validityMask) {
+      std::vector<float> depth(s.layerSize(), 1.0f);
+      for (size_t i = 0; i < depth.size(); ++i) depth[i] = i < s.valid.size() && s.valid[i] ? 1.0f : 0.0f;
+      glCreateTextures(GL_TEXTURE_2D, 1, &validDepth);
+      glTextureStorage2D(validDepth, 1, GL_DEPTH_COMPONENT32F, s.width, s.height);
+      glTextureSubImage2D(validDepth, 0, 0, 0, s.width, s.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+      glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, validDepth, 0);
+    }
     if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw Error(ErrorCode::Gl, "", "accumulation framebuffer incomplete");
     clear();
   }
   ~GpuPage() {
     glDeleteFramebuffers(1, &fbo);
-    GLuint t[3] = {positionWeight, normal, accum};
-    glDeleteTextures(3, t);
+    GLuint t[4] = {positionWeight, normal, accum, validDepth};
+    glDeleteTextures(4, t);
   }
   void clear() {
     const float zero[4] = {0, 0, 0, 0};
@@ -207,6 +218,9 @@ class GlBaker {
   void accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes);
   void bakeDirect(const Light& light);
   void bindGBuffer(const GpuPage& page) const;
+  void shadowPassState() const;
+  void lightMapPassState() const;
+  const GlProgram& vplProgram(int layers);
   void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
 
   const BakeInputs& in_;
@@ -215,8 +229,9 @@ class GlBaker {
   ShadowScale scale_;
   std::unique_ptr<GpuGeometry> geometry_;
   std::vector<std::unique_ptr<GpuPage>> pages_;
-  std::unique_ptr<GlProgram> depthProgram_, vplProgram_, directProgram_;
-  GLuint vplUbo_ = 0, emptyVao_ = 0;
+  std::unique_ptr<GlProgram> depthProgram_, directProgram_;
+  std::map<int, std::unique_ptr<GlProgram>> vplPrograms_;  // by supersample layer count
+  GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
 };
@@ -226,6 +241,28 @@ void GlBaker::finishStage(double& seconds, StageClock& sw, double* cpuSeconds) c
   seconds += sw.wall.seconds();
   if (cpuSeconds) *cpuSeconds += processCpuSeconds() - sw.cpuStart;
   sw.reset();
+}
+
+// Depth-only views: depth test and writes, scissor; no blending.
+void GlBaker::shadowPassState() const {
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_SCISSOR_TEST);
+  glDisable(GL_BLEND);
+}
+
+// Light-map passes: additive blending; with the validity mask, depth 0 passes GL_LESS only where the
+// mask holds 1 (valid texels), and the mask is never written.
+void GlBaker::lightMapPassState() const {
+  glDisable(GL_SCISSOR_TEST);
+  glEnable(GL_BLEND);
+  if (opt_.skipInvalidTexels) {
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LESS);
+  } else {
+    glDisable(GL_DEPTH_TEST);
+  }
 }
 
 void GlBaker::drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ) {
@@ -266,26 +303,51 @@ void GlBaker::bindGBuffer(const GpuPage& page) const {
 }
 
 void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes) {
-  std::vector<VplGpu> batch(opt_.vplsPerPass);
+  std::vector<VplTexels> batch(count);
   for (size_t k = 0; k < count; ++k) {
     const Vpl& v = in_.vpls.vpls[first + k];
     const VplFrame f = vplFrame(v.normal);
-    batch[k] = {glm::vec4(v.position, scale_.originOffset), glm::vec4(f.normal, 0), glm::vec4(v.power, 0),
-                glm::vec4(f.tangent, 0), glm::vec4(f.bitangent, 0)};
+    batch[k] = {glm::vec4(v.position, v.power.r), glm::vec4(f.normal, v.power.g), glm::vec4(f.tangent, v.power.b)};
   }
-  glNamedBufferSubData(vplUbo_, 0, batch.size() * sizeof(VplGpu), batch.data());
-  vplProgram_->use();
-  glUniform1i(vplProgram_->uniform("vplCount"), static_cast<GLint>(count));
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, vplUbo_);
+  if (count > 0) glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
+  glBindTextureUnit(3, vplTable_);
   glBindTextureUnit(2, cubes.texture);
   glBindVertexArray(emptyVao_);
   for (auto& page : pages_) {
+    const GlProgram& program = vplProgram(page->samples->supersample * page->samples->supersample);
+    program.use();
+    glUniform1i(program.uniform("vplCount"), static_cast<GLint>(count));
     glBindFramebuffer(GL_FRAMEBUFFER, page->fbo);
     glViewport(0, 0, page->samples->width, page->samples->height);
     bindGBuffer(*page);
-    glUniform1i(vplProgram_->uniform("layers"), page->samples->supersample * page->samples->supersample);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
+}
+
+// The accumulation program for pages of `layers` supersample layers (compiled on first use).
+const GlProgram& GlBaker::vplProgram(int layers) {
+  std::unique_ptr<GlProgram>& p = vplPrograms_[layers];
+  if (p) return *p;
+  std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
+  if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
+  auto constant = [&](const char* name, float value) {
+    char text[64];
+    std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
+    defines.push_back(text);
+  };
+  constant("CLAMP_BOUND", std::isfinite(in_.eval.clampBound) ? in_.eval.clampBound : 0.0f);  // ≤ 0: no clamp
+  constant("NEAR_PLANE", scale_.nearPlane);
+  constant("CONSTANT_BIAS", scale_.constantBias);
+  constant("SLOPE_BIAS", opt_.slopeBias);
+  constant("NORMAL_OFFSET", opt_.normalOffset);
+  constant("TEXEL_ANGLE", 2.0f / opt_.cubeFaceSize);
+  constant("ORIGIN_OFFSET", scale_.originOffset);
+  if (opt_.normalOffset != 0.0f) defines.push_back("#define HAS_NORMAL_OFFSET 1");
+  p = std::make_unique<GlProgram>(
+      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
+                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
+      defines);
+  return *p;
 }
 
 void GlBaker::bakeDirect(const Light& light) {
@@ -300,9 +362,7 @@ void GlBaker::bakeDirect(const Light& light) {
   int shadowKind = 0;
   depthProgram_->use();
   glBindVertexArray(geometry_->vao);
-  glEnable(GL_DEPTH_TEST);
-  glEnable(GL_SCISSOR_TEST);
-  glDisable(GL_BLEND);
+  shadowPassState();
   if (cube) {
     maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.pointFaceSize, kFaces);
     const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
@@ -328,9 +388,7 @@ void GlBaker::bakeDirect(const Light& light) {
   }
   finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
 
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_SCISSOR_TEST);
-  glEnable(GL_BLEND);  // added to the VPL partial sums not yet folded
+  lightMapPassState();  // blended: added to the VPL partial sums not yet folded
   directProgram_->use();
   const GlProgram& p = *directProgram_;
   glUniform1i(p.uniform("lightType"), light.type == LightType::Point ? 0 : light.type == LightType::Spot ? 1 : 2);
@@ -368,22 +426,16 @@ std::vector<Lightmap> GlBaker::run() {
 
   geometry_ = std::make_unique<GpuGeometry>();
   uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
-  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s));
+  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, opt_.skipInvalidTexels));
 
   const int K = std::clamp(opt_.vplsPerPass, 1, 256);
-  std::vector<std::string> defines{"#define MAX_BATCH " + std::to_string(K)};
-  if (opt_.shadowPcf) defines.push_back("#define SHADOW_PCF 1");
   depthProgram_ = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
-  vplProgram_ = std::make_unique<GlProgram>(
-      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
-      defines);
   directProgram_ = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}},
-      defines);
-  for (const GlProgram* p : {vplProgram_.get(), directProgram_.get()}) {
+                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}});
+  {
+    const GlProgram* p = directProgram_.get();
     p->use();
     glUniform1f(p->uniform("clampBound"), in_.eval.clampBound);
     glUniform1f(p->uniform("nearPlane"), scale_.nearPlane);
@@ -391,35 +443,49 @@ std::vector<Lightmap> GlBaker::run() {
     glUniform1f(p->uniform("slopeBias"), opt_.slopeBias);
     glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   }
-  vplProgram_->use();
-  glUniform1f(vplProgram_->uniform("texelAngle"), 2.0f / opt_.cubeFaceSize);
-  glCreateBuffers(1, &vplUbo_);
-  glNamedBufferStorage(vplUbo_, K * sizeof(VplGpu), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  if (in_.eval.includeVpls && !in_.vpls.vpls.empty())
+    for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
+  glCreateBuffers(1, &vplBuffer_);
+  glNamedBufferStorage(vplBuffer_, K * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateTextures(GL_TEXTURE_BUFFER, 1, &vplTable_);
+  glTextureBuffer(vplTable_, GL_RGBA32F, vplBuffer_);
   glCreateVertexArrays(1, &emptyVao_);
   // Reversed-Z with [0,1] clip depth: depth = near / distance keeps float precision at every range.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glBlendFunc(GL_ONE, GL_ONE);
   glBlendEquation(GL_FUNC_ADD);
-  checkGlError("GL backend setup");
-  finishStage(stats_.setupSeconds, sw);
 
   const auto& vpls = in_.vpls.vpls;
   const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
   const size_t totalWork = vplCount + lightCount * K;
+  std::unique_ptr<DepthTargets> cubeTargets;
   if (vplCount > 0) {
-    DepthTargets cubes(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
+    cubeTargets = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
+    if (opt_.shadowPcf && opt_.shadowCompare) {
+      // Sampled through sampler2DArrayShadow: lit (1) where the stored depth ≤ the reference.
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    }
+    // A pass over zero VPLs (adds 0): llvmpipe compiles the accumulation shader for this state at its
+    // first draw, which then counts as setup, not as the first batch's accumulation.
+    lightMapPassState();
+    accumulateVplBatch(0, 0, *cubeTargets);
+  }
+  checkGlError("GL backend setup");
+  finishStage(stats_.setupSeconds, sw);
+
+  if (vplCount > 0) {
+    DepthTargets& cubes = *cubeTargets;
     int passesSinceFold = 0;
     for (size_t first = 0; first < vplCount; first += K) {
       const size_t count = std::min<size_t>(K, vplCount - first);
-      glEnable(GL_DEPTH_TEST);
-      glEnable(GL_SCISSOR_TEST);
-      glDisable(GL_BLEND);
+      shadowPassState();
       renderVplBatch(first, count, cubes);
       finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
-      glDisable(GL_DEPTH_TEST);
-      glDisable(GL_SCISSOR_TEST);
-      glEnable(GL_BLEND);
+      lightMapPassState();
       accumulateVplBatch(first, count, cubes);
       finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
       ++stats_.passes;
@@ -462,7 +528,8 @@ std::vector<Lightmap> GlBaker::run() {
     }
     maps.push_back(std::move(m));
   }
-  glDeleteBuffers(1, &vplUbo_);
+  glDeleteTextures(1, &vplTable_);
+  glDeleteBuffers(1, &vplBuffer_);
   glDeleteVertexArrays(1, &emptyVao_);
   if (in_.progress) in_.progress("gl", 1.0);
   return maps;

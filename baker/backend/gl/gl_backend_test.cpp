@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "backend/gl/shadow_views.h"
 #include "common/error.h"
@@ -195,6 +196,67 @@ TEST(GlBackend, VplShadowsMatchRayTracedVisibility) {
   size_t off = 0;
   for (size_t i = 0; i < ref.size(); ++i) off += std::abs(maps[0].texels[i].x - ref[i].x) > 0.02 * ref[i].x + 1e-6;
   EXPECT_LT(off, ref.size() / 50);  // only texels on a shadow edge may differ
+}
+
+// The sampler's depth comparison (GL_LINEAR on a compare-mode depth array) is the same 2×2 percentage-
+// closer filter as the four texelFetch taps and compares it replaced. The sampler rounds its filter
+// weights its own way: here 1 of ~650 shadow-edge texels differs by 0.4% of one VPL's unshadowed value
+// (bound: 1/256, a GPU's 8-bit sub-texel precision); every other texel agrees to float rounding.
+TEST(GlBackend, HardwareDepthCompareEqualsFourTapPcf) {
+  Fixture f = floorScene(true);
+  for (int i = 0; i < 5; ++i) {
+    Vpl v;
+    v.position = {-0.4f + 0.2f * i, 0.1f * i - 0.2f, 0.9f + 0.05f * i};
+    v.normal = glm::normalize(glm::vec3(0.1f * i - 0.2f, 0.05f, -1.0f));
+    v.power = glm::vec3(1.0f);
+    f.vpls.vpls.push_back(v);
+  }
+  GlBackendOptions hw, taps;
+  hw.cubeFaceSize = taps.cubeFaceSize = 64;  // coarse: many texels on a filtered shadow edge
+  taps.shadowCompare = false;
+  const auto a = f.bake({}, hw), b = f.bake({}, taps);
+  size_t partial = 0, rounded = 0;  // texels on a filtered edge; texels differing beyond float rounding
+  double num = 0, den = 0;
+  const auto open = cpuReference(f, f.pages[0], 0.0f, false);
+  for (size_t i = 0; i < a[0].size(); ++i) {
+    const double d = std::abs(a[0].texels[i].x - b[0].texels[i].x);
+    EXPECT_LE(d, open[i].x / 256.0 + 1e-9) << i;
+    rounded += d > 1e-5 * open[i].x + 1e-9;
+    partial += a[0].texels[i].x > 0.01 * open[i].x && a[0].texels[i].x < 0.99 * open[i].x;
+    num += d * d;
+    den += double(b[0].texels[i].x) * b[0].texels[i].x;
+  }
+  EXPECT_GT(partial, 20u);            // the filter is exercised
+  EXPECT_LT(rounded, partial);        // only edge texels can differ beyond rounding
+  EXPECT_LT(std::sqrt(num / den), 1e-3);
+  std::printf("edge texels %zu, beyond rounding %zu, relative RMSE %.2e\n", partial, rounded, std::sqrt(num / den));
+}
+
+// Invalid texels are skipped by the early depth test against the page's validity mask: they stay 0
+// and the valid texels are exactly what a bake without the mask gives.
+TEST(GlBackend, ValidityMaskSkipsOnlyInvalidTexels) {
+  Fixture f = floorScene(true);
+  TexelSamples& s = f.pages[0];
+  for (size_t i = 0; i < s.layerSize(); ++i)
+    if ((i * 7) % 5 == 0 || (i / 32) % 8 < 2) s.valid[i] = 0;  // scattered and whole 8-texel rows
+  Vpl v;
+  v.position = {0.3f, 0.2f, 0.9f};
+  v.normal = {0, 0, -1};
+  v.power = glm::vec3(1.0f);
+  f.vpls.vpls.push_back(v);
+  f.scene.lights.push_back(testing::pointLight({-0.2f, 0.1f, 1.1f}, 2.0f));
+  GlBackendOptions masked, unmasked;
+  masked.pointFaceSize = unmasked.pointFaceSize = 256;
+  unmasked.skipInvalidTexels = false;
+  const auto a = f.bake({}, masked), b = f.bake({}, unmasked);
+  size_t valid = 0;
+  for (size_t i = 0; i < s.layerSize(); ++i) {
+    EXPECT_EQ(a[0].valid[i], s.valid[i]);
+    EXPECT_EQ(a[0].texels[i], b[0].texels[i]) << i;
+    if (!s.valid[i]) EXPECT_EQ(a[0].texels[i], glm::vec3(0.0f)) << i;
+    valid += s.valid[i] && a[0].texels[i].x > 0.0f;
+  }
+  EXPECT_GT(valid, s.layerSize() / 3);
 }
 
 TEST(GlBackend, ClampBoundsGeometryTerm) {
