@@ -309,12 +309,7 @@ int sceneBench(const std::vector<std::string>& args) {
           go.stats = &one;
           go.stageTimings = true;
           auto m = bakeGl(i, go);
-          st.renderer = one.renderer;
-          st.setupSeconds += one.setupSeconds;
-          st.shadowSeconds += one.shadowSeconds;
-          st.accumulateSeconds += one.accumulateSeconds;
-          st.shadowCpuSeconds += one.shadowCpuSeconds;
-          st.accumulateCpuSeconds += one.accumulateCpuSeconds;
+          st.add(one);
           return m;
         });
       } else {

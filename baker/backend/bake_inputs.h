@@ -27,4 +27,15 @@ struct BakeInputs {
   ProgressCallback progress;
 };
 
+// A page's map with every texel 0 and invalid, sized like its texel samples.
+inline Lightmap blankLightmap(const TexelSamples& ts) {
+  Lightmap map;
+  map.page = ts.page;
+  map.width = ts.width;
+  map.height = ts.height;
+  map.texels.assign(ts.layerSize(), glm::vec3(0.0f));
+  map.valid.assign(ts.layerSize(), 0);
+  return map;
+}
+
 }  // namespace irbake

@@ -41,14 +41,7 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
         go.stats = &st;
         go.context = &context;
         std::vector<Lightmap> maps = bakeGl(in, go);
-        total.renderer = st.renderer;
-        total.setupSeconds += st.setupSeconds;
-        total.shadowSeconds += st.shadowSeconds;
-        total.accumulateSeconds += st.accumulateSeconds;
-        total.foldSeconds += st.foldSeconds;
-        total.passes += st.passes;
-        total.facesRendered += st.facesRendered;
-        total.trianglesDrawn += st.trianglesDrawn;
+        total.add(st);
         return maps;
       };
       InterleaveStats is;

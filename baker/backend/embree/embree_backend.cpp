@@ -170,12 +170,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
   const size_t numVpls = in.eval.includeVpls ? in.vpls.vpls.size() : 0;
 
   for (const TexelSamples& ts : in.texels) {
-    Lightmap map;
-    map.page = ts.page;
-    map.width = ts.width;
-    map.height = ts.height;
-    map.texels.assign(ts.layerSize(), glm::vec3(0.0f));
-    map.valid.assign(ts.layerSize(), 0);
+    Lightmap map = blankLightmap(ts);
     const size_t slots = ts.slotCount();
     std::vector<glm::vec3> slotValue(slots, glm::vec3(0.0f));
 

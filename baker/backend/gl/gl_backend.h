@@ -25,6 +25,21 @@ struct GlBakeStats {
   size_t facesRendered = 0;      // shadow views drawn (cube faces, spot/directional maps)
   size_t trianglesDrawn = 0;     // triangles submitted to shadow views after CPU culling
   size_t trianglesBeforeCulling = 0;  // triangles that would be submitted without culling
+  // Adds another call's figures (interleaved sampling calls the backend once per texel class).
+  void add(const GlBakeStats& o) {
+    renderer = o.renderer;
+    setupSeconds += o.setupSeconds;
+    shadowSeconds += o.shadowSeconds;
+    accumulateSeconds += o.accumulateSeconds;
+    foldSeconds += o.foldSeconds;
+    shadowCpuSeconds += o.shadowCpuSeconds;
+    accumulateCpuSeconds += o.accumulateCpuSeconds;
+    vpls += o.vpls;
+    passes += o.passes;
+    facesRendered += o.facesRendered;
+    trianglesDrawn += o.trianglesDrawn;
+    trianglesBeforeCulling += o.trianglesBeforeCulling;
+  }
 };
 
 struct GlBackendOptions {

@@ -74,13 +74,8 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
     ++calls;
   } else {
     for (const TexelSamples& ts : in.texels) {
-      Lightmap map;
-      map.page = ts.page;
-      map.width = ts.width;
-      map.height = ts.height;
-      map.texels.assign(ts.layerSize(), glm::vec3(0.0f));
-      map.valid = ts.valid;
-      maps.push_back(std::move(map));
+      maps.push_back(blankLightmap(ts));
+      maps.back().valid = ts.valid;
     }
   }
 
