@@ -13,7 +13,8 @@ namespace irbake::testing {
 
 inline int addMaterial(Scene& s, glm::vec3 albedo, glm::vec3 emission = glm::vec3(0.0f)) {
   Material m;
-  m.name = "m" + std::to_string(s.materials.size());
+  m.name = std::to_string(s.materials.size());
+  m.name.insert(0, 1, 'm');  // not "m" + to_string(): GCC 12 warns falsely (-Wrestrict) on that inlined operator+
   m.baseColorFactor = glm::vec4(albedo, 1.0f);
   m.emissiveFactor = emission;
   s.materials.push_back(m);
