@@ -1,7 +1,10 @@
 // irview frame time on this machine's GL (llvmpipe in CI): one frame = clear + one textured draw per
-// primitive into a 1280×720 RGBA8 framebuffer with the display shading (exposure + sRGB), then
-// glFinish, as the window does before a swap. Scenes: the baked Cornell box (Embree backend) and a
-// generated ~100k-triangle height field with a 1024² light-map page.
+// primitive into a 1280×720 8-bit framebuffer with the display shading (exposure + sRGB), then
+// glFinish, as the window does before a swap. The target is sRGB (GL_SRGB8_ALPHA8, encoded on store)
+// as the window's back buffer is where the visual offers one; the `_shaderSrgb` row is the fallback
+// (RGBA8, sRGB encoded in the shader). Scenes: the baked Cornell box (Embree backend) and a generated
+// ~100k-triangle height field with a 1024² light-map page, untextured and with a 512² base colour
+// texture repeated 8 × 8.
 // Run: viewer_bench --benchmark_repetitions=9 --benchmark_report_aggregates_only=true (quote medians).
 #include <sys/resource.h>
 
@@ -36,8 +39,9 @@ GlContext& context() {
   return gl;
 }
 
-// A wavy n×n height field over 10 × 10 m: 2n² triangles, uv1 over one page with a smooth map.
-ViewerScene heightField(int n, int pageSize) {
+// A wavy n×n height field over 10 × 10 m: 2n² triangles, uv1 over one page with a smooth map;
+// textured: a 512² base colour texture (a coloured brick-like pattern) repeated 8 × 8 over uv0.
+ViewerScene heightField(int n, int pageSize, bool textured = false) {
   Scene s;
   s.materials.emplace_back();
   s.materials[0].baseColorFactor = glm::vec4(0.7f, 0.7f, 0.7f, 1.0f);
@@ -48,7 +52,7 @@ ViewerScene heightField(int n, int pageSize) {
       float x = 10 * u - 5, z = 10 * v - 5;
       p.positions.emplace_back(x, 0.3f * std::sin(3 * x) * std::cos(2 * z), z);
       p.normals.emplace_back(0, 1, 0);
-      p.uv0.emplace_back(u, v);
+      p.uv0.emplace_back(8 * u, 8 * v);
       p.uv1.emplace_back(u, v);
     }
   for (int j = 0; j < n; ++j)
@@ -58,6 +62,20 @@ ViewerScene heightField(int n, int pageSize) {
     }
   p.lightmap = {0, pageSize, pageSize};
   s.primitives.push_back(std::move(p));
+  if (textured) {
+    Texture t;
+    t.width = t.height = 512;
+    for (int y = 0; y < t.height; ++y)
+      for (int x = 0; x < t.width; ++x) {
+        const bool mortar = y % 32 < 2 || (x + (y / 32 % 2) * 32) % 64 < 2;
+        const float grain = 0.85f + 0.15f * std::sin(0.37f * x + 0.11f * y) * std::cos(0.23f * y);
+        t.texels.push_back(mortar ? glm::vec4(0.55f, 0.55f, 0.5f, 1.0f)
+                                  : glm::vec4(0.6f * grain, 0.25f * grain, 0.15f * grain, 1.0f));
+      }
+    s.textures.push_back(std::move(t));
+    s.materials[0].baseColorFactor = glm::vec4(1.0f);
+    s.materials[0].baseColorTexture = 0;
+  }
   Lightmap page;
   page.width = page.height = pageSize;
   for (int y = 0; y < pageSize; ++y)
@@ -76,7 +94,7 @@ ViewerScene bakedCornell() {
   return makeViewerScene(std::move(r.scene), std::move(r.maps));
 }
 
-void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam) {
+void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam, bool srgbTarget = true) {
   context();
   ViewRenderer renderer(v);
   GLuint fbo = 0, color = 0, depth = 0;
@@ -84,7 +102,7 @@ void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& 
   glGenRenderbuffers(1, &color);
   glGenRenderbuffers(1, &depth);
   glBindRenderbuffer(GL_RENDERBUFFER, color);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, kWidth, kHeight);
+  glRenderbufferStorage(GL_RENDERBUFFER, srgbTarget ? GL_SRGB8_ALPHA8 : GL_RGBA8, kWidth, kHeight);
   glBindRenderbuffer(GL_RENDERBUFFER, depth);
   glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, kWidth, kHeight);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -92,6 +110,8 @@ void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& 
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
   DrawSettings settings;
   settings.encodeSrgb = true;
+  settings.srgbFramebuffer = drawFramebufferIsSrgb();
+  if (settings.srgbFramebuffer != srgbTarget) state.SkipWithError("sRGB framebuffer query disagrees with the target");
   renderer.draw(cam, kWidth, kHeight, settings);  // warm-up: shader compile, texture residency
   glFinish();
   const double cpu0 = processCpuSeconds();
@@ -102,6 +122,16 @@ void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& 
   state.counters["cpu_ms_per_frame"] =
       benchmark::Counter(1000.0 * (processCpuSeconds() - cpu0), benchmark::Counter::kAvgIterations);
   state.counters["triangles"] = static_cast<double>(renderer.triangleCount());
+  // Fragments that pass the depth test in one frame (visible pixels plus overdraw drawn front-most so far).
+  GLuint query = 0;
+  glGenQueries(1, &query);
+  glBeginQuery(GL_SAMPLES_PASSED, query);
+  renderer.draw(cam, kWidth, kHeight, settings);
+  glEndQuery(GL_SAMPLES_PASSED);
+  GLuint samples = 0;
+  glGetQueryObjectuiv(query, GL_QUERY_RESULT, &samples);
+  glDeleteQueries(1, &query);
+  state.counters["fragments"] = static_cast<double>(samples);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glDeleteFramebuffers(1, &fbo);
   glDeleteRenderbuffers(1, &color);
@@ -118,8 +148,20 @@ void BM_Frame100kTriangles(benchmark::State& state) {
   frameLoop(state, v, lookAt({0, 4, 8}, {0, 0, 0}, 50.0f, v.scene.bounds()));
 }
 
+void BM_Frame100kTriangles_shaderSrgb(benchmark::State& state) {
+  static ViewerScene v = heightField(224, 1024);
+  frameLoop(state, v, lookAt({0, 4, 8}, {0, 0, 0}, 50.0f, v.scene.bounds()), false);
+}
+
+void BM_Frame100kTrianglesTextured(benchmark::State& state) {
+  static ViewerScene v = heightField(224, 1024, true);
+  frameLoop(state, v, lookAt({0, 4, 8}, {0, 0, 0}, 50.0f, v.scene.bounds()));
+}
+
 }  // namespace
 
 BENCHMARK(BM_FrameCornellBox)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(BM_Frame100kTriangles)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(BM_Frame100kTriangles_shaderSrgb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(BM_Frame100kTrianglesTextured)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK_MAIN();
