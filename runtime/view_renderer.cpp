@@ -97,17 +97,17 @@ ViewMode parseViewMode(const std::string& name) {
 // base colour unless it cuts alpha-mask holes). Packed into an int as the program cache key.
 struct Variant {
   int mode = 0;         // ViewMode, 5 = the wireframe's line pass
-  int output = 0;       // 0 linear, 1 exposure + sRGB in the shader, 2 exposure only (sRGB framebuffer)
+  int output = 0;       // 0 linear radiance, 1 exposure + sRGB encode (display)
   int baseTex = 0;      // 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
   int emissiveTex = 0;  // 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
   int lightmap = 0;     // 1: the primitive has a light map
   int alphaMask = 0;    // 1: alphaMode MASK
 
   int key() const {
-    return mode | output << 3 | baseTex << 5 | emissiveTex << 7 | lightmap << 9 | alphaMask << 10;
+    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9;
   }
   static Variant fromKey(int k) {
-    return {k & 7, (k >> 3) & 3, (k >> 5) & 3, (k >> 7) & 3, (k >> 9) & 1, (k >> 10) & 1};
+    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1};
   }
   // `all`: every feature of the primitive; keeps those `mode` reads.
   static Variant forMode(int mode, int output, const Variant& all) {
@@ -127,19 +127,6 @@ struct Variant {
   int needNormal() const { return mode == 3; }
   int needChart() const { return mode == 3 || mode == 4; }
 };
-
-bool drawFramebufferIsSrgb() {
-  while (glGetError() != GL_NO_ERROR) {
-  }
-  GLint fbo = 0, encoding = GL_LINEAR;
-  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
-  glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, fbo ? GL_COLOR_ATTACHMENT0 : GL_BACK_LEFT,
-                                        GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING, &encoding);
-  const bool ok = glGetError() == GL_NO_ERROR;
-  while (glGetError() != GL_NO_ERROR) {
-  }
-  return ok && encoding == GL_SRGB;
-}
 
 struct ViewRenderer::Impl {
   struct GpuPrimitive {
@@ -350,14 +337,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   const float aspect = static_cast<float>(width) / std::max(height, 1);
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
-  // The sRGB framebuffer path: GL encodes on store, the shader applies the exposure only.
-  const int output = !settings.encodeSrgb ? 0 : settings.srgbFramebuffer ? 2 : 1;
-  if (output == 2)
-    glEnable(GL_FRAMEBUFFER_SRGB);
-  else
-    glDisable(GL_FRAMEBUFFER_SRGB);
-  // Line colour 0.9 as displayed: through an sRGB framebuffer it is given linear.
-  const float line = output == 2 ? 0.7874f : 0.9f;
+  const int output = settings.encodeSrgb ? 1 : 0;
 
   std::vector<std::pair<int, size_t>> order(I.prims.size());  // (variant key, primitive), grouped by key
   auto drawAll = [&](int mode) {
@@ -372,7 +352,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
         glUniform1i(I.u("uBaseColorTex"), 0);
         glUniform1i(I.u("uEmissiveTex"), 1);
         glUniform1i(I.u("uLightmap"), 2);
-        glUniform3f(I.u("uLineColor"), line, line, line);
+        glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
       }
       const Material& m = I.scene.materials.at(g.material);
       glUniform4fv(I.u("uBaseColorFactor"), 1, &m.baseColorFactor[0]);
@@ -406,7 +386,6 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   }
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
-  glDisable(GL_FRAMEBUFFER_SRGB);
   throwOnGlError("drawing the scene");
 }
 

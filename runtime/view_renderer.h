@@ -20,9 +20,7 @@ ViewMode parseViewMode(const std::string& name);
 struct DrawSettings {
   ViewMode mode = ViewMode::Lit;   // what to show
   float exposure = 0.0f;           // EV stops, display only (×2^EV before the sRGB encode)
-  bool encodeSrgb = false;         // true: display output, exposure + sRGB (window); false: linear out
-  bool srgbFramebuffer = false;    // with encodeSrgb: the bound target is sRGB (drawFramebufferIsSrgb),
-                                   // so GL_FRAMEBUFFER_SRGB encodes on store and the shader does not
+  bool encodeSrgb = false;         // true: exposure + sRGB in the shader (window); false: linear out
   glm::vec3 background{0.0f};      // clear colour (linear)
 };
 
@@ -32,11 +30,6 @@ struct RgbaImage {
   std::vector<glm::vec4> pixels;
   const glm::vec4& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
-
-// Whether the bound draw framebuffer's colour buffer (attachment 0, or the default framebuffer's back
-// buffer) stores sRGB-encoded values, i.e. GL_FRAMEBUFFER_SRGB would encode into it. Clears any GL
-// error the query raises (a surfaceless context has no default framebuffer).
-bool drawFramebufferIsSrgb();
 
 class ViewRenderer {
  public:

@@ -1,7 +1,11 @@
 // Renderer tests on scenes built in code with closed-form light maps: pixels are compared with
 // baseColor × map + emissive evaluated on the CPU at the surface point each pixel sees.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
+#include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
@@ -171,6 +175,63 @@ TEST(ViewRenderer, TexturedPlaneMatchesAlbedoTimesClosedFormMap) {
   RgbaImage map = r.render(cam, w, h, {ViewMode::Lightmap});
   EXPECT_NEAR(albedo.at(cx, cy).g, sampleBilinear(c.view.scene.textures[0], uv).g, 0.01f);
   EXPECT_NEAR(map.at(cx, cy).r / c.mapAt(p), 1.0f, 0.02f);
+}
+
+// The window's output (draw with encodeSrgb into an 8-bit target): the shader's sRGB encode is a fit
+// (no pow()), so check it against the exact IEC 61966-2-1 encode of 2^EV × the linear render, pixel
+// by pixel: within one 8-bit step, over dark, mid and clipped values.
+TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
+  GlContext gl;
+  PlaneCase c = texturedPlane();
+  ViewRenderer r(c.view);
+  const int w = 160, h = 120;
+  ViewCamera cam = lookAt({0.2f, 3.0f, 2.5f}, {0, 0, -0.3f}, 55.0f, c.view.scene.bounds());
+  GLuint fbo = 0, color = 0, depth = 0;
+  glGenFramebuffers(1, &fbo);
+  glGenRenderbuffers(1, &color);
+  glGenRenderbuffers(1, &depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, color);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  ASSERT_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
+  auto exactSrgb = [](float x) {
+    x = std::clamp(x, 0.0f, 1.0f);
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  };
+  const RgbaImage linear = r.render(cam, w, h, {});  // binds its own framebuffer, restores ours
+  int worst = 0, dark = 0, mid = 0, clipped = 0;
+  for (float ev : {-6.0f, -3.0f, 0.0f, 2.0f}) {
+    DrawSettings display;
+    display.encodeSrgb = true;
+    display.exposure = ev;
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    r.draw(cam, w, h, display);
+    std::vector<uint8_t> rgba(static_cast<size_t>(w) * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int k = 0; k < 3; ++k) {
+          const int got = rgba[(static_cast<size_t>(h - 1 - y) * w + x) * 4 + k];  // GL row 0 = bottom
+          const int expected = static_cast<int>(std::lround(255.0f * exactSrgb(std::exp2(ev) * linear.at(x, y)[k])));
+          worst = std::max(worst, std::abs(got - expected));
+          dark += expected > 0 && expected < 64;
+          mid += expected >= 64 && expected < 200;
+          clipped += expected == 255;
+        }
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteRenderbuffers(1, &color);
+  glDeleteRenderbuffers(1, &depth);
+  EXPECT_LE(worst, 1);
+  EXPECT_GT(dark, 1000);
+  EXPECT_GT(mid, 1000);
+  EXPECT_GT(clipped, 1000);
 }
 
 TEST(ViewRenderer, MaterialLightmapTextureIsScaledByIntensity) {

@@ -98,9 +98,7 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  // An sRGB-capable back buffer encodes on store (GL_FRAMEBUFFER_SRGB), cheaper on llvmpipe than pow()
-  // in the shader; where the visual has none, the shader encodes.
-  glfwWindowHint(GLFW_SRGB_CAPABLE, GLFW_TRUE);
+  glfwWindowHint(GLFW_SRGB_CAPABLE, GLFW_FALSE);  // the shader encodes sRGB itself
   GLFWwindow* window = glfwCreateWindow(o.width, o.height, ("irview - " + o.scene.filename().string()).c_str(),
                                         nullptr, nullptr);
   if (!window)
@@ -114,9 +112,6 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   s.settings.mode = o.mode;
   s.settings.exposure = o.exposure;
   s.settings.encodeSrgb = true;
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  s.settings.srgbFramebuffer = drawFramebufferIsSrgb();
-  log::debug(std::string("window back buffer: ") + (s.settings.srgbFramebuffer ? "sRGB" : "linear, sRGB encoded in the shader"));
   s.fly.setFrom(startCamera(o, v.scene));
   s.speed = std::max(0.25f * v.scene.bounds().diagonal(), 1e-3f);
   glfwSetWindowUserPointer(window, &s);
