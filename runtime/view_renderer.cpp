@@ -159,19 +159,21 @@ struct ViewRenderer::Impl {
     return uniforms[name] = glGetUniformLocation(program, name);
   }
 
-  // Binds the shader variant for a key (see variantKey), compiling it on first use. Returns true
+  // Binds the shader variant for a key (Variant::key), compiling it on first use. Returns true
   // when the program changed, so the caller sets its per-frame uniforms again.
   bool useProgram(int key) {
     auto it = programs.find(key);
     if (it == programs.end()) {
       const Variant f = Variant::fromKey(key);
+      auto define = [](const char* name, int value) {
+        return "#define " + std::string(name) + " " + std::to_string(value);
+      };
       const std::vector<std::string> defines = {
-          "#define VIEW_MODE " + std::to_string(f.mode), "#define OUTPUT " + std::to_string(f.output),
-          "#define BASE_TEX " + std::to_string(f.baseTex), "#define EMISSIVE_TEX " + std::to_string(f.emissiveTex),
-          "#define HAS_LIGHTMAP " + std::to_string(f.lightmap), "#define ALPHA_MASK " + std::to_string(f.alphaMask),
-          "#define NEED_UV0 " + std::to_string(f.needUv0()), "#define NEED_UV1 " + std::to_string(f.needUv1()),
-          "#define NEED_NORMAL " + std::to_string(f.needNormal()),
-          "#define NEED_CHART " + std::to_string(f.needChart())};
+          define("VIEW_MODE", f.mode),          define("OUTPUT", f.output),
+          define("BASE_TEX", f.baseTex),        define("EMISSIVE_TEX", f.emissiveTex),
+          define("HAS_LIGHTMAP", f.lightmap),   define("ALPHA_MASK", f.alphaMask),
+          define("NEED_UV0", f.needUv0()),      define("NEED_UV1", f.needUv1()),
+          define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart())};
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
@@ -270,14 +272,15 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     glBufferData(GL_ARRAY_BUFFER, verts.size() * sizeof(Vertex), verts.data(), GL_STATIC_DRAW);
     glGenBuffers(1, &g.ebo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
-    if (p.positions.size() <= 65536) {
+    if (*std::max_element(p.indices.begin(), p.indices.end()) <= 0xffff) {
       // Half the index bytes for llvmpipe's vertex fetch to read.
-      std::vector<uint16_t> shortIndices(p.indices.begin(), p.indices.end());
+      const std::vector<uint16_t> shortIndices(p.indices.begin(), p.indices.end());
       glBufferData(GL_ELEMENT_ARRAY_BUFFER, shortIndices.size() * sizeof(uint16_t), shortIndices.data(),
                    GL_STATIC_DRAW);
       g.indexType = GL_UNSIGNED_SHORT;
     } else {
-      glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(), GL_STATIC_DRAW);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(),
+                   GL_STATIC_DRAW);
     }
     const GLsizei stride = sizeof(Vertex);
     glEnableVertexAttribArray(0);
@@ -338,11 +341,14 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
   const int output = settings.encodeSrgb ? 1 : 0;
-
-  std::vector<std::pair<int, size_t>> order(I.prims.size());  // (variant key, primitive), grouped by key
+  // Primitives grouped by shader variant, one program switch per group (the depth test makes the
+  // order invisible but for exactly coplanar overlaps).
+  std::vector<std::pair<int, size_t>> order(I.prims.size());  // (variant key, primitive index)
   auto drawAll = [&](int mode) {
-    for (size_t i = 0; i < I.prims.size(); ++i) order[i] = {Variant::forMode(mode, output, I.prims[i].features).key(), i};
-    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t i = 0; i < I.prims.size(); ++i)
+      order[i] = {Variant::forMode(mode, output, I.prims[i].features).key(), i};
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
     I.program = 0;
     for (const auto& [key, index] : order) {
       const auto& g = I.prims[index];
