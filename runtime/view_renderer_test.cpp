@@ -234,6 +234,83 @@ TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
   EXPECT_GT(clipped, 1000);
 }
 
+// Each material feature selects its own shader variant; check each against the CPU: a base colour
+// texture read through TEXCOORD_1 (uv0 mirrored, so reading the wrong set shows), an emissive
+// texture on TEXCOORD_0 over a base colour factor, and an alpha-masked texture (alpha = u, cutoff
+// 0.5) whose holes show the background in the lit, light-map and charts views. Map = 1 everywhere.
+TEST(ViewRenderer, MaterialFeaturesMatchTheirClosedForm) {
+  GlContext gl;
+  Scene s;
+  Texture t;
+  t.name = "gradient";
+  t.width = t.height = 64;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const float u = (x + 0.5f) / t.width;
+      t.texels.emplace_back(0.2f + 0.6f * u, 0.5f, 0.8f - 0.6f * u, u);
+    }
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  s.textures.push_back(t);
+  Material onUv1;
+  onUv1.baseColorTexture = 0;
+  onUv1.baseColorTexCoord = 1;
+  Material emissive;
+  emissive.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  emissive.emissiveFactor = glm::vec3(0.3f);
+  emissive.emissiveTexture = 0;
+  Material masked;
+  masked.baseColorTexture = 0;
+  masked.alphaMode = AlphaMode::Mask;
+  masked.alphaCutoff = 0.5f;
+  s.materials = {onUv1, emissive, masked};
+  std::vector<Lightmap> pages;
+  const float x0[3] = {-3.2f, -1.0f, 1.2f};  // quads x0 .. x0 + 2, z -1 .. 1; u = (z + 1)/2, v = (x − x0)/2
+  for (int q = 0; q < 3; ++q) {
+    addQuad(s, {x0[q], 0, -1}, {x0[q], 0, 1}, {x0[q] + 2, 0, 1}, {x0[q] + 2, 0, -1}, q, q, 8);
+    pages.push_back(constantPage(q, 8, glm::vec3(1.0f)));
+  }
+  for (auto& uv : s.primitives[0].uv0) uv.x = 1.0f - uv.x;
+  ViewerScene v = makeViewerScene(std::move(s), std::move(pages));
+  ViewRenderer r(v);
+  const int w = 200, h = 64;
+  ViewCamera cam = lookAt({0, 6, 0.01f}, {0, 0, 0}, 24.0f, v.scene.bounds());
+  const RgbaImage lit = r.render(cam, w, h, {});
+  const RgbaImage map = r.render(cam, w, h, {ViewMode::Lightmap});
+  const RgbaImage charts = r.render(cam, w, h, {ViewMode::Charts});
+  const Texture& tex = v.scene.textures[0];
+  int checked[3] = {0, 0, 0}, holes = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      glm::vec3 p;
+      if (!floorPointAt(cam, w, h, x, y, p)) continue;
+      for (int q = 0; q < 3; ++q) {
+        const glm::vec2 uv((p.z + 1) / 2, (p.x - x0[q]) / 2);
+        if (uv.x < 0.05f || uv.x > 0.95f || uv.y < 0.05f || uv.y > 0.95f) continue;
+        glm::vec3 expected;
+        if (q == 0) expected = glm::vec3(sampleBilinear(tex, uv));
+        if (q == 1) expected = glm::vec3(0.5f) + 0.3f * glm::vec3(sampleBilinear(tex, uv));
+        if (q == 2) {
+          if (std::abs(uv.x - 0.5f) < 0.05f) continue;  // the cut itself
+          if (uv.x < 0.5f) {
+            ++holes;
+            EXPECT_EQ(lit.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            EXPECT_EQ(map.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            EXPECT_EQ(charts.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            continue;
+          }
+          expected = glm::vec3(sampleBilinear(tex, uv));
+        }
+        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(lit.at(x, y)[k] / expected[k] - 1.0f));
+        EXPECT_NEAR(map.at(x, y).r, 1.0f, 1e-3f);
+        ++checked[q];
+      }
+    }
+  EXPECT_LT(worst, 0.02f);
+  for (int q = 0; q < 3; ++q) EXPECT_GT(checked[q], 150) << "quad " << q;
+  EXPECT_GT(holes, 150);
+}
+
 TEST(ViewRenderer, MaterialLightmapTextureIsScaledByIntensity) {
   // No float pages: MOZ_lightmap texture (0.25) × intensity (4) = 1, on albedo 0.6.
   GlContext gl;
