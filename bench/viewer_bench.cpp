@@ -113,7 +113,10 @@ ViewerScene furnishedRoom() {
   auto finish = [&](Primitive& p, int material) {
     const int cell = nextCell++;
     const glm::vec2 origin(cell % cells, cell / cells);
-    for (auto& uv : p.uv0) p.uv1.push_back((origin + 0.05f + 0.9f * glm::clamp(uv - glm::floor(uv * 0.999f), 0.0f, 1.0f)) / float(cells));
+    for (auto& uv : p.uv0) {
+      const glm::vec2 local = glm::clamp(uv - glm::floor(uv * 0.999f), 0.0f, 1.0f);  // 0..1 in the cell
+      p.uv1.push_back((origin + 0.05f + 0.9f * local) / float(cells));
+    }
     p.material = material;
     p.lightmap = {0, pageSize, pageSize};
     s.primitives.push_back(std::move(p));
@@ -136,7 +139,9 @@ ViewerScene furnishedRoom() {
           p.normals.push_back(n);
           p.uv0.emplace_back(q[a] / 2, q[b] / 2);
         }
-        const bool flip = glm::dot(glm::cross(p.positions[base + 1] - p.positions[base], p.positions[base + 2] - p.positions[base]), n) < 0;
+        const glm::vec3 e1 = p.positions[base + 1] - p.positions[base];
+        const glm::vec3 e2 = p.positions[base + 2] - p.positions[base];
+        const bool flip = glm::dot(glm::cross(e1, e2), n) < 0;
         if (flip) p.indices.insert(p.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
         else p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
       }

@@ -217,7 +217,8 @@ TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
       for (int x = 0; x < w; ++x)
         for (int k = 0; k < 3; ++k) {
           const int got = rgba[(static_cast<size_t>(h - 1 - y) * w + x) * 4 + k];  // GL row 0 = bottom
-          const int expected = static_cast<int>(std::lround(255.0f * exactSrgb(std::exp2(ev) * linear.at(x, y)[k])));
+          const float shown = exactSrgb(std::exp2(ev) * linear.at(x, y)[k]);
+          const int expected = static_cast<int>(std::lround(255.0f * shown));
           worst = std::max(worst, std::abs(got - expected));
           dark += expected > 0 && expected < 64;
           mid += expected >= 64 && expected < 200;
@@ -386,6 +387,96 @@ TEST(ViewerScene, ChartIdsAreConnectedComponents) {
   p.indices = {0, 1, 2, 2, 1, 3, 4, 5, 6};  // two triangles sharing an edge, and one apart
   auto ids = chartIds(p);
   EXPECT_EQ(ids, (std::vector<uint32_t>{0, 0, 0, 0, 1, 1, 1}));
+}
+
+
+// A cube of half size h around c, four vertices per face (split like atlas seams), wound
+// counter-clockwise seen from outside (outward) or from inside.
+Primitive cube(glm::vec3 c, float h, bool outward) {
+  Primitive p;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      glm::vec3 n(0.0f);
+      n[axis] = (side ? 1.0f : -1.0f) * (outward ? 1.0f : -1.0f);
+      const uint32_t base = static_cast<uint32_t>(p.positions.size());
+      for (int k = 0; k < 4; ++k) {
+        glm::vec3 q = c;
+        q[axis] += side ? h : -h;
+        q[a] += (k == 1 || k == 2) ? h : -h;
+        q[b] += k >= 2 ? h : -h;
+        p.positions.push_back(q);
+        p.normals.push_back(n);
+        p.uv0.emplace_back(k == 1 || k == 2 ? 1.0f : 0.0f, k >= 2 ? 1.0f : 0.0f);
+      }
+      const glm::vec3 e1 = p.positions[base + 1] - p.positions[base];
+      const glm::vec3 e2 = p.positions[base + 2] - p.positions[base];
+      if (glm::dot(glm::cross(e1, e2), n) > 0)
+        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      else
+        p.indices.insert(p.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  p.uv1 = p.uv0;
+  return p;
+}
+
+TEST(ViewerScene, ClosedOutwardSolidsAreDetected) {
+  EXPECT_TRUE(isClosedOutward(cube({1, 2, 3}, 0.5f, true)));
+  EXPECT_FALSE(isClosedOutward(cube({1, 2, 3}, 0.5f, false))) << "inward (a room): walls seen from inside";
+  Primitive open = cube({0, 0, 0}, 1.0f, true);
+  open.indices.resize(open.indices.size() - 6);  // one face missing
+  EXPECT_FALSE(isClosedOutward(open));
+  Primitive flipped = cube({0, 0, 0}, 1.0f, true);
+  std::swap(flipped.indices[1], flipped.indices[2]);  // one triangle wound the other way
+  EXPECT_FALSE(isClosedOutward(flipped));
+  // A UV sphere: seams welded by position, the poles' degenerate triangles ignored.
+  Primitive sphere;
+  const int rings = 8, segments = 12;
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const float th = kPi * i / rings, ph = 2 * kPi * j / segments;
+      // Exact poles and seam: the same position from every (i, j) that lands there.
+      const float st = (i == 0 || i == rings) ? 0.0f : std::sin(th);
+      const float ct = i == 0 ? 1.0f : i == rings ? -1.0f : std::cos(th);
+      const float cp = j % segments == 0 ? 1.0f : std::cos(ph), sp = j % segments == 0 ? 0.0f : std::sin(ph);
+      sphere.positions.emplace_back(st * cp, ct, st * sp);
+    }
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = i * (segments + 1) + j, b = a + 1, c = a + segments + 1, d = c + 1;
+      sphere.indices.insert(sphere.indices.end(), {a, b, c, b, d, c});
+    }
+  EXPECT_TRUE(isClosedOutward(sphere));
+  Primitive quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  EXPECT_FALSE(isClosedOutward(quad));
+}
+
+// Back faces are culled on closed outward solids only: a cube seen from outside shows albedo × map,
+// from inside it is not drawn (only its back faces face the eye); an inward cube (a room) still
+// shows its walls from outside, as any wall seen from behind.
+TEST(ViewRenderer, BackFacesAreCulledOnClosedOutwardSolidsOnly) {
+  GlContext gl;
+  for (bool outward : {true, false}) {
+    Scene s;
+    Material m;
+    m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+    s.materials.push_back(m);
+    Primitive p = cube({0, 0, 0}, 1.0f, outward);
+    p.lightmap = {0, 8, 8};
+    s.primitives.push_back(p);
+    ViewerScene v = makeViewerScene(std::move(s), {constantPage(0, 8, glm::vec3(0.8f))});
+    ViewRenderer r(v);
+    const Bounds3 b = v.scene.bounds();
+    const RgbaImage outside = r.render(lookAt({0.3f, 0.4f, 5}, {0, 0, 0}, 30.0f, b), 32, 32, {});
+    const RgbaImage inside = r.render(lookAt({0.1f, 0.2f, 0.3f}, {0, 0, -1}, 60.0f, b), 32, 32, {});
+    EXPECT_NEAR(outside.at(16, 16).r, 0.4f, 0.004f) << (outward ? "outward" : "inward");
+    if (outward)
+      EXPECT_EQ(inside.at(16, 16), glm::vec4(0, 0, 0, 1));  // culled: the background
+    else
+      EXPECT_NEAR(inside.at(16, 16).r, 0.4f, 0.004f);
+  }
 }
 
 }  // namespace
