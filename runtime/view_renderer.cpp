@@ -92,6 +92,42 @@ ViewMode parseViewMode(const std::string& name) {
               "unknown view '" + name + "' (lit, lightmap, albedo, charts, density, wireframe)");
 }
 
+// One shader variant: the view mode, the output encoding and what the primitive's material uses,
+// reduced to what that mode shows (the lightmap view needs no emissive texture, the charts view no
+// base colour unless it cuts alpha-mask holes). Packed into an int as the program cache key.
+struct Variant {
+  int mode = 0;         // ViewMode, 5 = the wireframe's line pass
+  int output = 0;       // 0 linear radiance, 1 exposure + sRGB encode (display)
+  int baseTex = 0;      // 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
+  int emissiveTex = 0;  // 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
+  int lightmap = 0;     // 1: the primitive has a light map
+  int alphaMask = 0;    // 1: alphaMode MASK
+
+  int key() const {
+    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9;
+  }
+  static Variant fromKey(int k) {
+    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1};
+  }
+  // `all`: every feature of the primitive; keeps those `mode` reads.
+  static Variant forMode(int mode, int output, const Variant& all) {
+    Variant v;
+    v.mode = mode;
+    v.output = output;
+    if (mode == 5) return v;  // line colour only
+    v.alphaMask = all.alphaMask;
+    const bool baseShown = mode == 0 || mode == 2;
+    v.baseTex = baseShown || all.alphaMask ? all.baseTex : 0;  // other views read base alpha for holes only
+    v.emissiveTex = mode == 0 ? all.emissiveTex : 0;
+    v.lightmap = mode == 0 || mode == 1 ? all.lightmap : 0;
+    return v;
+  }
+  int needUv0() const { return baseTex == 1 || emissiveTex == 1; }
+  int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4; }
+  int needNormal() const { return mode == 3; }
+  int needChart() const { return mode == 3 || mode == 4; }
+};
+
 struct ViewRenderer::Impl {
   struct GpuPrimitive {
     GLuint vao = 0, vbo = 0, ebo = 0;
@@ -100,6 +136,10 @@ struct ViewRenderer::Impl {
     GLuint lightmap = 0;          // 0: none (albedo only)
     float lightmapScale = 1.0f;   // MOZ_lightmap intensity
     glm::vec2 lightmapSize{1.0f};
+    GLenum indexType = GL_UNSIGNED_INT;  // GL_UNSIGNED_SHORT when every index fits
+    Variant features;                    // everything the material uses (mode and output unset)
+    glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // world-space bounds, for the draw order
+    bool cullBackFaces = false;          // closed outward solid, opaque: back faces only show from inside
   };
   const Scene& scene;
   GLuint program = 0;                      // the bound variant
@@ -121,13 +161,21 @@ struct ViewRenderer::Impl {
     return uniforms[name] = glGetUniformLocation(program, name);
   }
 
-  // Binds the shader variant for a view mode (0..5) and output encoding, compiling it on first use.
-  void useProgram(int mode, bool srgb) {
-    const int key = mode * 2 + (srgb ? 1 : 0);
+  // Binds the shader variant for a key (Variant::key), compiling it on first use. Returns true
+  // when the program changed, so the caller sets its per-frame uniforms again.
+  bool useProgram(int key) {
     auto it = programs.find(key);
     if (it == programs.end()) {
-      const std::vector<std::string> defines = {"#define VIEW_MODE " + std::to_string(mode),
-                                                std::string("#define ENCODE_SRGB ") + (srgb ? "1" : "0")};
+      const Variant f = Variant::fromKey(key);
+      auto define = [](const char* name, int value) {
+        return "#define " + std::string(name) + " " + std::to_string(value);
+      };
+      const std::vector<std::string> defines = {
+          define("VIEW_MODE", f.mode),          define("OUTPUT", f.output),
+          define("BASE_TEX", f.baseTex),        define("EMISSIVE_TEX", f.emissiveTex),
+          define("HAS_LIGHTMAP", f.lightmap),   define("ALPHA_MASK", f.alphaMask),
+          define("NEED_UV0", f.needUv0()),      define("NEED_UV1", f.needUv1()),
+          define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart())};
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
@@ -135,8 +183,10 @@ struct ViewRenderer::Impl {
                                  defines, "330 core"))
                .first;
     }
+    if (program == it->second->id()) return false;
     program = it->second->id();
     glUseProgram(program);
+    return true;
   }
 
   GLuint colorTexture(int index) {
@@ -172,8 +222,6 @@ struct ViewRenderer::Impl {
 
 ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(v.scene)) {
   Impl& I = *impl_;
-  I.useProgram(0, false);  // compile errors surface here, not at the first frame
-
   for (const Lightmap& page : v.pages)
     I.pageTextures.push_back(page.size() > 0 && page.texels.size() == page.size()
                                  ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
@@ -226,7 +274,16 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     glBufferData(GL_ARRAY_BUFFER, verts.size() * sizeof(Vertex), verts.data(), GL_STATIC_DRAW);
     glGenBuffers(1, &g.ebo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(), GL_STATIC_DRAW);
+    if (*std::max_element(p.indices.begin(), p.indices.end()) <= 0xffff) {
+      // Half the index bytes for llvmpipe's vertex fetch to read.
+      const std::vector<uint16_t> shortIndices(p.indices.begin(), p.indices.end());
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, shortIndices.size() * sizeof(uint16_t), shortIndices.data(),
+                   GL_STATIC_DRAW);
+      g.indexType = GL_UNSIGNED_SHORT;
+    } else {
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(),
+                   GL_STATIC_DRAW);
+    }
     const GLsizei stride = sizeof(Vertex);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, position)));
@@ -240,10 +297,20 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, chart)));
     glBindVertexArray(0);
     g.indexCount = static_cast<GLsizei>(p.indices.size());
+    g.boundsMin = g.boundsMax = p.positions.front();
+    for (const glm::vec3& q : p.positions) {
+      g.boundsMin = glm::min(g.boundsMin, q);
+      g.boundsMax = glm::max(g.boundsMax, q);
+    }
     triangles_ += p.indices.size() / 3;
     // Upload the material's colour textures now so the first frame does no uploads.
-    I.colorTexture(m.baseColorTexture);
-    I.colorTexture(m.emissiveTexture);
+    g.features.baseTex = I.colorTexture(m.baseColorTexture) ? (m.baseColorTexCoord == 1 ? 2 : 1) : 0;
+    g.features.emissiveTex = I.colorTexture(m.emissiveTexture) ? (m.emissiveTexCoord == 1 ? 2 : 1) : 0;
+    g.features.lightmap = g.lightmap ? 1 : 0;
+    g.features.alphaMask = m.alphaMode == AlphaMode::Mask ? 1 : 0;
+    g.cullBackFaces = !g.features.alphaMask && isClosedOutward(p);  // a masked hole would show the back
+    // Compile the lit variant now: shader errors surface here, and the first frame compiles nothing.
+    I.useProgram(Variant::forMode(0, 0, g.features).key());
     I.prims.push_back(g);
   }
   throwOnGlError("uploading the scene");
@@ -276,43 +343,58 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);  // light maps cover both sides that matter; never hide a wall seen from behind
+  // Culling only for closed outward solids (isClosedOutward): a wall seen from behind is still drawn,
+  // but the hidden far side of a closed object costs no rasterisation (furnished room −30% CPU).
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
   const float aspect = static_cast<float>(width) / std::max(height, 1);
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
+  const int output = settings.encodeSrgb ? 1 : 0;
+  // Front to back, by the distance to each primitive's farthest bounding-box corner (a room's walls,
+  // whose far corner is the farthest thing in view, go last): llvmpipe tests depth before shading,
+  // so what is drawn behind something already drawn costs no shading (furnished-room bench: 1.72 M
+  // → 1.10 M fragments pass the depth test, −13% CPU). Program switches cost less than that, so the
+  // order ignores the shader variant.
+  const glm::vec3 eye = camera.position();
+  std::vector<std::pair<float, size_t>> order(I.prims.size());  // (squared distance, primitive index)
+  for (size_t i = 0; i < I.prims.size(); ++i) {
+    const glm::vec3 far = glm::max(glm::abs(eye - I.prims[i].boundsMin), glm::abs(eye - I.prims[i].boundsMax));
+    order[i] = {glm::dot(far, far), i};
+  }
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   auto drawAll = [&](int mode) {
-    I.useProgram(mode, settings.encodeSrgb);
-    glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
-    glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
-    glUniform1i(I.u("uBaseColorTex"), 0);
-    glUniform1i(I.u("uEmissiveTex"), 1);
-    glUniform1i(I.u("uLightmap"), 2);
-    glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
-    for (const auto& g : I.prims) {
+    I.program = 0;
+    for (const auto& [distance, index] : order) {
+      const auto& g = I.prims[index];
+      if (I.useProgram(Variant::forMode(mode, output, g.features).key())) {
+        glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
+        glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
+        glUniform1i(I.u("uBaseColorTex"), 0);
+        glUniform1i(I.u("uEmissiveTex"), 1);
+        glUniform1i(I.u("uLightmap"), 2);
+        glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
+      }
       const Material& m = I.scene.materials.at(g.material);
       glUniform4fv(I.u("uBaseColorFactor"), 1, &m.baseColorFactor[0]);
-      GLuint base = I.colorTexture(m.baseColorTexture);
-      glUniform1i(I.u("uHasBaseColorTex"), base ? 1 : 0);
-      glUniform1i(I.u("uBaseColorUv1"), m.baseColorTexCoord == 1 ? 1 : 0);
       glActiveTexture(GL_TEXTURE0);
-      glBindTexture(GL_TEXTURE_2D, base);
+      glBindTexture(GL_TEXTURE_2D, I.colorTexture(m.baseColorTexture));
       const glm::vec3 emission = m.emission();
       glUniform3fv(I.u("uEmissive"), 1, &emission[0]);
-      GLuint emissive = I.colorTexture(m.emissiveTexture);
-      glUniform1i(I.u("uHasEmissiveTex"), emissive ? 1 : 0);
-      glUniform1i(I.u("uEmissiveUv1"), m.emissiveTexCoord == 1 ? 1 : 0);
       glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, emissive);
-      glUniform1i(I.u("uHasLightmap"), g.lightmap ? 1 : 0);
+      glBindTexture(GL_TEXTURE_2D, I.colorTexture(m.emissiveTexture));
       glUniform1f(I.u("uLightmapScale"), g.lightmapScale);
       glUniform2fv(I.u("uLightmapSize"), 1, &g.lightmapSize[0]);
       glActiveTexture(GL_TEXTURE2);
       glBindTexture(GL_TEXTURE_2D, g.lightmap);
-      glUniform1i(I.u("uAlphaMask"), m.alphaMode == AlphaMode::Mask ? 1 : 0);
       glUniform1f(I.u("uAlphaCutoff"), m.alphaCutoff);
+      if (g.cullBackFaces)
+        glEnable(GL_CULL_FACE);
+      else
+        glDisable(GL_CULL_FACE);
       glBindVertexArray(g.vao);
-      glDrawElements(GL_TRIANGLES, g.indexCount, GL_UNSIGNED_INT, nullptr);
+      glDrawElements(GL_TRIANGLES, g.indexCount, g.indexType, nullptr);
     }
   };
 
@@ -330,6 +412,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   }
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
+  glDisable(GL_CULL_FACE);
   throwOnGlError("drawing the scene");
 }
 

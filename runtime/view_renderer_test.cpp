@@ -1,7 +1,11 @@
 // Renderer tests on scenes built in code with closed-form light maps: pixels are compared with
 // baseColor × map + emissive evaluated on the CPU at the surface point each pixel sees.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
+#include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
@@ -173,6 +177,141 @@ TEST(ViewRenderer, TexturedPlaneMatchesAlbedoTimesClosedFormMap) {
   EXPECT_NEAR(map.at(cx, cy).r / c.mapAt(p), 1.0f, 0.02f);
 }
 
+// The window's output (draw with encodeSrgb into an 8-bit target): the shader's sRGB encode is a fit
+// (no pow()), so check it against the exact IEC 61966-2-1 encode of 2^EV × the linear render, pixel
+// by pixel: within one 8-bit step, over dark, mid and clipped values.
+TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
+  GlContext gl;
+  PlaneCase c = texturedPlane();
+  ViewRenderer r(c.view);
+  const int w = 160, h = 120;
+  ViewCamera cam = lookAt({0.2f, 3.0f, 2.5f}, {0, 0, -0.3f}, 55.0f, c.view.scene.bounds());
+  GLuint fbo = 0, color = 0, depth = 0;
+  glGenFramebuffers(1, &fbo);
+  glGenRenderbuffers(1, &color);
+  glGenRenderbuffers(1, &depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, color);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  ASSERT_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
+  auto exactSrgb = [](float x) {
+    x = std::clamp(x, 0.0f, 1.0f);
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  };
+  const RgbaImage linear = r.render(cam, w, h, {});  // binds its own framebuffer, restores ours
+  int worst = 0, dark = 0, mid = 0, clipped = 0;
+  for (float ev : {-6.0f, -3.0f, 0.0f, 2.0f}) {
+    DrawSettings display;
+    display.encodeSrgb = true;
+    display.exposure = ev;
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    r.draw(cam, w, h, display);
+    std::vector<uint8_t> rgba(static_cast<size_t>(w) * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int k = 0; k < 3; ++k) {
+          const int got = rgba[(static_cast<size_t>(h - 1 - y) * w + x) * 4 + k];  // GL row 0 = bottom
+          const float shown = exactSrgb(std::exp2(ev) * linear.at(x, y)[k]);
+          const int expected = static_cast<int>(std::lround(255.0f * shown));
+          worst = std::max(worst, std::abs(got - expected));
+          dark += expected > 0 && expected < 64;
+          mid += expected >= 64 && expected < 200;
+          clipped += expected == 255;
+        }
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteRenderbuffers(1, &color);
+  glDeleteRenderbuffers(1, &depth);
+  EXPECT_LE(worst, 1);
+  EXPECT_GT(dark, 1000);
+  EXPECT_GT(mid, 1000);
+  EXPECT_GT(clipped, 1000);
+}
+
+// Each material feature selects its own shader variant; check each against the CPU: a base colour
+// texture read through TEXCOORD_1 (uv0 mirrored, so reading the wrong set shows), an emissive
+// texture on TEXCOORD_0 over a base colour factor, and an alpha-masked texture (alpha = u, cutoff
+// 0.5) whose holes show the background in the lit, light-map and charts views. Map = 1 everywhere.
+TEST(ViewRenderer, MaterialFeaturesMatchTheirClosedForm) {
+  GlContext gl;
+  Scene s;
+  Texture t;
+  t.name = "gradient";
+  t.width = t.height = 64;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const float u = (x + 0.5f) / t.width;
+      t.texels.emplace_back(0.2f + 0.6f * u, 0.5f, 0.8f - 0.6f * u, u);
+    }
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  s.textures.push_back(t);
+  Material onUv1;
+  onUv1.baseColorTexture = 0;
+  onUv1.baseColorTexCoord = 1;
+  Material emissive;
+  emissive.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  emissive.emissiveFactor = glm::vec3(0.3f);
+  emissive.emissiveTexture = 0;
+  Material masked;
+  masked.baseColorTexture = 0;
+  masked.alphaMode = AlphaMode::Mask;
+  masked.alphaCutoff = 0.5f;
+  s.materials = {onUv1, emissive, masked};
+  std::vector<Lightmap> pages;
+  const float x0[3] = {-3.2f, -1.0f, 1.2f};  // quads x0 .. x0 + 2, z -1 .. 1; u = (z + 1)/2, v = (x − x0)/2
+  for (int q = 0; q < 3; ++q) {
+    addQuad(s, {x0[q], 0, -1}, {x0[q], 0, 1}, {x0[q] + 2, 0, 1}, {x0[q] + 2, 0, -1}, q, q, 8);
+    pages.push_back(constantPage(q, 8, glm::vec3(1.0f)));
+  }
+  for (auto& uv : s.primitives[0].uv0) uv.x = 1.0f - uv.x;
+  ViewerScene v = makeViewerScene(std::move(s), std::move(pages));
+  ViewRenderer r(v);
+  const int w = 200, h = 64;
+  ViewCamera cam = lookAt({0, 6, 0.01f}, {0, 0, 0}, 24.0f, v.scene.bounds());
+  const RgbaImage lit = r.render(cam, w, h, {});
+  const RgbaImage map = r.render(cam, w, h, {ViewMode::Lightmap});
+  const RgbaImage charts = r.render(cam, w, h, {ViewMode::Charts});
+  const Texture& tex = v.scene.textures[0];
+  int checked[3] = {0, 0, 0}, holes = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      glm::vec3 p;
+      if (!floorPointAt(cam, w, h, x, y, p)) continue;
+      for (int q = 0; q < 3; ++q) {
+        const glm::vec2 uv((p.z + 1) / 2, (p.x - x0[q]) / 2);
+        if (uv.x < 0.05f || uv.x > 0.95f || uv.y < 0.05f || uv.y > 0.95f) continue;
+        glm::vec3 expected;
+        if (q == 0) expected = glm::vec3(sampleBilinear(tex, uv));
+        if (q == 1) expected = glm::vec3(0.5f) + 0.3f * glm::vec3(sampleBilinear(tex, uv));
+        if (q == 2) {
+          if (std::abs(uv.x - 0.5f) < 0.05f) continue;  // the cut itself
+          if (uv.x < 0.5f) {
+            ++holes;
+            EXPECT_EQ(lit.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            EXPECT_EQ(map.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            EXPECT_EQ(charts.at(x, y), glm::vec4(0, 0, 0, 1)) << x << "," << y;
+            continue;
+          }
+          expected = glm::vec3(sampleBilinear(tex, uv));
+        }
+        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(lit.at(x, y)[k] / expected[k] - 1.0f));
+        EXPECT_NEAR(map.at(x, y).r, 1.0f, 1e-3f);
+        ++checked[q];
+      }
+    }
+  EXPECT_LT(worst, 0.02f);
+  for (int q = 0; q < 3; ++q) EXPECT_GT(checked[q], 150) << "quad " << q;
+  EXPECT_GT(holes, 150);
+}
+
 TEST(ViewRenderer, MaterialLightmapTextureIsScaledByIntensity) {
   // No float pages: MOZ_lightmap texture (0.25) × intensity (4) = 1, on albedo 0.6.
   GlContext gl;
@@ -248,6 +387,96 @@ TEST(ViewerScene, ChartIdsAreConnectedComponents) {
   p.indices = {0, 1, 2, 2, 1, 3, 4, 5, 6};  // two triangles sharing an edge, and one apart
   auto ids = chartIds(p);
   EXPECT_EQ(ids, (std::vector<uint32_t>{0, 0, 0, 0, 1, 1, 1}));
+}
+
+
+// A cube of half size h around c, four vertices per face (split like atlas seams), wound
+// counter-clockwise seen from outside (outward) or from inside.
+Primitive cube(glm::vec3 c, float h, bool outward) {
+  Primitive p;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      glm::vec3 n(0.0f);
+      n[axis] = (side ? 1.0f : -1.0f) * (outward ? 1.0f : -1.0f);
+      const uint32_t base = static_cast<uint32_t>(p.positions.size());
+      for (int k = 0; k < 4; ++k) {
+        glm::vec3 q = c;
+        q[axis] += side ? h : -h;
+        q[a] += (k == 1 || k == 2) ? h : -h;
+        q[b] += k >= 2 ? h : -h;
+        p.positions.push_back(q);
+        p.normals.push_back(n);
+        p.uv0.emplace_back(k == 1 || k == 2 ? 1.0f : 0.0f, k >= 2 ? 1.0f : 0.0f);
+      }
+      const glm::vec3 e1 = p.positions[base + 1] - p.positions[base];
+      const glm::vec3 e2 = p.positions[base + 2] - p.positions[base];
+      if (glm::dot(glm::cross(e1, e2), n) > 0)
+        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      else
+        p.indices.insert(p.indices.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+    }
+  p.uv1 = p.uv0;
+  return p;
+}
+
+TEST(ViewerScene, ClosedOutwardSolidsAreDetected) {
+  EXPECT_TRUE(isClosedOutward(cube({1, 2, 3}, 0.5f, true)));
+  EXPECT_FALSE(isClosedOutward(cube({1, 2, 3}, 0.5f, false))) << "inward (a room): walls seen from inside";
+  Primitive open = cube({0, 0, 0}, 1.0f, true);
+  open.indices.resize(open.indices.size() - 6);  // one face missing
+  EXPECT_FALSE(isClosedOutward(open));
+  Primitive flipped = cube({0, 0, 0}, 1.0f, true);
+  std::swap(flipped.indices[1], flipped.indices[2]);  // one triangle wound the other way
+  EXPECT_FALSE(isClosedOutward(flipped));
+  // A UV sphere: seams welded by position, the poles' degenerate triangles ignored.
+  Primitive sphere;
+  const int rings = 8, segments = 12;
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const float th = kPi * i / rings, ph = 2 * kPi * j / segments;
+      // Exact poles and seam: the same position from every (i, j) that lands there.
+      const float st = (i == 0 || i == rings) ? 0.0f : std::sin(th);
+      const float ct = i == 0 ? 1.0f : i == rings ? -1.0f : std::cos(th);
+      const float cp = j % segments == 0 ? 1.0f : std::cos(ph), sp = j % segments == 0 ? 0.0f : std::sin(ph);
+      sphere.positions.emplace_back(st * cp, ct, st * sp);
+    }
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const uint32_t a = i * (segments + 1) + j, b = a + 1, c = a + segments + 1, d = c + 1;
+      sphere.indices.insert(sphere.indices.end(), {a, b, c, b, d, c});
+    }
+  EXPECT_TRUE(isClosedOutward(sphere));
+  Primitive quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  EXPECT_FALSE(isClosedOutward(quad));
+}
+
+// Back faces are culled on closed outward solids only: a cube seen from outside shows albedo × map,
+// from inside it is not drawn (only its back faces face the eye); an inward cube (a room) still
+// shows its walls from outside, as any wall seen from behind.
+TEST(ViewRenderer, BackFacesAreCulledOnClosedOutwardSolidsOnly) {
+  GlContext gl;
+  for (bool outward : {true, false}) {
+    Scene s;
+    Material m;
+    m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+    s.materials.push_back(m);
+    Primitive p = cube({0, 0, 0}, 1.0f, outward);
+    p.lightmap = {0, 8, 8};
+    s.primitives.push_back(p);
+    ViewerScene v = makeViewerScene(std::move(s), {constantPage(0, 8, glm::vec3(0.8f))});
+    ViewRenderer r(v);
+    const Bounds3 b = v.scene.bounds();
+    const RgbaImage outside = r.render(lookAt({0.3f, 0.4f, 5}, {0, 0, 0}, 30.0f, b), 32, 32, {});
+    const RgbaImage inside = r.render(lookAt({0.1f, 0.2f, 0.3f}, {0, 0, -1}, 60.0f, b), 32, 32, {});
+    EXPECT_NEAR(outside.at(16, 16).r, 0.4f, 0.004f) << (outward ? "outward" : "inward");
+    if (outward)
+      EXPECT_EQ(inside.at(16, 16), glm::vec4(0, 0, 0, 1));  // culled: the background
+    else
+      EXPECT_NEAR(inside.at(16, 16).r, 0.4f, 0.004f);
+  }
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #include "viewer_scene.h"
 
+#include <array>
+#include <map>
 #include <numeric>
+#include <unordered_map>
 
 #include "common/error.h"
 #include "common/log.h"
@@ -82,6 +85,32 @@ std::vector<uint32_t> chartIds(const Primitive& p) {
     out[i] = id[r];
   }
   return out;
+}
+
+bool isClosedOutward(const Primitive& p) {
+  if (p.indices.size() < 12 || p.indices.size() % 3 != 0) return false;  // a closed solid has ≥ 4 triangles
+  // Weld by exact position.
+  std::map<std::array<float, 3>, uint32_t> ids;
+  std::vector<uint32_t> weld(p.positions.size());
+  for (size_t i = 0; i < p.positions.size(); ++i) {
+    const glm::vec3& q = p.positions[i];
+    weld[i] = ids.emplace(std::array<float, 3>{q.x, q.y, q.z}, static_cast<uint32_t>(ids.size())).first->second;
+  }
+  std::unordered_map<uint64_t, int> directed;  // edge a→b (a << 32 | b) → uses
+  double volume6 = 0.0;                                   // 6 × signed volume
+  for (size_t t = 0; t < p.indices.size(); t += 3) {
+    if (p.indices[t] >= weld.size() || p.indices[t + 1] >= weld.size() || p.indices[t + 2] >= weld.size())
+      return false;
+    const uint32_t v[3] = {weld[p.indices[t]], weld[p.indices[t + 1]], weld[p.indices[t + 2]]};
+    if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) continue;  // degenerate (e.g. a sphere's pole): no edges
+    for (int k = 0; k < 3; ++k)
+      if (++directed[uint64_t{v[k]} << 32 | v[(k + 1) % 3]] > 1) return false;
+    const glm::dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]);
+    volume6 += glm::dot(a, glm::cross(b, glm::dvec3(p.positions[p.indices[t + 2]])));
+  }
+  for (const auto& [edge, uses] : directed)
+    if (!directed.count((edge & 0xffffffffu) << 32 | edge >> 32)) return false;
+  return !directed.empty() && volume6 > 0.0;
 }
 
 }  // namespace irbake::view

@@ -33,4 +33,10 @@ ViewerScene loadViewerScene(const std::filesystem::path& path);
 // vertices are split along chart seams, so these are the atlas charts.
 std::vector<uint32_t> chartIds(const Primitive& p);
 
+// Whether the primitive is a closed solid facing outward: after welding vertices by position (atlas
+// seams split them), every edge of a non-degenerate triangle is used exactly once in each direction
+// (closed, consistently wound), and the signed volume is positive (counter-clockwise front faces point
+// out). Its back faces can then only be seen from inside the solid, so the viewer culls them.
+bool isClosedOutward(const Primitive& p);
+
 }  // namespace irbake::view

@@ -98,7 +98,8 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  glfwWindowHint(GLFW_SRGB_CAPABLE, GLFW_FALSE);  // the shader encodes sRGB itself
+  glfwWindowHint(GLFW_SRGB_CAPABLE, GLFW_FALSE);  // the shader encodes sRGB itself (cheaper than GL's on llvmpipe)
+  glfwWindowHint(GLFW_STENCIL_BITS, 0);           // depth only, as viewer_bench measures: no stencil to preserve
   GLFWwindow* window = glfwCreateWindow(o.width, o.height, ("irview - " + o.scene.filename().string()).c_str(),
                                         nullptr, nullptr);
   if (!window)

@@ -1,38 +1,75 @@
 // irview shading: baseColor × lightmap + emissive, in linear radiance. The light map stores
 // irradiance/π, so a Lambertian surface of albedo ρ shows ρ·map (docs/units.md).
-// Compiled once per view (VIEW_MODE) and output (ENCODE_SRGB), both defined by the renderer: a
-// software rasteriser pays for every instruction of a shader, taken branch or not, and for every
-// varying, so each variant keeps only what it shows.
+// Compiled once per view, output encoding and material features, all defined by the renderer:
+// llvmpipe executes both sides of a branch, even on a uniform, so a texture fetch behind
+// `if (uHasTexture)` is paid by every fragment; each variant keeps only what it shows.
 #ifndef VIEW_MODE
 #define VIEW_MODE 0  // 0 lit, 1 lightmap only, 2 albedo only, 3 charts, 4 texel density, 5 wire lines
 #endif
-#ifndef ENCODE_SRGB
-#define ENCODE_SRGB 0  // 1: exposure + sRGB here (window); 0: linear radiance out (offscreen)
+#ifndef OUTPUT
+#define OUTPUT 0  // 0: linear radiance (offscreen); 1: exposure + sRGB encode (display)
+#endif
+#ifndef BASE_TEX
+#define BASE_TEX 0  // base colour texture: 0 none, 1 reads TEXCOORD_0, 2 reads TEXCOORD_1
+#endif
+#ifndef EMISSIVE_TEX
+#define EMISSIVE_TEX 0  // emissive texture: 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
+#endif
+#ifndef HAS_LIGHTMAP
+#define HAS_LIGHTMAP 0  // 0: no map (shows albedo, map = 1)
+#endif
+#ifndef ALPHA_MASK
+#define ALPHA_MASK 0  // 1: discard below uAlphaCutoff (glTF alphaMode MASK)
+#endif
+#ifndef NEED_UV0
+#define NEED_UV0 1
+#endif
+#ifndef NEED_UV1
+#define NEED_UV1 1
+#endif
+#ifndef NEED_NORMAL
+#define NEED_NORMAL 1
+#endif
+#ifndef NEED_CHART
+#define NEED_CHART 1
 #endif
 
+#if NEED_NORMAL
 in vec3 vNormal;
+#endif
+#if NEED_UV0
 in vec2 vUv0;
+#endif
+#if NEED_UV1
 in vec2 vUv1;
+#endif
+#if NEED_CHART
 flat in float vChart;
+#endif
 
 uniform vec4 uBaseColorFactor;
-uniform bool uHasBaseColorTex;
-uniform sampler2D uBaseColorTex;   // linear (decoded from sRGB at load)
-uniform bool uBaseColorUv1;        // the base colour texture reads TEXCOORD_1
+uniform sampler2D uBaseColorTex;   // linear (decoded from sRGB by the sampler or at load)
 uniform vec3 uEmissive;            // factor × KHR_materials_emissive_strength
-uniform bool uHasEmissiveTex;
 uniform sampler2D uEmissiveTex;
-uniform bool uEmissiveUv1;
-uniform bool uHasLightmap;
 uniform sampler2D uLightmap;       // irradiance/π, linear
 uniform float uLightmapScale;      // MOZ_lightmap intensity (1 for float pages)
 uniform vec2 uLightmapSize;        // page size in texels (density checker)
-uniform bool uAlphaMask;
 uniform float uAlphaCutoff;
-uniform float uExposureScale;      // 2^EV (ENCODE_SRGB only)
+uniform float uExposureScale;      // 2^EV (OUTPUT 1)
 uniform vec3 uLineColor;
 
 out vec4 fragColor;
+
+#if BASE_TEX == 1
+#define BASE_UV vUv0
+#elif BASE_TEX == 2
+#define BASE_UV vUv1
+#endif
+#if EMISSIVE_TEX == 1
+#define EMISSIVE_UV vUv0
+#elif EMISSIVE_TEX == 2
+#define EMISSIVE_UV vUv1
+#endif
 
 vec3 chartColor(float id) {
   // Golden-ratio hue walk: neighbouring ids get distinct hues.
@@ -41,25 +78,43 @@ vec3 chartColor(float id) {
   return mix(vec3(0.25), k, 0.8);
 }
 
+// The sRGB encode (IEC 61966-2-1) without pow(): above the linear toe, 1.055 c^(1/2.4) − 0.055 is
+// fitted (minimax over [0.0031308, 1]) by a·c^(1/2) + b·c^(1/4) + d·c + e. Max error 3.6e-4, a tenth
+// of an 8-bit step; llvmpipe's pow() is a log2 and an exp2 polynomial each, this is two sqrt and
+// three multiply-adds (frame 100k: 13 ms of CPU for the exact encode, see docs/performance.md).
 vec3 encodeSrgb(vec3 c) {
   c = clamp(c, 0.0, 1.0);
-  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+  vec3 s1 = sqrt(c), s2 = sqrt(s1);
+  vec3 curve = 0.83380291 * s1 + 0.298077591 * s2 - 0.0553457088 * c - 0.0768988119;
+  return mix(c * 12.92, curve, step(vec3(0.0031308), c));
 }
 
 vec4 baseColor() {
   vec4 base = uBaseColorFactor;
-  if (uHasBaseColorTex) base *= texture(uBaseColorTex, uBaseColorUv1 ? vUv1 : vUv0);
-  if (uAlphaMask && base.a < uAlphaCutoff) discard;
+#if BASE_TEX
+  base *= texture(uBaseColorTex, BASE_UV);
+#endif
+#if ALPHA_MASK
+  if (base.a < uAlphaCutoff) discard;
+#endif
   return base;
 }
 
-vec3 lightmap() { return uHasLightmap ? texture(uLightmap, vUv1).rgb * uLightmapScale : vec3(1.0); }
+vec3 lightmap() {
+#if HAS_LIGHTMAP
+  return texture(uLightmap, vUv1).rgb * uLightmapScale;
+#else
+  return vec3(1.0);
+#endif
+}
 
 void main() {
   vec3 color;
 #if VIEW_MODE == 0
   vec3 emissive = uEmissive;
-  if (uHasEmissiveTex) emissive *= texture(uEmissiveTex, uEmissiveUv1 ? vUv1 : vUv0).rgb;
+#if EMISSIVE_TEX
+  emissive *= texture(uEmissiveTex, EMISSIVE_UV).rgb;
+#endif
   color = baseColor().rgb * lightmap() + emissive;
 #elif VIEW_MODE == 1
   baseColor();  // alpha-mask holes stay holes
@@ -76,7 +131,7 @@ void main() {
 #else
   color = uLineColor;
 #endif
-#if ENCODE_SRGB && VIEW_MODE != 5
+#if OUTPUT == 1 && VIEW_MODE != 5
   color = encodeSrgb(color * uExposureScale);
 #endif
   fragColor = vec4(color, 1.0);
