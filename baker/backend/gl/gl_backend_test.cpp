@@ -253,7 +253,9 @@ TEST(GlBackend, ValidityMaskSkipsOnlyInvalidTexels) {
   for (size_t i = 0; i < s.layerSize(); ++i) {
     EXPECT_EQ(a[0].valid[i], s.valid[i]);
     EXPECT_EQ(a[0].texels[i], b[0].texels[i]) << i;
-    if (!s.valid[i]) EXPECT_EQ(a[0].texels[i], glm::vec3(0.0f)) << i;
+    if (!s.valid[i]) {
+      EXPECT_EQ(a[0].texels[i], glm::vec3(0.0f)) << i;
+    }
     valid += s.valid[i] && a[0].texels[i].x > 0.0f;
   }
   EXPECT_GT(valid, s.layerSize() / 3);
