@@ -8,7 +8,7 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p out/samples
 ./build/baker/irbake samples out/samples
-# About 250k texels and 1536 light paths: ≈ 1.6% relative RMSE against a converged reference
+# About 250k texels and 1536 light paths: ≈ 1.9% relative RMSE against a converged reference
 # (docs/performance.md).
 ./build/baker/irbake bake out/samples/cornell_box.gltf -o out --texels-per-unit 360 --vpls 1536 "$@"
 echo
