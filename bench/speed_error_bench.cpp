@@ -308,6 +308,7 @@ int sceneBench(const std::vector<std::string>& args) {
           GlBackendOptions go;
           go.stats = &one;
           go.stageTimings = true;
+          if (const char* e = std::getenv("CUBE_FACE")) go.cubeFaceSize = std::atoi(e);  // diagnostics
           auto m = bakeGl(i, go);
           st.add(one);
           return m;
