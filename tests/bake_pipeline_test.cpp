@@ -86,6 +86,31 @@ TEST(BakePipeline, FurnaceMatchesTheClosedFormWithBiasCompensation) {
   EXPECT_TRUE(r.report["eval"]["biasCompensation"].get<bool>());
 }
 
+// The default bake (GL backend, k = 256 clamp, compensation gather, automatic interleaving) and the same
+// with 2×2 interleaving forced: the furnace's mean within 1% of Le/(1−ρ) = 2, and the report says what ran.
+TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
+  for (int interleave : {0, 2}) {
+    BakeOptions o;
+    o.atlas.texelsPerUnit = 12.0f;
+    o.walk.paths = 1024;
+    o.interleave = interleave;
+    BakeResult r = bake(loadSample("furnace"), o);
+    double sum = 0.0;
+    size_t n = 0;
+    for (const auto& m : r.maps)
+      for (size_t i = 0; i < m.size(); ++i)
+        if (m.valid[i]) sum += m.texels[i].x, ++n;
+    ASSERT_GT(n, 1000u);
+    std::printf("default GL furnace, interleave %d: mean %.5f (exact 2), %zu texels, gather added %.2f%%\n", interleave,
+                sum / n, n, 100 * r.report["compensation"]["addedFraction"].get<double>());
+    EXPECT_NEAR(sum / n, 2.0, 0.02) << "interleave " << interleave;
+    EXPECT_EQ(r.report["backend"], "gl");
+    EXPECT_EQ(r.report["eval"]["clampVplsPerMean"].get<double>(), 256.0);
+    EXPECT_GT(r.report["compensation"]["addedFraction"].get<double>(), 0.02);  // the tight clamp really bit
+    if (interleave == 2) EXPECT_EQ(r.report["interleave"]["classes"].get<int>(), 4);
+  }
+}
+
 TEST(BakePipeline, ThinWallDarkSideStaysDark) {
   // A zero-thickness partition at x = 0 between a lit room (light at x = −1) and a dark one.
   BakeResult r = bake(loadSample("thin_wall"), smallEmbreeBake(10.0f, 512));
