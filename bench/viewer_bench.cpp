@@ -197,17 +197,8 @@ ViewerScene bakedCornell() {
 void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam) {
   context();
   ViewRenderer renderer(v);
-  GLuint fbo = 0, color = 0, depth = 0;
-  glGenFramebuffers(1, &fbo);
-  glGenRenderbuffers(1, &color);
-  glGenRenderbuffers(1, &depth);
-  glBindRenderbuffer(GL_RENDERBUFFER, color);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, kWidth, kHeight);
-  glBindRenderbuffer(GL_RENDERBUFFER, depth);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, kWidth, kHeight);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  RenderTarget target(kWidth, kHeight, GL_RGBA8);
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
   DrawSettings settings;
   settings.encodeSrgb = true;
   renderer.draw(cam, kWidth, kHeight, settings);  // warm-up: shader compile, texture residency
@@ -231,9 +222,6 @@ void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& 
   glDeleteQueries(1, &query);
   state.counters["fragments"] = static_cast<double>(samples);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteRenderbuffers(1, &color);
-  glDeleteRenderbuffers(1, &depth);
 }
 
 void BM_FrameCornellBox(benchmark::State& state) {

@@ -149,8 +149,7 @@ struct ViewRenderer::Impl {
   std::map<int, GLuint> textureLightmaps;  // Scene::textures index → float light map texture
   std::vector<GLuint> pageTextures;        // ViewerScene::pages index → GL texture
   std::vector<GpuPrimitive> prims;
-  GLuint fbo = 0, colorRb = 0, depthRb = 0;
-  int fboWidth = 0, fboHeight = 0;
+  std::unique_ptr<RenderTarget> offscreen;  // float target of render(), resized on demand
 
   explicit Impl(const Scene& s) : scene(s) {}
 
@@ -199,26 +198,38 @@ struct ViewRenderer::Impl {
   }
 
   void ensureFramebuffer(int w, int h) {
-    if (fbo && w == fboWidth && h == fboHeight) return;
-    if (!fbo) {
-      glGenFramebuffers(1, &fbo);
-      glGenRenderbuffers(1, &colorRb);
-      glGenRenderbuffers(1, &depthRb);
-    }
-    glBindRenderbuffer(GL_RENDERBUFFER, colorRb);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, depthRb);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colorRb);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw Error(ErrorCode::Gl, "", "offscreen float framebuffer " + std::to_string(w) + "x" +
-                                         std::to_string(h) + " is incomplete");
-    fboWidth = w;
-    fboHeight = h;
+    if (offscreen && w == offscreen->width() && h == offscreen->height()) return;
+    offscreen.reset();
+    offscreen = std::make_unique<RenderTarget>(w, h, GL_RGBA32F);
   }
 };
+
+RenderTarget::RenderTarget(int width, int height, unsigned colorFormat) : width_(width), height_(height) {
+  glGenFramebuffers(1, &fbo_);
+  glGenRenderbuffers(1, &color_);
+  glGenRenderbuffers(1, &depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, color_);
+  glRenderbufferStorage(GL_RENDERBUFFER, colorFormat, width, height);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    release();
+    throw Error(ErrorCode::Gl, "", "offscreen framebuffer " + std::to_string(width) + "x" + std::to_string(height) +
+                                       " is incomplete");
+  }
+}
+
+RenderTarget::~RenderTarget() { release(); }
+
+void RenderTarget::release() {
+  if (fbo_) glDeleteFramebuffers(1, &fbo_);
+  if (color_) glDeleteRenderbuffers(1, &color_);
+  if (depth_) glDeleteRenderbuffers(1, &depth_);
+  fbo_ = color_ = depth_ = 0;
+}
 
 ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(v.scene)) {
   Impl& I = *impl_;
@@ -327,11 +338,7 @@ ViewRenderer::~ViewRenderer() {
   for (auto& [i, t] : I.textureLightmaps) glDeleteTextures(1, &t);
   for (GLuint t : I.pageTextures)
     if (t) glDeleteTextures(1, &t);
-  if (I.fbo) {
-    glDeleteFramebuffers(1, &I.fbo);
-    glDeleteRenderbuffers(1, &I.colorRb);
-    glDeleteRenderbuffers(1, &I.depthRb);
-  }
+  I.offscreen.reset();
   I.programs.clear();
 }
 
@@ -424,7 +431,7 @@ RgbaImage ViewRenderer::render(const ViewCamera& camera, int width, int height, 
   GLint previous = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &previous);
   I.ensureFramebuffer(width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, I.fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, I.offscreen->framebuffer());
   settings.encodeSrgb = false;
   draw(camera, width, height, settings);
   RgbaImage img;

@@ -31,6 +31,24 @@ struct RgbaImage {
   const glm::vec4& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
 
+// An offscreen framebuffer: one colour and one 24-bit depth renderbuffer (current context required).
+// Throws Error(Gl) when the framebuffer is incomplete.
+class RenderTarget {
+ public:
+  RenderTarget(int width, int height, unsigned colorFormat);  // e.g. GL_RGBA8, GL_RGBA32F
+  ~RenderTarget();
+  RenderTarget(const RenderTarget&) = delete;
+  RenderTarget& operator=(const RenderTarget&) = delete;
+  unsigned framebuffer() const { return fbo_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  void release();
+  unsigned fbo_ = 0, color_ = 0, depth_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
 class ViewRenderer {
  public:
   // Uploads every primitive and texture to the current context.

@@ -186,17 +186,8 @@ TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
   ViewRenderer r(c.view);
   const int w = 160, h = 120;
   ViewCamera cam = lookAt({0.2f, 3.0f, 2.5f}, {0, 0, -0.3f}, 55.0f, c.view.scene.bounds());
-  GLuint fbo = 0, color = 0, depth = 0;
-  glGenFramebuffers(1, &fbo);
-  glGenRenderbuffers(1, &color);
-  glGenRenderbuffers(1, &depth);
-  glBindRenderbuffer(GL_RENDERBUFFER, color);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
-  glBindRenderbuffer(GL_RENDERBUFFER, depth);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  RenderTarget target(w, h, GL_RGBA8);
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
   ASSERT_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
   auto exactSrgb = [](float x) {
     x = std::clamp(x, 0.0f, 1.0f);
@@ -208,7 +199,7 @@ TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
     DrawSettings display;
     display.encodeSrgb = true;
     display.exposure = ev;
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
     r.draw(cam, w, h, display);
     std::vector<uint8_t> rgba(static_cast<size_t>(w) * h * 4);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -226,9 +217,6 @@ TEST(ViewRenderer, DisplayOutputIsTheSrgbEncodeOfTheLinearRenderWithinOneStep) {
         }
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteRenderbuffers(1, &color);
-  glDeleteRenderbuffers(1, &depth);
   EXPECT_LE(worst, 1);
   EXPECT_GT(dark, 1000);
   EXPECT_GT(mid, 1000);
