@@ -107,7 +107,9 @@ TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
     EXPECT_EQ(r.report["backend"], "gl");
     EXPECT_EQ(r.report["eval"]["clampVplsPerMean"].get<double>(), 256.0);
     EXPECT_GT(r.report["compensation"]["addedFraction"].get<double>(), 0.02);  // the tight clamp really bit
-    if (interleave == 2) EXPECT_EQ(r.report["interleave"]["classes"].get<int>(), 4);
+    if (interleave == 2) {
+      EXPECT_EQ(r.report["interleave"]["classes"].get<int>(), 4);
+    }
   }
 }
 
