@@ -1,5 +1,6 @@
-// Accumulation: every texel sample of a page against a batch of VPLs, each with its depth cube
-// (layers 6k..6k+5 of a 2D array: a cube in the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance).
+// Accumulation: every texel sample of a page against a batch of VPLs, each with its depth cube (a cube in
+// the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance) stored as tiles 5k..5k+4 of
+// one 2D depth atlas (gl_backend.cpp, DepthAtlas: faces +X −X +Y −Y +Z; −Z is never drawn and reads as lit).
 // Output: the batch's contribution to irradiance/π, summed by additive blending.
 //
 // Cost on llvmpipe (8 fragments per SIMD vector, 2 threads) is everything inside the per-VPL loop, so
@@ -16,9 +17,9 @@
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
 #if defined(SHADOW_COMPARE)
-layout(binding = 2) uniform sampler2DArrayShadow vplDepth;  // 6 layers per VPL cube, compare GL_GEQUAL
+layout(binding = 2) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
 #else
-layout(binding = 2) uniform sampler2DArray vplDepth;        // 6 layers per VPL cube
+layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, 5 tiles per VPL cube
 #endif
 
 // The batch's VPLs: 3 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
@@ -48,6 +49,15 @@ const float slopeBias = SLOPE_BIAS;         // in shadow texels
 const float normalOffset = NORMAL_OFFSET;   // in shadow texels
 const float texelAngle = TEXEL_ANGLE;       // angular size of one cube texel at the face centre (2 / faceSize)
 const float originOffset = ORIGIN_OFFSET;   // VPL shadow origin = position + originOffset·normal (m)
+const float faceSize = FACE_SIZE;           // cube face tile size (texels)
+const int atlasCols = ATLAS_COLS;           // tiles per atlas row
+const vec2 atlasInvSize = vec2(ATLAS_INV_WIDTH, ATLAS_INV_HEIGHT);
+
+// Texel origin of a cube face's tile in the atlas (face 5, −Z, maps onto +Z; callers treat it as lit).
+ivec2 tileOrigin(int cube, int face) {
+  int t = 5 * cube + min(face, 4);
+  return ivec2(t % atlasCols, t / atlasCols) * int(faceSize);
+}
 
 layout(location = 0) out vec4 result;
 
@@ -64,17 +74,33 @@ float vplVisibility(int cube, vec3 v, float bias) {
 #ifdef SHADOW_COMPARE
   // lit where stored ≤ near / (axis − bias) (reversed-Z); axis ≤ bias: always lit (reference 1 ≥ any depth).
   // One division for both 1/axis and 1/(axis − bias); where axis − bias ≤ near the reference is 1 and
-  // the coordinates do not matter.
+  // the coordinates do not matter. The −Z face (below the VPL's surface, never drawn) is lit.
   float ax = axisDistance - bias;
   float inv = 1.0 / (axisDistance * ax);
-  float reference = ax > nearPlane ? nearPlane * axisDistance * inv : 1.0;
-  return texture(vplDepth, vec4(sctc * (0.5 * ax * inv) + 0.5, float(6 * cube + face), reference));
+  float reference = (ax > nearPlane && face < 5) ? nearPlane * axisDistance * inv : 1.0;
+  // Face coordinates in texels, clamped half a texel inside the tile: the 2×2 filtered compare then
+  // never reads a neighbouring tile (at the clamp the outer texel's weight is 0; the old layered
+  // lookup's GL_CLAMP_TO_EDGE gave the same edge texel).
+  vec2 t = clamp(sctc * (0.5 * faceSize * ax * inv) + 0.5 * faceSize, vec2(0.5), vec2(faceSize - 0.5));
+  return texture(vplDepth, vec3((t + vec2(tileOrigin(cube, face))) * atlasInvSize, reference));
 #elif defined(SHADOW_PCF)
-  return cubeVisibilityPcf(vplDepth, cube, v, nearPlane, bias);
+  // 2×2 percentage-closer filter by 4 texelFetch (texel indices clamped to the tile).
+  int size = int(faceSize);
+  vec2 st = (sctc / axisDistance * 0.5 + 0.5) * faceSize - 0.5;
+  vec2 f = fract(st);
+  ivec2 t0 = clamp(ivec2(floor(st)), ivec2(0), ivec2(size - 1));
+  ivec2 t1 = min(t0 + 1, ivec2(size - 1));
+  ivec2 o = tileOrigin(cube, face);
+  vec4 d = vec4(texelFetch(vplDepth, o + t0, 0).r, texelFetch(vplDepth, o + ivec2(t1.x, t0.y), 0).r,
+                texelFetch(vplDepth, o + ivec2(t0.x, t1.y), 0).r, texelFetch(vplDepth, o + t1, 0).r);
+  d = face < 5 ? d : vec4(0.0);
+  vec4 lit = vec4(lessThanEqual(axisDistance * d, vec4(nearPlane) + bias * d));
+  return mix(mix(lit.x, lit.y, f.x), mix(lit.z, lit.w, f.x), f.y);
 #else
-  float axis;
-  float depth = cubeDepth(vplDepth, cube, v, axis);
-  return cubeLit(depth, axis, nearPlane, bias) ? 1.0 : 0.0;
+  int size = int(faceSize);
+  ivec2 texel = clamp(ivec2((sctc / axisDistance * 0.5 + 0.5) * faceSize), ivec2(0), ivec2(size - 1));
+  float depth = face < 5 ? texelFetch(vplDepth, tileOrigin(cube, face) + texel, 0).r : 0.0;
+  return cubeLit(depth, axisDistance, nearPlane, bias) ? 1.0 : 0.0;
 #endif
 }
 

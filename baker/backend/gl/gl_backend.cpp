@@ -149,6 +149,52 @@ struct DepthTargets {
   }
 };
 
+// The VPL depth cubes of one batch as tiles of ONE 2D depth texture behind ONE framebuffer: tile
+// 5k + f holds face f (GL order +X −X +Y −Y +Z; the −Z face is never drawn for a hemisphere) of the
+// batch's k-th VPL, at column (5k + f) % cols, row (5k + f) / cols. Cleared once per batch, each face
+// drawn with its own viewport and scissor, so llvmpipe bins a whole batch as one scene instead of
+// paying a framebuffer switch and a scissored clear per face (docs/performance.md).
+struct DepthAtlas {
+  static constexpr int kTilesPerCube = 5;
+  GLuint texture = 0, fbo = 0;
+  int faceSize = 0, cols = 1, rows = 1;
+  DepthAtlas(int size, int cubes) : faceSize(size) {
+    const int tiles = std::max(1, cubes * kTilesPerCube);
+    GLint maxSize = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+    const int maxTiles = std::max(1, maxSize / size);
+    cols = std::min(maxTiles, std::max(1, int(std::ceil(std::sqrt(double(tiles))))));
+    rows = (tiles + cols - 1) / cols;
+    if (rows > maxTiles)
+      throw Error(ErrorCode::Gl, "", "VPL depth atlas of " + std::to_string(tiles) + " tiles of " +
+                                         std::to_string(size) + "² exceeds GL_MAX_TEXTURE_SIZE " +
+                                         std::to_string(maxSize) + " (lower the VPLs per pass or the face size)");
+    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+    glTextureStorage2D(texture, 1, GL_DEPTH_COMPONENT32F, width(), height());
+    glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(texture, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, texture, 0);
+    glNamedFramebufferDrawBuffer(fbo, GL_NONE);
+    glNamedFramebufferReadBuffer(fbo, GL_NONE);
+    if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw Error(ErrorCode::Gl, "", "depth atlas framebuffer incomplete");
+  }
+  ~DepthAtlas() {
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &texture);
+  }
+  int width() const { return cols * faceSize; }
+  int height() const { return rows * faceSize; }
+  glm::ivec2 tileOrigin(int cube, int face) const {
+    const int t = kTilesPerCube * cube + face;
+    return glm::ivec2(t % cols, t / cols) * faceSize;
+  }
+};
+
 // One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a
 // validity mask as depth (1 valid, 0 not): the light-map passes draw at depth 0 with GL_LESS, so
 // llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
@@ -214,8 +260,9 @@ class GlBaker {
 
  private:
   void drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ);
-  void renderVplBatch(size_t first, size_t count, DepthTargets& cubes);
-  void accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes);
+  void drawCulled(const ShadowView& view);
+  void renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas);
+  void accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas);
   void bakeDirect(const Light& light);
   void bindGBuffer(const GpuPage& page) const;
   void shadowPassState() const;
@@ -234,6 +281,7 @@ class GlBaker {
   GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
+  std::unique_ptr<DepthAtlas> atlas_;  // VPL depth cubes of one batch (created before the programs: its layout is compiled in)
 };
 
 void GlBaker::finishStage(double& seconds, StageClock& sw, double* cpuSeconds) const {
@@ -272,6 +320,11 @@ void GlBaker::drawView(const ShadowView& view, GLuint fbo, int size, bool revers
   glClearDepthf(reversedZ ? 0.0f : 1.0f);
   glDepthFunc(reversedZ ? GL_GREATER : GL_LESS);
   glClear(GL_DEPTH_BUFFER_BIT);
+  drawCulled(view);
+}
+
+// The view's clusters that survive CPU culling, into the bound framebuffer's viewport.
+void GlBaker::drawCulled(const ShadowView& view) {
   glUniformMatrix4fv(depthProgram_->uniform("shadowClip"), 1, GL_FALSE, &view.clip[0][0]);
   drawCounts_.clear();
   drawOffsets_.clear();
@@ -283,16 +336,30 @@ void GlBaker::drawView(const ShadowView& view, GLuint fbo, int size, bool revers
                         static_cast<GLsizei>(drawCounts_.size()));
 }
 
-void GlBaker::renderVplBatch(size_t first, size_t count, DepthTargets& cubes) {
+// The batch's cubes into the atlas: one unscissored clear (reversed-Z: 0 = nothing drawn), then each
+// face with the viewport of its tile and the scissor of its view moved into the tile (every face is
+// scissored to its tile, so nothing can spill into a neighbour).
+void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   depthProgram_->use();
   glBindVertexArray(geometry_->vao);
+  glBindFramebuffer(GL_FRAMEBUFFER, atlas.fbo);
+  glDisable(GL_SCISSOR_TEST);
+  glClearDepthf(0.0f);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_SCISSOR_TEST);
+  glDepthFunc(GL_GREATER);
+  const int size = atlas.faceSize;
   for (size_t k = 0; k < count; ++k) {
     const Vpl& v = in_.vpls.vpls[first + k];
     const VplFrame frame = vplFrame(v.normal);
     const glm::vec3 origin = v.position + frame.normal * scale_.originOffset;
-    for (int face = 0; face < kFaces; ++face) {
-      std::optional<ShadowView> view = cubeFaceView(origin, frame, face, cubes.size, scale_.nearPlane, true);
-      if (view) drawView(*view, cubes.fbos[k * kFaces + face], cubes.size, true);
+    for (int face = 0; face < DepthAtlas::kTilesPerCube; ++face) {
+      std::optional<ShadowView> view = cubeFaceView(origin, frame, face, size, scale_.nearPlane, true);
+      if (!view) continue;
+      const glm::ivec2 o = atlas.tileOrigin(static_cast<int>(k), face);
+      glViewport(o.x, o.y, size, size);
+      glScissor(o.x + view->scissor.x, o.y + view->scissor.y, view->scissor.z, view->scissor.w);
+      drawCulled(*view);
     }
   }
 }
@@ -302,7 +369,7 @@ void GlBaker::bindGBuffer(const GpuPage& page) const {
   glBindTextureUnit(1, page.normal);
 }
 
-void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets& cubes) {
+void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   std::vector<VplTexels> batch(count);
   for (size_t k = 0; k < count; ++k) {
     const Vpl& v = in_.vpls.vpls[first + k];
@@ -311,7 +378,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthTargets&
   }
   if (count > 0) glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
   glBindTextureUnit(3, vplTable_);
-  glBindTextureUnit(2, cubes.texture);
+  glBindTextureUnit(2, atlas.texture);
   glBindVertexArray(emptyVao_);
   for (auto& page : pages_) {
     const GlProgram& program = vplProgram(page->samples->supersample * page->samples->supersample);
@@ -342,6 +409,12 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   constant("NORMAL_OFFSET", opt_.normalOffset);
   constant("TEXEL_ANGLE", 2.0f / opt_.cubeFaceSize);
   constant("ORIGIN_OFFSET", scale_.originOffset);
+  if (atlas_) {  // the depth atlas layout (tiles of FACE_SIZE², ATLAS_COLS per row)
+    constant("FACE_SIZE", float(atlas_->faceSize));
+    constant("ATLAS_INV_WIDTH", 1.0f / atlas_->width());
+    constant("ATLAS_INV_HEIGHT", 1.0f / atlas_->height());
+    defines.push_back("#define ATLAS_COLS " + std::to_string(atlas_->cols));
+  }
   if (opt_.normalOffset != 0.0f) defines.push_back("#define HAS_NORMAL_OFFSET 1");
   p = std::make_unique<GlProgram>(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
@@ -443,8 +516,10 @@ std::vector<Lightmap> GlBaker::run() {
     glUniform1f(p->uniform("slopeBias"), opt_.slopeBias);
     glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   }
-  if (in_.eval.includeVpls && !in_.vpls.vpls.empty())
+  if (in_.eval.includeVpls && !in_.vpls.vpls.empty()) {
+    atlas_ = std::make_unique<DepthAtlas>(std::max(1, opt_.cubeFaceSize), K);
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
+  }
   glCreateBuffers(1, &vplBuffer_);
   glNamedBufferStorage(vplBuffer_, K * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
   glCreateTextures(GL_TEXTURE_BUFFER, 1, &vplTable_);
@@ -459,34 +534,32 @@ std::vector<Lightmap> GlBaker::run() {
   const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
   const size_t totalWork = vplCount + lightCount * K;
-  std::unique_ptr<DepthTargets> cubeTargets;
   if (vplCount > 0) {
-    cubeTargets = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.cubeFaceSize, K * kFaces);
     if (opt_.shadowPcf && opt_.shadowCompare) {
-      // Sampled through sampler2DArrayShadow: lit (1) where the stored depth ≤ the reference.
-      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
-      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(cubeTargets->texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      // Sampled through sampler2DShadow: lit (1) where the stored depth ≤ the reference.
+      glTextureParameteri(atlas_->texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTextureParameteri(atlas_->texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
+      glTextureParameteri(atlas_->texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(atlas_->texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     }
     // A pass over zero VPLs (adds 0): llvmpipe compiles the accumulation shader for this state at its
     // first draw, which then counts as setup, not as the first batch's accumulation.
     lightMapPassState();
-    accumulateVplBatch(0, 0, *cubeTargets);
+    accumulateVplBatch(0, 0, *atlas_);
   }
   checkGlError("GL backend setup");
   finishStage(stats_.setupSeconds, sw);
 
   if (vplCount > 0) {
-    DepthTargets& cubes = *cubeTargets;
+    const DepthAtlas& atlas = *atlas_;
     int passesSinceFold = 0;
     for (size_t first = 0; first < vplCount; first += K) {
       const size_t count = std::min<size_t>(K, vplCount - first);
       shadowPassState();
-      renderVplBatch(first, count, cubes);
+      renderVplBatch(first, count, atlas);
       finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
       lightMapPassState();
-      accumulateVplBatch(first, count, cubes);
+      accumulateVplBatch(first, count, atlas);
       finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
       ++stats_.passes;
       stats_.vpls += count;
