@@ -55,8 +55,12 @@ const vec2 atlasInvSize = vec2(ATLAS_INV_WIDTH, ATLAS_INV_HEIGHT);
 
 // Texel origin of a cube face's tile in the atlas (face 5, −Z, maps onto +Z; callers treat it as lit).
 ivec2 tileOrigin(int cube, int face) {
+#if ATLAS_COLS == 5
+  return ivec2(min(face, 4), cube) * int(faceSize);  // one cube per row
+#else
   int t = 5 * cube + min(face, 4);
   return ivec2(t % atlasCols, t / atlasCols) * int(faceSize);
+#endif
 }
 
 layout(location = 0) out vec4 result;

@@ -43,10 +43,11 @@ struct GlBakeStats {
 };
 
 struct GlBackendOptions {
-  int vplsPerPass = 16;          // K: VPLs (depth cubes, 6 array layers each) evaluated per accumulation pass
+  int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
   int cubeFaceSize = 256;        // VPL depth-cube face size (texels)
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
   int lightMapSize = 2048;       // spot / directional shadow map size (texels)
+  int shadowFlushTriangles = 32768;  // VPL shadow pass: glFlush after this many triangles drawn into the depth atlas (0: once per batch)
   int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
   int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling; 64: −20% drawn vs 256)
   float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
