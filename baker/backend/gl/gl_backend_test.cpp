@@ -232,6 +232,36 @@ TEST(GlBackend, HardwareDepthCompareEqualsFourTapPcf) {
   std::printf("edge texels %zu, beyond rounding %zu, relative RMSE %.2e\n", partial, rounded, std::sqrt(num / den));
 }
 
+// The VPL depth atlas: every lookup path (sampler compare, 4-tap PCF, nearest texel) reads only its own
+// tile, and flushing the shadow scene after every face or never gives the same maps bit for bit.
+TEST(GlBackend, DepthAtlasPathsAgreeAndFlushingChangesNothing) {
+  Fixture f = floorScene(true);
+  f.rt = std::make_unique<RayTracer>(f.scene);
+  for (int i = 0; i < 7; ++i) {  // 7 VPLs, 3 per pass: a partial last batch
+    Vpl v;
+    v.position = {-0.45f + 0.15f * i, 0.08f * i - 0.25f, 0.85f + 0.04f * i};
+    v.normal = glm::normalize(glm::vec3(0.08f * i - 0.25f, 0.05f, -1.0f));
+    v.power = glm::vec3(1.0f);
+    f.vpls.vpls.push_back(v);
+  }
+  GlBackendOptions base;
+  base.vplsPerPass = 3;
+  base.cubeFaceSize = 512;
+  GlBackendOptions flushAll = base, taps = base, nearest = base;
+  base.shadowFlushTriangles = 0;
+  flushAll.shadowFlushTriangles = 1;
+  taps.shadowCompare = false;
+  nearest.shadowPcf = false;
+  const auto a = f.bake({}, base), b = f.bake({}, flushAll), c = f.bake({}, taps), d = f.bake({}, nearest);
+  const auto ref = cpuReference(f, f.pages[0], 0.0f, true);
+  for (size_t i = 0; i < a[0].size(); ++i) EXPECT_EQ(a[0].texels[i], b[0].texels[i]) << i;
+  EXPECT_LT(relativeRmse(ref, a[0]), 0.03);
+  EXPECT_LT(relativeRmse(ref, c[0]), 0.03);
+  EXPECT_LT(relativeRmse(ref, d[0]), 0.04);
+  std::printf("vs ray traced: compare %.4f, taps %.4f, nearest %.4f\n", relativeRmse(ref, a[0]),
+              relativeRmse(ref, c[0]), relativeRmse(ref, d[0]));
+}
+
 // Invalid texels are skipped by the early depth test against the page's validity mask: they stay 0
 // and the valid texels are exactly what a bake without the mask gives.
 TEST(GlBackend, ValidityMaskSkipsOnlyInvalidTexels) {
