@@ -113,7 +113,8 @@ void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g) {
   glVertexArrayAttribBinding(g.vao, 0, 0);
 }
 
-// Depth-only render targets: `layers` layers of size×size (a 2D array: 6 per cube) or one 2D map; one FBO per layer.
+// Punctual lights' depth targets: `layers` layers of size×size (a 2D array: 6 per cube) or one 2D map; one FBO
+// per layer. (VPL cubes use the DepthAtlas below.)
 struct DepthTargets {
   GLuint texture = 0;
   GLenum target = 0;
