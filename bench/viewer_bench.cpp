@@ -37,6 +37,16 @@ GlContext& context() {
   return gl;
 }
 
+// A square light-map page of smooth values 0.5 ± 0.4 (sin(fx·x) cos(fy·y)), every texel valid.
+Lightmap smoothPage(int pageSize, float fx, float fy) {
+  Lightmap page;
+  page.width = page.height = pageSize;
+  for (int y = 0; y < pageSize; ++y)
+    for (int x = 0; x < pageSize; ++x) page.texels.emplace_back(0.5f + 0.4f * std::sin(fx * x) * std::cos(fy * y));
+  page.valid.assign(page.size(), 1);
+  return page;
+}
+
 // A wavy n×n height field over 10 × 10 m: 2n² triangles, uv1 over one page with a smooth map;
 // textured: a 512² base colour texture (a coloured brick-like pattern) repeated 8 × 8 over uv0.
 ViewerScene heightField(int n, int pageSize, bool textured = false) {
@@ -74,13 +84,7 @@ ViewerScene heightField(int n, int pageSize, bool textured = false) {
     s.materials[0].baseColorFactor = glm::vec4(1.0f);
     s.materials[0].baseColorTexture = 0;
   }
-  Lightmap page;
-  page.width = page.height = pageSize;
-  for (int y = 0; y < pageSize; ++y)
-    for (int x = 0; x < pageSize; ++x)
-      page.texels.emplace_back(0.5f + 0.4f * std::sin(0.05f * x) * std::cos(0.03f * y));
-  page.valid.assign(page.size(), 1);
-  return makeViewerScene(std::move(s), {page});
+  return makeViewerScene(std::move(s), {smoothPage(pageSize, 0.05f, 0.03f)});
 }
 
 // A textured brick-like 512² colour texture (tint × grain; mortar lines).
@@ -176,13 +180,7 @@ ViewerScene furnishedRoom() {
     sphere({x, 0.9f + 0.5f * (i % 3), z}, r, i % 3 == 0 ? 2 : 3);
   }
   s.cameras.clear();
-  Lightmap page;
-  page.width = page.height = pageSize;
-  for (int y = 0; y < pageSize; ++y)
-    for (int x = 0; x < pageSize; ++x)
-      page.texels.emplace_back(0.5f + 0.4f * std::sin(0.01f * x) * std::cos(0.013f * y));
-  page.valid.assign(page.size(), 1);
-  return makeViewerScene(std::move(s), {page});
+  return makeViewerScene(std::move(s), {smoothPage(pageSize, 0.01f, 0.013f)});
 }
 
 ViewerScene bakedCornell() {

@@ -6,73 +6,50 @@
 #include <tbb/parallel_for.h>
 
 namespace irbake {
-namespace {
 
-// Per texel: the weighted mean position and normal over its S×S samples (w = 0: no sample).
-struct TexelGeometry {
-  std::vector<glm::vec4> position;  // xyz, w = weight sum
-  std::vector<glm::vec3> normal;
-};
-
-TexelGeometry texelGeometry(const TexelSamples& ts) {
-  TexelGeometry g;
+SurfaceFilter::SurfaceFilter(const TexelSamples& ts) : width_(ts.width), height_(ts.height) {
   const size_t layer = ts.layerSize();
-  const int layers = ts.supersample * ts.supersample;
-  g.position.assign(layer, glm::vec4(0.0f));
-  g.normal.assign(layer, glm::vec3(0.0f));
-  for (int l = 0; l < layers; ++l)
-    for (size_t t = 0; t < layer; ++t) {
-      const size_t s = static_cast<size_t>(l) * layer + t;
-      const float w = ts.positionWeight[s].w;
-      if (!(w > 0.0f)) continue;
-      g.position[t] += glm::vec4(w * glm::vec3(ts.positionWeight[s]), w);
-      g.normal[t] += w * glm::vec3(ts.normal[s]);
-    }
+  position_.assign(layer, glm::vec3(0.0f));
+  normal_.assign(layer, glm::vec3(0.0f));
+  hasSample_.assign(layer, 0);
   for (size_t t = 0; t < layer; ++t) {
-    if (!(g.position[t].w > 0.0f)) continue;
-    g.position[t] = glm::vec4(glm::vec3(g.position[t]) / g.position[t].w, g.position[t].w);
-    const float len = glm::length(g.normal[t]);
-    if (len > 0.0f) g.normal[t] /= len;
+    if (!texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.positionWeight[s]); }, position_[t])) continue;
+    texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.normal[s]); }, normal_[t]);
+    const float len = glm::length(normal_[t]);
+    if (len > 0.0f) normal_[t] /= len;
+    hasSample_[t] = 1;
   }
-  return g;
-}
-
-float spacing(const TexelSamples& ts, const TexelGeometry& g) {
+  // Spacing: median over every other texel's right and lower neighbours on the same surface.
   std::vector<float> d;
-  const int W = ts.width, H = ts.height;
-  auto ok = [&](size_t i) { return i < ts.valid.size() && ts.valid[i] && g.position[i].w > 0.0f; };
+  const int W = width_, H = height_;
+  auto ok = [&](size_t i) { return i < ts.valid.size() && ts.valid[i] && hasSample_[i]; };
   for (int y = 0; y < H; y += 2)
     for (int x = 0; x < W; x += 2) {
-      size_t i = static_cast<size_t>(y) * W + x;
+      const size_t i = static_cast<size_t>(y) * W + x;
       if (!ok(i)) continue;
       for (size_t j : {i + 1, i + static_cast<size_t>(W)}) {
         if ((j == i + 1 && x + 1 >= W) || (j != i + 1 && y + 1 >= H) || !ok(j)) continue;
-        if (glm::dot(g.normal[i], g.normal[j]) < 0.99f) continue;
-        d.push_back(glm::length(glm::vec3(g.position[i]) - glm::vec3(g.position[j])));
+        if (glm::dot(normal_[i], normal_[j]) < 0.99f) continue;
+        d.push_back(glm::length(position_[i] - position_[j]));
       }
     }
-  if (d.empty()) return 0.0f;
+  if (d.empty()) return;
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
+  spacing_ = d[d.size() / 2];
 }
 
-}  // namespace
-
-float texelSpacing(const TexelSamples& ts) { return spacing(ts, texelGeometry(ts)); }
-
-std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector<glm::vec3>& values,
-                                       const std::vector<uint8_t>& valid, const TexelFilterOptions& options) {
+std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values, const std::vector<uint8_t>& valid,
+                                            const TexelFilterOptions& options) const {
   std::vector<glm::vec3> out = values;
   const int r = std::max(0, options.radius);
-  const TexelGeometry g = texelGeometry(ts);
-  const float h = spacing(ts, g);
+  const float h = spacing_;
   if (r == 0 || !(h > 0.0f)) return out;
-  const int W = ts.width, H = ts.height;
+  const int W = width_, H = height_;
   tbb::parallel_for(0, H, [&](int y) {
     for (int x = 0; x < W; ++x) {
       const size_t i = static_cast<size_t>(y) * W + x;
-      if (!valid[i] || !(g.position[i].w > 0.0f)) continue;
-      const glm::vec3 p(g.position[i]), n(g.normal[i]);
+      if (!valid[i] || !hasSample_[i]) continue;
+      const glm::vec3 p = position_[i], n = normal_[i];
       glm::vec3 sum(0.0f);
       float count = 0.0f;
       for (int dy = -r; dy <= r; ++dy) {
@@ -82,11 +59,11 @@ std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector
           const int xx = x + dx;
           if (xx < 0 || xx >= W) continue;
           const size_t j = static_cast<size_t>(yy) * W + xx;
-          if (!valid[j] || !(g.position[j].w > 0.0f)) continue;
+          if (!valid[j] || !hasSample_[j]) continue;
           if (j != i) {
-            if (glm::dot(n, g.normal[j]) < options.minNormalCos) continue;
+            if (glm::dot(n, normal_[j]) < options.minNormalCos) continue;
             const float reach = options.maxSpacings * h * std::sqrt(static_cast<float>(dx * dx + dy * dy));
-            const glm::vec3 d = glm::vec3(g.position[j]) - p;
+            const glm::vec3 d = position_[j] - p;
             if (glm::dot(d, d) > reach * reach) continue;
           }
           const float w = options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
@@ -98,6 +75,13 @@ std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector
     }
   });
   return out;
+}
+
+float texelSpacing(const TexelSamples& ts) { return SurfaceFilter(ts).spacing(); }
+
+std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector<glm::vec3>& values,
+                                       const std::vector<uint8_t>& valid, const TexelFilterOptions& options) {
+  return SurfaceFilter(ts).apply(values, valid, options);
 }
 
 }  // namespace irbake

@@ -20,12 +20,27 @@ struct TexelFilterOptions {
                                 // texel class (x mod n, y mod n) gets the same total weight
 };
 
-// World-space distance between horizontally or vertically adjacent valid texels of a page (median over
-// pairs on the same surface); 0 when the page has no such pair.
-float texelSpacing(const TexelSamples& ts);
+// The filter over one page: each texel's mean position and normal (over its S×S samples) and the page's
+// texel spacing, computed once, so one page can be filtered many times (the compensation's sweeps).
+class SurfaceFilter {
+ public:
+  explicit SurfaceFilter(const TexelSamples& ts);
+  // World-space distance between horizontally or vertically adjacent valid texels (median over pairs on
+  // the same surface); 0 when the page has no such pair.
+  float spacing() const { return spacing_; }
+  // values and valid: one per texel of the page. Invalid texels are returned unchanged.
+  std::vector<glm::vec3> apply(const std::vector<glm::vec3>& values, const std::vector<uint8_t>& valid,
+                               const TexelFilterOptions& options = {}) const;
 
-// values and valid: one per texel of the page (layer 0 positions/normals describe the texel). Invalid
-// texels are returned unchanged.
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<glm::vec3> position_, normal_;  // per texel
+  std::vector<uint8_t> hasSample_;            // per texel: some sample has weight
+  float spacing_ = 0.0f;
+};
+
+// One-off forms of the above.
+float texelSpacing(const TexelSamples& ts);
 std::vector<glm::vec3> filterOnSurface(const TexelSamples& ts, const std::vector<glm::vec3>& values,
                                        const std::vector<uint8_t>& valid, const TexelFilterOptions& options = {});
 

@@ -34,6 +34,26 @@ struct TexelSamples {
   size_t slotCount() const { return layerSize() * supersample * supersample; }
 };
 
+// Coverage-weighted mean of value(slot) over texel t's S×S samples, into mean; false (mean untouched)
+// when no sample of the texel has weight. How per-sample results become texel values.
+template <class T, class ValueOfSlot>
+bool texelMean(const TexelSamples& ts, size_t t, ValueOfSlot&& value, T& mean) {
+  T sum(0);
+  float weight = 0.0f;
+  const size_t layer = ts.layerSize();
+  const int layers = ts.supersample * ts.supersample;
+  for (int l = 0; l < layers; ++l) {
+    const size_t s = static_cast<size_t>(l) * layer + t;
+    const float w = ts.positionWeight[s].w;
+    if (!(w > 0.0f)) continue;
+    sum += w * value(s);
+    weight += w;
+  }
+  if (!(weight > 0.0f)) return false;
+  mean = sum / weight;
+  return true;
+}
+
 // Builds samples for every page referenced by the scene's primitives (pages sized as in LightmapRef).
 std::vector<TexelSamples> buildTexelSamples(const Scene& scene, const RayTracer& rt, const TexelSampleOptions& options);
 

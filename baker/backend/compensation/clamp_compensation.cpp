@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -102,16 +103,21 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
   const int refineHits = static_cast<int>(std::ceil(options.refineFraction * baseRays));
   // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
   // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
-  // per-sample ray count is low.
+  // per-sample ray count is low. Radius and texel geometry per page, once for all sweeps.
   const float clampRadius = 1.0f / std::sqrt(bound);
-  auto filterRadiusFor = [&](const TexelSamples& ts) {
-    if (options.filterRadius >= 0) return options.filterRadius;
-    if (baseRays >= 32) return 0;
-    const float h = texelSpacing(ts);
-    if (!(h > 0.0f)) return 0;
-    return static_cast<int>(std::min(2.0f, std::floor(0.05f * clampRadius / h)));
-  };
+  std::vector<int> radii(in.texels.size(), 0);
+  std::vector<std::unique_ptr<SurfaceFilter>> filters(in.texels.size());
   int filterRadius = 0;
+  for (size_t p = 0; p < in.texels.size(); ++p) {
+    if (options.filterRadius == 0 || (options.filterRadius < 0 && baseRays >= 32)) continue;
+    auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
+    const float h = filter->spacing();
+    radii[p] = options.filterRadius > 0 ? options.filterRadius
+               : h > 0.0f ? static_cast<int>(std::min(2.0f, std::floor(0.05f * clampRadius / h)))
+                          : 0;
+    filterRadius = std::max(filterRadius, radii[p]);
+    if (radii[p] > 0) filters[p] = std::move(filter);
+  }
   // Traces `count` cosine rays from slot s of page p (a rotated Fibonacci lattice: well stratified over
   // the hemisphere for any count) and appends the hits inside the clamp radius, not yet divided by the
   // slot's ray count.
@@ -235,27 +241,14 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
       const TexelSamples& ts = in.texels[p];
       const Lightmap& m = maps[p];
       const size_t layer = ts.layerSize();
-      const int layers = ts.supersample * ts.supersample;
       std::vector<glm::vec3> residual(layer, glm::vec3(0.0f));
       tbb::parallel_for(size_t(0), layer, [&](size_t t) {
-        if (t >= m.valid.size() || !m.valid[t]) return;
-        glm::vec3 sum(0.0f);
-        float weight = 0.0f;
-        for (int l = 0; l < layers; ++l) {
-          size_t s = static_cast<size_t>(l) * layer + t;
-          float w = ts.positionWeight[s].w;
-          if (!(w > 0.0f)) continue;
-          sum += w * slotResidual[p][s];
-          weight += w;
-        }
-        if (weight > 0.0f) residual[t] = sum / weight;
+        if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
-      const int radius = filterRadiusFor(ts);
-      filterRadius = std::max(filterRadius, radius);
-      if (radius > 0) {
+      if (filters[p]) {
         TexelFilterOptions fo;
-        fo.radius = radius;
-        residual = filterOnSurface(ts, residual, m.valid, fo);
+        fo.radius = radii[p];
+        residual = filters[p]->apply(residual, m.valid, fo);
       }
       for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
         if (m.valid[t]) next[p][t] += residual[t];

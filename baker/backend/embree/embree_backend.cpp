@@ -209,21 +209,10 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
     doneSlots += slots;
     progressSlots = 0;
 
-    const size_t layer = ts.layerSize();
-    const int layers = ts.supersample * ts.supersample;
-    for (size_t t = 0; t < layer; ++t) {
-      glm::vec3 sum(0.0f);
-      float weight = 0.0f;
-      for (int l = 0; l < layers; ++l) {
-        size_t s = static_cast<size_t>(l) * layer + t;
-        float w = ts.positionWeight[s].w;
-        if (w <= 0.0f) continue;
-        sum += w * slotValue[s];
-        weight += w;
-      }
-      bool valid = ts.valid.empty() ? weight > 0.0f : (ts.valid[t] != 0 && weight > 0.0f);
-      if (!valid) continue;
-      glm::vec3 value = sum / weight;  // weights sum to 1 per valid texel; divide anyway for robustness
+    for (size_t t = 0; t < ts.layerSize(); ++t) {
+      glm::vec3 value;
+      if (!texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value)) continue;
+      if (!ts.valid.empty() && ts.valid[t] == 0) continue;
       if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z))
         throw Error(ErrorCode::NumericError, in.scene.sourcePath,
                     "embree backend produced a non-finite value at page " + std::to_string(ts.page) + " texel " +

@@ -170,18 +170,24 @@ TEST(GlBackend, SingleVplMatchesClosedForm) {
   EXPECT_GT(maps[0].texels[16 * 32 + 16].r, 0.1f);
 }
 
+// n unit-power VPLs in a row above the floor (VPL i at first + i·step), each tilted by its y so the
+// shadow cubes see the occluder from several directions.
+void addVplRow(Fixture& f, int n, glm::vec3 first, glm::vec3 step) {
+  for (int i = 0; i < n; ++i) {
+    Vpl v;
+    v.position = first + step * static_cast<float>(i);
+    v.normal = glm::normalize(glm::vec3(v.position.y, 0.05f, -1.0f));
+    v.power = glm::vec3(1.0f);
+    f.vpls.vpls.push_back(v);
+  }
+}
+
 // VPLs above an occluder: the shadow cubes agree with Embree visibility (texels on the penumbra
 // boundary can differ by a shadow texel; the relative RMSE is what must be small).
 TEST(GlBackend, VplShadowsMatchRayTracedVisibility) {
   Fixture f = floorScene(true);
   f.rt = std::make_unique<RayTracer>(f.scene);
-  for (int i = 0; i < 5; ++i) {
-    Vpl v;
-    v.position = {-0.4f + 0.2f * i, 0.1f * i - 0.2f, 0.9f + 0.05f * i};
-    v.normal = glm::normalize(glm::vec3(0.1f * i - 0.2f, 0.05f, -1.0f));
-    v.power = glm::vec3(1.0f);
-    f.vpls.vpls.push_back(v);
-  }
+  addVplRow(f, 5, {-0.4f, -0.2f, 0.9f}, {0.2f, 0.1f, 0.05f});
   GlBackendOptions opt;
   opt.vplsPerPass = 2;  // several passes and folds
   opt.foldEveryPasses = 1;
@@ -204,13 +210,7 @@ TEST(GlBackend, VplShadowsMatchRayTracedVisibility) {
 // (bound: 1/256, a GPU's 8-bit sub-texel precision); every other texel agrees to float rounding.
 TEST(GlBackend, HardwareDepthCompareEqualsFourTapPcf) {
   Fixture f = floorScene(true);
-  for (int i = 0; i < 5; ++i) {
-    Vpl v;
-    v.position = {-0.4f + 0.2f * i, 0.1f * i - 0.2f, 0.9f + 0.05f * i};
-    v.normal = glm::normalize(glm::vec3(0.1f * i - 0.2f, 0.05f, -1.0f));
-    v.power = glm::vec3(1.0f);
-    f.vpls.vpls.push_back(v);
-  }
+  addVplRow(f, 5, {-0.4f, -0.2f, 0.9f}, {0.2f, 0.1f, 0.05f});
   GlBackendOptions hw, taps;
   hw.cubeFaceSize = taps.cubeFaceSize = 64;  // coarse: many texels on a filtered shadow edge
   taps.shadowCompare = false;
@@ -237,13 +237,7 @@ TEST(GlBackend, HardwareDepthCompareEqualsFourTapPcf) {
 TEST(GlBackend, DepthAtlasPathsAgreeAndFlushingChangesNothing) {
   Fixture f = floorScene(true);
   f.rt = std::make_unique<RayTracer>(f.scene);
-  for (int i = 0; i < 7; ++i) {  // 7 VPLs, 3 per pass: a partial last batch
-    Vpl v;
-    v.position = {-0.45f + 0.15f * i, 0.08f * i - 0.25f, 0.85f + 0.04f * i};
-    v.normal = glm::normalize(glm::vec3(0.08f * i - 0.25f, 0.05f, -1.0f));
-    v.power = glm::vec3(1.0f);
-    f.vpls.vpls.push_back(v);
-  }
+  addVplRow(f, 7, {-0.45f, -0.25f, 0.85f}, {0.15f, 0.08f, 0.04f});  // 3 per pass: a partial last batch
   GlBackendOptions base;
   base.vplsPerPass = 3;
   base.cubeFaceSize = 512;
