@@ -1,4 +1,5 @@
 #include "glcontext/gl_context.h"
+#include "glcontext/gl_program.h"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -46,6 +47,7 @@ struct GlContext::Impl {
   EglPlatform platform = EglPlatform::Surfaceless;
   std::string renderer, version, vendor;
   std::atomic<int> messages{0}, errors{0};
+  std::unique_ptr<GlProgramCache> programs = std::make_unique<GlProgramCache>();
 
   static void GLAPIENTRY onDebug(GLenum /*source*/, GLenum type, GLuint id, GLenum severity, GLsizei length,
                                  const GLchar* message, const void* user) {
@@ -179,6 +181,15 @@ GlContext::GlContext(const GlContextOptions& options) : impl_(std::make_unique<I
 
 GlContext::~GlContext() {
   if (!impl_ || impl_->display == EGL_NO_DISPLAY) return;
+  if (impl_->programs && impl_->programs->size() > 0 && impl_->context != EGL_NO_CONTEXT) {
+    // Programs are deleted on this context; whatever context the thread had current is restored.
+    const EGLContext previous = eglGetCurrentContext();
+    const EGLDisplay previousDisplay = eglGetCurrentDisplay();
+    const EGLSurface draw = eglGetCurrentSurface(EGL_DRAW), read = eglGetCurrentSurface(EGL_READ);
+    if (previous != impl_->context) eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context);
+    impl_->programs.reset();
+    if (previous != impl_->context && previous != EGL_NO_CONTEXT) eglMakeCurrent(previousDisplay, draw, read, previous);
+  }
   if (eglGetCurrentContext() == impl_->context) {
     if (impl_->context != EGL_NO_CONTEXT) glDebugMessageCallback(nullptr, nullptr);
     eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -187,6 +198,8 @@ GlContext::~GlContext() {
   // The display is not terminated: EGL displays are per-process singletons, and terminating one
   // would pull it away from another GlContext (the viewer and a bake) alive on it.
 }
+
+GlProgramCache& GlContext::programs() const { return *impl_->programs; }
 
 void GlContext::makeCurrent() const {
   if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))

@@ -8,6 +8,8 @@
 
 namespace irbake {
 
+class GlProgramCache;
+
 enum class EglPlatform { Surfaceless, Device };
 
 struct GlContextOptions {
@@ -33,6 +35,8 @@ class GlContext {
   EglPlatform platform() const;         // the platform that worked
   std::string description() const;      // "renderer | GL version | platform" for reports
   bool softwareRenderer() const;        // llvmpipe / softpipe / swrast
+  // Programs built on this context, reused across calls (use with this context current).
+  GlProgramCache& programs() const;
   // KHR_debug messages received so far (all severities), for tests and reports.
   int debugMessageCount() const;
   int debugErrorCount() const;  // messages of type GL_DEBUG_TYPE_ERROR

@@ -71,4 +71,22 @@ GlProgram::~GlProgram() {
   if (program_) glDeleteProgram(program_);
 }
 
+const GlProgram& GlProgramCache::get(const std::vector<ShaderStage>& stages, const std::vector<std::string>& defines,
+                                     const std::string& version) {
+  std::string key = version;
+  for (const ShaderStage& st : stages) key += "\n@" + std::to_string(st.type) + ":" + joinNames(st.files);
+  for (const std::string& d : defines) key += "\n" + d;
+  std::unique_ptr<GlProgram>& p = programs_[key];
+  if (!p) {
+    try {
+      p = std::make_unique<GlProgram>(stages, defines, version);
+    } catch (...) {
+      programs_.erase(key);
+      throw;
+    }
+    ++builds_;
+  }
+  return *p;
+}
+
 }  // namespace irbake

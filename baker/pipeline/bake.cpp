@@ -50,7 +50,7 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
       report["gl"] = {{"setupSeconds", total.setupSeconds},   {"shadowSeconds", total.shadowSeconds},
                       {"accumulateSeconds", total.accumulateSeconds}, {"foldSeconds", total.foldSeconds},
                       {"passes", total.passes},               {"facesRendered", total.facesRendered},
-                      {"trianglesDrawn", total.trianglesDrawn}};
+                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize}};
       report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
       return maps;
     }

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <memory>
 #include <optional>
 
@@ -258,8 +257,8 @@ struct GpuPage {
 
 class GlBaker {
  public:
-  GlBaker(const BakeInputs& in, const GlBackendOptions& opt, GlBakeStats& stats)
-      : in_(in), opt_(opt), stats_(stats) {}
+  GlBaker(const BakeInputs& in, const GlBackendOptions& opt, GlBakeStats& stats, GlProgramCache& programs)
+      : in_(in), opt_(opt), stats_(stats), programs_(programs) {}
 
   std::vector<Lightmap> run();
 
@@ -278,11 +277,12 @@ class GlBaker {
   const BakeInputs& in_;
   const GlBackendOptions& opt_;
   GlBakeStats& stats_;
+  GlProgramCache& programs_;  // the context's: programs outlive this call, so later calls skip compiling
   ShadowScale scale_;
   std::unique_ptr<GpuGeometry> geometry_;
   std::vector<std::unique_ptr<GpuPage>> pages_;
-  std::unique_ptr<GlProgram> depthProgram_, directProgram_;
-  std::map<int, std::unique_ptr<GlProgram>> vplPrograms_;  // by supersample layer count
+  const GlProgram* depthProgram_ = nullptr;
+  const GlProgram* directProgram_ = nullptr;
   GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
@@ -410,8 +410,6 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& a
 
 // The accumulation program for pages of `layers` supersample layers (compiled on first use).
 const GlProgram& GlBaker::vplProgram(int layers) {
-  std::unique_ptr<GlProgram>& p = vplPrograms_[layers];
-  if (p) return *p;
   std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
   auto constant = [&](const char* name, float value) {
@@ -424,7 +422,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   constant("CONSTANT_BIAS", scale_.constantBias);
   constant("SLOPE_BIAS", opt_.slopeBias);
   constant("NORMAL_OFFSET", opt_.normalOffset);
-  constant("TEXEL_ANGLE", 2.0f / opt_.cubeFaceSize);
+  constant("TEXEL_ANGLE", 2.0f / (atlas_ ? atlas_->faceSize : 256));
   constant("ORIGIN_OFFSET", scale_.originOffset);
   if (atlas_) {  // the depth atlas layout (tiles of FACE_SIZE², ATLAS_COLS per row)
     constant("FACE_SIZE", float(atlas_->faceSize));
@@ -433,11 +431,9 @@ const GlProgram& GlBaker::vplProgram(int layers) {
     defines.push_back("#define ATLAS_COLS " + std::to_string(atlas_->cols));
   }
   if (opt_.normalOffset != 0.0f) defines.push_back("#define HAS_NORMAL_OFFSET 1");
-  p = std::make_unique<GlProgram>(
-      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
-      defines);
-  return *p;
+  return programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
+                                                {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
+                      defines);
 }
 
 void GlBaker::bakeDirect(const Light& light) {
@@ -519,13 +515,12 @@ std::vector<Lightmap> GlBaker::run() {
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, opt_.skipInvalidTexels));
 
   const int K = std::clamp(opt_.vplsPerPass, 1, 256);
-  depthProgram_ = std::make_unique<GlProgram>(
+  depthProgram_ = &programs_.get(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
-  directProgram_ = std::make_unique<GlProgram>(
-      std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                               {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}});
+  directProgram_ = &programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
+                                                           {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}});
   {
-    const GlProgram* p = directProgram_.get();
+    const GlProgram* p = directProgram_;
     p->use();
     glUniform1f(p->uniform("clampBound"), in_.eval.clampBound);
     glUniform1f(p->uniform("nearPlane"), scale_.nearPlane);
@@ -534,7 +529,13 @@ std::vector<Lightmap> GlBaker::run() {
     glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   }
   if (in_.eval.includeVpls && !in_.vpls.vpls.empty()) {
-    atlas_ = std::make_unique<DepthAtlas>(std::max(1, opt_.cubeFaceSize), K);
+    const int faceSize = opt_.cubeFaceSize > 0
+                             ? opt_.cubeFaceSize
+                             : chooseCubeFaceSize(in_.vpls.vpls, in_.texels, in_.eval.clampBound, opt_.minCubeFaceSize,
+                                                  opt_.maxCubeFaceSize)
+                                   .size;
+    stats_.cubeFaceSize = faceSize;
+    atlas_ = std::make_unique<DepthAtlas>(faceSize, K);
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
   }
   glCreateBuffers(1, &vplBuffer_);
@@ -643,7 +644,7 @@ std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& o
   if (!options.context) log::info("GL backend: " + stats.renderer);  // a caller passing a context logs it once
   std::vector<Lightmap> maps;
   {
-    GlBaker baker(inputs, options, stats);
+    GlBaker baker(inputs, options, stats, ctx->programs());
     maps = baker.run();
   }
   stats.setupSeconds += contextSeconds;

@@ -1,6 +1,7 @@
 // The OpenGL backend: each VPL's shadowed contribution rendered into the light-map pages (EGL,
 // headless) and accumulated in float, folded into double. Same transport as the Embree backend.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ struct GlBakeStats {
   double foldSeconds = 0.0;      // read-backs into the double accumulators
   double shadowCpuSeconds = 0.0;     // process CPU time (all llvmpipe threads) in the shadow stage
   double accumulateCpuSeconds = 0.0; // process CPU time in the accumulation stage (load-independent figures)
+  int cubeFaceSize = 0;          // VPL depth-cube face size used (the largest over calls after add)
   size_t vpls = 0;               // VPLs evaluated
   size_t passes = 0;             // accumulation passes per page
   size_t facesRendered = 0;      // shadow views drawn (cube faces, spot/directional maps)
@@ -34,6 +36,7 @@ struct GlBakeStats {
     foldSeconds += o.foldSeconds;
     shadowCpuSeconds += o.shadowCpuSeconds;
     accumulateCpuSeconds += o.accumulateCpuSeconds;
+    cubeFaceSize = std::max(cubeFaceSize, o.cubeFaceSize);
     vpls += o.vpls;
     passes += o.passes;
     facesRendered += o.facesRendered;
@@ -44,7 +47,9 @@ struct GlBakeStats {
 
 struct GlBackendOptions {
   int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
-  int cubeFaceSize = 256;        // VPL depth-cube face size (texels)
+  int cubeFaceSize = 0;          // VPL depth-cube face size (texels); 0: from the light map (chooseCubeFaceSize)
+  int minCubeFaceSize = 64;      // automatic face size: lower bound
+  int maxCubeFaceSize = 256;     // automatic face size: upper bound
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
   int lightMapSize = 2048;       // spot / directional shadow map size (texels)
   int shadowFlushTriangles = 32768;  // VPL shadow pass: glFlush after this many triangles drawn into the depth atlas (0: once per batch)

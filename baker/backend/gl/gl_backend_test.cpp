@@ -10,6 +10,7 @@
 #include "backend/gl/shadow_views.h"
 #include "common/error.h"
 #include "glcontext/gl_context.h"
+#include "glcontext/gl_program.h"
 #include "raytrace/ray_tracer.h"
 #include "raytrace/test_scenes.h"
 
@@ -150,6 +151,30 @@ TEST(GlShadowViews, CullsClustersOutsideTheFace) {
 }
 
 // One VPL over an open floor: exactly the closed form Φ cosθx cosθy / (π² r²) per texel.
+// The automatic face size samples visibility at twice the light map's rate at the contribution-weighted
+// median VPL → texel distance r: F = 4r/h rounded up to a multiple of 32, within [min, max].
+TEST(GlShadowViews, CubeFaceSizeSamplesTwiceTheTexelRate) {
+  const float h = 0.002f;  // 8 × 8 texels over 16 mm
+  const std::vector<TexelSamples> pages{gridSamples({-0.008f, -0.008f, 0}, {0.016f, 0, 0}, {0, 0.016f, 0}, 8, 8)};
+  auto choose = [&](std::vector<Vpl> vpls) { return chooseCubeFaceSize(vpls, pages, 0.0f, 64, 256); };
+  auto above = [](float r) { return Vpl{{0.0f, 0.0f, r}, {0, 0, -1}, glm::vec3(1.0f), 1}; };
+
+  const CubeFaceChoice c = choose({above(0.05f)});
+  EXPECT_NEAR(c.texelSpacing, h, 1e-6f);
+  EXPECT_GE(c.medianDistance, 0.05f);
+  EXPECT_LE(c.medianDistance, std::sqrt(0.05f * 0.05f + 2 * 0.007f * 0.007f));  // farthest texel centre
+  EXPECT_EQ(c.size, 32 * static_cast<int>(std::ceil(4.0f * c.medianDistance / c.texelSpacing / 32.0f)));
+  EXPECT_EQ(c.size, 128);  // 4 · 0.05 / 0.002 = 100 (+ the patch's extent) → 128
+  EXPECT_EQ(choose({above(0.5f)}).size, 256);  // 1000: the upper bound
+  EXPECT_EQ(choose({above(0.01f)}).size, 64);  // 20: the lower bound
+  // Weighted by contribution (∝ 1/r²): a VPL 10× farther away moves the median hardly at all.
+  EXPECT_LT(choose({above(0.05f), above(0.5f)}).medianDistance, 0.06f);
+  // Nothing faces the texels: the upper bound, no distance.
+  const CubeFaceChoice none = choose({Vpl{{0, 0, 0.05f}, {0, 0, 1}, glm::vec3(1.0f), 1}});
+  EXPECT_EQ(none.size, 256);
+  EXPECT_EQ(none.medianDistance, 0.0f);
+}
+
 TEST(GlBackend, SingleVplMatchesClosedForm) {
   Fixture f = floorScene(false);
   Vpl v;
@@ -437,6 +462,23 @@ TEST(GlBackend, DirectAndVplPassesAdd) {
   }
   EXPECT_GT(sumB, 0.1 * sumA);
   EXPECT_GT(sumC, 0.1 * sumA);
+}
+
+// A context's programs are built once: a second bake on the same context compiles nothing and gives
+// the same map (interleaved sampling calls the backend n² + 1 times per bake).
+TEST(GlBackend, SecondBakeOnAContextReusesItsPrograms) {
+  Fixture f = floorScene(true);
+  f.vpls.vpls = {Vpl{{0.1f, 0.0f, 1.0f}, {0, 0, -1}, glm::vec3(2.0f), 1}};
+  GlContext context;
+  GlBackendOptions opt;
+  opt.context = &context;
+  const std::vector<Lightmap> first = f.bake({}, opt);
+  const size_t builds = context.programs().builds();
+  EXPECT_GE(builds, 2u);  // depth, direct, accumulation
+  const std::vector<Lightmap> second = f.bake({}, opt);
+  EXPECT_EQ(context.programs().builds(), builds);
+  ASSERT_EQ(first.size(), second.size());
+  for (size_t i = 0; i < first[0].size(); ++i) ASSERT_EQ(first[0].texels[i], second[0].texels[i]) << i;
 }
 
 TEST(GlBackend, EmptyInputsGiveZeroMaps) {

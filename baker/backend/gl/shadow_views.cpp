@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#include "texels/texel_filter.h"
 
 namespace irbake {
 
@@ -170,6 +173,76 @@ void cullClusters(const ShadowView& view, const std::vector<TriangleCluster>& cl
     }
   }
   flush();
+}
+
+CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vector<TexelSamples>& pages,
+                                  float clampBound, int minSize, int maxSize, int pairSamples) {
+  maxSize = std::max(1, maxSize);
+  minSize = std::clamp(minSize, 1, maxSize);
+  CubeFaceChoice choice;
+  choice.size = maxSize;
+  std::vector<float> spacings;
+  for (const TexelSamples& ts : pages)
+    if (const float h = texelSpacing(ts); h > 0.0f) spacings.push_back(h);
+  // Valid texels: the first weighted sample's position and normal stand for the texel.
+  std::vector<std::pair<glm::vec3, glm::vec3>> receivers;
+  for (const TexelSamples& ts : pages) {
+    const size_t layer = ts.layerSize();
+    const int layers = ts.supersample * ts.supersample;
+    for (size_t t = 0; t < layer && t < ts.valid.size(); ++t) {
+      if (!ts.valid[t]) continue;
+      for (int l = 0; l < layers; ++l) {
+        const size_t s = static_cast<size_t>(l) * layer + t;
+        if (s < ts.positionWeight.size() && ts.positionWeight[s].w > 0.0f && s < ts.normal.size()) {
+          receivers.emplace_back(glm::vec3(ts.positionWeight[s]), glm::vec3(ts.normal[s]));
+          break;
+        }
+      }
+    }
+  }
+  if (spacings.empty() || receivers.empty() || vpls.empty()) return choice;
+  std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
+  choice.texelSpacing = spacings[spacings.size() / 2];
+
+  // Pairs drawn by a fixed-seed generator (splitmix64), so the choice is deterministic.
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto next = [&state]() {
+    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  // (distance, contribution) of each facing pair; contribution = VPL power × clamped geometry term.
+  std::vector<std::pair<float, double>> pairs;
+  pairs.reserve(static_cast<size_t>(std::max(0, pairSamples)));
+  double total = 0.0;
+  for (int i = 0; i < pairSamples; ++i) {
+    const Vpl& v = vpls[next() % vpls.size()];
+    const auto& [p, n] = receivers[next() % receivers.size()];
+    const glm::vec3 d = p - v.position;
+    const float r = glm::length(d);
+    if (!(r > 0.0f)) continue;
+    const float cv = glm::dot(v.normal, d) / r, cr = -glm::dot(n, d) / r;
+    if (cv <= 0.0f || cr <= 0.0f) continue;
+    double g = double(cv) * cr / (double(r) * r);
+    if (clampBound > 0.0f) g = std::min(g, double(clampBound));
+    const double w = g * (v.power.r + v.power.g + v.power.b);
+    if (!(w > 0.0)) continue;
+    pairs.emplace_back(r, w);
+    total += w;
+  }
+  if (pairs.empty()) return choice;
+  std::sort(pairs.begin(), pairs.end());
+  double acc = 0.0;
+  for (const auto& [r, w] : pairs) {
+    acc += w;
+    choice.medianDistance = r;
+    if (acc >= 0.5 * total) break;
+  }
+  const double faces = 4.0 * choice.medianDistance / choice.texelSpacing;
+  const double rounded = 32.0 * std::ceil(std::min(faces, double(maxSize)) / 32.0);
+  choice.size = static_cast<int>(std::clamp(rounded, double(minSize), double(maxSize)));
+  return choice;
 }
 
 }  // namespace irbake

@@ -9,6 +9,8 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
 
 namespace irbake {
 
@@ -51,6 +53,22 @@ ShadowView spotView(const glm::vec3& position, const glm::vec3& direction, float
 // texelSize: out, world size of one texel (m); depthRange: out, metres per unit of window depth.
 ShadowView directionalView(const glm::vec3& direction, const Bounds3& bounds, int size, float& texelSize,
                            float& depthRange);
+
+// VPL cube face size from what the light map can show. Visibility is sampled at twice the light map's
+// rate (Nyquist) at the typical VPL → receiver distance r: a face texel's footprint there, 2r/F, is at most
+// half the texel spacing h, so F = 4r/h, rounded up to a multiple of 32 and clamped to [minSize, maxSize].
+// Finer cubes change nothing a texel can show (and cost rasterisation, fill and texture cache); coarser
+// ones move shadow edges, and the depth bias that scales with the footprint, by more than half a texel.
+// r: the median distance over sampled (VPL, valid texel) pairs that face each other; h: the median
+// texel spacing over the pages (under interleaved sampling the pages are one class's, so h is n times
+// the full page's spacing: the class filter blurs over n texels anyway).
+struct CubeFaceChoice {
+  int size = 0;                // chosen face size (texels)
+  float medianDistance = 0.0f; // r (m); 0 when no facing pair was found (size = maxSize)
+  float texelSpacing = 0.0f;   // h (m); 0 when no page has a spacing (size = maxSize)
+};
+CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vector<TexelSamples>& pages,
+                                  float clampBound, int minSize, int maxSize, int pairSamples = 4096);
 
 // Consecutive triangles of one primitive in the global index buffer with their bounds.
 struct TriangleCluster {
