@@ -313,6 +313,7 @@ int sceneBench(const std::vector<std::string>& args) {
           go.stats = &one;
           go.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
           if (const char* e = std::getenv("CUBE_FACE")) go.cubeFaceSize = std::atoi(e);  // diagnostics
+          if (const char* e = std::getenv("VPLS_PER_PASS")) go.vplsPerPass = std::atoi(e);  // diagnostics
           auto m = bakeGl(i, go);
           st.add(one);
           return m;
