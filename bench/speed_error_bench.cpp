@@ -314,6 +314,9 @@ int sceneBench(const std::vector<std::string>& args) {
           go.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
           if (const char* e = std::getenv("CUBE_FACE")) go.cubeFaceSize = std::atoi(e);  // diagnostics
           if (const char* e = std::getenv("VPLS_PER_PASS")) go.vplsPerPass = std::atoi(e);  // diagnostics
+          if (const char* e = std::getenv("SHADOW_PCF")) go.shadowPcf = std::atoi(e) != 0;  // diagnostics
+          if (const char* e = std::getenv("SLOPE_BIAS")) go.slopeBias = std::atof(e);  // diagnostics
+          if (const char* e = std::getenv("NORMAL_OFFSET")) go.normalOffset = std::atof(e);  // diagnostics
           auto m = bakeGl(i, go);
           st.add(one);
           return m;

@@ -229,6 +229,43 @@ TEST(GlBackend, VplShadowsMatchRayTracedVisibility) {
   EXPECT_LT(off, ref.size() / 50);  // only texels on a shadow edge may differ
 }
 
+// A wall standing on the floor, VPLs on one side: the floor behind the wall's foot is in shadow. The
+// slope-scaled bias lets a lookup pass occluders closer than slopeBias · footprint · (tanθ + 1.5) to the
+// receiver, so a lit band runs along the foot. With 128² faces (a 1.1 cm footprint here, 3.1 cm texels)
+// the old bias of 3 footprints lit a band 2–3 texels wide; 1 footprint (what the 2×2 filter needs: it
+// reads one texel around the lookup) leaves at most the first texel.
+TEST(GlBackend, CoarseCubesLeakAtMostOneTexelAlongAContact) {
+  Fixture f;
+  const int white = addMaterial(f.scene, glm::vec3(0.5f));
+  addQuad(f.scene, white, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 4);
+  addQuad(f.scene, white, {0, -1, 0}, {0, 2, 0}, {0, 0, 0.3f});  // the wall x = 0, 30 cm high
+  f.pages.push_back(gridSamples({0, -1, 0}, {1, 0, 0}, {0, 2, 0}, 32, 32));  // the floor behind it
+  f.rt = std::make_unique<RayTracer>(f.scene);
+  for (int i = 0; i < 4; ++i)
+    f.vpls.vpls.push_back(Vpl{{-0.5f, -0.3f + 0.2f * i, 0.5f}, glm::normalize(glm::vec3(1, 0, -1)), glm::vec3(1.0f), 1});
+  const auto ref = cpuReference(f, f.pages[0], 0.0f, true);
+  const auto open = cpuReference(f, f.pages[0], 0.0f, false);
+  // Widest lit band (texels from the foot) over the rows, where Embree sees the floor fully shadowed.
+  auto band = [&](float slopeBias) {
+    GlBackendOptions opt;
+    opt.cubeFaceSize = 128;
+    opt.slopeBias = slopeBias;
+    const auto maps = f.bake({}, opt);
+    int widest = 0;
+    for (int y = 0; y < 32; ++y) {
+      int x = 0;
+      while (x < 32 && ref[32 * y + x].x == 0.0 && maps[0].texels[32 * y + x].x > 0.05 * open[32 * y + x].x) ++x;
+      widest = std::max(widest, x);
+    }
+    return widest;
+  };
+  for (int y = 0; y < 32; ++y) ASSERT_EQ(ref[32 * y].x, 0.0) << y;  // the foot is in shadow
+  const int now = band(GlBackendOptions{}.slopeBias), old = band(3.0f);
+  std::printf("lit band along the foot: %d texel(s) (slope bias %.1f), %d (3.0)\n", now, GlBackendOptions{}.slopeBias, old);
+  EXPECT_LE(now, 1);
+  EXPECT_GE(old, 2);
+}
+
 // The sampler's depth comparison (GL_LINEAR on a compare-mode depth array) is the same 2×2 percentage-
 // closer filter as the four texelFetch taps and compares it replaced. The sampler rounds its filter
 // weights its own way: here 1 of ~650 shadow-edge texels differs by 0.4% of one VPL's unshadowed value
