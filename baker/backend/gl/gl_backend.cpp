@@ -541,7 +541,8 @@ std::vector<Lightmap> GlBaker::run() {
   if (in_.eval.includeVpls && !in_.vpls.vpls.empty()) {
     const int faceSize = opt_.cubeFaceSize > 0
                              ? opt_.cubeFaceSize
-                             : chooseCubeFaceSize(in_.vpls.vpls, in_.texels, in_.eval.clampBound, opt_.minCubeFaceSize,
+                             : chooseCubeFaceSize(in_.vpls.vpls, in_.texels, in_.eval.clampBound, opt_.cubeFootprintPerTexel,
+                                                  opt_.minCubeFaceSize,
                                                   opt_.maxCubeFaceSize)
                                    .size;
     stats_.cubeFaceSize = faceSize;

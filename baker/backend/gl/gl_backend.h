@@ -48,6 +48,7 @@ struct GlBakeStats {
 struct GlBackendOptions {
   int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
   int cubeFaceSize = 0;          // VPL depth-cube face size (texels); 0: from the light map (chooseCubeFaceSize)
+  float cubeFootprintPerTexel = 1.0f;  // automatic face size: face texel footprint at the median VPL distance, in texel spacings
   int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see: furnished room, 64: GL vs Embree 1.2%, 128: 0.3%)
   int maxCubeFaceSize = 256;     // automatic face size: upper bound
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)

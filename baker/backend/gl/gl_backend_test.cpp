@@ -151,22 +151,23 @@ TEST(GlShadowViews, CullsClustersOutsideTheFace) {
 }
 
 // One VPL over an open floor: exactly the closed form Φ cosθx cosθy / (π² r²) per texel.
-// The automatic face size samples visibility at twice the light map's rate at the contribution-weighted
-// median VPL → texel distance r: F = 4r/h rounded up to a multiple of 32, within [min, max].
-TEST(GlShadowViews, CubeFaceSizeSamplesTwiceTheTexelRate) {
+// The automatic face size holds a face texel's footprint at the contribution-weighted median VPL → texel
+// distance r to k texel spacings: F = 2r/(k·h) rounded up to a multiple of 32, within [min, max].
+TEST(GlShadowViews, CubeFaceSizeHoldsTheFootprintToTheTexelSpacing) {
   const float h = 0.002f;  // 8 × 8 texels over 16 mm
   const std::vector<TexelSamples> pages{gridSamples({-0.008f, -0.008f, 0}, {0.016f, 0, 0}, {0, 0.016f, 0}, 8, 8)};
-  auto choose = [&](std::vector<Vpl> vpls) { return chooseCubeFaceSize(vpls, pages, 0.0f, 64, 256); };
+  auto choose = [&](std::vector<Vpl> vpls, float k = 1.0f) { return chooseCubeFaceSize(vpls, pages, 0.0f, k, 32, 256); };
   auto above = [](float r) { return Vpl{{0.0f, 0.0f, r}, {0, 0, -1}, glm::vec3(1.0f), 1}; };
 
   const CubeFaceChoice c = choose({above(0.05f)});
   EXPECT_NEAR(c.texelSpacing, h, 1e-6f);
   EXPECT_GE(c.medianDistance, 0.05f);
   EXPECT_LE(c.medianDistance, std::sqrt(0.05f * 0.05f + 2 * 0.007f * 0.007f));  // farthest texel centre
-  EXPECT_EQ(c.size, 32 * static_cast<int>(std::ceil(4.0f * c.medianDistance / c.texelSpacing / 32.0f)));
-  EXPECT_EQ(c.size, 128);  // 4 · 0.05 / 0.002 = 100 (+ the patch's extent) → 128
-  EXPECT_EQ(choose({above(0.5f)}).size, 256);  // 1000: the upper bound
-  EXPECT_EQ(choose({above(0.01f)}).size, 64);  // 20: the lower bound
+  EXPECT_EQ(c.size, 32 * static_cast<int>(std::ceil(2.0f * c.medianDistance / c.texelSpacing / 32.0f)));
+  EXPECT_EQ(c.size, 64);                                 // 2 · 0.05 / 0.002 = 50 (+ the patch's extent) → 64
+  EXPECT_EQ(choose({above(0.05f)}, 0.5f).size, 128);     // Nyquist: 100 → 128
+  EXPECT_EQ(choose({above(0.5f)}).size, 256);            // 500: the upper bound
+  EXPECT_EQ(choose({above(0.01f)}).size, 32);            // 10: the lower bound
   // Weighted by contribution (∝ 1/r²): a VPL 10× farther away moves the median hardly at all.
   EXPECT_LT(choose({above(0.05f), above(0.5f)}).medianDistance, 0.06f);
   // Nothing faces the texels: the upper bound, no distance.

@@ -176,7 +176,8 @@ void cullClusters(const ShadowView& view, const std::vector<TriangleCluster>& cl
 }
 
 CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vector<TexelSamples>& pages,
-                                  float clampBound, int minSize, int maxSize, int pairSamples) {
+                                  float clampBound, float footprintPerTexel, int minSize, int maxSize,
+                                  int pairSamples) {
   maxSize = std::max(1, maxSize);
   minSize = std::clamp(minSize, 1, maxSize);
   CubeFaceChoice choice;
@@ -239,7 +240,8 @@ CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vecto
     choice.medianDistance = r;
     if (acc >= 0.5 * total) break;
   }
-  const double faces = 4.0 * choice.medianDistance / choice.texelSpacing;
+  const double faces =
+      2.0 * choice.medianDistance / (std::max(footprintPerTexel, 1e-3f) * double(choice.texelSpacing));
   const double rounded = 32.0 * std::ceil(std::min(faces, double(maxSize)) / 32.0);
   choice.size = static_cast<int>(std::clamp(rounded, double(minSize), double(maxSize)));
   return choice;

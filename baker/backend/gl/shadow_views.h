@@ -54,21 +54,23 @@ ShadowView spotView(const glm::vec3& position, const glm::vec3& direction, float
 ShadowView directionalView(const glm::vec3& direction, const Bounds3& bounds, int size, float& texelSize,
                            float& depthRange);
 
-// VPL cube face size from what the light map can show. Visibility is sampled at twice the light map's
-// rate (Nyquist) at the typical VPL → receiver distance r: a face texel's footprint there, 2r/F, is at most
-// half the texel spacing h, so F = 4r/h, rounded up to a multiple of 32 and clamped to [minSize, maxSize].
-// Finer cubes change nothing a texel can show (and cost rasterisation, fill and texture cache); coarser
-// ones move shadow edges, and the depth bias that scales with the footprint, by more than half a texel.
-// r: the median distance over sampled (VPL, valid texel) pairs that face each other; h: the median
-// texel spacing over the pages (under interleaved sampling the pages are one class's, so h is n times
-// the full page's spacing: the class filter blurs over n texels anyway).
+// VPL cube face size from what the light map can show. A face texel's footprint at the typical VPL →
+// receiver distance r, 2r/F, is held to `footprintPerTexel` texel spacings h: F = 2r / (footprintPerTexel·h),
+// rounded up to a multiple of 32 and clamped to [minSize, maxSize]. At 1 (the GL backend's default) the
+// 2×2 filter blurs a shadow edge over about ±1 footprint, what the light map blurs anyway (a texel, or ±n
+// texels of the interleaving filter); 0.5 samples visibility at twice the map's rate (Nyquist). The slope
+// bias and the contact leak scale with the footprint too (docs/performance.md has the measured trade).
+// r: the contribution-weighted median distance over sampled (VPL, valid texel) pairs that face each other
+// (weight: VPL power × clamped geometry term); h: the median texel spacing over the pages (under
+// interleaved sampling the pages are one class's, so h is n times the full page's spacing).
 struct CubeFaceChoice {
   int size = 0;                // chosen face size (texels)
   float medianDistance = 0.0f; // r (m); 0 when no facing pair was found (size = maxSize)
   float texelSpacing = 0.0f;   // h (m); 0 when no page has a spacing (size = maxSize)
 };
 CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vector<TexelSamples>& pages,
-                                  float clampBound, int minSize, int maxSize, int pairSamples = 4096);
+                                  float clampBound, float footprintPerTexel, int minSize, int maxSize,
+                                  int pairSamples = 4096);
 
 // Consecutive triangles of one primitive in the global index buffer with their bounds.
 struct TriangleCluster {
