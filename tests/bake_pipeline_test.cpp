@@ -113,6 +113,24 @@ TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
   }
 }
 
+// The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
+// give the same map, bit for bit, as tracing them after it: the trace reads no map.
+TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {
+  BakeResult runs[2];
+  for (int overlap : {0, 1}) {
+    BakeOptions o;
+    o.atlas.texelsPerUnit = 12.0f;
+    o.walk.paths = 256;
+    o.overlapCompensation = overlap;
+    runs[overlap] = bake(loadSample("furnace"), o);
+    EXPECT_EQ(runs[overlap].report["compensationOverlapped"].get<bool>(), overlap == 1);
+    EXPECT_GT(runs[overlap].report["compensation"]["hitsKept"].get<size_t>(), 0u);
+  }
+  ASSERT_EQ(runs[0].maps.size(), runs[1].maps.size());
+  for (size_t p = 0; p < runs[0].maps.size(); ++p)
+    for (size_t i = 0; i < runs[0].maps[p].size(); ++i) ASSERT_EQ(runs[0].maps[p].texels[i], runs[1].maps[p].texels[i]) << i;
+}
+
 TEST(BakePipeline, ThinWallDarkSideStaysDark) {
   // A zero-thickness partition at x = 0 between a lit room (light at x = −1) and a dark one.
   BakeResult r = bake(loadSample("thin_wall"), smallEmbreeBake(10.0f, 512));

@@ -8,6 +8,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "common/error.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
 #include "vpl/sampling.h"
@@ -59,31 +60,53 @@ glm::vec3 lookup(const Lightmap& m, const std::vector<glm::vec3>& value, glm::ve
   return nearest;
 }
 
+// Kept hits of one tile of slots (a tile owns its slots, so tiles are traced and swept in parallel).
+struct Tile {
+  size_t page = 0, begin = 0, end = 0;
+  std::vector<KeptHit> hits;
+};
+
 }  // namespace
 
-void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options,
-                     ClampCompensationStats* stats) {
+struct ClampGather::Impl {
+  const BakeInputs& in;
+  ClampCompensationOptions options;
+  bool enabled = false;
+  std::vector<int32_t> mapOfPage;  // light-map page number → index of its texel page (= its map)
+  std::vector<Tile> tiles;         // kept hits, by tile of slots
+  std::vector<std::vector<uint16_t>> raysOf;  // rays traced per slot
+  std::vector<int> radii;          // residual filter radius per page
+  std::vector<std::unique_ptr<SurfaceFilter>> filters;
+  int filterRadius = 0, baseRays = 0;
+  size_t rays = 0, refined = 0;
+  double traceSeconds = 0.0;
+  Impl(const BakeInputs& i, const ClampCompensationOptions& o) : in(i), options(o) {}
+};
+
+ClampGather::~ClampGather() = default;
+double ClampGather::traceSeconds() const { return impl_->traceSeconds; }
+
+ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& options)
+    : impl_(std::make_unique<Impl>(in, options)) {
   Stopwatch clock;
+  Impl& g = *impl_;
   const float bound = in.eval.clampBound;
-  if (!in.eval.includeVpls || !(bound > 0.0f) || maps.size() != in.texels.size()) return;
+  g.enabled = in.eval.includeVpls && bound > 0.0f;
+  if (!g.enabled) return;
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
 
-  // Light-map page number → index into maps.
-  std::vector<int32_t> mapOfPage;
-  for (size_t i = 0; i < maps.size(); ++i) {
-    int page = maps[i].page;
+  // Light-map page number → index of its texel page (= its map, in the same order).
+  std::vector<int32_t>& mapOfPage = g.mapOfPage;
+  for (size_t i = 0; i < in.texels.size(); ++i) {
+    int page = in.texels[i].page;
     if (page < 0) continue;
     if (static_cast<size_t>(page) >= mapOfPage.size()) mapOfPage.resize(page + 1, -1);
     mapOfPage[page] = static_cast<int32_t>(i);
   }
 
   // Round 1: trace, keep hits with w > 0. Per page, per tile of slots, one list (tiles own their slots).
-  struct Tile {
-    size_t page = 0, begin = 0, end = 0;
-    std::vector<KeptHit> hits;
-  };
-  std::vector<Tile> tiles;
+  std::vector<Tile>& tiles = g.tiles;
   constexpr size_t kTile = 256;
   for (size_t p = 0; p < in.texels.size(); ++p)
     for (size_t b = 0; b < in.texels[p].slotCount(); b += kTile)
@@ -105,9 +128,11 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
   // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
   // per-sample ray count is low. Radius and texel geometry per page, once for all sweeps.
   const float clampRadius = 1.0f / std::sqrt(bound);
-  std::vector<int> radii(in.texels.size(), 0);
-  std::vector<std::unique_ptr<SurfaceFilter>> filters(in.texels.size());
-  int filterRadius = 0;
+  std::vector<int>& radii = g.radii;
+  std::vector<std::unique_ptr<SurfaceFilter>>& filters = g.filters;
+  radii.assign(in.texels.size(), 0);
+  filters.resize(in.texels.size());
+  int& filterRadius = g.filterRadius;
   for (size_t p = 0; p < in.texels.size(); ++p) {
     if (options.filterRadius == 0 || (options.filterRadius < 0 && baseRays >= 32)) continue;
     auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
@@ -154,7 +179,7 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
         const uint32_t* idx = &prim.indices[3 * static_cast<size_t>(hit.triangle)];
         float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
         glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
-        const Lightmap& m = maps[mapOfPage[page]];
+        const TexelSamples& m = in.texels[mapOfPage[page]];
         k.map = mapOfPage[page];
         k.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
       }
@@ -165,7 +190,9 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
   };
 
   // Round 1: every sample, baseRays each. raysOf = rays traced per slot (0: empty slot).
-  std::vector<std::vector<uint16_t>> raysOf(in.texels.size()), firstHits(in.texels.size());
+  std::vector<std::vector<uint16_t>>& raysOf = g.raysOf;
+  raysOf.resize(in.texels.size());
+  std::vector<std::vector<uint16_t>> firstHits(in.texels.size());
   for (size_t p = 0; p < in.texels.size(); ++p) {
     raysOf[p].assign(in.texels[p].slotCount(), 0);
     firstHits[p].assign(in.texels[p].slotCount(), 0);
@@ -216,6 +243,26 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
       k.albedo *= inv;
     }
   });
+
+  g.baseRays = baseRays;
+  g.rays = rays;
+  g.refined = refined;
+  g.traceSeconds = clock.seconds();
+}
+
+void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats) const {
+  Stopwatch clock;
+  const Impl& g = *impl_;
+  const BakeInputs& in = g.in;
+  const ClampCompensationOptions& options = g.options;
+  if (!g.enabled || maps.size() != in.texels.size()) return;
+  for (size_t p = 0; p < maps.size(); ++p)
+    if (maps[p].width != in.texels[p].width || maps[p].height != in.texels[p].height ||
+        maps[p].valid.size() != maps[p].size())
+      throw Error(ErrorCode::InvalidData, "", "clamp compensation: map " + std::to_string(p) + " does not match its texel page");
+  const std::vector<Tile>& tiles = g.tiles;
+  const auto& radii = g.radii;
+  const auto& filters = g.filters;
 
   // Sweeps: residual per slot from the current maps, folded into texels; the next sweep reads base + residual.
   std::vector<std::vector<glm::vec3>> base(maps.size()), current(maps.size());
@@ -268,14 +315,22 @@ void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const Cl
     }
   }
   if (stats) {
-    stats->raysTraced = rays;
-    stats->samplesRefined = refined;
+    stats->raysTraced = g.rays;
+    stats->samplesRefined = g.refined;
     stats->hitsKept = kept;
-    stats->raysPerSample = baseRays;
-    stats->filterRadius = filterRadius;
+    stats->raysPerSample = g.baseRays;
+    stats->filterRadius = g.filterRadius;
     stats->addedFraction = before > 0.0 ? added / before : 0.0;
-    stats->seconds = clock.seconds();
+    stats->seconds = g.traceSeconds + clock.seconds();
   }
 }
+
+void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options,
+                     ClampCompensationStats* stats) {
+  if (maps.size() != in.texels.size()) return;
+  ClampGather(in, options).apply(maps, stats);
+}
+
+
 
 }  // namespace irbake

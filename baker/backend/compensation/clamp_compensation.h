@@ -15,6 +15,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "backend/bake_inputs.h"
@@ -52,8 +53,27 @@ struct ClampCompensationStats {
   double seconds = 0;
 };
 
+// The two halves of compensateClamp. Construction traces the rays and keeps the hits inside the clamp
+// radius: it reads the geometry and the texel samples only, not the maps, so it can run while a backend
+// bakes them (the pipeline does so for the GL backend, whose rasteriser leaves CPU time idle; on a GPU
+// the whole trace hides behind it). apply() then runs the sweeps on the baked maps. `in` must outlive it.
+class ClampGather {
+ public:
+  explicit ClampGather(const BakeInputs& in, const ClampCompensationOptions& options = {});
+  ~ClampGather();
+  ClampGather(const ClampGather&) = delete;
+  ClampGather& operator=(const ClampGather&) = delete;
+  // Adds the residual to maps (one per page of the inputs' texels, same order and size).
+  void apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats = nullptr) const;
+  double traceSeconds() const;  // the construction's wall time
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // Adds the clamp residual to maps (one per page of in.texels, same order; in.eval.clampBound is B).
-// Does nothing when B ≤ 0 or the VPLs are not evaluated. Only valid texels change.
+// Does nothing when B ≤ 0 or the VPLs are not evaluated. Only valid texels change. = ClampGather + apply.
 void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options = {},
                      ClampCompensationStats* stats = nullptr);
 
