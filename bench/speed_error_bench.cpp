@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -333,7 +334,11 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("COMP_REFINE")) co.refineRays = std::atoi(e);
         if (const char* e = std::getenv("COMP_FILTER")) co.filterRadius = std::atoi(e);
         if (const char* e = std::getenv("COMP_FRACTION")) co.refineFraction = std::atof(e);
-        compensateClamp(in, maps, co);
+        if (const char* e = std::getenv("COMP_SWEEPS")) co.sweeps = std::atoi(e);
+        if (const char* e = std::getenv("COMP_TOL")) co.sweepTolerance = std::atof(e);
+        ClampCompensationStats cst;
+        compensateClamp(in, maps, co, &cst);
+        if (std::getenv("COMP_VERBOSE")) std::printf("  compensation: %d sweeps, %zu hits kept, added %.2f%%\n", cst.sweeps, cst.hitsKept, 100 * cst.addedFraction);
         compensationSeconds = cw.seconds();
       }
       const double backendSeconds = sw.seconds();
@@ -352,6 +357,34 @@ int sceneBench(const std::vector<std::string>& args) {
         continue;
       }
       const MapDifference d = compareMaps(maps, reference, areas);
+      if (std::getenv("DIAG_PRIM")) {  // diagnostics: squared error by primitive (first weighted sample's)
+        struct Acc { double se = 0, diff = 0, ref = 0, w = 0; size_t n = 0; };
+        std::map<uint32_t, Acc> acc;
+        double total = 0;
+        for (size_t p = 0; p < reference.size(); ++p)
+          for (size_t i = 0; i < reference[p].size(); ++i) {
+            if (!maps[p].valid[i] || !reference[p].valid[i]) continue;
+            const double a = areas.empty() ? 1.0 : areas[p][i];
+            const glm::vec3 e = maps[p].texels[i] - reference[p].texels[i], r = reference[p].texels[i];
+            const glm::vec3 re = refError[p].texels[i];
+            const uint32_t prim = i < texels[p].primitive.size() ? texels[p].primitive[i] : UINT32_MAX;
+            Acc& q = acc[prim];
+            const double se = a * (glm::dot(e, e) - glm::dot(re, re)) / 3.0;
+            q.se += se; total += se;
+            q.diff += a * (e.x + e.y + e.z) / 3.0;
+            q.ref += a * (r.x + r.y + r.z) / 3.0;
+            q.w += a; ++q.n;
+          }
+        std::vector<std::pair<double, uint32_t>> order;
+        for (auto& [k, q] : acc) order.push_back({-q.se, k});
+        std::sort(order.begin(), order.end());
+        for (size_t j = 0; j < order.size() && j < 12; ++j) {
+          const Acc& q = acc[order[j].second];
+          std::printf("    prim %u (%s): %zu texels, area %.3f, share of corrected SE %.1f%%, bias %+.2f%%, mean ref %.4f\n",
+                      order[j].second, order[j].second < scene.primitives.size() ? scene.primitives[order[j].second].name.c_str() : "?",
+                      q.n, q.w, 100 * q.se / total, 100 * q.diff / std::max(q.ref, 1e-30), q.ref / std::max(q.w, 1e-30));
+        }
+      }
       // The reference's own noise adds its variance to the squared error: remove it (area-weighted
       // mean of SE², same weights as compareMaps) so the figure estimates the error against the truth.
       double wse = 0, w = 0, wref = 0;

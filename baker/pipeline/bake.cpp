@@ -214,7 +214,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
                               {"addedFraction", cs.addedFraction},
                               {"raysPerSample", cs.raysPerSample},
                               {"filterRadius", cs.filterRadius},
-                              {"sweeps", co.sweeps}};
+                              {"sweeps", cs.sweeps}};
   }
 
   stage.reset();

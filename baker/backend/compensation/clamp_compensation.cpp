@@ -272,6 +272,13 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   size_t kept = 0;
   for (const Tile& t : tiles) kept += t.hits.size();
 
+  // Σ over valid texels of the map before the residual (channel mean): the scale of the stopping test.
+  double mapTotal = 0.0;
+  for (size_t p = 0; p < maps.size(); ++p)
+    for (size_t t = 0; t < maps[p].size(); ++t)
+      if (maps[p].valid[t]) mapTotal += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
+  double lastAdded = 0.0;
+  int sweepsDone = 0;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
       const Tile& tile = tiles[ti];
@@ -301,6 +308,19 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         if (m.valid[t]) next[p][t] += residual[t];
     }
     current.swap(next);
+    ++sweepsDone;
+    // Each sweep adds one more bounce inside the clamp radius: stop once that changes the map by less
+    // than the tolerance (a narrow gap needs more bounces than an open corner).
+    double added = 0.0;
+    for (size_t p = 0; p < maps.size(); ++p)
+      for (size_t t = 0; t < maps[p].size(); ++t)
+        if (maps[p].valid[t]) {
+          const glm::vec3 d = current[p][t] - base[p][t];
+          if (std::isfinite(d.x + d.y + d.z)) added += (d.x + d.y + d.z) / 3.0;
+        }
+    const bool converged = sweep > 0 && std::abs(added - lastAdded) <= options.sweepTolerance * std::abs(mapTotal);
+    lastAdded = added;
+    if (converged) break;
   }
 
   double before = 0.0, added = 0.0;
@@ -320,6 +340,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     stats->hitsKept = kept;
     stats->raysPerSample = g.baseRays;
     stats->filterRadius = g.filterRadius;
+    stats->sweeps = sweepsDone;
     stats->addedFraction = before > 0.0 ? added / before : 0.0;
     stats->seconds = g.traceSeconds + clock.seconds();
   }

@@ -136,6 +136,35 @@ TEST(ClampCompensation, FurnaceEmbreeWithinOnePercent) {
   expectFurnaceCompensated(maps, maps, in, "embree");
 }
 
+// The Jacobi sweeps add one bounce inside the clamp radius each and stop once a sweep changes the summed
+// map by less than sweepTolerance: the result is then as close to the fully iterated one as that, while a
+// single sweep (the residual's first bounce only) is measurably short of it.
+TEST(ClampCompensation, SweepsStopWhenAnotherBounceNoLongerChangesTheMap) {
+  FurnaceBake f(512, 256.0);
+  const BakeInputs in = f.inputs();
+  const auto clamped = bakeEmbree(in);
+  auto run = [&](int sweeps, double tolerance, int* done = nullptr) {
+    std::vector<Lightmap> maps = clamped;
+    ClampCompensationOptions o;
+    o.sweeps = sweeps;
+    o.sweepTolerance = tolerance;
+    ClampCompensationStats st;
+    compensateClamp(in, maps, o, &st);
+    if (done) *done = st.sweeps;
+    return validMean(maps);
+  };
+  int byDefault = 0, full = 0, one = 0;
+  const double d = run(ClampCompensationOptions{}.sweeps, ClampCompensationOptions{}.sweepTolerance, &byDefault);
+  const double converged = run(40, -1.0, &full), first = run(1, -1.0, &one);
+  std::printf("[ figure ] furnace sweeps: default %d → %.5f, 40 → %.5f, 1 → %.5f\n", byDefault, d, converged, first);
+  EXPECT_EQ(full, 40);
+  EXPECT_EQ(one, 1);
+  EXPECT_GE(byDefault, 2);
+  EXPECT_LT(byDefault, ClampCompensationOptions{}.sweeps);  // stopped by the tolerance, not the cap
+  EXPECT_NEAR(d / converged, 1.0, 1e-3);
+  EXPECT_GT(std::abs(first / converged - 1.0), 2e-3);
+}
+
 // Issue 5 item 8: the GL backend's furnace within the same 1% as the Embree backend's.
 TEST(ClampCompensation, FurnaceGlWithinOnePercent) {
   FurnaceBake f(2048, 256.0);
