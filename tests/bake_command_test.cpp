@@ -224,6 +224,24 @@ TEST(BakeCommand, DefaultBackendIsGlAndAgreesWithEmbree) {
   EXPECT_LT(d["relativeRmse"].get<double>(), 1e-3);  // direct light only: both exact up to shadow-map bias
 }
 
+// --cube-face sets the GL backend's VPL cube face size; by default it follows the light map (128..256).
+TEST(BakeCommand, CubeFaceSizeIsAutomaticOrSet) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("cube_face");
+  fs::path scene = samplesDir() / "cornell_box.gltf";
+  std::string log;
+  const std::string common = " --texels-per-unit 20 --vpls 64";
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "auto") + common, &log), 0) << log;
+  ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "set") + common + " --cube-face 96", &log), 0) << log;
+  const int automatic = nlohmann::json::parse(std::ifstream(dir / "auto" / "report.json"))["gl"]["cubeFaceSize"];
+  const int set = nlohmann::json::parse(std::ifstream(dir / "set" / "report.json"))["gl"]["cubeFaceSize"];
+  EXPECT_GE(automatic, 128);
+  EXPECT_LE(automatic, 256);
+  EXPECT_EQ(set, 96);
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "bad") + " --cube-face 4", &log), 2) << log;
+  EXPECT_NE(log.find("--cube-face"), std::string::npos) << log;
+}
+
 TEST(BakeCommand, ReferenceBackendReportsItsSamplesAndMatchesTheClosedForm) {
   ASSERT_FALSE(samplesDir().empty());
   fs::path dir = scratch("reference");

@@ -27,6 +27,8 @@ const char* kBakeHelp =
     "  --interleave N|auto      interleaved sampling: each texel of an N×N block sees 1/N² of the VPLs,\n"
     "                           then a filter on the surface mixes them (default auto: 1..4 from the texel\n"
     "                           size and the clamp radius; 1 = every VPL everywhere)\n"
+    "  --cube-face N|auto       GL backend: VPL depth-cube face size in texels (default auto: a shadow\n"
+    "                           texel's footprint held to the light-map texel spacing, 128..256)\n"
     "  --seed K                 walk seed (default 0)\n"
     "  --spp N                  reference backend: paths per texel sample (default 256)\n"
     "  --sun DX,DY,DZ,E         add a directional light travelling along D with irradiance E (W/m²)\n"
@@ -48,7 +50,8 @@ int positiveInt(const ArgParser& a, const std::string& name, int fallback, int l
 int runBake(const Args& args) {
   ArgParser a(args,
               {"-o", "--output", "--backend", "--vpls", "--bounces", "--texels-per-unit", "--supersample", "--clamp",
-               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine", "--interleave"},
+               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine", "--interleave",
+               "--cube-face"},
               {"--help", "-h", "--bias-compensation", "--no-bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
                "--quiet"});
   if (a.flag("--help") || a.flag("-h")) {
@@ -87,6 +90,7 @@ int runBake(const Args& args) {
   o.compensation.refineRays = positiveInt(a, "--comp-refine", o.compensation.refineRays, 0, 65536);
   o.referenceSpp = positiveInt(a, "--spp", o.referenceSpp, 1, 1 << 20);
   o.interleave = a.valueOr("--interleave", "auto") == "auto" ? 0 : positiveInt(a, "--interleave", 0, 1, 8);
+  o.gl.cubeFaceSize = a.valueOr("--cube-face", "auto") == "auto" ? 0 : positiveInt(a, "--cube-face", 0, 16, 2048);
   o.postDilate = !a.flag("--no-dilate");
   o.postSeams = !a.flag("--no-seams");
 

@@ -41,7 +41,7 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
       GlBakeStats total;
       VplBackend gl = [&](const BakeInputs& in) {
         GlBakeStats st;
-        GlBackendOptions go;
+        GlBackendOptions go = options.gl;
         go.stats = &st;
         go.context = &context;
         std::vector<Lightmap> maps = bakeGl(in, go);

@@ -9,6 +9,7 @@
 #include "atlas/atlas.h"
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
+#include "backend/gl/gl_backend.h"
 #include "backend/embree/geometry_term.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
@@ -38,6 +39,7 @@ struct BakeOptions {
                                           // bias compensation, 16 without (docs/accuracy.md)
   int interleave = 0;                     // n: VPLs split over n×n texel classes (Keller & Heidrich 2001);
                                           // 1 = off, 0 = automatic (chooseInterleave: 1…4)
+  GlBackendOptions gl;                    // GL backend: cube face size (0 = from the light map), VPLs per pass, biases
   int overlapCompensation = -1;           // trace the compensation's rays while the GL backend bakes: -1 auto
                                           // (hardware renderers only: on llvmpipe both fight over the cores,
                                           // bake 1.95 → 2.43 s), 0 never, 1 always
