@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <tuple>
 #include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -642,8 +643,42 @@ class Loader {
     }
   }
 
-  // Provided normals go through the inverse-transpose; missing or zero ones come from the
-  // area-weighted sum of the adjacent world-space face normals.
+  // glTF 2.0 (3.7.2.1): "When normals are not specified, client implementations MUST calculate flat
+  // normals." Each corner takes its face's normal; a vertex shared by faces of different orientation (a box
+  // corner) is split, one copy per orientation, while coplanar faces keep sharing (sourceVertex records
+  // the accessor vertex). Smooth normals here bent a box's shading normals by up to 55° at its corners.
+  void flatNormals(Primitive& out) {
+    const size_t n = out.positions.size();
+    const bool hasUv0 = out.uv0.size() == n, hasUv1 = out.uv1.size() == n;
+    Primitive split;
+    std::map<std::tuple<uint32_t, int, int, int>, uint32_t> copies;  // (vertex, quantised normal) → new vertex
+    split.indices.reserve(out.indices.size());
+    for (size_t t = 0; t < out.indices.size(); t += 3) {
+      const uint32_t a = out.indices[t], b = out.indices[t + 1], c = out.indices[t + 2];
+      const glm::vec3 f = glm::normalize(glm::cross(out.positions[b] - out.positions[a], out.positions[c] - out.positions[a]));
+      const glm::ivec3 q(glm::round(f * 1e4f));  // faces within ~1e-4 rad share a vertex
+      for (uint32_t v : {a, b, c}) {
+        auto [it, fresh] = copies.try_emplace({v, q.x, q.y, q.z}, static_cast<uint32_t>(split.positions.size()));
+        if (fresh) {
+          split.positions.push_back(out.positions[v]);
+          split.normals.push_back(f);
+          if (hasUv0) split.uv0.push_back(out.uv0[v]);
+          if (hasUv1) split.uv1.push_back(out.uv1[v]);
+          split.sourceVertex.push_back(v);
+        }
+        split.indices.push_back(it->second);
+      }
+    }
+    out.positions.swap(split.positions);
+    out.normals.swap(split.normals);
+    if (hasUv0) out.uv0.swap(split.uv0);
+    if (hasUv1) out.uv1.swap(split.uv1);
+    out.indices.swap(split.indices);
+    out.sourceVertex.swap(split.sourceVertex);
+  }
+
+  // Provided normals go through the inverse-transpose; missing ones are flat (flatNormals); zero or
+  // non-finite ones in a provided attribute come from the area-weighted adjacent face normals.
   void finishNormals(const LocalPrimitive& lp, const glm::mat3& normalMatrix, Primitive& out) {
     const size_t n = out.positions.size();
     std::vector<glm::vec3> computed;
@@ -663,8 +698,7 @@ class Loader {
     };
     out.normals.resize(n);
     if (lp.normals.empty() && options_.computeMissingNormals) {
-      faceWeighted();
-      out.normals = computed;
+      flatNormals(out);
       ++scene_.stats.normalsComputed;
       return;
     }

@@ -8,7 +8,7 @@ namespace irbake {
 
 struct LoadOptions {
   bool decodeImages = true;      // decode base colour / emissive / lightmap images (false: textures stay empty)
-  bool computeMissingNormals = true;  // area-weighted vertex normals when NORMAL is absent
+  bool computeMissingNormals = true;  // flat normals when NORMAL is absent (the glTF rule; vertices split per face orientation)
 };
 
 // Loads a glTF or GLB file. Throws Error(Io | Parse | InvalidData | EmptyScene, path, one-line message).

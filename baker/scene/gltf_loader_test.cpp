@@ -98,6 +98,36 @@ TEST(GltfLoader, StripsAndFansAreTriangulatedWithConsistentWinding) {
   EXPECT_EQ(s.stats.normalsComputed, 2u);
 }
 
+// Without NORMAL, glTF requires flat normals: a unit cube of 8 shared vertices becomes 24 (one per corner
+// and face orientation; the two triangles of a face still share theirs), every normal is exactly its
+// face's, and sourceVertex leads back to the accessor vertex.
+TEST(GltfLoader, MissingNormalsAreFlatAndSplitSharedCorners) {
+  std::vector<glm::vec3> corners;
+  for (int i = 0; i < 8; ++i) corners.push_back(glm::vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  // Six faces, counter-clockwise seen from outside (corner bits: x = 1, y = 2, z = 4).
+  const std::vector<uint32_t> faces[6] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  std::vector<uint32_t> indices;
+  for (const auto& f : faces) indices.insert(indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
+  auto dir = testFolder("loader_flat");
+  writeDocument(meshDocument(corners, indices), dir / "cube.gltf");
+  Scene s = loadScene(dir / "cube.gltf");
+  ASSERT_EQ(s.primitives.size(), 1u);
+  const Primitive& p = s.primitives[0];
+  EXPECT_EQ(s.stats.normalsComputed, 1u);
+  EXPECT_EQ(p.triangleCount(), 12u);
+  EXPECT_EQ(p.positions.size(), 24u);
+  ASSERT_EQ(p.sourceVertex.size(), p.positions.size());
+  for (size_t v = 0; v < p.positions.size(); ++v) EXPECT_EQ(p.positions[v], corners[p.sourceVertex[v]]) << v;
+  for (size_t t = 0; t < p.triangleCount(); ++t) {
+    const glm::vec3 f = faceNormal(p, t);
+    EXPECT_NEAR(std::abs(f.x) + std::abs(f.y) + std::abs(f.z), 1.0f, 1e-6f);  // axis-aligned
+    const glm::vec3 centre = (p.positions[p.indices[3 * t]] + p.positions[p.indices[3 * t + 1]] +
+                              p.positions[p.indices[3 * t + 2]]) / 3.0f;
+    EXPECT_GT(glm::dot(f, centre - glm::vec3(0.5f)), 0.0f) << t;  // outward
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(p.normals[p.indices[3 * t + k]], f) << t;
+  }
+}
+
 TEST(GltfLoader, PointsAndLinesAreSkippedWithAWarning) {
   GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
   json lines = doc.root["meshes"][0]["primitives"][0];
@@ -112,10 +142,12 @@ TEST(GltfLoader, PointsAndLinesAreSkippedWithAWarning) {
   EXPECT_NE(s.stats.warnings[0].find("points or lines"), std::string::npos);
 }
 
-TEST(GltfLoader, MissingNormalsAreAreaWeighted) {
+// A provided NORMAL with a zero vector (a broken exporter) gets the area-weighted adjacent face normals
+// for that vertex; the others keep theirs.
+TEST(GltfLoader, ZeroNormalsInAProvidedAttributeAreAreaWeighted) {
   // Vertex 0 is shared by a unit right triangle in z = 0 (area 0.5) and a 2×2 one in x = 0 (area 2).
   std::vector<glm::vec3> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 0, 2}};
-  GltfDocument doc = meshDocument(pos, {0, 1, 2, 0, 3, 4});
+  GltfDocument doc = meshDocument(pos, {0, 1, 2, 0, 3, 4}, {{0, 0, 0}, {0, 0, 1}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}});
   auto dir = testFolder("loader_normals");
   writeDocument(doc, dir / "n.gltf");
   Scene s = loadScene(dir / "n.gltf");

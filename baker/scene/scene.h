@@ -58,18 +58,20 @@ struct LightmapRef {
 };
 
 // One glTF primitive instanced by one node, flattened to world space.
-// Vertex i is accessor vertex i of the source primitive (strips and fans are triangulated in indices).
+// Vertex i is accessor vertex i of the source primitive (strips and fans are triangulated in indices),
+// or sourceVertex[i] where vertices were split (flat normals for a primitive without NORMAL; atlas seams).
 struct Primitive {
   std::string name;
   std::vector<glm::vec3> positions;  // world space, metres
-  std::vector<glm::vec3> normals;    // world space, unit length (computed, area-weighted, when absent)
+  std::vector<glm::vec3> normals;    // world space, unit length (flat, as glTF requires, when absent)
   std::vector<glm::vec2> uv0;        // TEXCOORD_0 (empty when absent)
   std::vector<glm::vec2> uv1;        // TEXCOORD_1: lightmap UV in [0,1] over the page (empty when absent)
   std::vector<uint32_t> indices;     // triangle list, counter-clockwise front faces in world space
   int material = 0;                  // index into Scene::materials (always valid: a default is added)
   int node = -1, gltfMesh = -1, gltfPrimitive = -1;  // provenance for export
   glm::mat4 nodeToWorld{1.0f};       // the node's world matrix (positions here are already transformed)
-  // Atlas output: vertex i came from source vertex sourceVertex[i] (empty: identity).
+  // Vertex i came from source accessor vertex sourceVertex[i] (empty: identity); set by the loader's
+  // flat normals and by the atlas.
   std::vector<uint32_t> sourceVertex;
   LightmapRef lightmap;
   size_t triangleCount() const { return indices.size() / 3; }
