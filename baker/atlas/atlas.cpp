@@ -235,6 +235,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
       dst.gltfMesh = src.gltfMesh;
       dst.gltfPrimitive = src.gltfPrimitive;
       dst.nodeToWorld = src.nodeToWorld;
+      dst.normalsComputed = src.normalsComputed;
       const AtlasPage& pg = result.pages[size_t(page)];
       dst.lightmap = {page, pg.width, pg.height};
       const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);

@@ -104,7 +104,8 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   }
   omerr().enable();
 
-  const bool hasNormals = prim.normals.size() == prim.positions.size();
+  // Normal breaks are seams only when authored: flat normals the loader computed break at every edge.
+  const bool hasNormals = prim.normals.size() == prim.positions.size() && !prim.normalsComputed;
   const double hardCos = std::cos(glm::radians(options.hardNormalDegrees));
   for (size_t f = 0; f < faces; ++f) {
     if (mesh.degenerate[f]) continue;

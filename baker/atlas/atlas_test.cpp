@@ -15,6 +15,7 @@
 #include "common/error.h"
 #include "export/gltf_export.h"
 #include "scene/gltf_loader.h"
+#include "scene/test_gltf_builder.h"
 
 namespace irbake {
 namespace {
@@ -283,6 +284,28 @@ TEST(Atlas, CubeWithSharedVerticesStillSplitsAtCreases) {
   for (size_t v = 0; v < s.primitives[0].positions.size(); ++v)
     EXPECT_EQ(glm::vec3(p.positions[s.primitives[0].sourceVertex[v]]), s.primitives[0].positions[v]);
   expectValid(s, r, 2);
+}
+
+// A glTF without NORMAL gets flat normals from the loader (the glTF rule), split at every edge of a curved
+// surface; those breaks are not authored hard edges, so the charts are the same as without any normals.
+// The same flat normals marked as authored make every side edge a seam.
+TEST(Atlas, LoaderFlatNormalsAreNotSeams) {
+  Primitive c = cylinder(0.5f, 2.0f, 48);
+  const auto dir = std::filesystem::current_path() / "test_scratch" / "atlas_flat";  // under the build folder
+  std::filesystem::create_directories(dir);
+  writeAllAtomically(testing::meshDocument(c.positions, c.indices).files(dir / "cylinder.gltf"));
+  Scene loaded = loadScene(dir / "cylinder.gltf");
+  ASSERT_EQ(loaded.primitives.size(), 1u);
+  ASSERT_TRUE(loaded.primitives[0].normalsComputed);
+  ASSERT_GT(loaded.primitives[0].positions.size(), c.positions.size());  // split per face orientation
+  Scene authored = loaded;
+  authored.primitives[0].normalsComputed = false;
+  const AtlasResult r = unwrap(loaded, 40), hard = unwrap(authored, 40);
+  EXPECT_GE(r.stats.charts, 3u);
+  EXPECT_LE(r.stats.charts, 12u);
+  EXPECT_GE(hard.stats.charts, 48u);
+  expectValid(loaded, r, 2);
+  for (const Primitive& p : loaded.primitives) EXPECT_TRUE(p.normalsComputed);
 }
 
 TEST(Atlas, CylinderCapsArePlanarAndTheSideIsLowStretch) {

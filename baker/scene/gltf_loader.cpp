@@ -699,6 +699,7 @@ class Loader {
     out.normals.resize(n);
     if (lp.normals.empty() && options_.computeMissingNormals) {
       flatNormals(out);
+      out.normalsComputed = true;
       ++scene_.stats.normalsComputed;
       return;
     }

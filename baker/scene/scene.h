@@ -64,6 +64,7 @@ struct Primitive {
   std::string name;
   std::vector<glm::vec3> positions;  // world space, metres
   std::vector<glm::vec3> normals;    // world space, unit length (flat, as glTF requires, when absent)
+  bool normalsComputed = false;      // the loader made them (NORMAL absent): their breaks are not authored seams
   std::vector<glm::vec2> uv0;        // TEXCOORD_0 (empty when absent)
   std::vector<glm::vec2> uv1;        // TEXCOORD_1: lightmap UV in [0,1] over the page (empty when absent)
   std::vector<uint32_t> indices;     // triangle list, counter-clockwise front faces in world space
