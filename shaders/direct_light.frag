@@ -4,6 +4,7 @@ layout(binding = 0) uniform sampler2DArray gPositionWeight;
 layout(binding = 1) uniform sampler2DArray gNormal;
 layout(binding = 2) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
 layout(binding = 3) uniform sampler2D mapDepth;          // spot (perspective) / directional (ortho)
+layout(binding = 4) uniform sampler2DArray gGeomNormal;  // the sample's triangle's normal (bias, self-shadow)
 
 uniform int layers;
 uniform int lightType;         // 0 point, 1 spot, 2 directional
@@ -69,8 +70,10 @@ void main() {
       e = I / (r * r);
     }
     float cosTheta = dot(n, toLight);
-    if (cosTheta <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
-    sum += pw.w * e * cosTheta * lit(pw.xyz, n, cosTheta, r);
+    vec3 ng = texelFetch(gGeomNormal, ivec3(px, l), 0).xyz;
+    float cosGeom = dot(ng, toLight);  // ≤ 0: the sample's own triangle hides the light
+    if (cosTheta <= 0.0 || cosGeom <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
+    sum += pw.w * e * cosTheta * lit(pw.xyz, n, cosGeom, r);
   }
   result = vec4(sum / kPi, 0.0);
 }

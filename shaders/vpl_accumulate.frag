@@ -16,6 +16,7 @@
 // cube-map-array sampler doing the face selection (no faster).
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
+layout(binding = 4) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle
 #if defined(SHADOW_COMPARE)
 layout(binding = 2) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
 #else
@@ -108,10 +109,13 @@ float vplVisibility(int cube, vec3 v, float bias) {
 #endif
 }
 
-// One VPL's unweighted contribution (Φ G V, before 1/π²) at receiver x with normal nx.
-vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
+// One VPL's unweighted contribution (Φ G V, before 1/π²) at receiver x with shading normal nx and
+// geometric normal ng. The cosine is the shading normal's; the depth bias follows the triangle the cube
+// sampled (ng), and a receiver whose own triangle faces away from the VPL is in its own shadow (as the
+// ray tracer finds: its shadow ray crosses that triangle first).
+vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, vec3 ng, float noClamp) {
   vec3 d = v.position - x;  // receiver → VPL
-  float cx = dot(nx, d), cy = -dot(v.normal, d);
+  float cx = dot(nx, d), cy = -dot(v.normal, d), cg = dot(ng, d);
   float r2 = dot(d, d);
   float g = min(cx * cy / (r2 * r2), noClamp);  // vplGeometryTerm, inlined
   float r = sqrt(r2);
@@ -123,10 +127,10 @@ vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, float noClamp) {
   vec3 o = nx * (normalOffset * footprint);
   local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));
 #endif
-  float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cx * cx, 0.0)) / cx);
+  float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cg * cg, 0.0)) / cg);
   float visibility = vplVisibility(cube, local, bias);
   // Selected, not multiplied: behind either surface the lookup may be meaningless (even NaN).
-  return (cx > 0.0 && cy > 0.0) ? v.power * (g * visibility) : vec3(0.0);
+  return (cx > 0.0 && cy > 0.0 && cg > 0.0) ? v.power * (g * visibility) : vec3(0.0);
 }
 
 void main() {
@@ -142,8 +146,9 @@ void main() {
     vec4 pw = texelFetch(gPositionWeight, ivec3(p, l), 0);
     vec3 x = pw.xyz;
     vec3 nx = texelFetch(gNormal, ivec3(p, l), 0).xyz;
+    vec3 ng = texelFetch(gGeomNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
-    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, noClamp);
+    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, ng, noClamp);
     sum += pw.w > 0.0 ? pw.w * s : vec3(0.0);
   }
   result = vec4(sum * kInvPi2, 0.0);

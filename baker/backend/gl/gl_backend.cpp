@@ -204,14 +204,15 @@ struct DepthAtlas {
 // llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
 struct GpuPage {
   const TexelSamples* samples = nullptr;
-  GLuint positionWeight = 0, normal = 0, accum = 0, validDepth = 0, fbo = 0;
+  GLuint positionWeight = 0, normal = 0, geomNormal = 0, accum = 0, validDepth = 0, fbo = 0;
   std::vector<glm::dvec3> sum;
   std::vector<glm::vec4> readback;
-  GpuPage(const TexelSamples& s, bool validityMask) : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
+  GpuPage(const TexelSamples& s, const Scene& scene, bool validityMask)
+      : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
     const int layers = s.supersample * s.supersample;
     if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
       throw Error(ErrorCode::InvalidData, "", "texel samples of page " + std::to_string(s.page) + " are incomplete");
-    for (GLuint* t : {&positionWeight, &normal}) {
+    for (GLuint* t : {&positionWeight, &normal, &geomNormal}) {
       glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, t);
       glTextureStorage3D(*t, 1, GL_RGBA32F, s.width, s.height, layers);
       glTextureParameteri(*t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -220,6 +221,20 @@ struct GpuPage {
     glTextureSubImage3D(positionWeight, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT,
                         s.positionWeight.data());
     glTextureSubImage3D(normal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, s.normal.data());
+    // The sample's triangle's own normal: the depth bias follows the surface the shadow map sampled, not
+    // the interpolated shading normal (smooth normals on a hard-edged box lean up to 55° off its faces).
+    std::vector<glm::vec4> faceNormal(s.slotCount());
+    for (size_t i = 0; i < faceNormal.size(); ++i) {
+      faceNormal[i] = s.normal[i];
+      if (i >= s.primitive.size() || i >= s.triangle.size() || s.primitive[i] >= scene.primitives.size()) continue;
+      const Primitive& p = scene.primitives[s.primitive[i]];
+      if (3 * size_t(s.triangle[i]) + 2 >= p.indices.size()) continue;
+      const uint32_t* idx = &p.indices[3 * size_t(s.triangle[i])];
+      const glm::vec3 n = glm::cross(p.positions[idx[1]] - p.positions[idx[0]], p.positions[idx[2]] - p.positions[idx[0]]);
+      const float len = glm::length(n);
+      if (len > 0.0f && std::isfinite(len)) faceNormal[i] = glm::vec4(n / len, 0.0f);
+    }
+    glTextureSubImage3D(geomNormal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, faceNormal.data());
     glCreateTextures(GL_TEXTURE_2D, 1, &accum);
     glTextureStorage2D(accum, 1, GL_RGBA32F, s.width, s.height);
     glCreateFramebuffers(1, &fbo);
@@ -238,8 +253,8 @@ struct GpuPage {
   }
   ~GpuPage() {
     glDeleteFramebuffers(1, &fbo);
-    GLuint t[4] = {positionWeight, normal, accum, validDepth};
-    glDeleteTextures(4, t);
+    GLuint t[5] = {positionWeight, normal, geomNormal, accum, validDepth};
+    glDeleteTextures(5, t);
   }
   void clear() {
     const float zero[4] = {0, 0, 0, 0};
@@ -393,6 +408,7 @@ void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas
 void GlBaker::bindGBuffer(const GpuPage& page) const {
   glBindTextureUnit(0, page.positionWeight);
   glBindTextureUnit(1, page.normal);
+  glBindTextureUnit(4, page.geomNormal);
 }
 
 void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
@@ -521,7 +537,7 @@ std::vector<Lightmap> GlBaker::run() {
 
   geometry_ = std::make_unique<GpuGeometry>();
   uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
-  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, opt_.skipInvalidTexels));
+  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels));
 
   const int K = std::clamp(opt_.vplsPerPass, 1, 256);
   depthProgram_ = &programs_.get(
