@@ -338,6 +338,9 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("COMP_TOL")) co.sweepTolerance = std::atof(e);
         ClampCompensationStats cst;
         compensateClamp(in, maps, co, &cst);
+        if (std::getenv("GL_VERBOSE") && st.facesRendered > 0)
+          std::printf("  gl: %zu faces, %.0f triangles drawn per face (of %zu)\n", st.facesRendered,
+                      double(st.trianglesDrawn) / st.facesRendered, scene.triangleCount());
         if (std::getenv("COMP_VERBOSE")) std::printf("  compensation: %d sweeps, %zu hits kept, added %.2f%%\n", cst.sweeps, cst.hitsKept, 100 * cst.addedFraction);
         compensationSeconds = cw.seconds();
       }
