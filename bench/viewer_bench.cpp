@@ -47,6 +47,19 @@ Lightmap smoothPage(int pageSize, float fx, float fy) {
   return page;
 }
 
+// A textured brick-like 512² colour texture (tint × grain; mortar lines).
+Texture brickTexture(glm::vec3 tint) {
+  Texture t;
+  t.width = t.height = 512;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const bool mortar = y % 32 < 2 || (x + (y / 32 % 2) * 32) % 64 < 2;
+      const float grain = 0.85f + 0.15f * std::sin(0.37f * x + 0.11f * y) * std::cos(0.23f * y);
+      t.texels.push_back(mortar ? glm::vec4(0.55f, 0.55f, 0.5f, 1.0f) : glm::vec4(tint * grain, 1.0f));
+    }
+  return t;
+}
+
 // A wavy n×n height field over 10 × 10 m: 2n² triangles, uv1 over one page with a smooth map;
 // textured: a 512² base colour texture (a coloured brick-like pattern) repeated 8 × 8 over uv0.
 ViewerScene heightField(int n, int pageSize, bool textured = false) {
@@ -71,33 +84,11 @@ ViewerScene heightField(int n, int pageSize, bool textured = false) {
   p.lightmap = {0, pageSize, pageSize};
   s.primitives.push_back(std::move(p));
   if (textured) {
-    Texture t;
-    t.width = t.height = 512;
-    for (int y = 0; y < t.height; ++y)
-      for (int x = 0; x < t.width; ++x) {
-        const bool mortar = y % 32 < 2 || (x + (y / 32 % 2) * 32) % 64 < 2;
-        const float grain = 0.85f + 0.15f * std::sin(0.37f * x + 0.11f * y) * std::cos(0.23f * y);
-        t.texels.push_back(mortar ? glm::vec4(0.55f, 0.55f, 0.5f, 1.0f)
-                                  : glm::vec4(0.6f * grain, 0.25f * grain, 0.15f * grain, 1.0f));
-      }
-    s.textures.push_back(std::move(t));
+    s.textures.push_back(brickTexture({0.6f, 0.25f, 0.15f}));
     s.materials[0].baseColorFactor = glm::vec4(1.0f);
     s.materials[0].baseColorTexture = 0;
   }
   return makeViewerScene(std::move(s), {smoothPage(pageSize, 0.05f, 0.03f)});
-}
-
-// A textured brick-like 512² colour texture (tint × grain; mortar lines).
-Texture brickTexture(glm::vec3 tint) {
-  Texture t;
-  t.width = t.height = 512;
-  for (int y = 0; y < t.height; ++y)
-    for (int x = 0; x < t.width; ++x) {
-      const bool mortar = y % 32 < 2 || (x + (y / 32 % 2) * 32) % 64 < 2;
-      const float grain = 0.85f + 0.15f * std::sin(0.37f * x + 0.11f * y) * std::cos(0.23f * y);
-      t.texels.push_back(mortar ? glm::vec4(0.55f, 0.55f, 0.5f, 1.0f) : glm::vec4(tint * grain, 1.0f));
-    }
-  return t;
 }
 
 // A furnished room, ~100k triangles in 67 primitives: a 6 × 3 × 5 m box (textured floor), 24 boxes

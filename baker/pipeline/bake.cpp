@@ -30,7 +30,7 @@ nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y
 constexpr size_t kSoftwareGlTriangleHint = 10000;
 
 // The backend stage. The GL engineer owns the GL line (options, stats); every backend returns one
-// Lightmap per texel page.
+// Lightmap per texel page. glContext: the bake's context (current on this thread) for the GL backend.
 std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& inputs, nlohmann::json& report,
                                  GlContext* glContext) {
   const int interleave =
@@ -38,16 +38,12 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
   switch (options.backend) {
     case BackendKind::Gl: {
       // One context for every call (interleaved sampling makes n² + 1 of them).
-      std::unique_ptr<GlContext> owned;
-      if (!glContext) glContext = (owned = std::make_unique<GlContext>()).get();
-      GlContext& context = *glContext;
-      context.makeCurrent();
       GlBakeStats total;
       VplBackend gl = [&](const BakeInputs& in) {
         GlBakeStats st;
         GlBackendOptions go = options.gl;
         go.stats = &st;
-        go.context = &context;
+        go.context = glContext;
         std::vector<Lightmap> maps = bakeGl(in, go);
         total.add(st);
         return maps;

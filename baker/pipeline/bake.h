@@ -10,7 +10,6 @@
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/gl/gl_backend.h"
-#include "backend/embree/geometry_term.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"

@@ -291,6 +291,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       }
     });
     std::vector<std::vector<glm::vec3>> next = base;
+    double added = 0.0;  // Σ residual (channel mean) = what this sweep's map adds to the base
     for (size_t p = 0; p < maps.size(); ++p) {
       const TexelSamples& ts = in.texels[p];
       const Lightmap& m = maps[p];
@@ -305,19 +306,15 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         residual = filters[p]->apply(residual, m.valid, fo);
       }
       for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
-        if (m.valid[t]) next[p][t] += residual[t];
+        if (m.valid[t]) {
+          next[p][t] += residual[t];
+          added += (residual[t].x + residual[t].y + residual[t].z) / 3.0;
+        }
     }
     current.swap(next);
     ++sweepsDone;
     // Each sweep adds one more bounce inside the clamp radius: stop once that changes the map by less
     // than the tolerance (a narrow gap needs more bounces than an open corner).
-    double added = 0.0;
-    for (size_t p = 0; p < maps.size(); ++p)
-      for (size_t t = 0; t < maps[p].size(); ++t)
-        if (maps[p].valid[t]) {
-          const glm::vec3 d = current[p][t] - base[p][t];
-          if (std::isfinite(d.x + d.y + d.z)) added += (d.x + d.y + d.z) / 3.0;
-        }
     const bool converged = sweep > 0 && std::abs(added - lastAdded) <= options.sweepTolerance * std::abs(mapTotal);
     lastAdded = added;
     if (converged) break;

@@ -312,11 +312,10 @@ void GlBaker::finishStage(double& seconds, StageClock& sw, double* cpuSeconds) c
   sw.reset();
 }
 
-// Depth-only views: depth test and writes, scissor; no blending.
+// Depth-only views: depth test and writes, no blending (punctual maps scissor in drawView; VPL faces clip).
 void GlBaker::shadowPassState() const {
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
-  glEnable(GL_SCISSOR_TEST);
   glDisable(GL_BLEND);
 }
 
@@ -337,6 +336,7 @@ void GlBaker::lightMapPassState() const {
 void GlBaker::drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ) {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, size, size);
+  glEnable(GL_SCISSOR_TEST);
   glScissor(view.scissor.x, view.scissor.y, view.scissor.z, view.scissor.w);
   glClearDepthf(reversedZ ? 0.0f : 1.0f);
   glDepthFunc(reversedZ ? GL_GREATER : GL_LESS);
@@ -376,7 +376,7 @@ void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas
   depthProgram_->use();
   glBindVertexArray(geometry_->vao);
   glBindFramebuffer(GL_FRAMEBUFFER, atlas.fbo);
-  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_SCISSOR_TEST);  // the clear covers the whole atlas
   glClearDepthf(0.0f);
   glClear(GL_DEPTH_BUFFER_BIT);
   for (int d = 0; d < 4; ++d) glEnable(GL_CLIP_DISTANCE0 + d);

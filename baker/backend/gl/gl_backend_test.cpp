@@ -48,6 +48,12 @@ struct Fixture {
   }
 };
 
+// One downward VPL and one point light above the floor scene: a VPL pass and a direct pass.
+void addVplAndPointLight(Fixture& f) {
+  f.vpls.vpls.push_back(Vpl{{0.3f, 0.2f, 0.9f}, {0, 0, -1}, glm::vec3(1.0f), 0});
+  f.scene.lights.push_back(testing::pointLight({-0.2f, 0.1f, 1.1f}, 2.0f));
+}
+
 // Floor z = 0 of 2×2 m, sampled 32×32; optional occluder square at height h.
 Fixture floorScene(bool occluder) {
   Fixture f;
@@ -363,12 +369,7 @@ TEST(GlBackend, ValidityMaskSkipsOnlyInvalidTexels) {
   TexelSamples& s = f.pages[0];
   for (size_t i = 0; i < s.layerSize(); ++i)
     if ((i * 7) % 5 == 0 || (i / 32) % 8 < 2) s.valid[i] = 0;  // scattered and whole 8-texel rows
-  Vpl v;
-  v.position = {0.3f, 0.2f, 0.9f};
-  v.normal = {0, 0, -1};
-  v.power = glm::vec3(1.0f);
-  f.vpls.vpls.push_back(v);
-  f.scene.lights.push_back(testing::pointLight({-0.2f, 0.1f, 1.1f}, 2.0f));
+  addVplAndPointLight(f);
   GlBackendOptions masked, unmasked;
   masked.pointFaceSize = unmasked.pointFaceSize = 256;
   unmasked.skipInvalidTexels = false;
@@ -518,12 +519,7 @@ TEST(GlBackend, DirectionalLightIsExactWithOrthoShadowMap) {
 // added to the VPL partial sums that are still on the GPU (none folded: one pass, no fold).
 TEST(GlBackend, DirectAndVplPassesAdd) {
   Fixture f = floorScene(true);
-  Vpl v;
-  v.position = {0.3f, 0.2f, 0.9f};
-  v.normal = {0, 0, -1};
-  v.power = glm::vec3(1.0f);
-  f.vpls.vpls.push_back(v);
-  f.scene.lights.push_back(testing::pointLight({-0.2f, 0.1f, 1.1f}, 2.0f));
+  addVplAndPointLight(f);
   GlBackendOptions opt;
   opt.foldEveryPasses = 100;
   VplEvalOptions both, vplOnly, directOnly;

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "texels/texel_filter.h"
+#include "vpl/sampling.h"
 
 namespace irbake {
 
@@ -185,41 +186,29 @@ CubeFaceChoice chooseCubeFaceSize(const std::vector<Vpl>& vpls, const std::vecto
   std::vector<float> spacings;
   for (const TexelSamples& ts : pages)
     if (const float h = texelSpacing(ts); h > 0.0f) spacings.push_back(h);
-  // Valid texels: the first weighted sample's position and normal stand for the texel.
+  // Valid texels: their mean sample position and normal.
   std::vector<std::pair<glm::vec3, glm::vec3>> receivers;
-  for (const TexelSamples& ts : pages) {
-    const size_t layer = ts.layerSize();
-    const int layers = ts.supersample * ts.supersample;
-    for (size_t t = 0; t < layer && t < ts.valid.size(); ++t) {
-      if (!ts.valid[t]) continue;
-      for (int l = 0; l < layers; ++l) {
-        const size_t s = static_cast<size_t>(l) * layer + t;
-        if (s < ts.positionWeight.size() && ts.positionWeight[s].w > 0.0f && s < ts.normal.size()) {
-          receivers.emplace_back(glm::vec3(ts.positionWeight[s]), glm::vec3(ts.normal[s]));
-          break;
-        }
-      }
+  for (const TexelSamples& ts : pages)
+    for (size_t t = 0; t < ts.layerSize() && t < ts.valid.size(); ++t) {
+      glm::vec3 p, n;
+      if (ts.valid[t] && texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.positionWeight[s]); }, p) &&
+          texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.normal[s]); }, n))
+        receivers.emplace_back(p, n);
     }
-  }
   if (spacings.empty() || receivers.empty() || vpls.empty()) return choice;
   std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
   choice.texelSpacing = spacings[spacings.size() / 2];
 
-  // Pairs drawn by a fixed-seed generator (splitmix64), so the choice is deterministic.
-  uint64_t state = 0x9E3779B97F4A7C15ull;
-  auto next = [&state]() {
-    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  };
+  // Pairs drawn by a fixed-seed generator, so the choice is deterministic.
+  Rng rng(hashSeed(0x63756265u));
+  auto pick = [&rng](size_t n) { return std::min(n - 1, static_cast<size_t>(rng.uniform() * double(n))); };
   // (distance, contribution) of each facing pair; contribution = VPL power × clamped geometry term.
   std::vector<std::pair<float, double>> pairs;
   pairs.reserve(static_cast<size_t>(std::max(0, pairSamples)));
   double total = 0.0;
   for (int i = 0; i < pairSamples; ++i) {
-    const Vpl& v = vpls[next() % vpls.size()];
-    const auto& [p, n] = receivers[next() % receivers.size()];
+    const Vpl& v = vpls[pick(vpls.size())];
+    const auto& [p, n] = receivers[pick(receivers.size())];
     const glm::vec3 d = p - v.position;
     const float r = glm::length(d);
     if (!(r > 0.0f)) continue;
