@@ -12,8 +12,8 @@ int runSamples(const Args& args) {
   ArgParser parser(args, {}, {"--help", "--quiet"});
   if (parser.flag("--help")) {
     std::puts("usage: irbake samples OUTDIR [--quiet]\n"
-              "  writes cornell_box, furnace, point_over_plane, quad_over_plane, corner, thin_wall and\n"
-              "  textured_plane as OUTDIR/<name>.gltf (+ .bin)");
+              "  writes cornell_box, furnace, point_over_plane, quad_over_plane, corner, thin_wall,\n"
+              "  textured_plane and contacts as OUTDIR/<name>.gltf (+ .bin)");
     return 0;
   }
   if (parser.positionals().size() != 1) throw Error(ErrorCode::Usage, "", "samples takes exactly one OUTDIR argument");

@@ -54,7 +54,9 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
       report["gl"] = {{"setupSeconds", total.setupSeconds},   {"shadowSeconds", total.shadowSeconds},
                       {"accumulateSeconds", total.accumulateSeconds}, {"foldSeconds", total.foldSeconds},
                       {"passes", total.passes},               {"facesRendered", total.facesRendered},
-                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize}};
+                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize},
+                      {"contactTexels", total.contactTexels},   {"contactSeconds", total.contactSeconds},
+                      {"contactFraction", total.texelsEvaluated ? double(total.contactTexels) / total.texelsEvaluated : 0.0}};
       report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
       return maps;
     }
