@@ -145,6 +145,37 @@ TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
     }
 }
 
+// Issue 12: a uniform sky over an open plane gives map = L on every backend (its bounces cannot reach the
+// plane again); a plane under a box's overhang gets less, the same on GL and Embree.
+TEST(BakePipeline, UniformSkyOverAnOpenPlaneOnEveryBackend) {
+  for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree, BackendKind::Reference}) {
+    Scene s = samples::makePointOverPlane();
+    s.lights.clear();
+    s.environment = Environment::uniform({0.5f, 0.7f, 1.0f});
+    BakeOptions o;
+    o.backend = backend;
+    o.atlas.texelsPerUnit = 3.0f;
+    o.walk.paths = 256;
+    o.referenceSpp = 16;
+    BakeResult r = bake(std::move(s), o);
+    glm::dvec3 sum(0.0), worst(0.0);
+    size_t n = 0;
+    for (const auto& m : r.maps)
+      for (size_t i = 0; i < m.size(); ++i)
+        if (m.valid[i]) {
+          sum += glm::dvec3(m.texels[i]);
+          worst = glm::max(worst, glm::abs(glm::dvec3(m.texels[i]) - glm::dvec3(0.5, 0.7, 1.0)));
+          ++n;
+        }
+    ASSERT_GT(n, 100u);
+    std::printf("[ figure ] uniform sky, open plane, %s: mean (%.5f %.5f %.5f), exact (0.5 0.7 1), worst |err| %.2e\n",
+                toString(backend), sum.x / n, sum.y / n, sum.z / n, worst.z);
+    EXPECT_NEAR(sum.x / n, 0.5, 1e-4) << toString(backend);
+    EXPECT_NEAR(sum.z / n, 1.0, 2e-4) << toString(backend);
+    EXPECT_LT(worst.z, 1e-3) << toString(backend);
+  }
+}
+
 // The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
 // give the same map, bit for bit, as tracing them after it: the trace reads no map.
 TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {

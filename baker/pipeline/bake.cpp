@@ -208,6 +208,20 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   }
   seconds["backend"] = stage.seconds();
 
+  // The sky's direct light, traced (every VPL backend; the reference integrator finds the sky itself).
+  // Before the compensation, whose gather reads the map as the light leaving each surface.
+  if (s.environment.present() && options.backend != BackendKind::Reference) {
+    stage.reset();
+    SkyLightOptions so = options.sky;
+    so.seed = options.walk.seed;
+    SkyLightStats ss;
+    addSkyLight(inputs, r.maps, so, &ss);
+    seconds["sky"] = stage.seconds();
+    report["sky"] = {{"rays", ss.rays}, {"raysPerSample", ss.raysPerSample},
+                     {"uniform", s.environment.isUniform()}, {"source", s.environment.source()},
+                     {"integral", rgb(s.environment.integral())}};
+  }
+
   if (compensate) {
     stage.reset();
     ClampCompensationStats cs;

@@ -139,6 +139,20 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
         vpls.push_back(Vpl{origin, normal, glm::vec3(pathPower), 0});
         dir = cosineHemisphere(normal, halton.sample(2, i), halton.sample(3, i));
         surfaceStart = true;
+      } else if (sources.hasSky && s == numTriangles + scene.lights.size()) {
+        // The sky: a direction towards it by luminance, a point on a disc covering the bounding sphere
+        // upstream; the path carries L(ω)/p(ω) · π R² / N (its colour included).
+        double pdf = 0.0;
+        const glm::vec3 toSky = scene.environment.sample(halton.sample(2, i), halton.sample(3, i), pdf);
+        dir = -toSky;
+        glm::vec3 t, b;
+        orthonormalBasis(dir, t, b);
+        const double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
+        origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+                 b * float(r * std::sin(phi));
+        const double R = sources.sceneRadius;
+        pathPower = pdf > 0.0 ? glm::dvec3(scene.environment.radiance(toSky)) * (kPi * R * R / (pdf * p * static_cast<double>(N)))
+                              : glm::dvec3(0.0);
       } else {
         const Light& l = scene.lights[s - numTriangles];
         pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
