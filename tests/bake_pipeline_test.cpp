@@ -176,6 +176,23 @@ TEST(BakePipeline, UniformSkyOverAnOpenPlaneOnEveryBackend) {
   }
 }
 
+// --backend auto (the default): GL for a small scene (on llvmpipe too), Embree as soon as a material is
+// see-through (GL's shadow maps would treat it as opaque); the choice and its reason in the report.
+TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
+  BakeOptions o;
+  o.atlas.texelsPerUnit = 4.0f;
+  o.walk.paths = 64;
+  BakeResult small = bake(samples::makeFurnace(), o);
+  EXPECT_EQ(small.report["backendChoice"]["asked"], "auto");
+  EXPECT_EQ(small.report["backend"], "gl");
+  EXPECT_FALSE(small.report["backendChoice"]["reason"].get<std::string>().empty());
+  Scene glass = samples::makeCornellBox();
+  glass.materials[0].alphaMode = AlphaMode::Blend;
+  BakeResult seeThrough = bake(std::move(glass), o);
+  EXPECT_EQ(seeThrough.report["backend"], "embree");
+  EXPECT_NE(seeThrough.report["backendChoice"]["reason"].get<std::string>().find("BLEND"), std::string::npos);
+}
+
 // The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
 // give the same map, bit for bit, as tracing them after it: the trace reads no map.
 TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {

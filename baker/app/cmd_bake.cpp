@@ -14,7 +14,7 @@ namespace irbake::app {
 namespace {
 const char* kBakeHelp =
     "usage: irbake bake SCENE -o OUTDIR [options]\n"
-    "  --backend gl|embree|reference   evaluator (default gl; embree: ray-traced; reference: path traced)\n"
+    "  --backend auto|gl|embree|reference   evaluator (default auto: GL on a GPU or for small scenes, else embree)\n"
     "  --vpls N                 light paths of the quasi-random walk (default 1024)\n"
     "  --bounces N|auto         diffuse bounces (default auto: follow the energy left)\n"
     "  --texels-per-unit T      texels per metre (default: fit about one 1024 page)\n"
@@ -66,7 +66,7 @@ int runBake(const Args& args) {
   if (a.flag("--quiet")) log::setLevel(log::Level::Warn);
 
   BakeOptions o;
-  o.backend = parseBackend(a.valueOr("--backend", "gl"));
+  o.backend = parseBackend(a.valueOr("--backend", "auto"));
   o.walk.paths = positiveInt(a, "--vpls", o.walk.paths, 1, 1 << 26);
   std::string bounces = a.valueOr("--bounces", "auto");
   o.walk.maxBounces = bounces == "auto" ? -1 : positiveInt(a, "--bounces", 0, 0, 64);
@@ -114,7 +114,7 @@ int runBake(const Args& args) {
   oo.writeGltf = !a.flag("--no-gltf");
   Stopwatch writeTime;
   auto files = writeBakeOutputs(result, oo);
-  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + toString(o.backend) + " in " +
+  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() + " in " +
             std::to_string(result.report["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
             " s writing)");
   for (const auto& f : files) std::printf("%s\n", f.string().c_str());

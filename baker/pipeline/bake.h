@@ -18,7 +18,10 @@
 
 namespace irbake {
 
-enum class BackendKind { Gl, Embree, Reference };
+// Auto: GL on a hardware renderer, or on a software one for small scenes (≤ 10k triangles); Embree for
+// larger scenes on a software renderer, without a GL context, or with see-through materials (MASK, BLEND,
+// transmission), which only the ray-traced backends model.
+enum class BackendKind { Auto, Gl, Embree, Reference };
 
 // The default evaluation: derived clamp, bias compensation on, direct and VPLs.
 inline VplEvalOptions compensatedEval() {
@@ -28,7 +31,7 @@ inline VplEvalOptions compensatedEval() {
 }
 
 struct BakeOptions {
-  BackendKind backend = BackendKind::Gl;  // gl (default), embree, reference
+  BackendKind backend = BackendKind::Auto;  // auto (default), gl, embree, reference
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
@@ -61,7 +64,7 @@ struct BakeResult {
 // Runs the whole bake on a loaded scene. Throws Error on failure.
 BakeResult bake(Scene scene, const BakeOptions& options);
 
-// "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
+// "auto" | "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
 BackendKind parseBackend(const std::string& name);
 const char* toString(BackendKind kind);
 

@@ -182,6 +182,17 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
       for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
         glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
         RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+        // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
+        // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
+        // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
+        for (int layer = 0; hit.hit && layer < 64; ++layer) {
+          const SurfaceTransmission st = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+          if (st.fraction <= 0.0f) break;
+          Rng pass(hashSeed(options.seed, i, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
+          if (pass.uniform() >= st.fraction) break;
+          throughput *= glm::dvec3(st.tint);
+          hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
+        }
         if (!hit.hit) break;  // escaped: its energy leaves the scene
         throughput *= glm::dvec3(rt.albedoAt(hit));
         glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side

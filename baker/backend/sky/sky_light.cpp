@@ -24,12 +24,13 @@ glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& 
   glm::dvec3 sum(0.0);
   if (sky.isUniform()) {
     // Cosine rays: (L cosθ / p) / π = L for p = cosθ/π, so the value is L × the visible fraction.
-    int visible = 0;
+    glm::vec3 visible(0.0f);  // Σ transmittance over the rays (1 per clear ray without see-through surfaces)
     for (int i = 0; i < rays; ++i) {
       const double u = std::fmod((i + 0.5) / rays + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
-      if (!rt.occluded(origin, cosineHemisphere(n, u, v), 0.0f, 1e30f)) ++visible;
+      const glm::vec3 dir = cosineHemisphere(n, u, v);
+      if (!rt.occluded(origin, dir, 0.0f, 1e30f)) visible += rt.transmittance(origin, dir, 0.0f, 1e30f);
     }
-    return sky.uniformRadiance() * (static_cast<float>(visible) / static_cast<float>(std::max(1, rays)));
+    return sky.uniformRadiance() * visible / static_cast<float>(std::max(1, rays));
   }
   // Two strategies, half the rays each, balance heuristic: f / (n_c p_c + n_e p_e) summed over all rays.
   const int half = std::max(1, rays / 2);
@@ -48,7 +49,7 @@ glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& 
     const double pdfCosine = cosTheta / kPi, pdfSky = sky.pdf(dir);
     const glm::vec3 L = sky.radiance(dir);
     if (L == glm::vec3(0.0f) || rt.occluded(origin, dir, 0.0f, 1e30f)) continue;
-    sum += glm::dvec3(L) * (cosTheta / (half * (pdfCosine + pdfSky)));
+    sum += glm::dvec3(L * rt.transmittance(origin, dir, 0.0f, 1e30f)) * (cosTheta / (half * (pdfCosine + pdfSky)));
   }
   return glm::vec3(sum / kPi);
 }

@@ -140,7 +140,9 @@ TEST(SkyLight, OneTexelEnvironmentMatchesTheSun) {
     sumSun += b.x;
     // Away from the shadow's edge (the texel spans 5.6° × 5.6°: a penumbra the sun does not have).
     if (std::abs(a.x - b.x) > 0.02 * std::max(b.x, 1e-3f)) worst = std::max(worst, std::abs(double(a.x) - b.x));
-    if (a.x > 0.0f) EXPECT_NEAR(a.y / a.x, 0.8, 1e-3);  // the texel's colour
+    if (a.x > 0.0f) {
+      EXPECT_NEAR(a.y / a.x, 0.8, 1e-3);  // the texel's colour
+    }
     ++points;
   }
   ASSERT_GT(points, 150);
