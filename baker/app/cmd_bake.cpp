@@ -27,6 +27,9 @@ const char* kBakeHelp =
     "  --interleave N|auto      interleaved sampling: each texel of an N×N block sees 1/N² of the VPLs,\n"
     "                           then a filter on the surface mixes them (default auto: 1..4 from the texel\n"
     "                           size and the clamp radius; 1 = every VPL everywhere)\n"
+    "  --sky R,G,B              a uniform sky of that radiance (W/(m² sr)): direct light traced, bounces as VPLs\n"
+    "  --env FILE.exr|.hdr      an equirectangular environment (+Y up, centre towards −Z) instead;\n"
+    "  --env-intensity S        scales it (default 1), --env-rotation DEG turns it about +Y\n"
     "  --cube-face N|auto       GL backend: VPL depth-cube face size in texels (default auto: a shadow\n"
     "                           texel's footprint held to the light-map texel spacing, 128..256)\n"
     "  --seed K                 walk seed (default 0)\n"
@@ -51,7 +54,7 @@ int runBake(const Args& args) {
   ArgParser a(args,
               {"-o", "--output", "--backend", "--vpls", "--bounces", "--texels-per-unit", "--supersample", "--clamp",
                "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine", "--interleave",
-               "--cube-face"},
+               "--cube-face", "--sky", "--env", "--env-intensity", "--env-rotation"},
               {"--help", "-h", "--bias-compensation", "--no-bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
                "--quiet"});
   if (a.flag("--help") || a.flag("-h")) {
@@ -99,6 +102,16 @@ int runBake(const Args& args) {
   Scene scene = loadScene(scenePath);
   if (auto sun = a.numberList("--sun", 4); !sun.empty())
     scene.lights.push_back(sunLight(glm::vec3(sun[0], sun[1], sun[2]), static_cast<float>(sun[3])));
+  if (auto sky = a.numberList("--sky", 3); !sky.empty()) {
+    for (double c : sky)
+      if (!(c >= 0.0) || !std::isfinite(c)) throw Error(ErrorCode::Usage, "", "--sky needs three radiances ≥ 0 (R,G,B)");
+    scene.environment = Environment::uniform(glm::vec3(sky[0], sky[1], sky[2]));
+  }
+  if (auto env = a.value("--env")) {
+    if (a.value("--sky")) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
+    scene.environment = loadEnvironment(*env, static_cast<float>(a.doubleOr("--env-intensity", 1.0)),
+                                        static_cast<float>(a.doubleOr("--env-rotation", 0.0)));
+  }
   requireLight(scene, scenePath);
   double loadSeconds = loadTime.seconds();
 

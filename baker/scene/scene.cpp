@@ -110,7 +110,7 @@ glm::vec3 Scene::emitterPower() const {
 }
 
 bool Scene::hasLightOrEmitter() const {
-  if (!lights.empty()) return true;
+  if (!lights.empty() || environment.present()) return true;
   for (const auto& p : primitives)
     if (materials[p.material].isEmissive()) return true;
   return false;
