@@ -20,7 +20,7 @@ namespace irbake {
 
 // Auto: GL on a hardware renderer, or on a software one for small scenes (≤ 10k triangles); Embree for
 // larger scenes on a software renderer, without a GL context, or with see-through materials (MASK, BLEND,
-// transmission), which only the ray-traced backends model.
+// transmission), whose texels the GL backend would mostly trace with rays anyway.
 enum class BackendKind { Auto, Gl, Embree, Reference };
 
 // The default evaluation: derived clamp, bias compensation on, direct and VPLs.
