@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "common/output_lock.h"
 #include "export/exr_io.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"
@@ -293,6 +294,28 @@ TEST(BakeCommand, HelpListsOptionsAndExitCodesAndVersionIsPrinted) {
   ASSERT_EQ(runIrbake("--version", &log), 0) << log;
   EXPECT_EQ(log.rfind("irbake 0.", 0), 0u) << log;
   EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+}
+
+// A bake into a folder another bake holds fails at once (exit 3, the folder named) and writes nothing;
+// once the holder is gone the same command bakes and leaves no lock file.
+TEST(BakeCommand, SecondBakeIntoABusyFolderFailsAtOnce) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("busy");
+  fs::path out = dir / "out";
+  fs::path scene = samplesDir() / "point_over_plane.gltf";
+  const std::string command = "bake " + q(scene) + " -o " + q(out) + " --backend embree --texels-per-unit 2 --vpls 16";
+  std::string log;
+  {
+    OutputFolderLock holder(out);  // stands for a bake in progress (flock conflicts across processes)
+    EXPECT_EQ(runIrbake(command, &log), 3) << log;
+    EXPECT_NE(log.find(out.string()), std::string::npos) << log;
+    EXPECT_NE(log.find("output folder is busy"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(out / "lightmap_0.exr"));
+    EXPECT_FALSE(fs::exists(out / "report.json"));
+  }
+  ASSERT_EQ(runIrbake(command, &log), 0) << log;
+  EXPECT_TRUE(fs::exists(out / "lightmap_0.exr"));
+  EXPECT_FALSE(fs::exists(out / OutputFolderLock::kFileName));
 }
 
 // On a terminal (a pty from `script`): a bar for each stage, through compensation, post and writing,

@@ -6,6 +6,7 @@
 #include "common/command_line.h"
 #include "common/error.h"
 #include "common/log.h"
+#include "common/output_lock.h"
 #include "common/progress.h"
 #include "pipeline/bake.h"
 #include "scene/gltf_loader.h"
@@ -88,6 +89,7 @@ int runBake(const Args& args) {
   o.postDilate = !noDilate;
   o.postSeams = !noSeams;
 
+  const OutputFolderLock lock(out);  // before any work: a second bake into OUTDIR fails at once
   const std::filesystem::path scenePath = scenes[0];
   Stopwatch loadTime;
   Scene scene = loadScene(scenePath);

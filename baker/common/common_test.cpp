@@ -4,11 +4,14 @@
 #include <set>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/output_lock.h"
 
 namespace fs = std::filesystem;
 using namespace irbake;
@@ -121,6 +124,33 @@ TEST(CommandLine, HelpListsTheExitCodes) {
     EXPECT_NE(help.find("  " + std::to_string(exitCodeFor(c)) + "  " + toString(c) + ":"), std::string::npos) << help;
   auto app = cli::makeApp("test", "test");
   EXPECT_NE(app->help().find(help), std::string::npos);
+}
+
+TEST(OutputFolderLock, SecondLockFailsAtOnceAndNothingIsLeftBehind) {
+  fs::path dir = fs::current_path() / "test_scratch" / "common" / "locked_out";
+  fs::remove_all(dir);
+  {
+    OutputFolderLock first(dir);
+    EXPECT_TRUE(fs::exists(dir / OutputFolderLock::kFileName));
+    // flock locks belong to the open file: a second lock in this process conflicts like another process.
+    try {
+      OutputFolderLock second(dir);
+      FAIL() << "two locks on one folder";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Io);
+      const std::string what = e.what();
+      EXPECT_NE(what.find(dir.string()), std::string::npos) << what;
+      EXPECT_NE(what.find("output folder is busy"), std::string::npos) << what;
+      EXPECT_NE(what.find("process " + std::to_string(::getpid())), std::string::npos) << what;
+    }
+  }
+  // Released: the folder this lock created was left empty, so it is gone; a new lock succeeds.
+  EXPECT_FALSE(fs::exists(dir));
+  fs::create_directories(dir);
+  std::ofstream(dir / "kept.txt") << "x";
+  { OutputFolderLock again(dir); }
+  EXPECT_TRUE(fs::exists(dir / "kept.txt"));
+  EXPECT_FALSE(fs::exists(dir / OutputFolderLock::kFileName));
 }
 
 TEST(AtomicFile, WritesFinalNameOnlyOnSuccess) {
