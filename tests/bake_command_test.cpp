@@ -284,7 +284,7 @@ TEST(BakeCommand, ReferenceBackendReportsItsSamplesAndMatchesTheClosedForm) {
 TEST(BakeCommand, HelpListsOptionsAndExitCodesAndVersionIsPrinted) {
   std::string log;
   ASSERT_EQ(runIrbake("bake --help", &log), 0) << log;
-  for (const char* option : {"--vpls", "--bounces", "--texels-per-unit", "--seed", "--sun", "--quiet"})
+  for (const char* option : {"--vpls", "--bounces", "--texels-per-unit", "--max-texels", "--seed", "--sun", "--quiet"})
     EXPECT_NE(log.find(option), std::string::npos) << option;
   EXPECT_NE(log.find("exit codes:"), std::string::npos) << log;
   EXPECT_NE(log.find("  2  usage error"), std::string::npos) << log;
@@ -294,6 +294,41 @@ TEST(BakeCommand, HelpListsOptionsAndExitCodesAndVersionIsPrinted) {
   ASSERT_EQ(runIrbake("--version", &log), 0) << log;
   EXPECT_EQ(log.rfind("irbake 0.", 0), 0u) << log;
   EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+}
+
+// --texels-per-unit 1e6 on the Cornell box (570 MB and 16 warnings before) fails at once against the
+// texel budget, naming a density that fits; that density then passes the same budget.
+TEST(BakeCommand, TexelBudgetRefusesAnAtlasTooLargeAndNamesTheDensityThatFits) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("texel_budget");
+  fs::path scene = samplesDir() / "cornell_box.gltf";
+  std::string log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "out") + " --texels-per-unit 1e6", &log), 2) << log;
+  EXPECT_NE(log.find("cornell_box.gltf"), std::string::npos) << log;
+  EXPECT_NE(log.find("over the budget of 16.78 M (--max-texels 16777216)"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir / "out" / "lightmap_0.exr"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+
+  const std::string budget = " --max-texels 100000";
+  EXPECT_EQ(runIrbake("unwrap " + q(scene) + " -o " + q(dir / "u.gltf") + " --texels-per-unit 1e6" + budget, &log), 2)
+      << log;
+  const std::string marker = "use --texels-per-unit ";
+  const size_t at = log.find(marker);
+  ASSERT_NE(at, std::string::npos) << log;
+  const double fits = std::stod(log.substr(at + marker.size()));
+  // Cornell box: 5 walls of 0.555² m² plus two blocks ≈ 2.1 m²; 1e5 × 0.6 / 2.1 m² → about 170 texels/m.
+  EXPECT_GT(fits, 100.0);
+  EXPECT_LT(fits, 250.0);
+  ASSERT_EQ(runIrbake("unwrap " + q(scene) + " -o " + q(dir / "u.gltf") + " --texels-per-unit " + std::to_string(fits) +
+                          budget + " --report " + q(dir / "u.json"),
+                      &log),
+            0)
+      << log;
+  nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "u.json"));
+  size_t texels = 0;
+  for (const auto& p : report["pages"]) texels += p["width"].get<size_t>() * p["height"].get<size_t>();
+  EXPECT_LE(texels, 100000u);
+  EXPECT_GT(texels, 30000u);  // the named density uses the budget, not a small part of it
 }
 
 // A bake into a folder another bake holds fails at once (exit 3, the folder named) and writes nothing;

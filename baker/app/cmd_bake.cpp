@@ -35,6 +35,9 @@ int runBake(const Args& args) {
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
+  app->add_option("--max-texels", o.atlas.maxTexels, "texel budget of all pages together (default 16777216 = 16M);\n"
+                                                   "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
+      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
       ->transform(cli::integerIn(1, 8))->type_name("S");
   auto* clampOption = app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp (default: derived "

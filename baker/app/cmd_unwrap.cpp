@@ -56,6 +56,8 @@ int runUnwrap(const Args& args) {
   app->add_option("-o,--output", output, "the unwrapped scene")->type_name("OUT.gltf|OUT.glb");
   app->add_option("--texels-per-unit", tpu, "texel density per metre (default: fit the charts into about one target page)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
+  app->add_option("--max-texels", options.maxTexels, "texel budget of all pages together (default 16M; 0 = no limit)")
+      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--padding", options.padding, "empty texels between charts (default 2)")
       ->transform(cli::integerIn(0, 256))->type_name("P");
   app->add_option("--max-page", options.maxPageSize, "largest page edge in texels (default 2048); more pages when full")

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -75,12 +77,60 @@ std::vector<ChartUv> chartsFromUv1(const Primitive& prim, const AtlasMesh& mesh)
   return charts;
 }
 
+// The texel budget (options.maxTexels). Charts fill about kTypicalFill of the pages they are packed
+// into (the auto-fit below aims at the same figure), so N texels hold area × density² / kTypicalFill.
+constexpr double kTypicalFill = 0.6;
+
+// A density a little under the one that fits, shown with 3 significant digits.
+std::string densityThatFits(double density) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3g", density * 0.97);
+  return text;
+}
+
+[[noreturn]] void overBudget(const Scene& scene, const AtlasOptions& options, double density, double texels,
+                             double densityFits, const char* how) {
+  char message[400];
+  std::snprintf(message, sizeof(message),
+                "at %.6g texels per unit the light-map atlas %s %.4g M texels, over the budget of %.4g M "
+                "(--max-texels %zu): use --texels-per-unit %s or less, or raise --max-texels",
+                density, how, texels / 1e6, double(options.maxTexels) / 1e6, options.maxTexels,
+                densityThatFits(densityFits).c_str());
+  throw Error(ErrorCode::Usage, scene.sourcePath, message);
+}
+
+// Before any work: the surface area at the requested density.
+void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
+  if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
+  double area = 0.0;
+  for (const Primitive& p : scene.primitives)
+    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      const glm::dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]), c(p.positions[p.indices[t + 2]]);
+      area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+  const double density = options.texelsPerUnit;
+  const double estimate = area * density * density / kTypicalFill;
+  if (estimate > double(options.maxTexels))
+    overBudget(scene, options, density, estimate, std::sqrt(double(options.maxTexels) * kTypicalFill / area),
+               "would need about");
+}
+
+// After packing: the pages as they are.
+void checkTexelBudget(const Scene& scene, const AtlasOptions& options, double density, const std::vector<AtlasPage>& pages) {
+  if (options.maxTexels == 0) return;
+  double texels = 0.0;
+  for (const AtlasPage& p : pages) texels += double(p.width) * p.height;
+  if (texels > double(options.maxTexels))
+    overBudget(scene, options, density, texels, density * std::sqrt(double(options.maxTexels) / texels), "needs");
+}
+
 }  // namespace
 
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.padding < 0) throw Error(ErrorCode::Usage, "", "atlas padding must be ≥ 0");
   if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
   if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
+  checkTexelEstimate(scene, options);
   AtlasResult result;
   AtlasStats& stats = result.stats;
   auto progress = [&](double f) {
@@ -187,6 +237,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
     stats.warnings.push_back(w);
   }
   result.pages = packed.pages;
+  checkTexelBudget(scene, options, density, result.pages);
   stats.secondsPack = clock.seconds();
   progress(0.85);
 
