@@ -84,7 +84,7 @@ constexpr double kTypicalFill = 0.6;
 // A density a little under the one that fits, shown with 3 significant digits.
 std::string densityThatFits(double density) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.3g", density * 0.97);
+  std::snprintf(text, sizeof(text), "%.4g", density * 0.97);
   return text;
 }
 
@@ -92,9 +92,10 @@ std::string densityThatFits(double density) {
                              double densityFits, const char* how) {
   char message[400];
   std::snprintf(message, sizeof(message),
-                "at %.6g texels per unit the light-map atlas %s %.4g M texels, over the budget of %.4g M "
+                "at %.6g texels per unit the light-map atlas %s %.4g %stexels, over the budget of %.4g M "
                 "(--max-texels %zu): use --texels-per-unit %s or less, or raise --max-texels",
-                density, how, texels / 1e6, double(options.maxTexels) / 1e6, options.maxTexels,
+                density, how, texels < 1e9 ? texels / 1e6 : texels, texels < 1e9 ? "M " : "", double(options.maxTexels) / 1e6,
+                options.maxTexels,
                 densityThatFits(densityFits).c_str());
   throw Error(ErrorCode::Usage, scene.sourcePath, message);
 }
@@ -115,13 +116,28 @@ void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
                "would need about");
 }
 
-// After packing: the pages as they are.
-void checkTexelBudget(const Scene& scene, const AtlasOptions& options, double density, const std::vector<AtlasPage>& pages) {
-  if (options.maxTexels == 0) return;
-  double texels = 0.0;
-  for (const AtlasPage& p : pages) texels += double(p.width) * p.height;
-  if (texels > double(options.maxTexels))
-    overBudget(scene, options, density, texels, density * std::sqrt(double(options.maxTexels) / texels), "needs");
+size_t pageTexels(const std::vector<AtlasPage>& pages) {
+  size_t texels = 0;
+  for (const AtlasPage& p : pages) texels += size_t(p.width) * p.height;
+  return texels;
+}
+
+// After packing: the pages as they are. Padding does not shrink with the density, so the density
+// named is one whose packing was tried and fits.
+void checkTexelBudget(const Scene& scene, const AtlasOptions& options, const std::vector<ChartUv>& charts,
+                      atlas::PackOptions packOptions, const std::vector<AtlasPage>& pages) {
+  const size_t texels = pageTexels(pages);
+  if (options.maxTexels == 0 || texels <= options.maxTexels) return;
+  const double density = packOptions.texelsPerUnit;
+  double fits = density, used = double(texels);
+  for (int attempt = 0; attempt < 12 && used > double(options.maxTexels); ++attempt) {
+    fits *= std::sqrt(double(options.maxTexels) / used) * 0.97;
+    packOptions.texelsPerUnit = fits;
+    std::vector<ChartUv> trial = charts;  // packing places (and may scale) the charts it is given
+    used = double(pageTexels(atlas::packCharts(trial, packOptions).pages));
+  }
+  // overBudget names 0.97 × its argument: hand it the density that fitted, over 0.97.
+  overBudget(scene, options, density, double(texels), fits / 0.97, "needs");
 }
 
 }  // namespace
@@ -237,7 +253,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
     stats.warnings.push_back(w);
   }
   result.pages = packed.pages;
-  checkTexelBudget(scene, options, density, result.pages);
+  checkTexelBudget(scene, options, charts, packOptions, result.pages);
   stats.secondsPack = clock.seconds();
   progress(0.85);
 
