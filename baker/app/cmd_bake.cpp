@@ -22,9 +22,9 @@ int runBake(const Args& args) {
   bool quiet = false, noGltf = false, noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
 
-  auto app = cli::makeApp("irbake bake", "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with "
-                                              "MOZ_lightmap.\nWrites OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf "
-                                              "and the report.");
+  auto app = cli::makeApp("irbake bake",
+                          "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
+                          "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
   app->add_option("SCENE", scenes, "the glTF/GLB scene to bake");
   app->add_option("-o,--output", out, "output folder (OUTDIR)")->type_name("OUTDIR");
   app->add_option("--backend", backend, "evaluator (default gl; embree: ray-traced; reference: path traced)")
@@ -35,16 +35,19 @@ int runBake(const Args& args) {
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
-  app->add_option("--max-texels", o.atlas.maxTexels, "texel budget of all pages together (default 16777216 = 16M);\n"
-                                                   "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
+  app->add_option("--max-texels", o.atlas.maxTexels,
+                  "texel budget of all pages together (default 16777216 = 16M);\n"
+                  "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
       ->transform(cli::integerIn(1, 8))->type_name("S");
-  auto* clampOption = app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp (default: derived "
-                                                       "from the scene)")
-                          ->transform(cli::numberIn(0.0, 1e30))->type_name("B");
-  app->add_option("--clamp-k", o.clampVplsPerMean, "derived clamp: no VPL adds more than 1/K of the mean\n(default 256 "
-                                                 "with bias compensation, 16 without; 0 = automatic)")
+  auto* clampOption =
+      app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
+          ->transform(cli::numberIn(0.0, 1e30))
+          ->type_name("B");
+  app->add_option("--clamp-k", o.clampVplsPerMean,
+                  "derived clamp: no VPL adds more than 1/K of the mean\n"
+                  "(default 256 with bias compensation, 16 without; 0 = automatic)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
   app->add_flag("--no-bias-compensation", noBiasCompensation,
                "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");
@@ -53,13 +56,14 @@ int runBake(const Args& args) {
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
       ->transform(cli::integerIn(0, 65536))->type_name("N");
-  app->add_option("--interleave", o.interleave, "interleaved sampling: each texel of an N×N block sees 1/N²\nof the "
-                                              "VPLs, then a filter on the surface mixes them\n(default auto: 1..4 from "
-                                              "the texel size and the clamp radius;\n1 = every VPL everywhere)")
+  app->add_option("--interleave", o.interleave,
+                  "interleaved sampling: each texel of an N×N block sees 1/N²\n"
+                  "of the VPLs, then a filter on the surface mixes them\n"
+                  "(default auto: 1..4 from the texel size and the clamp radius;\n1 = every VPL everywhere)")
       ->transform(cli::integerOrAuto(1, 8, 0))->type_name("N|auto");
-  app->add_option("--cube-face", o.gl.cubeFaceSize, "GL backend: VPL depth-cube face size in texels\n(default auto: a "
-                                                  "shadow texel's footprint held to the\nlight-map texel spacing, "
-                                                  "128..256)")
+  app->add_option("--cube-face", o.gl.cubeFaceSize,
+                  "GL backend: VPL depth-cube face size in texels\n"
+                  "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, 128..256)")
       ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
   app->add_option("--seed", seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
   app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default 256)")

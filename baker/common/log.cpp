@@ -23,7 +23,6 @@ void emit(Level l, const char* tag, const std::string& msg) {
 }  // namespace
 
 void setProgram(const char* name) { gProgram = name; }
-const char* program() { return gProgram; }
 
 void drawStatusLine(const std::string& text) {
   std::lock_guard<std::mutex> lock(gMutex);

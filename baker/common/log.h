@@ -8,7 +8,6 @@ enum class Level { Debug, Info, Warn, Error, Quiet };
 
 // The program name before every line ("irbake: warning: ..."); irview sets "irview".
 void setProgram(const char* name);
-const char* program();
 void setLevel(Level level);
 Level level();
 void debug(const std::string& msg);
