@@ -143,6 +143,48 @@ Scene makeCornellBox() {
   return b.finish();
 }
 
+Scene makeContacts() {
+  SceneBuilder b;
+  const int floorMat = b.material("floor", glm::vec3(0.5f));
+  const int wallMat = b.material("wall", glm::vec3(0.7f));
+  const int woodMat = b.material("cupboard", {0.6f, 0.45f, 0.3f});
+  const int boxMat = b.material("box", {0.3f, 0.5f, 0.7f});
+  const int lampMat = b.material("lamp", glm::vec3(0.8f), glm::vec3(8.0f));
+  const glm::vec3 lo(0.0f), hi(4.0f, 2.5f, 3.0f), inside = 0.5f * (lo + hi);
+  // The room: floor, ceiling and walls as parts of their own (normals inward).
+  b.quadToward(b.part("floor", floorMat), {0, 0, 0}, {4, 0, 0}, {4, 0, 3}, {0, 0, 3}, inside);
+  b.quadToward(b.part("ceiling", wallMat), {0, 2.5f, 0}, {4, 2.5f, 0}, {4, 2.5f, 3}, {0, 2.5f, 3}, inside);
+  Primitive& walls = b.part("walls", wallMat);
+  b.quadToward(walls, {0, 0, 0}, {4, 0, 0}, {4, 2.5f, 0}, {0, 2.5f, 0}, inside);
+  b.quadToward(walls, {0, 0, 3}, {4, 0, 3}, {4, 2.5f, 3}, {0, 2.5f, 3}, inside);
+  b.quadToward(walls, {0, 0, 0}, {0, 0, 3}, {0, 2.5f, 3}, {0, 2.5f, 0}, inside);
+  b.quadToward(walls, {4, 0, 0}, {4, 0, 3}, {4, 2.5f, 3}, {4, 2.5f, 0}, inside);
+  // Closed boxes with outward faces (bottom included: it lies on the floor plane).
+  auto box = [&](const std::string& name, int material, glm::vec3 l, glm::vec3 h) {
+    Primitive& p = b.part(name, material);
+    const glm::vec3 c = 0.5f * (l + h);
+    auto v = [&](int i) { return glm::vec3(i & 1 ? h.x : l.x, i & 2 ? h.y : l.y, i & 4 ? h.z : l.z); };
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+    for (const auto& f : faces) b.quadToward(p, v(f[0]), v(f[1]), v(f[2]), v(f[3]), c, false);
+  };
+  box("cupboard", woodMat, {1.5f, 0.0f, 0.001f}, {2.5f, 2.0f, 0.601f});  // 1 mm in front of the back wall
+  box("box", boxMat, {0.6f, 0.0f, 1.6f}, {1.1f, 0.5f, 2.1f});
+  const float ly = 2.5f - 1e-4f;  // 0.1 mm under the ceiling
+  b.quad(b.part("lamp", lampMat), {1.75f, ly, 1.55f}, {2.25f, ly, 1.55f}, {2.25f, ly, 2.05f}, {1.75f, ly, 2.05f},
+         glm::vec3(0, -1, 0));
+
+  Camera cam;
+  cam.name = "contacts_camera";
+  // From the front wall's side, looking −Z at the cupboard (glTF cameras look down −Z).
+  cam.cameraToWorld = glm::translate(glm::mat4(1.0f), glm::vec3(2.0f, 1.4f, 2.95f)) *
+                      glm::rotate(glm::mat4(1.0f), -0.25f, glm::vec3(1, 0, 0));
+  cam.yfov = 1.2f;
+  cam.aspectRatio = 1.0f;
+  cam.znear = 0.01f;
+  b.scene.cameras.push_back(cam);
+  return b.finish();
+}
+
 Scene makeFurnace(float rho, float Le) {
   SceneBuilder b;
   int m = b.material("furnace_wall", glm::vec3(rho), glm::vec3(Le));
@@ -224,6 +266,7 @@ std::vector<NamedSample> allSamples() {
   out.push_back({"corner", makeCorner()});
   out.push_back({"thin_wall", makeThinWall()});
   out.push_back({"textured_plane", makeTexturedPlane()});
+  out.push_back({"contacts", makeContacts()});
   return out;
 }
 

@@ -47,6 +47,15 @@ Scene makeThinWall();
 // independent of albedo); albedo at a point = checker value.
 Scene makeTexturedPlane();
 
+// Contacts that a shadow map cannot resolve, from exact dimensions (metres, +Y up): a closed room
+// x ∈ [0, 4], y ∈ [0, 2.5], z ∈ [0, 3] (normals inward; floor 0.5, walls and ceiling 0.7); a cupboard
+// x ∈ [1.5, 2.5], y ∈ [0, 2], z ∈ [0.001, 0.601] standing on the floor 1 mm in front of the back wall
+// z = 0; a 0.5 m cube resting on the floor at x ∈ [0.6, 1.1], z ∈ [1.6, 2.1]
+// (bottom face on the floor plane); a 0.5 × 0.5 m emissive quad (Le = 8 W/(m² sr)) 0.1 mm under the
+// ceiling, centred at (2, ·, 1.8), facing down. No closed form: the GL backend must match the Embree
+// backend (ray-traced visibility) on the same VPLs, and both the reference integrator.
+Scene makeContacts();
+
 // Map value (E/π) at point p on the plane y = 0 (normal +Y) under a Lambertian rectangle of
 // radiance Le parallel to it at height h > 0, spanning [x0,x1] × [z0,z1] and facing down:
 // Le × the point-to-rectangle form factor (sum of four corner-aligned closed forms).

@@ -15,6 +15,8 @@ uniform vec3 lightIntensity;   // colour × intensity (W/sr or W/m²)
 uniform float lightRange;      // 0: infinite
 uniform float cosOuter, spotScale;  // spot falloff: t = clamp((cos − cosOuter)·spotScale, 0, 1), I·t²
 uniform mat4 shadowClip;       // 2D maps: world → clip
+uniform mat4 shadowClipInverse;  // 2D maps: clip → world (contact check)
+uniform int contactFlags;      // 1: alpha gets the light of lookups the map cannot resolve (contacts, edges)
 uniform float nearPlane;       // perspective maps: near plane (reversed-Z depth = near / distance)
 uniform float orthoDepthRange; // ortho: metres per unit of depth
 uniform float constantBias, slopeBias, normalOffset;
@@ -22,8 +24,23 @@ uniform float texelAngle;      // cube / perspective: angle of one texel (rad); 
 
 layout(location = 0) out vec4 result;
 
-// 1 when the point p (normal n, cosθ to the light) is lit according to the shadow map.
-float lit(vec3 p, vec3 n, float cosTheta, float r) {
+// Contact check of a lit lookup (see ambiguousWeight in vpl_accumulate.frag): the stored surface, put
+// back at the centre of its texel, must not lie in front of the receiver's plane (normal ng through p).
+// In front of it, it is something else that the bias let through: a contact the map cannot resolve.
+// Tolerance: 1e-5 of the scale for float rounding plus 5% of a texel's footprint (the rasteriser snaps
+// vertices to a sub-texel grid, which tilts a stored plane by a fraction of its change across a texel).
+bool inFrontOfPlane(vec3 stored, vec3 p, vec3 ng, float scale, float footprint) {
+  return dot(ng, stored - p) > 1e-5 * scale + 0.01 * footprint;
+}
+
+// Shadow edges: where the 2×2 texels around the lookup disagree, the one texel read decides a result the
+// map cannot resolve (the edge lies somewhere inside that texel): ambiguous as well (contactFlags).
+bool mixed(bvec4 litTexels) { return any(litTexels) && !all(litTexels); }
+
+// 1 when the point p (normal n, cosθ to the light) is lit according to the shadow map; `ambiguous` set
+// when that answer may be wrong: a contact the bias let through, or a shadow edge (contactFlags).
+float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) {
+  ambiguous = false;
   float footprint = shadowKind == 2 ? texelAngle : r * texelAngle;
   vec3 q = p + n * (normalOffset * footprint);
   float bias = shadowBias(constantBias, slopeBias, footprint, cosTheta);
@@ -31,22 +48,63 @@ float lit(vec3 p, vec3 n, float cosTheta, float r) {
     vec3 local = q - lightPosition;
     float axisDistance;
     float depth = cubeDepth(cubeMaps, 0, local, axisDistance);
-    return cubeLit(depth, axisDistance, nearPlane, bias) ? 1.0 : 0.0;
+    bool isLit = cubeLit(depth, axisDistance, nearPlane, bias);
+    if (contactFlags != 0) {
+      if (isLit && depth > 0.0) {
+        // The stored surface at the centre of its texel (axis distance near / depth).
+        vec3 stored = lightPosition + cubeTexelCentreDirection(local, textureSize(cubeMaps, 0).x) * (nearPlane / depth);
+        ambiguous = inFrontOfPlane(stored, p, ng, length(stored - lightPosition), footprint);
+      }
+      // The 2×2 texels around the lookup in its face (as cubeDepth's table).
+      vec3 a = abs(local);
+      bool xMajor = a.x >= a.y && a.x >= a.z;
+      bool yMajor = !xMajor && a.y >= a.z;
+      int face = xMajor ? (local.x >= 0.0 ? 0 : 1) : (yMajor ? (local.y >= 0.0 ? 2 : 3) : (local.z >= 0.0 ? 4 : 5));
+      vec2 sctc = xMajor ? vec2(local.x >= 0.0 ? -local.z : local.z, -local.y)
+                         : (yMajor ? vec2(local.x, local.y >= 0.0 ? local.z : -local.z)
+                                   : vec2(local.z >= 0.0 ? local.x : -local.x, -local.y));
+      int size = textureSize(cubeMaps, 0).x;
+      ivec2 t0 = clamp(ivec2(floor((sctc / axisDistance * 0.5 + 0.5) * float(size) - 0.5)), ivec2(0), ivec2(size - 2));
+      vec4 d = vec4(texelFetch(cubeMaps, ivec3(t0, face), 0).r, texelFetch(cubeMaps, ivec3(t0 + ivec2(1, 0), face), 0).r,
+                    texelFetch(cubeMaps, ivec3(t0 + ivec2(0, 1), face), 0).r, texelFetch(cubeMaps, ivec3(t0 + 1, face), 0).r);
+      ambiguous = ambiguous || mixed(lessThanEqual(axisDistance * d, vec4(nearPlane) + bias * d));
+    }
+    return isLit ? 1.0 : 0.0;
   }
   vec4 c = shadowClip * vec4(q, 1.0);
   if (c.w <= 0.0) return 0.0;
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadowKind == 2 ? 1.0 : 0.0;
-  float depth = textureLod(mapDepth, uv, 0.0).r;
-  if (shadowKind == 1) {
-    return cubeLit(depth, c.w, nearPlane, bias) ? 1.0 : 0.0;
+  // The texel picked here (not by the sampler's own rounding), so its centre below is the one read.
+  ivec2 size = textureSize(mapDepth, 0);
+  ivec2 texel = clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
+  float depth = texelFetch(mapDepth, texel, 0).r;
+  bool isLit = shadowKind == 1 ? cubeLit(depth, c.w, nearPlane, bias)
+                               : !(c.z * orthoDepthRange > depth * orthoDepthRange + bias);
+  bool drawn = shadowKind == 1 ? depth > 0.0 : depth < 1.0;
+  if (contactFlags != 0) {
+    if (isLit && drawn) {
+      // The stored surface at the centre of its texel, back in world space.
+      vec2 centre = (vec2(texel) + 0.5) / vec2(size);
+      vec4 w = shadowClipInverse * vec4(centre * 2.0 - 1.0, depth, 1.0);
+      vec3 stored = w.xyz / w.w;
+      ambiguous = inFrontOfPlane(stored, p, ng, shadowKind == 2 ? orthoDepthRange : length(stored - lightPosition),
+                                 footprint);
+    }
+    ivec2 t0 = clamp(ivec2(floor(uv * vec2(size) - 0.5)), ivec2(0), size - 2);
+    vec4 d = vec4(texelFetch(mapDepth, t0, 0).r, texelFetch(mapDepth, t0 + ivec2(1, 0), 0).r,
+                  texelFetch(mapDepth, t0 + ivec2(0, 1), 0).r, texelFetch(mapDepth, t0 + 1, 0).r);
+    bvec4 l = shadowKind == 1 ? lessThanEqual(c.w * d, vec4(nearPlane) + bias * d)
+                              : lessThanEqual(vec4(c.z * orthoDepthRange), d * orthoDepthRange + bias);
+    ambiguous = ambiguous || mixed(l);
   }
-  return c.z * orthoDepthRange > depth * orthoDepthRange + bias ? 0.0 : 1.0;
+  return isLit ? 1.0 : 0.0;
 }
 
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
+  float leak = 0.0;
   for (int l = 0; l < layers; ++l) {
     vec4 pw = texelFetch(gPositionWeight, ivec3(px, l), 0);
     if (pw.w <= 0.0) continue;
@@ -73,7 +131,10 @@ void main() {
     vec3 ng = texelFetch(gGeomNormal, ivec3(px, l), 0).xyz;
     float cosGeom = dot(ng, toLight);  // ≤ 0: the sample's own triangle hides the light
     if (cosTheta <= 0.0 || cosGeom <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
-    sum += pw.w * e * cosTheta * lit(pw.xyz, n, cosGeom, r);
+    bool ambiguous;
+    vec3 unshadowed = pw.w * e * cosTheta;
+    sum += unshadowed * lit(pw.xyz, n, ng, cosGeom, r, ambiguous);
+    leak += ambiguous ? dot(unshadowed, vec3(1.0 / 3.0)) : 0.0;  // what the texel gets if the answer is wrong
   }
-  result = vec4(sum / kPi, 0.0);
+  result = vec4(sum / kPi, leak / kPi);
 }

@@ -31,6 +31,26 @@ float cubeDepth(sampler2DArray cubes, int cube, vec3 v, out float axisDistance) 
   return texelFetch(cubes, ivec3(texel, 6 * cube + face), 0).r;
 }
 
+// The direction (axis component ±1) of the centre of the cube texel that the lookup point v reads in
+// cubeDepth: the inverse of the face table, so a stored depth can be put back where it was rendered.
+vec3 cubeTexelCentreDirection(vec3 v, int size) {
+  vec3 a = abs(v);
+  bool xMajor = a.x >= a.y && a.x >= a.z;
+  bool yMajor = !xMajor && a.y >= a.z;
+  float axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
+  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
+  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
+                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  ivec2 texel = clamp(ivec2((sctc / axisDistance * 0.5 + 0.5) * float(size)), ivec2(0), ivec2(size - 1));
+  vec2 q = (vec2(texel) + 0.5) / float(size) * 2.0 - 1.0;
+  return face == 0 ? vec3(1.0, -q.y, -q.x)
+       : face == 1 ? vec3(-1.0, -q.y, q.x)
+       : face == 2 ? vec3(q.x, 1.0, q.y)
+       : face == 3 ? vec3(q.x, -1.0, -q.y)
+       : face == 4 ? vec3(q.x, -q.y, 1.0)
+                   : vec3(-q.x, -q.y, -1.0);
+}
+
 // Fraction of a 2×2 texel neighbourhood (bilinear weights, percentage-closer filtering) that lets
 // the lookup point v see the cube's centre: shadow edges become fractional instead of one texel of
 // all-or-nothing, which halves the edge error against ray-traced visibility at the same map size.

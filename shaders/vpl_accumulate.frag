@@ -17,7 +17,9 @@
 layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
 layout(binding = 4) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle
-#if defined(SHADOW_COMPARE)
+#if defined(CONTACT_FLAGS)
+layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, raw depths (2×2 filter by textureGather)
+#elif defined(SHADOW_COMPARE)
 layout(binding = 2) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
 #else
 layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, 5 tiles per VPL cube
@@ -66,9 +68,52 @@ ivec2 tileOrigin(int cube, int face) {
 
 layout(location = 0) out vec4 result;
 
+#ifdef CONTACT_FLAGS
+// Receiver-plane check of a biased lookup (contact leaks). The depth bias lets through whatever lies
+// within `bias` in front of the receiver: its own surface (why the bias exists) but also a true occluder
+// at a contact (a box on a floor, a lamp 0.1 mm under a ceiling, a wall 1 mm behind a cupboard). Each
+// of the 2×2 texels the filter counted as lit is put back on its own ray: where the plane of the
+// receiver's triangle meets that ray (axis distance nv / (n·w(q))), the stored surface must not lie in
+// front of it. Returns the filter weight of texels that fail: the lookup cannot tell a contact from
+// the receiver, and the backend resolves the texel with rays (gl_backend.cpp, contact texels).
+// n: the receiver triangle's normal in the cube frame; v: the lookup point (cube frame); q0: face
+// coordinates (axis-normalised, −1…1) of texel (i0, j0)'s centre; dq: one texel in those units.
+float ambiguousWeight(int face, vec3 n, vec3 v, vec4 stored, float reference, vec2 q0, float dq, vec2 f, vec2 ql) {
+  // n·w(q) = a0 + q.x·as + q.y·at for the face's direction w(q) (the inverse of the lookup's face table).
+  vec3 a = face == 0 ? vec3(n.x, -n.z, -n.y)
+         : face == 1 ? vec3(-n.x, n.z, -n.y)
+         : face == 2 ? vec3(n.y, n.x, n.z)
+         : face == 3 ? vec3(-n.y, n.x, -n.z)
+                     : vec3(n.z, n.x, -n.y);
+  float nv = dot(n, v);  // < 0: the receiver faces the cube's origin
+  // Tolerance: the rasteriser snaps vertices to a sub-texel grid, so a stored plane is off by a small
+  // fraction of its depth change across one texel (at the lookup: |∂A/∂q|·dq); 5% of that, plus 1e-5 of
+  // the distance for float rounding. A contact nearly face-on (a lamp 0.1 mm under a ceiling lit from
+  // below) stays far above it; at grazing angles the slope bias itself is of that order.
+  float Dl = a.x + ql.x * a.y + ql.y * a.z;
+  float Al = nv / min(Dl, -1e-30);
+  float tol = 1e-5 * Al + 0.05 * Al * (abs(a.y) + abs(a.z)) * dq / max(abs(Dl), 1e-30);
+  // textureGather order: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0).
+  vec4 qx = vec4(q0.x, q0.x + dq, q0.x + dq, q0.x);
+  vec4 qy = vec4(q0.y + dq, q0.y + dq, q0.y, q0.y);
+  vec4 D = a.x + qx * a.y + qy * a.z;
+  // The plane's axis distance on each texel's ray (a ray that never meets it: infinitely far), and the
+  // stored surface's (near / s).
+  vec4 planeDepth = mix(vec4(3.0e38), nv / min(D, vec4(-1e-30)), lessThan(D, vec4(0.0)));
+  vec4 storedDepth = nearPlane / max(stored, vec4(1e-30));
+  bvec4 litTexel = lessThanEqual(stored, vec4(reference));
+  bvec4 drawn = greaterThan(stored, vec4(0.0));
+  vec4 inFront = vec4(lessThan(storedDepth, planeDepth - tol));
+  vec4 amb = vec4(litTexel) * vec4(drawn) * inFront;
+  vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+  return dot(amb, w);
+}
+#endif
+
 // Fraction of the lookup point (local: relative to the cube's origin, in its frame) that sees the
 // cube's centre, 2×2 percentage-closer filtered (or a single texel without SHADOW_PCF).
-float vplVisibility(int cube, vec3 v, float bias) {
+float vplVisibility(int cube, vec3 v, float bias, vec3 nLocal, out float ambiguous) {
+  ambiguous = 0.0;
   vec3 a = abs(v);
   bool xMajor = a.x >= a.y && a.x >= a.z;
   bool yMajor = !xMajor && a.y >= a.z;
@@ -76,7 +121,33 @@ float vplVisibility(int cube, vec3 v, float bias) {
   int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
   vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
                      : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
-#ifdef SHADOW_COMPARE
+#ifdef CONTACT_FLAGS
+  // As SHADOW_COMPARE below, with the 2×2 filter done by hand on textureGather's raw depths, so that
+  // every texel the bias lets through is checked against the receiver's plane (ambiguousWeight).
+  float ax = axisDistance - bias;
+  float inv = 1.0 / (axisDistance * ax);
+  if (face == 5) return 1.0;
+  if (ax <= nearPlane) {  // the receiver lies within the bias of the cube's origin: unresolvable
+    ambiguous = 1.0;
+    return 1.0;
+  }
+  float reference = nearPlane * axisDistance * inv;
+  vec2 t = clamp(sctc * (0.5 * faceSize * ax * inv) + 0.5 * faceSize, vec2(0.5), vec2(faceSize - 0.5));
+  // The 2×2 texels are picked here (i0 = floor(t − 0.5)) and gathered at their shared corner, where the
+  // sampler's own rounding of the coordinate (8 sub-texel bits on llvmpipe) cannot pick other ones.
+  vec2 st = t - 0.5;
+  vec2 i0 = floor(st);
+  vec2 f = st - i0;
+  vec4 stored = textureGather(vplDepth, (i0 + 1.0 + vec2(tileOrigin(cube, face))) * atlasInvSize);
+  vec4 litTexel = vec4(lessThanEqual(stored, vec4(reference)));
+  float visibility = mix(mix(litTexel.w, litTexel.z, f.x), mix(litTexel.x, litTexel.y, f.x), f.y);
+  if (visibility > 0.0) {
+    float dq = 2.0 / faceSize;
+    vec2 q0 = (i0 + 0.5) * dq - 1.0;
+    ambiguous = ambiguousWeight(face, nLocal, v, stored, reference, q0, dq, f, sctc / axisDistance);
+  }
+  return visibility;
+#elif defined(SHADOW_COMPARE)
   // lit where stored ≤ near / (axis − bias) (reversed-Z); axis ≤ bias: always lit (reference 1 ≥ any depth).
   // One division for both 1/axis and 1/(axis − bias); where axis − bias ≤ near the reference is 1 and
   // the coordinates do not matter. The −Z face (below the VPL's surface, never drawn) is lit.
@@ -113,7 +184,7 @@ float vplVisibility(int cube, vec3 v, float bias) {
 // geometric normal ng. The cosine is the shading normal's; the depth bias follows the triangle the cube
 // sampled (ng), and a receiver whose own triangle faces away from the VPL is in its own shadow (as the
 // ray tracer finds: its shadow ray crosses that triangle first).
-vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, vec3 ng, float noClamp) {
+vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, vec3 ng, float noClamp, inout float leak) {
   vec3 d = v.position - x;  // receiver → VPL
   float cx = dot(nx, d), cy = -dot(v.normal, d), cg = dot(ng, d);
   float r2 = dot(d, d);
@@ -128,14 +199,19 @@ vec3 vplTerm(Vpl v, int cube, vec3 x, vec3 nx, vec3 ng, float noClamp) {
   local += vec3(dot(o, v.tangent), dot(o, v.bitangent), dot(o, v.normal));
 #endif
   float bias = shadowBiasTan(constantBias, slopeBias, footprint, sqrt(max(r2 - cg * cg, 0.0)) / cg);
-  float visibility = vplVisibility(cube, local, bias);
+  vec3 nLocal = vec3(dot(ng, v.tangent), dot(ng, v.bitangent), dot(ng, v.normal));
+  float ambiguous;
+  float visibility = vplVisibility(cube, local, bias, nLocal, ambiguous);
   // Selected, not multiplied: behind either surface the lookup may be meaningless (even NaN).
-  return (cx > 0.0 && cy > 0.0 && cg > 0.0) ? v.power * (g * visibility) : vec3(0.0);
+  bool front = cx > 0.0 && cy > 0.0 && cg > 0.0;
+  leak += front ? dot(v.power, vec3(1.0 / 3.0)) * g * ambiguous : 0.0;
+  return front ? v.power * (g * visibility) : vec3(0.0);
 }
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
+  float leak = 0.0;
   float noClamp = clampBound > 0.0 ? clampBound : 3.0e38;
 #ifdef LAYERS
   const int layerCount = LAYERS;
@@ -148,8 +224,12 @@ void main() {
     vec3 nx = texelFetch(gNormal, ivec3(p, l), 0).xyz;
     vec3 ng = texelFetch(gGeomNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
-    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, ng, noClamp);
+    float sampleLeak = 0.0;
+    for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, ng, noClamp, sampleLeak);
     sum += pw.w > 0.0 ? pw.w * s : vec3(0.0);
+    leak += pw.w > 0.0 ? pw.w * sampleLeak : 0.0;
   }
-  result = vec4(sum * kInvPi2, 0.0);
+  // alpha: the channel-mean light that lookups let through without being able to tell a contact from
+  // the receiver (CONTACT_FLAGS; 0 otherwise), in map units like rgb.
+  result = vec4(sum * kInvPi2, leak * kInvPi2);
 }

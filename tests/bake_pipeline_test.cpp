@@ -4,14 +4,19 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "common/error.h"
+#include "export/exr_io.h"
 #include "pipeline/bake.h"
 #include "raytrace/ray_tracer.h"
+#include "scene/environment.h"
 #include "scene/gltf_loader.h"
+#include "samples/sample_scenes.h"
 #include "texels/texel_samples.h"
 
 namespace fs = std::filesystem;
@@ -110,6 +115,68 @@ TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
     if (interleave == 2) {
       EXPECT_EQ(r.report["interleave"]["classes"].get<int>(), 4);
     }
+  }
+}
+
+// Issue 11: high albedo with default options (only the texel density lowered to keep the test short:
+// the mean does not depend on it). The walk no longer stops at a fixed 16 bounces (−17% at ρ = 0.9, −84%
+// at ρ = 0.99): it follows the light up to its VPL budget and adds the rest as a geometric tail.
+TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
+  for (float rho : {0.9f, 0.99f})
+    for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree}) {
+      BakeOptions o;
+      o.backend = backend;
+      o.atlas.texelsPerUnit = 12.0f;
+      const float Le = 1.0f - rho;  // exact map Le/(1−ρ) = 1
+      BakeResult r = bake(samples::makeFurnace(rho, Le), o);
+      double sum = 0.0, worst = 0.0;
+      size_t n = 0;
+      for (const auto& m : r.maps)
+        for (size_t i = 0; i < m.size(); ++i)
+          if (m.valid[i]) {
+            const double v = (m.texels[i].x + m.texels[i].y + m.texels[i].z) / 3.0;
+            sum += v;
+            worst = std::max(worst, std::abs(v - 1.0));
+            ++n;
+          }
+      ASSERT_GT(n, 1000u);
+      const double mean = sum / n;
+      std::printf("[ figure ] furnace rho %.2f %s, defaults: mean %.5f (exact 1), worst texel %+.2f%%, %d bounces, "
+                  "%zu VPLs, tail factor %.2f\n",
+                  rho, toString(backend), mean, 100 * worst, r.report["vpls"]["bounces"].get<int>(),
+                  r.report["vpls"]["count"].get<size_t>(), r.vpls.tailFactor.x);
+      EXPECT_NEAR(mean, 1.0, rho < 0.95f ? 0.01 : 0.03) << "rho " << rho << " " << toString(backend);
+    }
+}
+
+// Issue 12: a uniform sky over an open plane gives map = L on every backend (its bounces cannot reach the
+// plane again); a plane under a box's overhang gets less, the same on GL and Embree.
+TEST(BakePipeline, UniformSkyOverAnOpenPlaneOnEveryBackend) {
+  for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree, BackendKind::Reference}) {
+    Scene s = samples::makePointOverPlane();
+    s.lights.clear();
+    s.environment = Environment::uniform({0.5f, 0.7f, 1.0f});
+    BakeOptions o;
+    o.backend = backend;
+    o.atlas.texelsPerUnit = 3.0f;
+    o.walk.paths = 256;
+    o.referenceSpp = 16;
+    BakeResult r = bake(std::move(s), o);
+    glm::dvec3 sum(0.0), worst(0.0);
+    size_t n = 0;
+    for (const auto& m : r.maps)
+      for (size_t i = 0; i < m.size(); ++i)
+        if (m.valid[i]) {
+          sum += glm::dvec3(m.texels[i]);
+          worst = glm::max(worst, glm::abs(glm::dvec3(m.texels[i]) - glm::dvec3(0.5, 0.7, 1.0)));
+          ++n;
+        }
+    ASSERT_GT(n, 100u);
+    std::printf("[ figure ] uniform sky, open plane, %s: mean (%.5f %.5f %.5f), exact (0.5 0.7 1), worst |err| %.2e\n",
+                toString(backend), sum.x / n, sum.y / n, sum.z / n, worst.z);
+    EXPECT_NEAR(sum.x / n, 0.5, 1e-4) << toString(backend);
+    EXPECT_NEAR(sum.z / n, 1.0, 2e-4) << toString(backend);
+    EXPECT_LT(worst.z, 1e-3) << toString(backend);
   }
 }
 
@@ -230,4 +297,40 @@ TEST(BakePipeline, SeamsOfASmoothSphereAreStitched) {
     for (size_t i = 0; i < m.size(); ++i)
       if (m.valid[i]) brightest = std::max(brightest, double(m.texels[i].x));
   EXPECT_NEAR(brightest, exact, 0.03 * exact);
+}
+
+// An equirectangular EXR read through the imageio plugin keeps every texel, its size and its source;
+// a file that is not an image is InvalidData naming it.
+TEST(EnvironmentFile, LoadsThroughTheImagePluginTexelForTexel) {
+  const std::filesystem::path dir = std::filesystem::current_path() / "test_scratch" / "environment_file";
+  std::filesystem::create_directories(dir);
+  Lightmap map;
+  map.width = 4;
+  map.height = 2;
+  for (int i = 0; i < 8; ++i) map.texels.push_back(glm::vec3(0.5f * i, 1.0f + i, 0.25f));
+  map.valid.assign(8, 1);
+  writeExr(map, dir / "sky.exr");
+  const Environment env = loadEnvironment(dir / "sky.exr", 2.0f);
+  ASSERT_EQ(env.width(), 4);
+  ASSERT_EQ(env.height(), 2);
+  EXPECT_EQ(env.source(), (dir / "sky.exr").string());
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const glm::vec3 t = map.texels[size_t(y) * 4 + x] * 2.0f;  // the intensity scales every texel
+      // The direction through the texel's centre (+Y up; φ from -Z towards +X).
+      const double theta = M_PI * (y + 0.5) / 2.0, phi = 2.0 * M_PI * (x + 0.5) / 4.0 - M_PI;
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const glm::vec3 e = env.radiance(d);
+      EXPECT_NEAR(e.x, t.x, 1e-6f);
+      EXPECT_NEAR(e.y, t.y, 1e-6f);
+      EXPECT_NEAR(e.z, t.z, 1e-6f);
+    }
+  std::ofstream(dir / "not_an_image.exr") << "plain text";
+  try {
+    loadEnvironment(dir / "not_an_image.exr");
+    FAIL() << "text accepted as an environment";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("not_an_image.exr"), std::string::npos) << e.what();
+  }
 }

@@ -12,8 +12,8 @@ int runSamples(const Args& args) {
   std::vector<std::string> folders;
   bool quiet = false;
   auto app = cli::makeApp("irbake samples",
-                              "Writes cornell_box, furnace, point_over_plane, quad_over_plane, corner, thin_wall and\n"
-                              "textured_plane as OUTDIR/<name>.gltf (+ .bin).");
+                          "Writes cornell_box, furnace, point_over_plane, quad_over_plane, corner, thin_wall,\n"
+                          "textured_plane and contacts as OUTDIR/<name>.gltf (+ .bin).");
   app->add_option("OUTDIR", folders, "output folder");
   app->add_flag("--quiet", quiet, "do not list the files written");
   if (!cli::parse(*app, args)) return 0;

@@ -54,7 +54,9 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
       report["gl"] = {{"setupSeconds", total.setupSeconds},   {"shadowSeconds", total.shadowSeconds},
                       {"accumulateSeconds", total.accumulateSeconds}, {"foldSeconds", total.foldSeconds},
                       {"passes", total.passes},               {"facesRendered", total.facesRendered},
-                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize}};
+                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize},
+                      {"contactTexels", total.contactTexels},   {"contactSeconds", total.contactSeconds},
+                      {"contactFraction", total.texelsEvaluated ? double(total.contactTexels) / total.texelsEvaluated : 0.0}};
       report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
       return maps;
     }
@@ -205,6 +207,20 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
     if (r.maps[p].valid.size() != r.maps[p].size()) r.maps[p].valid = texels[p].valid;
   }
   seconds["backend"] = stage.seconds();
+
+  // The sky's direct light, traced (every VPL backend; the reference integrator finds the sky itself).
+  // Before the compensation, whose gather reads the map as the light leaving each surface.
+  if (s.environment.present() && options.backend != BackendKind::Reference) {
+    stage.reset();
+    SkyLightOptions so = options.sky;
+    so.seed = options.walk.seed;
+    SkyLightStats ss;
+    addSkyLight(inputs, r.maps, so, &ss);
+    seconds["sky"] = stage.seconds();
+    report["sky"] = {{"rays", ss.rays}, {"raysPerSample", ss.raysPerSample},
+                     {"uniform", s.environment.isUniform()}, {"source", s.environment.source()},
+                     {"integral", rgb(s.environment.integral())}};
+  }
 
   if (compensate) {
     stage.reset();

@@ -10,6 +10,7 @@
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/gl/gl_backend.h"
+#include "backend/sky/sky_light.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
@@ -33,6 +34,7 @@ struct BakeOptions {
   WalkOptions walk;                       // VPL paths, bounces, seed
   VplEvalOptions eval = compensatedEval();  // clamp (0 = derived from the scene), bias compensation (on)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
+  SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)

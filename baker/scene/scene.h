@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/environment.h"
+
 namespace irbake {
 
 struct Bounds3 {
@@ -126,6 +128,7 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
+  Environment environment;         // the sky (none unless --sky / --env)
   LoadStats stats;
   // Baked float pages named in the root extras of an irbake export ("lightmapPages": [uri, ...]),
   // resolved to paths beside the glTF; empty for other scenes.

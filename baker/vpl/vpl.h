@@ -21,8 +21,10 @@ struct Vpl {
 
 struct WalkOptions {
   int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights)
-  int maxBounces = -1;     // -1 = auto: follow the energy left (ρ̄^j N ≥ 1 path), capped by bounceCap
-  int bounceCap = 16;      // hard cap for auto
+  int maxBounces = -1;     // -1 = auto (autoBounceDepth); ≥ 0: exactly this deepest bounce, no tail added
+  double tailEnergy = 1e-3;      // auto: stop once the light not yet placed, ρ̄^(J+1), is below this fraction
+  double maxVplsPerPath = 8.0;   // auto: VPL budget Σ_j M_j ≤ this × N (a scene of ρ̄ = 0.9 reaches J = 14)
+  bool geometricTail = true;     // auto: the bounces beyond J added to bounce J as a geometric series
   uint32_t seed = 0;       // Halton scramble / start offset
   ProgressCallback progress;
 };
@@ -34,7 +36,20 @@ struct VplSet {
   glm::dvec3 emittedPower{0.0};             // area emitters + punctual lights (W)
   double meanReflectivity = 0.0;            // ρ̄ used for the path-count reduction
   int bounces = 0;                          // deepest bounce generated
+  glm::dvec3 tailFactor{1.0};               // bounces ⌈J/2⌉…J carry this × their own power: with it, the
+                                            // light of bounces > J, P_J r/(1−r) per channel, r the ratio of
+                                            // successive bounce powers pooled over those bounces
 };
+
+// The deepest bounce of the auto walk for N paths at mean reflectivity ρ̄: the largest J with
+// M_J = ⌊N ρ̄^J⌋ ≥ 1 while ρ̄^J ≥ tailEnergy (the light left after J − 1 is still worth placing) and
+// Σ_{j≤J} M_j ≤ maxVplsPerPath · N. The light beyond J is added as a tail (docs/units.md).
+int autoBounceDepth(uint64_t paths, double rho, const WalkOptions& options);
+
+// 1/(1 − r) per channel with r = lastPower / previousPower clamped to [0, 0.999]: the bounces beyond J, each assumed
+// to be the previous one times r (exact when the bounce distribution has reached the transport
+// operator's dominant mode, e.g. a closed furnace, where r = ρ).
+glm::dvec3 geometricTailFactor(const glm::dvec3& lastPower, const glm::dvec3& previousPower);
 
 VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options);
 

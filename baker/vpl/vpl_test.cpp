@@ -96,6 +96,7 @@ TEST(Walk, EnergyOfAreaEmitterWalkIsExactInAClosedRoom) {
   RayTracer rt(s);
   WalkOptions o;
   o.paths = 1000;
+  o.geometricTail = false;  // the bounces as walked; the tail has its own test
   VplSet set = generateVpls(s, rt, o);
   double rho = set.meanReflectivity;
   EXPECT_NEAR(rho, 0.6, 1e-6);
@@ -128,12 +129,61 @@ TEST(Walk, EnergyIsExactWhenStartsLieOnEdges) {
     RayTracer rt(s);
     WalkOptions o;
     o.paths = 1024;
-    o.bounceCap = 200;
+    o.tailEnergy = 0.0;       // walk until ρ̄^j N < 1
+    o.maxVplsPerPath = 1e9;
+    o.geometricTail = false;
     VplSet set = generateVpls(s, rt, o);
     double Phi = kPi * 6.0, expected = 0.0;
     for (int j = 0; j <= set.bounces; ++j) expected += Phi * std::pow(double(rho), j);
     EXPECT_NEAR(sumPower(set), expected, 1e-6 * expected) << "rho " << rho;
     EXPECT_EQ(set.bounces, static_cast<int>(std::floor(std::log(1024.0) / -std::log(double(rho)) + 1e-9)));
+  }
+}
+
+// The auto depth: the energy rule, the VPL budget, and the survivor rule, each where it binds.
+TEST(Walk, AutoBounceDepthFollowsEnergyAndBudget) {
+  WalkOptions o;  // tailEnergy 1e-3, budget 8 VPLs per path
+  // ρ̄ = 0.5: 0.5^9 = 2.0e-3 ≥ 1e-3 > 0.5^10; the budget (Σ ≤ 2N) never binds.
+  EXPECT_EQ(autoBounceDepth(1024, 0.5, o), 9);
+  // ρ̄ = 0.9: Σ_{j≤J} 0.9^j ≤ 8 ⇔ 1 − 0.9^(J+1) ≤ 0.8 ⇔ J ≤ 14.3 (survivor floors shift it by < 1 path).
+  EXPECT_EQ(autoBounceDepth(1 << 20, 0.9, o), 14);
+  // ρ̄ = 0.99: Σ 0.99^j ≤ 8 ⇔ J ≤ 7.3.
+  EXPECT_EQ(autoBounceDepth(1 << 20, 0.99, o), 7);
+  // Few paths: ⌊N ρ̄^J⌋ ≥ 1 binds first (4 · 0.5^2 = 1).
+  EXPECT_EQ(autoBounceDepth(4, 0.5, o), 2);
+  o.maxVplsPerPath = 1e9;
+  o.tailEnergy = 0.0;
+  EXPECT_EQ(autoBounceDepth(1024, 0.9, o), static_cast<int>(std::floor(std::log(1024.0) / -std::log(0.9) + 1e-9)));
+}
+
+TEST(Walk, GeometricTailFactorIsOneOverOneMinusRatio) {
+  const glm::dvec3 f = geometricTailFactor(glm::dvec3(0.9, 0.5, 0.0), glm::dvec3(1.0, 1.0, 1.0));
+  EXPECT_NEAR(f.x, 10.0, 1e-9);
+  EXPECT_NEAR(f.y, 2.0, 1e-9);
+  EXPECT_NEAR(f.z, 1.0, 1e-12);  // nothing left in that channel
+  EXPECT_NEAR(geometricTailFactor(glm::dvec3(2.0), glm::dvec3(1.0)).x, 1000.0, 1e-6);  // r clamped to 0.999
+}
+
+// High-albedo furnaces: the auto walk stops at the VPL budget and adds the rest as a geometric tail;
+// in a closed grey box every bounce is the previous one times ρ, so the total is Φ/(1−ρ) exactly.
+TEST(Walk, TailMakesHighAlbedoFurnaceEnergyExact) {
+  for (float rho : {0.9f, 0.99f}) {
+    Scene s;
+    addBox(s, addMaterial(s, glm::vec3(rho), glm::vec3(1.0f)), glm::vec3(0), glm::vec3(1), true, 2);
+    RayTracer rt(s);
+    WalkOptions o;
+    o.paths = 1024;
+    VplSet set = generateVpls(s, rt, o);
+    const double Phi = kPi * 6.0, exact = Phi / (1.0 - rho);
+    EXPECT_NEAR(sumPower(set), exact, 1e-5 * exact) << "rho " << rho;
+    // Bounces ⌈J/2⌉…J (power Φ Σ ρ^j) also carry the tail Φ ρ^(J+1)/(1−ρ).
+    const int J = set.bounces;
+    double carriers = 0.0;
+    for (int j = std::max(1, (J + 1) / 2); j <= J; ++j) carriers += std::pow(double(rho), j);
+    EXPECT_NEAR(set.tailFactor.x, 1.0 + std::pow(double(rho), J + 1) / (1.0 - rho) / carriers, 1e-4) << "rho " << rho;
+    EXPECT_LE(static_cast<double>(set.vpls.size()), o.maxVplsPerPath * o.paths);
+    std::printf("[ figure ] furnace walk rho=%.2f: %d bounces, %zu VPLs, tail factor %.2f, power %.6f of exact\n", rho,
+                set.bounces, set.vpls.size(), set.tailFactor.x, sumPower(set) / exact);
   }
 }
 

@@ -169,15 +169,19 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
   const size_t tile = static_cast<size_t>(std::max(1, options.tileSlots));
   const size_t numVpls = in.eval.includeVpls ? in.vpls.vpls.size() : 0;
 
-  for (const TexelSamples& ts : in.texels) {
+  for (size_t page = 0; page < in.texels.size(); ++page) {
+    const TexelSamples& ts = in.texels[page];
     Lightmap map = blankLightmap(ts);
-    const size_t slots = ts.slotCount();
+    const size_t slots = ts.slotCount(), layer = std::max<size_t>(1, ts.layerSize());
     std::vector<glm::vec3> slotValue(slots, glm::vec3(0.0f));
+    const std::vector<uint8_t>* subset =
+        options.texelSubset && page < options.texelSubset->size() ? &(*options.texelSubset)[page] : nullptr;
+    auto wanted = [&](size_t t) { return !subset || (t < subset->size() && (*subset)[t] != 0); };
 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, tile), [&](const tbb::blocked_range<size_t>& r) {
       std::vector<size_t> active;
       for (size_t s = r.begin(); s != r.end(); ++s)
-        if (ts.positionWeight[s].w > 0.0f) active.push_back(s);
+        if (ts.positionWeight[s].w > 0.0f && wanted(s % layer)) active.push_back(s);
       std::vector<KahanSum> acc(active.size());
       // VPLs in blocks: one block stays hot in cache while every sample of the tile loops over it.
       for (size_t b0 = 0; b0 < numVpls; b0 += block) {
@@ -211,6 +215,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
 
     for (size_t t = 0; t < ts.layerSize(); ++t) {
       glm::vec3 value;
+      if (!wanted(t)) continue;
       if (!texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value)) continue;
       if (!ts.valid.empty() && ts.valid[t] == 0) continue;
       if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z))

@@ -20,6 +20,9 @@ struct EmbreeOptions {
   int vplBlock = 256;            // VPLs per block: a block stays in cache while a tile of samples loops over it
   int tileSlots = 64;            // texel samples per parallel task
   bool packets = true;           // shadow rays in packets of 8 (rtcOccluded8): 1.5–1.6× faster than one by one
+  // Per page, per texel: evaluate only texels marked ≠ 0, the rest come back invalid (null: every texel).
+  // The GL backend resolves its contact texels this way.
+  const std::vector<std::vector<uint8_t>>* texelSubset = nullptr;
 };
 
 // One Lightmap per TexelSamples page; valid = the texel's valid flag. Throws Error(NumericError) on NaN/Inf.

@@ -1,5 +1,7 @@
 #include "backend/gl/gl_backend.h"
 
+#include "backend/embree/embree_backend.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -206,9 +208,10 @@ struct GpuPage {
   const TexelSamples* samples = nullptr;
   GLuint positionWeight = 0, normal = 0, geomNormal = 0, accum = 0, validDepth = 0, fbo = 0;
   std::vector<glm::dvec3> sum;
+  std::vector<double> leak;  // alpha: light of lookups that could not tell a contact from the receiver
   std::vector<glm::vec4> readback;
   GpuPage(const TexelSamples& s, const Scene& scene, bool validityMask)
-      : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)) {
+      : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)), leak(s.layerSize(), 0.0) {
     const int layers = s.supersample * s.supersample;
     if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
       throw Error(ErrorCode::InvalidData, "", "texel samples of page " + std::to_string(s.page) + " are incomplete");
@@ -265,7 +268,10 @@ struct GpuPage {
     readback.resize(samples->layerSize());
     glGetTextureImage(accum, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(readback.size() * sizeof(glm::vec4)),
                       readback.data());
-    for (size_t i = 0; i < sum.size(); ++i) sum[i] += glm::dvec3(readback[i]);
+    for (size_t i = 0; i < sum.size(); ++i) {
+      sum[i] += glm::dvec3(readback[i]);
+      leak[i] += readback[i].w;
+    }
     clear();
   }
 };
@@ -276,6 +282,8 @@ class GlBaker {
       : in_(in), opt_(opt), stats_(stats), programs_(programs) {}
 
   std::vector<Lightmap> run();
+  // Per page, per texel: 1 where the shadow lookups could not tell a contact from the receiver (after run).
+  const std::vector<std::vector<uint8_t>>& contactTexels() const { return contactTexels_; }
 
  private:
   void drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ);
@@ -287,6 +295,8 @@ class GlBaker {
   void shadowPassState() const;
   void lightMapPassState() const;
   const GlProgram& vplProgram(int layers);
+  // The contact check runs on the default lookup (2×2 filter); with the other lookups alpha stays 0.
+  bool contactFlags() const { return opt_.resolveContacts && opt_.shadowPcf && opt_.shadowCompare; }
   void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
 
   const BakeInputs& in_;
@@ -302,6 +312,7 @@ class GlBaker {
   GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
+  std::vector<std::vector<uint8_t>> contactTexels_;
   std::unique_ptr<DepthAtlas> atlas_;  // VPL depth cubes of one batch (created before the programs: its layout is compiled in)
 };
 
@@ -437,6 +448,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& a
 const GlProgram& GlBaker::vplProgram(int layers) {
   std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
+  if (contactFlags()) defines.push_back("#define CONTACT_FLAGS 1");
   auto constant = [&](const char* name, float value) {
     char text[64];
     std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
@@ -514,6 +526,9 @@ void GlBaker::bakeDirect(const Light& light) {
   glUniform1f(p.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
   const glm::mat4 clip = view2d ? view2d->clip : glm::mat4(1.0f);
   glUniformMatrix4fv(p.uniform("shadowClip"), 1, GL_FALSE, &clip[0][0]);
+  const glm::mat4 clipInverse = glm::inverse(clip);
+  glUniformMatrix4fv(p.uniform("shadowClipInverse"), 1, GL_FALSE, &clipInverse[0][0]);
+  glUniform1i(p.uniform("contactFlags"), opt_.resolveContacts ? 1 : 0);
   glUniform1f(p.uniform("orthoDepthRange"), orthoRange);
   glUniform1f(p.uniform("texelAngle"), texelAngle);
   glBindTextureUnit(cube ? 2 : 3, maps->texture);
@@ -580,7 +595,7 @@ std::vector<Lightmap> GlBaker::run() {
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
   const size_t totalWork = vplCount + lightCount * K;
   if (vplCount > 0) {
-    if (opt_.shadowPcf && opt_.shadowCompare) {
+    if (opt_.shadowPcf && opt_.shadowCompare && !contactFlags()) {
       // Sampled through sampler2DShadow: lit (1) where the stored depth ≤ the reference.
       glTextureParameteri(atlas_->texture, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
       glTextureParameteri(atlas_->texture, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
@@ -635,9 +650,14 @@ std::vector<Lightmap> GlBaker::run() {
     m.height = s.height;
     m.texels.resize(m.size());
     m.valid.assign(m.size(), 0);
+    std::vector<uint8_t>& contact = contactTexels_.emplace_back(m.size(), 0);
     for (size_t i = 0; i < m.size(); ++i) {
       const bool valid = i < s.valid.size() && s.valid[i];
       m.valid[i] = valid ? 1 : 0;
+      stats_.texelsEvaluated += valid;
+      if (valid && page->leak[i] > 0.0 &&
+          page->leak[i] > opt_.contactLeakFraction * (page->sum[i].x + page->sum[i].y + page->sum[i].z) / 3.0)
+        contact[i] = 1;
       const glm::dvec3 v = valid ? page->sum[i] : glm::dvec3(0.0);
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
         throw Error(ErrorCode::NumericError, "", "GL backend produced a non-finite texel on page " +
@@ -651,6 +671,26 @@ std::vector<Lightmap> GlBaker::run() {
   glDeleteVertexArrays(1, &emptyVao_);
   if (in_.progress) in_.progress("gl", 1.0);
   return maps;
+}
+
+// The contact texels again with rays: the Embree backend on the same VPLs and lights (the clamped sum,
+// as here), over those texels only, replaces what the shadow maps gave them.
+void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<uint8_t>>& contact,
+                          std::vector<Lightmap>& maps, GlBakeStats& stats) {
+  size_t count = 0;
+  for (const auto& page : contact) count += static_cast<size_t>(std::count(page.begin(), page.end(), uint8_t{1}));
+  stats.contactTexels += count;
+  if (count == 0) return;
+  Stopwatch watch;
+  BakeInputs rays{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};
+  rays.eval.biasCompensation = false;  // the GL backend evaluates the clamped sum only
+  EmbreeOptions eo;
+  eo.texelSubset = &contact;
+  const std::vector<Lightmap> traced = bakeEmbree(rays, eo);
+  for (size_t p = 0; p < maps.size() && p < traced.size(); ++p)
+    for (size_t i = 0; i < maps[p].size(); ++i)
+      if (contact[p][i] && traced[p].valid[i]) maps[p].texels[i] = traced[p].texels[i];
+  stats.contactSeconds += watch.seconds();
 }
 
 }  // namespace
@@ -670,11 +710,14 @@ std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& o
   stats.renderer = ctx->description();
   if (!options.context) log::info("GL backend: " + stats.renderer);  // a caller passing a context logs it once
   std::vector<Lightmap> maps;
+  std::vector<std::vector<uint8_t>> contact;
   {
     GlBaker baker(inputs, options, stats, ctx->programs());
     maps = baker.run();
+    contact = baker.contactTexels();
   }
   stats.setupSeconds += contextSeconds;
+  if (options.resolveContacts) resolveContactTexels(inputs, contact, maps, stats);
   return maps;
 }
 

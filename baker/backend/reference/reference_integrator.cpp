@@ -69,7 +69,10 @@ glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const Lig
     // Hemisphere sample: emission found here is MIS-weighted; reflection continues the path.
     glm::vec3 dir = cosineHemisphere(n, rng.uniform(), rng.uniform());
     RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
-    if (!hit.hit) break;
+    if (!hit.hit) {  // escaped: the sky, found by the hemisphere sample alone (no sky sampling here)
+      if (scene.environment.present()) value += beta * glm::dvec3(scene.environment.radiance(dir));
+      break;
+    }
     const Primitive& prim = scene.primitives[hit.primitive];
     if (!hit.backFace && scene.materials[prim.material].isEmissive()) {
       glm::dvec3 Le(scene.emissionAt(prim, hit.triangle, hit.barycentric));
