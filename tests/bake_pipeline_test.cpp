@@ -4,13 +4,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "common/error.h"
+#include "export/exr_io.h"
 #include "pipeline/bake.h"
 #include "raytrace/ray_tracer.h"
+#include "scene/environment.h"
 #include "scene/gltf_loader.h"
 #include "samples/sample_scenes.h"
 #include "texels/texel_samples.h"
@@ -310,4 +314,40 @@ TEST(BakePipeline, SeamsOfASmoothSphereAreStitched) {
     for (size_t i = 0; i < m.size(); ++i)
       if (m.valid[i]) brightest = std::max(brightest, double(m.texels[i].x));
   EXPECT_NEAR(brightest, exact, 0.03 * exact);
+}
+
+// An equirectangular EXR read through the imageio plugin keeps every texel, its size and its source;
+// a file that is not an image is InvalidData naming it.
+TEST(EnvironmentFile, LoadsThroughTheImagePluginTexelForTexel) {
+  const std::filesystem::path dir = std::filesystem::current_path() / "test_scratch" / "environment_file";
+  std::filesystem::create_directories(dir);
+  Lightmap map;
+  map.width = 4;
+  map.height = 2;
+  for (int i = 0; i < 8; ++i) map.texels.push_back(glm::vec3(0.5f * i, 1.0f + i, 0.25f));
+  map.valid.assign(8, 1);
+  writeExr(map, dir / "sky.exr");
+  const Environment env = loadEnvironment(dir / "sky.exr", 2.0f);
+  ASSERT_EQ(env.width(), 4);
+  ASSERT_EQ(env.height(), 2);
+  EXPECT_EQ(env.source(), (dir / "sky.exr").string());
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const glm::vec3 t = map.texels[size_t(y) * 4 + x] * 2.0f;  // the intensity scales every texel
+      // The direction through the texel's centre (+Y up; φ from -Z towards +X).
+      const double theta = M_PI * (y + 0.5) / 2.0, phi = 2.0 * M_PI * (x + 0.5) / 4.0 - M_PI;
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const glm::vec3 e = env.radiance(d);
+      EXPECT_NEAR(e.x, t.x, 1e-6f);
+      EXPECT_NEAR(e.y, t.y, 1e-6f);
+      EXPECT_NEAR(e.z, t.z, 1e-6f);
+    }
+  std::ofstream(dir / "not_an_image.exr") << "plain text";
+  try {
+    loadEnvironment(dir / "not_an_image.exr");
+    FAIL() << "text accepted as an environment";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("not_an_image.exr"), std::string::npos) << e.what();
+  }
 }

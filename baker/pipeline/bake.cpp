@@ -271,8 +271,10 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   if (compensate) {
     stage.reset();
     ClampCompensationStats cs;
+    if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
     std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(inputs, co);
     g->apply(r.maps, &cs);
+    if (options.progress) options.progress("compensate", 1.0);
     seconds["compensation"] = stage.seconds();  // with the GL backend: the sweeps (and any trace not yet done)
     seconds["compensationTrace"] = g->traceSeconds();
     report["compensation"] = {{"rays", cs.raysTraced},
@@ -288,7 +290,9 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   PostOptions post;
   post.dilate = options.postDilate;
   post.stitchSeams = options.postSeams;
+  if (options.progress) options.progress("post", 0.0);
   PostStats postStats = postProcess(s, r.maps, post);
+  if (options.progress) options.progress("post", 1.0);
   seconds["post"] = stage.seconds();
   seconds["bake"] = total.seconds();
 

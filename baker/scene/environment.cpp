@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-
-#include <OpenImageIO/imageio.h>
+#include <string>
 
 #include "common/error.h"
+#include "imageio/image_io.h"
 
 namespace irbake {
 
@@ -111,25 +111,24 @@ Environment loadEnvironment(const std::filesystem::path& file, float intensity, 
   if (!std::filesystem::exists(file)) throw Error(ErrorCode::Io, name, "environment image not found");
   if (!(intensity >= 0.0f) || !std::isfinite(intensity))
     throw Error(ErrorCode::Usage, name, "--env-intensity must be a finite number ≥ 0");
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) throw Error(ErrorCode::InvalidData, name, "cannot read the environment image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 2 || spec.height < 1 || spec.nchannels < 1)
-    throw Error(ErrorCode::InvalidData, name, "environment image is empty");
-  std::vector<float> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw Error(ErrorCode::InvalidData, name, "cannot decode the environment image: " + in->geterror());
-  in->close();
-  std::vector<glm::vec3> texels(static_cast<size_t>(spec.width) * spec.height);
+  // Read through the imageio plugin (OpenImageIO, loaded on first use: imageio/image_io.h).
+  imageio::Pixels px;
+  try {
+    px = imageio::api().readFile(name);
+  } catch (const Error& e) {
+    throw Error(ErrorCode::InvalidData, name, std::string("cannot read the environment image (") + e.what() + ")");
+  }
+  if (px.width < 2 || px.height < 1 || px.channels < 1) throw Error(ErrorCode::InvalidData, name, "environment image is empty");
+  std::vector<glm::vec3> texels(static_cast<size_t>(px.width) * px.height);
   for (size_t i = 0; i < texels.size(); ++i) {
-    const float* p = &pixels[i * spec.nchannels];
-    texels[i] = spec.nchannels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
+    const float* p = &px.f32[i * px.channels];
+    texels[i] = px.channels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
     for (int c = 0; c < 3; ++c)
       if (!std::isfinite(texels[i][c]) || texels[i][c] < 0.0f)
-        throw Error(ErrorCode::InvalidData, name, "environment pixel " + std::to_string(i % spec.width) + "," +
-                                                      std::to_string(i / spec.width) + " is negative or not finite");
+        throw Error(ErrorCode::InvalidData, name, "environment pixel " + std::to_string(i % px.width) + "," +
+                                                      std::to_string(i / px.width) + " is negative or not finite");
   }
-  return Environment::fromEquirect(spec.width, spec.height, std::move(texels), intensity,
+  return Environment::fromEquirect(px.width, px.height, std::move(texels), intensity,
                                    static_cast<float>(rotationDegrees * kPi / 180.0), name);
 }
 
