@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <iterator>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -380,4 +382,34 @@ TEST(BakeCommand, ProgressBarsOnATerminalNeverGlueLogLinesAndQuietDrawsNone) {
   const std::string quiet = runOnTerminal("--quiet");
   EXPECT_EQ(quiet.find("ETA"), std::string::npos) << quiet;
   EXPECT_NE(quiet.find("lightmap_0.exr"), std::string::npos) << quiet;
+}
+
+// Issue 14: the same scene, options and seed give byte-identical EXR pages, glTF and .bin on either backend
+// and any thread count (twice each).
+TEST(BakeCommand, IdenticalBytesForAnyThreadCountAndRun) {
+  const fs::path scene = samplesDir() / "cornell_box.gltf";
+  const fs::path dir = scratch("identical_bytes");
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  for (const char* backend : {"gl", "embree"}) {
+    std::vector<fs::path> runs;
+    for (int threads : {1, 2})
+      for (int again = 0; again < 2; ++again) {
+        const fs::path out = dir / (std::string(backend) + "_t" + std::to_string(threads) + "_" + std::to_string(again));
+        std::string log;
+        ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(out) + " --backend " + backend +
+                                " --vpls 96 --texels-per-unit 60 --seed 5 --quiet --threads " + std::to_string(threads),
+                            &log),
+                  0)
+            << log;
+        runs.push_back(out);
+      }
+    for (const char* file : {"lightmap_0.exr", "scene.gltf", "scene.bin"}) {
+      const std::string reference = bytes(runs[0] / file);
+      ASSERT_FALSE(reference.empty()) << file;
+      for (size_t r = 1; r < runs.size(); ++r) EXPECT_TRUE(bytes(runs[r] / file) == reference) << runs[r] / file;
+    }
+  }
 }

@@ -1,6 +1,9 @@
 // irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR.
 #include <cstdio>
+#include <memory>
 #include <string>
+
+#include <tbb/global_control.h>
 
 #include "app/commands.h"
 #include "common/command_line.h"
@@ -20,6 +23,7 @@ int runBake(const Args& args) {
   double envIntensity = 1.0, envRotation = 0.0;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0;
+  int threads = 0;
   bool quiet = false, noGltf = false, noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
 
@@ -85,6 +89,8 @@ int runBake(const Args& args) {
   app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
+  app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
+      ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
   if (!cli::parse(*app, args)) return 0;
 
@@ -93,6 +99,9 @@ int runBake(const Args& args) {
                                           "); see 'irbake bake --help'");
   if (out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
   if (quiet) log::setLevel(log::Level::Warn);
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (threads > 0)
+    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
 
   o.backend = parseBackend(backend);
   o.walk.seed = static_cast<uint32_t>(seed);

@@ -1,5 +1,8 @@
 // The OpenImageIO side of imageio/image_io.h, built as libirbake_imageio_oiio.so and opened with
 // dlopen on first use (see image_io.h for why).
+#include <cstdlib>
+#include <ctime>
+
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
@@ -53,6 +56,21 @@ std::vector<uint8_t> encodePngMemory(const uint8_t* rgba, int width, int height,
   return std::vector<uint8_t>(out.begin(), out.end());
 }
 
+// "YYYY:MM:DD HH:MM:SS" (UTC) of SOURCE_DATE_EPOCH, or of 0 when it is unset or not a number.
+std::string reproducibleDateTime() {
+  std::time_t t = 0;
+  if (const char* e = std::getenv("SOURCE_DATE_EPOCH")) {
+    char* end = nullptr;
+    const long long v = std::strtoll(e, &end, 10);
+    if (end && *end == '\0' && v >= 0) t = static_cast<std::time_t>(v);
+  }
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &utc);
+  return text;
+}
+
 void writeFile(const std::string& file, const char* format, const Pixels& px, int page, const std::string& name) {
   // The file is usually a temp name without an image extension: the format is named explicitly.
   auto out = OIIO::ImageOutput::create(format);
@@ -60,6 +78,9 @@ void writeFile(const std::string& file, const char* format, const Pixels& px, in
   const bool isFloat = px.u8.empty();
   OIIO::ImageSpec spec(px.width, px.height, px.channels, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   if (std::string(format) == "openexr") spec.attribute("compression", "zip");
+  // Byte-identical outputs for identical bakes: OpenEXR's writer stamps the current time (capDate) unless a
+  // DateTime is given, so give the reproducible-builds one: SOURCE_DATE_EPOCH when set, else the epoch.
+  spec.attribute("DateTime", reproducibleDateTime());
   if (page >= 0) {
     spec.attribute("irbake:page", page);
     spec.attribute("irbake:content", "irradiance/pi, linear");
