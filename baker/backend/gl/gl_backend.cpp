@@ -292,6 +292,7 @@ class GlBaker {
       : in_(in), opt_(opt), stats_(stats), programs_(programs) {}
 
   std::vector<Lightmap> run();
+  std::vector<Lightmap> readMaps();
   // Per page, per texel: 1 where the shadow lookups could not tell a contact from the receiver (after run).
   const std::vector<std::vector<uint8_t>>& contactTexels() const { return contactTexels_; }
 
@@ -587,6 +588,37 @@ void GlBaker::bakeDirect(const Light& light) {
   finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
 }
 
+// The pages' double sums as maps (valid texels only), and the contact texels: those where lookups that
+// could not tell a contact from the receiver carried more than contactLeakFraction of the texel's light.
+std::vector<Lightmap> GlBaker::readMaps() {
+  std::vector<Lightmap> maps;
+  for (const auto& page : pages_) {
+    const TexelSamples& s = *page->samples;
+    Lightmap m;
+    m.page = s.page;
+    m.width = s.width;
+    m.height = s.height;
+    m.texels.resize(m.size());
+    m.valid.assign(m.size(), 0);
+    std::vector<uint8_t>& contact = contactTexels_.emplace_back(m.size(), 0);
+    for (size_t i = 0; i < m.size(); ++i) {
+      const bool valid = i < s.valid.size() && s.valid[i];
+      m.valid[i] = valid ? 1 : 0;
+      stats_.texelsEvaluated += valid;
+      if (valid && page->leak[i] > 0.0 &&
+          page->leak[i] > opt_.contactLeakFraction * (page->sum[i].x + page->sum[i].y + page->sum[i].z) / 3.0)
+        contact[i] = 1;
+      const glm::dvec3 v = valid ? page->sum[i] : glm::dvec3(0.0);
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        throw Error(ErrorCode::NumericError, "", "GL backend produced a non-finite texel on page " +
+                                                     std::to_string(s.page));
+      m.texels[i] = glm::vec3(v);
+    }
+    maps.push_back(std::move(m));
+  }
+  return maps;
+}
+
 std::vector<Lightmap> GlBaker::run() {
   StageClock sw;
   const float diagonal = std::max(in_.scene.bounds().diagonal(), 1e-6f);
@@ -692,31 +724,7 @@ std::vector<Lightmap> GlBaker::run() {
   checkGlError("GL backend passes");
   finishStage(stats_.foldSeconds, sw);
 
-  std::vector<Lightmap> maps;
-  for (const auto& page : pages_) {
-    const TexelSamples& s = *page->samples;
-    Lightmap m;
-    m.page = s.page;
-    m.width = s.width;
-    m.height = s.height;
-    m.texels.resize(m.size());
-    m.valid.assign(m.size(), 0);
-    std::vector<uint8_t>& contact = contactTexels_.emplace_back(m.size(), 0);
-    for (size_t i = 0; i < m.size(); ++i) {
-      const bool valid = i < s.valid.size() && s.valid[i];
-      m.valid[i] = valid ? 1 : 0;
-      stats_.texelsEvaluated += valid;
-      if (valid && page->leak[i] > 0.0 &&
-          page->leak[i] > opt_.contactLeakFraction * (page->sum[i].x + page->sum[i].y + page->sum[i].z) / 3.0)
-        contact[i] = 1;
-      const glm::dvec3 v = valid ? page->sum[i] : glm::dvec3(0.0);
-      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
-        throw Error(ErrorCode::NumericError, "", "GL backend produced a non-finite texel on page " +
-                                                     std::to_string(s.page));
-      m.texels[i] = glm::vec3(v);
-    }
-    maps.push_back(std::move(m));
-  }
+  std::vector<Lightmap> maps = readMaps();
   glDeleteTextures(1, &vplTable_);
   glDeleteBuffers(1, &vplBuffer_);
   glDeleteVertexArrays(1, &emptyVao_);
