@@ -218,7 +218,7 @@ def git_commit(irbake):
 
 
 def slug(opts):
-    s = re.sub(r"[^A-Za-z0-9.,=-]+", "_", opts.strip()).strip("_")
+    s = re.sub(r"[^A-Za-z0-9.,=-]+", "_", opts.strip()).strip("_-")
     return s or "default"
 
 
