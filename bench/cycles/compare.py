@@ -19,8 +19,9 @@ For each option set (--opts, repeatable; "" = defaults) it runs `irbake bake SCE
         seeds 1 and 2); irview renders our export at 4W x 4H, averaged 4x4 down. Pixels left out: emitters
         (either image above --emitter-cut in any channel, dilated by one pixel), background (both zero), and
         1-pixel edges: pixels whose `irview --view charts` colour at W x H differs from any 4-neighbour's
-        (chart borders = silhouettes, creases, and the few seams inside flat regions). 4x4 (8x8) pixel bins
-        with at least half their pixels kept.
+        (chart borders = silhouettes, creases, and seams inside flat regions; both pixels of a border).
+        4x4 (8x8) pixel bins with at least half their pixels kept. Columns *_with_edges: the same with the
+        edge pixels kept (emitters and background still out).
 Figures: mean ratio ours/Cycles over kept pixels/texels; relative RMSE over bins = sqrt(mean (o-r)^2) /
 sqrt(mean r^2) over bins and RGB channels; the reference's noise on the same bins (half the seeds'
 difference); the error with that noise removed, sqrt(max(0, err^2 - noise^2)).
@@ -54,7 +55,7 @@ REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)),
 NICE = ["nice", "-n", "15"]
 CSV_FIELDS = ["date", "commit", "scene", "mode", "view", "our_options", "our_wall_s", "our_bake_s", "texels",
               "width", "height", "kept", "mean_ratio", "rel_rmse_4", "rel_rmse_8", "ref_noise_4", "ref_noise_8",
-              "rel_rmse_4_corrected", "ref_spp", "ref_s", "cycles_spp", "cycles_s", "cycles_total_s"]
+              "rel_rmse_4_corrected", "kept_with_edges", "rel_rmse_4_with_edges", "ref_spp", "ref_s", "cycles_spp", "cycles_s", "cycles_total_s"]
 
 
 def log(*a):
@@ -206,11 +207,17 @@ def score(ours, ref_a, ref_b, mask):
 
 
 def git_commit(irbake):
+    """The last commit that touched the baker's sources in the checkout irbake was built in (bench-only
+    commits after it do not change the binary), with +dirty when those sources have local changes."""
+    src = ["baker", "runtime", "shaders", "samples", "CMakeLists.txt", "cmake"]
     try:
-        src = os.path.dirname(os.path.abspath(irbake))
-        top = subprocess.run(["git", "-C", src, "rev-parse", "--show-toplevel"], capture_output=True, text=True).stdout.strip()
-        c = subprocess.run(["git", "-C", top or REPO, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", top or REPO, "status", "--porcelain", "--untracked-files=no"],
+        d = os.path.dirname(os.path.abspath(irbake))
+        top = subprocess.run(["git", "-C", d, "rev-parse", "--show-toplevel"], capture_output=True,
+                             text=True).stdout.strip() or REPO
+        paths = [p for p in src if os.path.exists(os.path.join(top, p))]
+        c = subprocess.run(["git", "-C", top, "log", "-1", "--format=%h", "--"] + paths, capture_output=True,
+                           text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", top, "status", "--porcelain", "--untracked-files=no", "--"] + paths,
                                capture_output=True, text=True).stdout.strip()
         return c + ("+dirty" if dirty else "")
     except OSError:
@@ -315,6 +322,8 @@ def view_mode(args, out, row, rows):
         empty = (ours.max(axis=2) <= 0) & (a.max(axis=2) <= 0) & (b.max(axis=2) <= 0)
         mask = ~(edge | e2 | empty)
         s = score(ours, a, b, mask)
+        s_all = score(ours, a, b, ~(e2 | empty))  # edges kept: how much the edge rule matters
+        s["kept_with_edges"], s["rel_rmse_4_with_edges"] = s_all["kept"], s_all["rel_rmse_4"]
         ref_s = sum(r[1].get("render_time_s", 0.0) for r in refs)
         rows.append(dict(row, mode="view", view=str(v), width=w, height=h, ref_spp=2 * half, ref_s=round(ref_s, 2), **s))
         log("VIEW %d %s: mean ratio %.4f, binned 4x4 %.2f%% (8x8 %.2f%%), ref noise %.2f%%; kept %d/%d px "
@@ -372,14 +381,17 @@ def main():
             map_mode(args, out, rep, row, rows)
         if args.views:
             view_mode(args, out, row, rows)
-    new = not os.path.isfile(args.csv)
     os.makedirs(os.path.dirname(os.path.abspath(args.csv)), exist_ok=True)
-    with open(args.csv, "a", newline="") as f:
+    old = list(csv.DictReader(open(args.csv))) if os.path.isfile(args.csv) else []
+    tmp = args.csv + ".tmp"
+    with open(tmp, "w", newline="") as f:  # rewritten whole: an older file may lack newer columns
         wr = csv.DictWriter(f, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        if new:
-            wr.writeheader()
+        wr.writeheader()
+        for r in old:
+            wr.writerow(r)
         for r in rows:
             wr.writerow({k: (round(v, 5) if isinstance(v, float) else v) for k, v in r.items()})
+    os.replace(tmp, args.csv)
     log("appended %d row(s) to %s" % (len(rows), args.csv))
 
 
