@@ -139,8 +139,7 @@ def build_mcguire(shared, out):
         elif t[0] == "f":
             idx = [int(x.split("/")[0]) for x in t[1:]]
             idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
-            for k in range(1, len(idx) - 1):
-                groups[cur].append((verts[idx[0]], verts[idx[k]], verts[idx[k + 1]]))
+            groups[cur].append([verts[i] for i in idx])  # one polygon, its corners shared by its triangles
     blob, accessors, views, meshes, materials, nodes = bytearray(), [], [], [], [], []
     for name in order:
         m = mats.get(name)
@@ -160,8 +159,12 @@ def build_mcguire(shared, out):
             mat["emissiveFactor"] = [k / s for k in ke]
             mat["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": s}}
         materials.append(mat)
-        tris = groups[name]
-        pos = [p for tri in tris for p in tri]
+        pos, ind = [], []
+        for poly in groups[name]:
+            b = len(pos)
+            pos += poly
+            for k in range(1, len(poly) - 1):
+                ind += [b, b + k, b + k + 1]
         off = len(blob)
         for p in pos:
             blob += struct.pack("<3f", *p)
@@ -170,7 +173,14 @@ def build_mcguire(shared, out):
         hi = [max(p[i] for p in pos) for i in range(3)]
         accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": len(pos), "type": "VEC3",
                           "min": lo, "max": hi})
-        meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 1},
+        off = len(blob)
+        for i in ind:
+            blob += struct.pack("<H", i)
+        blob += b"\0" * ((4 - len(blob) % 4) % 4)
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": 2 * len(ind), "target": 34963})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5123, "count": len(ind), "type": "SCALAR"})
+        meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                                     "indices": len(accessors) - 1,
                                                      "material": len(materials) - 1, "mode": 4}]})
         nodes.append({"name": name, "mesh": len(meshes) - 1})
     eye, target = (0.0, 1.0, 3.94), (0.0, 1.0, 0.0)
@@ -188,7 +198,8 @@ def build_mcguire(shared, out):
     write_atomic(os.path.join(out, "mcguire_cornell.bin"), bytes(blob))
     path = os.path.join(out, "mcguire_cornell.gltf")
     write_atomic(path, json.dumps(doc, indent=1).encode())
-    print("wrote", path, "(%d triangles, %d materials)" % (sum(len(g) for g in groups.values()), len(materials)))
+    print("wrote", path, "(%d triangles, %d materials)" % (sum(len(p) - 2 for g in groups.values() for p in g),
+                                                          len(materials)))
     return path
 
 
