@@ -12,7 +12,9 @@ For each option set (--opts, repeatable; "" = defaults) it runs `irbake bake SCE
   MAP   (--maps): Cycles bakes its irradiance/pi into our page 0 through cycles_bake.py --uv UVMap.001 at the
         page size. Reference = the mean of two bakes of spp/2 samples (seeds 1, 2); its noise = half their
         difference. Compared over texels Cycles covers (texel centre in a UV triangle, A = 1), minus the ring
-        of covered texels next to an uncovered one (chart borders, where both bakers extrapolate), in 4x4
+        of covered texels next to an uncovered one (chart borders, where both bakers extrapolate), and hidden
+        texels (Cycles below 2% of the mean, plus a 2-texel ring: under the blocks, above the light; our
+        baker marks them invalid and fills them by dilation), in 4x4
         (and 8x8) texel bins with at least half their texels kept. The ladder (--map-ladder) bakes Cycles at
         each spp (seed 3) and scores it against the reference the same way: Cycles' time for an error.
   VIEW  (--views): cycles_render.py renders the input SCENE from glTF camera i at W x H (two renders of spp/2,
@@ -264,13 +266,24 @@ def map_mode(args, out, rep, row, rows):
             for s in (1, 2)]
     a, b = read_exr(refs[0][0]), read_exr(refs[1][0])
     cov = (a[..., 3] > 0.5) & (b[..., 3] > 0.5)
-    mask = erode_cover(cov)
+    # Hidden texels (under a block resting on the floor, the ceiling above the light): our baker marks them
+    # invalid and fills them by dilation, Cycles finds them dark. Left out: texels where Cycles' sum of both
+    # halves is below --hidden-cut of the mean over covered texels, with a 2-texel ring around them.
+    lum = (a[..., :3] + b[..., :3]).mean(axis=2)
+    hidden = cov & (lum < args.hidden_cut * lum[cov].mean())
+    for _ in range(2):
+        hidden = ~erode_cover(~hidden)
+    mask = erode_cover(cov) & ~hidden
+    log("MAP texels: covered %d, hidden %d, kept %d" % (cov.sum(), (hidden & cov).sum(), mask.sum()))
     ours = read_exr(os.path.join(out, "lightmap_0.exr"))[..., :3]
     if ours.shape[:2] != a.shape[:2]:
         fail("page size mismatch: ours %s, Cycles %s" % (ours.shape, a.shape))
     a, b = a[..., :3], b[..., :3]
     ref_s = sum(r[1].get("bake_time_s", 0.0) for r in refs)
     s = score(ours, a, b, mask)
+    if args.save_diff:
+        ratio = np.where(mask[..., None], ours / np.maximum(0.5 * (a + b), 1e-6), 0.0)
+        oiio.ImageBuf(np.ascontiguousarray(ratio.astype(np.float32))).write(os.path.join(out, "map_ratio.exr"))
     rows.append(dict(row, mode="map", view="page0", width=w, height=h, ref_spp=2 * half, ref_s=round(ref_s, 2), **s))
     log("MAP %s: mean ratio %.4f, binned 4x4 %.2f%% (8x8 %.2f%%), ref noise %.2f%%" % (
         row["our_options"] or "default", s["mean_ratio"], 100 * s["rel_rmse_4"], 100 * s["rel_rmse_8"],
@@ -354,6 +367,8 @@ def main():
     ap.add_argument("--view-spp", type=int, default=2048, help="reference samples per pixel (two halves)")
     ap.add_argument("--max-bounces", type=int, default=64)
     ap.add_argument("--emitter-cut", type=float, default=3.0, help="radiance above which a pixel is an emitter")
+    ap.add_argument("--hidden-cut", type=float, default=0.02,
+                    help="maps: covered texels darker than this fraction of the mean in Cycles are hidden (left out)")
     ap.add_argument("--save-diff", action="store_true", help="write view<i>_ratio.exr (ours/Cycles) beside our bake")
     ap.add_argument("--csv", help="append rows here (default bench/results/cycles_NAME.csv)")
     args = ap.parse_args()
