@@ -14,8 +14,9 @@ nice -n 15 "$IRBAKE" samples $S/samples
 CORNELL=$S/samples/cornell_box.gltf
 MCGUIRE=$S/mcguire_cornell.gltf
 SPONZA=$S/sponza_sun.glb
-"${C[@]}" $CORNELL --name cornell_sample --opts "" --opts "--vpls 4096" --views 0 --view-size 128x128 --view-spp 2048 --save-diff
-"${C[@]}" $MCGUIRE --name mcguire_cornell --opts "" --opts "--vpls 4096" --views 0 --view-size 128x128 --view-spp 2048 --save-diff
+"${C[@]}" $CORNELL --name cornell_sample --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \
+    --views 0 --view-size 128x128 --view-spp 2048 --save-diff
+"${C[@]}" $MCGUIRE --name mcguire_cornell --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \
+    --views 0 --view-size 128x128 --view-spp 2048 --save-diff
 "${C[@]}" $SPONZA --name sponza_sun --opts "" --views 0,1,2,3 --view-size 160x100 --view-spp 1024 --save-diff
-"${C[@]}" $CORNELL --name cornell_sample --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64
-"${C[@]}" $MCGUIRE --name mcguire_cornell --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64
+/usr/bin/python3 bench/cycles/table.py bench/results/cycles_*.csv

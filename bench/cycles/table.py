@@ -3,9 +3,11 @@
 
 usage: /usr/bin/python3 bench/cycles/table.py bench/results/cycles_*.csv
 
-Prints (1) ours against Cycles per scene, mode and view; (2) for maps, Cycles' bake time at our error: the
-Cycles spp ladder's (time, noise-corrected error) points interpolated log-log at our bake's corrected error
-(extrapolated along the last two points, marked "~", when our error lies outside the ladder).
+Prints (1) ours against Cycles per scene, mode and view; (2) Cycles' spp ladder; (3) for maps, Cycles' bake
+time at our error: the samples per texel Cycles needs for our bake's noise-corrected error (log-log
+interpolation of its ladder's (spp, error); "~" = extrapolated along the nearest two points) times the
+median cost of one sample per texel over all Cycles bakes of that page (ladder and reference halves: single
+timings swing 2x with the shared machine's load); the last column interpolates the ladder's own timings.
 """
 import csv
 import math
@@ -38,6 +40,21 @@ def time_at(ladder, err):
     return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0))), "~"
 
 
+def spp_at(ladder, err):
+    """Samples per texel Cycles needs for `err`: log-log interpolation of its ladder's (spp, error)."""
+    pts = sorted((int(r["cycles_spp"]), float(r["rel_rmse_4_corrected"])) for r in ladder)
+    pts = [p for p in pts if p[1] > 0]
+    if len(pts) < 2:
+        return None, ""
+    for (s0, e0), (s1, e1) in zip(pts, pts[1:]):
+        if e1 <= err <= e0:
+            f = (math.log(err) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(s0) + f * (math.log(s1) - math.log(s0))), ""
+    (s0, e0), (s1, e1) = (pts[0], pts[1]) if err > pts[0][1] else (pts[-2], pts[-1])
+    f = (math.log(err) - math.log(e0)) / (math.log(e1) - math.log(e0))
+    return math.exp(math.log(s0) + f * (math.log(s1) - math.log(s0))), "~"
+
+
 def main(paths):
     rows = [r for p in paths for r in csv.DictReader(open(p))]
     rows = latest(rows, lambda r: (r["scene"], r["mode"], r["view"], r["our_options"], r["cycles_spp"]))
@@ -59,18 +76,25 @@ def main(paths):
             print("| %s | %s | %s | %s | %s | %.4f |" % (r["scene"], r["cycles_spp"], r["cycles_s"], pct(r["rel_rmse_4"]),
                                                       pct(r["rel_rmse_4_corrected"]), float(r["mean_ratio"])))
     print()
-    print("| scene | our options | our bake, wall (s) | our error (4×4, noise removed) | Cycles' bake at that error (s) | ratio |")
-    print("|---|---|---|---|---|---|")
+    print("| scene | our options | our bake, wall (s) | our error (4×4, noise removed) | Cycles spp for it | "
+          "Cycles s per spp (median) | Cycles' bake at that error (s) | Cycles time / ours | ladder interpolation (s) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         if r["mode"] != "map":
             continue
         ladder = [c for c in rows if c["mode"] == "map-cycles" and c["scene"] == r["scene"]]
-        t, mark = time_at(ladder, float(r["rel_rmse_4_corrected"]))
-        if t is None:
+        err = float(r["rel_rmse_4_corrected"])
+        spp, mark = spp_at(ladder, err)
+        t, mark2 = time_at(ladder, err)
+        if spp is None:
             continue
-        print("| %s | %s | %s | %s | %s%.1f | %s%.2f× |" % (r["scene"], r["our_options"] or "default", r["our_wall_s"],
-                                                       pct(r["rel_rmse_4_corrected"]), mark, t, mark,
-                                                       t / float(r["our_wall_s"])))
+        # every Cycles bake of this page, ladder and reference halves: the median cost of one sample per texel
+        per = sorted([float(c["cycles_s"]) / int(c["cycles_spp"]) for c in ladder] +
+                     [float(r["ref_s"]) / int(r["ref_spp"])] * 2)
+        med = per[len(per) // 2] if len(per) % 2 else 0.5 * (per[len(per) // 2 - 1] + per[len(per) // 2])
+        print("| %s | %s | %s | %s | %s%.0f | %.2f | %s%.1f | %s%.2f× | %s%.1f |" % (
+            r["scene"], r["our_options"] or "default", r["our_wall_s"], pct(err), mark, spp, med, mark, spp * med,
+            mark, spp * med / float(r["our_wall_s"]), mark2, t))
 
 
 if __name__ == "__main__":
