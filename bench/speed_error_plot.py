@@ -2,13 +2,18 @@
 """Time against error, log-log, from speed_error_bench's CSV (one line per scene and backend).
 
 usage: python3 bench/speed_error_plot.py bench/results/speed_error.csv docs/performance.png [BEFORE.csv]
+                                         [--cycles bench/results/cycles_X.csv ...]
 BEFORE.csv (optional, e.g. bench/results/speed_error_session1.csv) is drawn dashed and faded: the
 estimator of an earlier version on the same scenes.
 x: backend seconds (the VPL evaluation: GL or Embree), y: relative RMSE against the reference with the
 reference's own noise removed (column relative_rmse_corrected). Points are labelled with N (paths).
+--cycles (bench/cycles/compare.py's CSVs) adds a second panel: the error against Blender Cycles baked into
+our own atlas (4x4-texel bins, Cycles' own noise removed: rel_rmse_4_corrected) against wall-clock time,
+for our whole bake (irbake process, labelled with its options) and for Cycles' bake call at each spp of
+its ladder (mode map-cycles, labelled with spp), both from one run on one machine.
 """
+import argparse
 import csv
-import sys
 
 import matplotlib
 
@@ -25,8 +30,46 @@ def load(src):
     return series
 
 
-def main(src, dst, before=None):
-    fig, ax = plt.subplots(figsize=(8, 5.5))
+def cycles_panel(ax, paths):
+    for path in paths:
+        rows = [r for r in csv.DictReader(open(path)) if r["mode"] in ("map", "map-cycles")]
+        if not rows:
+            continue
+        last = rows[-1]["date"]  # the latest run only: one run, one machine
+        scene = rows[-1]["scene"]
+        rows = [r for r in rows if r["date"][:13] == last[:13]]
+        ours = [r for r in rows if r["mode"] == "map"]
+        cyc = sorted((r for r in rows if r["mode"] == "map-cycles"), key=lambda r: int(r["cycles_spp"]))
+        if ours:
+            xs = [float(r["our_wall_s"]) for r in ours]
+            ys = [max(float(r["rel_rmse_4_corrected"]), 1e-4) for r in ours]
+            line = ax.plot(xs, ys, "o", label=f"{scene}: irbake ({ours[0]['commit']})")[0]
+            for r, x, y in zip(ours, xs, ys):
+                ax.annotate(r["our_options"] or "default", (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            color = line.get_color()
+        else:
+            color = None
+        if cyc:
+            xs = [float(r["cycles_s"]) for r in cyc]
+            ys = [max(float(r["rel_rmse_4_corrected"]), 1e-4) for r in cyc]
+            ax.plot(xs, ys, "--", marker="^", color=color, label=f"{scene}: Cycles bake")
+            for r, x, y in zip(cyc, xs, ys):
+                ax.annotate(r["cycles_spp"] + " spp", (x, y), textcoords="offset points", xytext=(4, -9), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall-clock time (s): our whole bake / Cycles' bake call")
+    ax.set_ylabel("relative RMSE vs Cycles (4x4-texel bins, its noise removed)")
+    ax.set_title("Against Blender Cycles, in our atlas")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def main(src, dst, before=None, cycles=None):
+    if cycles:
+        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(14, 5.5))
+        cycles_panel(ax2, cycles)
+    else:
+        fig, ax = plt.subplots(figsize=(8, 5.5))
     markers = {"gl": "o", "embree": "s"}
     sets = [(load(src), "-", 1.0, "")]
     if before:
@@ -53,6 +96,10 @@ def main(src, dst, before=None):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) not in (3, 4):
-        sys.exit(__doc__)
-    main(*sys.argv[1:])
+    ap = argparse.ArgumentParser(usage=__doc__)
+    ap.add_argument("src")
+    ap.add_argument("dst")
+    ap.add_argument("before", nargs="?")
+    ap.add_argument("--cycles", nargs="+", default=[])
+    a = ap.parse_args()
+    main(a.src, a.dst, a.before, a.cycles)

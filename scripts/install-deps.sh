@@ -22,7 +22,7 @@ packages=(
   xvfb xauth               # windowed viewer test without a display
 )
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-matplotlib python3-numpy)
+  packages+=(python3-matplotlib python3-numpy python3-openimageio)   # openimageio: bench/cycles reads EXRs
 fi
 
 missing=()

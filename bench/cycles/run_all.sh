@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The whole comparison against Blender Cycles (docs/accuracy.md, "Against an independent renderer").
+# From the repository root, after a Release build:  bash bench/cycles/run_all.sh [IRBAKE [IRVIEW]]
+# Cycles results are cached under build/cycles-cache (by input checksum): a re-run after a baker change
+# re-runs our bakes and re-bakes Cycles' maps only if our atlas changed. Rows are appended to
+# bench/results/cycles_<scene>.csv. Cost on the shared 2-core machine, cold cache: about an hour.
+set -euo pipefail
+IRBAKE=${1:-build/baker/irbake}
+IRVIEW=${2:-build/runtime/irview}
+C=(nice -n 15 /usr/bin/python3 bench/cycles/compare.py --irbake "$IRBAKE" --irview "$IRVIEW")
+S=build/cycles-scenes
+/usr/bin/python3 bench/cycles/scenes.py all $S
+nice -n 15 "$IRBAKE" samples $S/samples
+CORNELL=$S/samples/cornell_box.gltf
+MCGUIRE=$S/mcguire_cornell.gltf
+SPONZA=$S/sponza_sun.glb
+"${C[@]}" $CORNELL --name cornell_sample --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \
+    --views 0 --view-size 128x128 --view-spp 2048 --save-diff
+"${C[@]}" $MCGUIRE --name mcguire_cornell --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \
+    --views 0 --view-size 128x128 --view-spp 2048 --save-diff
+"${C[@]}" $SPONZA --name sponza_sun --opts "" --views 0,1,2,3 --view-size 160x100 --view-spp 1024 --save-diff
+/usr/bin/python3 bench/cycles/table.py bench/results/cycles_*.csv
