@@ -119,6 +119,39 @@ void forEachViewRef(json& root, F&& f) {
               if (ext.is_object() && ext.contains("bufferView")) f(ext["bufferView"]);
 }
 
+// Texture references: every textureInfo in a material (any object with an integer "index", core and
+// extension alike: baseColorTexture, normalTexture, MOZ_lightmap, KHR_materials_* ...).
+template <class F>
+void forEachTextureInfo(json& j, F&& f) {
+  if (j.is_object()) {
+    if (j.contains("index") && j["index"].is_number_integer()) f(j["index"]);
+    for (auto& [k, v] : j.items())
+      if (v.is_structured()) forEachTextureInfo(v, f);
+  } else if (j.is_array()) {
+    for (auto& v : j) forEachTextureInfo(v, f);
+  }
+}
+template <class F>
+void forEachTextureRef(json& root, F&& f) {
+  if (root.contains("materials")) forEachTextureInfo(root["materials"], f);
+}
+
+// Textures may be collected only when materials are the only place that can name them: no root
+// extension other than lights (an unknown one, e.g. image-based lighting, might use a texture).
+bool texturesOnlyInMaterials(const json& root) {
+  if (!root.contains("extensions") || !root["extensions"].is_object()) return true;
+  for (const auto& [name, ext] : root["extensions"].items())
+    if (name != "KHR_lights_punctual") return false;
+  return true;
+}
+
+template <class F>
+void forEachSamplerRef(json& root, F&& f) {
+  if (root.contains("textures"))
+    for (auto& t : root["textures"])
+      if (t.contains("sampler")) f(t["sampler"]);
+}
+
 // Image references: textures' source and any "source" in a texture extension (KHR_texture_basisu,
 // EXT_texture_webp, ...).
 template <class F>
@@ -252,6 +285,12 @@ void compactDocument(GltfDocument& doc) {
   keepUsed(root, "meshes", usedBy(root, "meshes", nodeMeshRefs), nodeMeshRefs);
   auto accessorRefs = [](json& r, auto&& f) { forEachAccessorRef(r, f); };
   keepUsed(root, "accessors", usedBy(root, "accessors", accessorRefs), accessorRefs);
+  if (texturesOnlyInMaterials(root)) {
+    auto textureRefs = [](json& r, auto&& f) { forEachTextureRef(r, f); };
+    keepUsed(root, "textures", usedBy(root, "textures", textureRefs), textureRefs);
+    auto samplerRefs = [](json& r, auto&& f) { forEachSamplerRef(r, f); };
+    keepUsed(root, "samplers", usedBy(root, "samplers", samplerRefs), samplerRefs);
+  }
   auto imageRefs = [](json& r, auto&& f) { forEachImageRef(r, f); };
   keepUsed(root, "images", usedBy(root, "images", imageRefs), imageRefs);
 

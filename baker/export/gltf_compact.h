@@ -30,9 +30,10 @@ AccessorBytes readAccessor(const GltfDocument& doc, int index, const std::string
 // when `withMinMax` (POSITION needs them). Returns the accessor index.
 int addGatheredAccessor(GltfDocument& doc, const AccessorBytes& source, const std::vector<uint32_t>& at, bool withMinMax);
 
-// Removes meshes no node uses, accessors no mesh/skin/animation/instancing uses, images no texture
-// uses and buffer views nothing uses, renumbering every reference; buffer 0 is rebuilt from the kept
-// views only (each 4-byte aligned).
+// Removes meshes no node uses, accessors no mesh/skin/animation/instancing uses, textures no material
+// uses and samplers no texture uses (only when no root extension but lights could name a texture),
+// images no texture uses and buffer views nothing uses, renumbering every reference; buffer 0 is
+// rebuilt from the kept views only (each 4-byte aligned).
 void compactDocument(GltfDocument& doc);
 
 // Key of an image's original URI while the document is being built (never written).

@@ -180,6 +180,22 @@ TEST(GltfExport, SourceSceneKeepsImagesCamerasLightsAndReplacesMeshes) {
   }
   ASSERT_EQ(r.lightmapExrPaths.size(), 2u);
   EXPECT_TRUE(std::filesystem::exists(r.lightmapExrPaths[1]));
+
+  // Baking the export again replaces its light maps: the old PNGs, their textures and samplers go.
+  Scene again = loadScene(o.output);
+  for (int i = 0; i < 2; ++i) {
+    again.primitives[i].uv1 = {{0.1f, 0.1f}, {0.9f, 0.1f}, {0.9f, 0.9f}, {0.1f, 0.9f}};
+    again.primitives[i].lightmap = {i, 8, 4};
+  }
+  ExportOptions o2;
+  o2.output = dir / "again" / "baked.gltf";
+  exportGltf(again, ramps(), o2);
+  const json j = readJson(o2.output);
+  EXPECT_EQ(j["images"].size(), 3u);    // albedo + two pages
+  EXPECT_EQ(j["textures"].size(), 3u);
+  EXPECT_EQ(j["materials"].size(), 2u);  // "grey" for page 0 in place, its page-1 copy
+  EXPECT_EQ(filesIn(dir / "again"), (std::vector<std::string>{"albedo.png", "baked.bin", "baked.gltf", "lightmap_0.exr", "lightmap_0.png",
+                                                              "lightmap_1.exr", "lightmap_1.png"}));
 }
 
 TEST(GltfExport, UnwrapExportWithoutMapsHasOnlyTexcoord1AndRecords) {
