@@ -21,6 +21,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/log.h"
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
 #include "export/lightmap_png.h"
@@ -148,6 +149,19 @@ json mozLightmap(int texture, const LightmapPng& png) {
   return moz;
 }
 
+// True when a material's texture (core or extension) reads TEXCOORD_1.
+bool readsTexcoord1(const json& j) {
+  if (j.is_object()) {
+    if (j.contains("texCoord") && j["texCoord"] == 1) return true;
+    for (const auto& [k, v] : j.items())
+      if (v.is_structured() && readsTexcoord1(v)) return true;
+  } else if (j.is_array()) {
+    for (const auto& v : j)
+      if (readsTexcoord1(v)) return true;
+  }
+  return false;
+}
+
 // The source document with only the light-map data added (see the file comment).
 class SourceExport {
  public:
@@ -230,6 +244,15 @@ class SourceExport {
       }
       return outAttrs;
     };
+    if (!warnedTexcoord1_ && source.contains("material") && source["material"].is_number_integer() &&
+        source["material"].get<int>() < static_cast<int>(sourceMaterials_.size())) {
+      json mat = sourceMaterials_[source["material"].get<int>()];
+      if (mat.contains("extensions") && mat["extensions"].is_object()) mat["extensions"].erase("MOZ_lightmap");
+      if (readsTexcoord1(mat)) {
+        warnedTexcoord1_ = true;
+        log::warn(file_ + ": a material reads textures with TEXCOORD_1, which the export replaces by the light-map UVs");
+      }
+    }
     prim["attributes"] = gather(source.value("attributes", json::object()), false);
     if (part.uv1.size() == n) prim["attributes"]["TEXCOORD_1"] = doc_.addVec2(part.uv1);
     if (source.contains("targets") && source["targets"].is_array()) {
@@ -305,6 +328,7 @@ class SourceExport {
   std::map<std::pair<int, int>, int> materialFor_;
   std::set<int> sourceMaterialsTaken_;
   std::map<int, int> pageTexture_;
+  bool warnedTexcoord1_ = false;
 };
 
 // Generated scene (no source document): our writer from a copy whose materials carry the light maps.
