@@ -198,6 +198,7 @@ class SourceExport {
       }
     }
     if (!pngs_.empty()) doc_.useExtension("MOZ_lightmap");
+    repairEmissiveFactors();
     compactDocument(doc_);
     doc_.root["asset"]["generator"] = "irbake (from " + doc_.root["asset"].value("generator", std::string("unknown")) + ")";
     return std::move(doc_);
@@ -254,7 +255,13 @@ class SourceExport {
       }
     }
     prim["attributes"] = gather(source.value("attributes", json::object()), false);
-    if (part.uv1.size() == n) prim["attributes"]["TEXCOORD_1"] = doc_.addVec2(part.uv1);
+    if (part.uv1.size() == n) {
+      const int uv1 = doc_.addVec2(part.uv1);
+      prim["attributes"]["TEXCOORD_1"] = uv1;
+      // glTF numbers TEXCOORD sets from 0 without gaps: a primitive without TEXCOORD_0 shares the
+      // light-map UVs as its set 0 (MOZ_lightmap keeps texCoord 1 for every primitive).
+      if (!prim["attributes"].contains("TEXCOORD_0")) prim["attributes"]["TEXCOORD_0"] = uv1;
+    }
     if (source.contains("targets") && source["targets"].is_array()) {
       json targets = json::array();
       for (const auto& t : source["targets"]) targets.push_back(gather(t, true));
@@ -272,6 +279,30 @@ class SourceExport {
     else prim.erase("material");
     setLightmapRecord(prim, part.lightmap);
     return prim;
+  }
+
+  // glTF keeps emissiveFactor in [0, 1]; a source above that (the loader took it as factor × strength)
+  // is written as factor / peak with KHR_materials_emissive_strength × peak: the same emission, valid.
+  void repairEmissiveFactors() {
+    if (!doc_.root.contains("materials")) return;
+    for (auto& mat : doc_.root["materials"]) {
+      if (!mat.contains("emissiveFactor") || !mat["emissiveFactor"].is_array() || mat["emissiveFactor"].size() != 3) continue;
+      double peak = 0.0;
+      for (const auto& c : mat["emissiveFactor"])
+        if (c.is_number()) peak = std::max(peak, c.get<double>());
+      if (!(peak > 1.0)) continue;
+      for (auto& c : mat["emissiveFactor"])
+        if (c.is_number()) c = c.get<double>() / peak;
+      if (!mat.contains("extensions") || !mat["extensions"].is_object()) mat["extensions"] = json::object();
+      json& ext = mat["extensions"]["KHR_materials_emissive_strength"];
+      const double strength = ext.is_object() && ext.contains("emissiveStrength") ? ext["emissiveStrength"].get<double>() : 1.0;
+      ext = {{"emissiveStrength", strength * peak}};
+      doc_.useExtension("KHR_materials_emissive_strength");
+      if (!warnedEmissive_) {
+        warnedEmissive_ = true;
+        log::warn(file_ + ": emissiveFactor above 1 written as KHR_materials_emissive_strength (glTF keeps the factor in [0, 1])");
+      }
+    }
   }
 
   const AccessorBytes& accessorBytes(int index) {
@@ -329,6 +360,7 @@ class SourceExport {
   std::set<int> sourceMaterialsTaken_;
   std::map<int, int> pageTexture_;
   bool warnedTexcoord1_ = false;
+  bool warnedEmissive_ = false;
 };
 
 // Generated scene (no source document): our writer from a copy whose materials carry the light maps.

@@ -461,3 +461,32 @@ TEST(GltfExport, GlbEmbedsImages) {
   ASSERT_GE(m.lightmapTexture, 0);
   EXPECT_EQ(r.textures[m.lightmapTexture].width, 8);
 }
+
+// glTF numbers TEXCOORD sets from 0 without gaps: a source primitive without TEXCOORD_0 shares the
+// light-map UVs as set 0 (the validator's MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY error otherwise);
+// an emissiveFactor above 1 (invalid glTF the loader accepts) moves into KHR_materials_emissive_strength.
+TEST(GltfExport, PrimitiveWithoutTexcoord0AndEmissiveAboveOneStayValid) {
+  auto dir = irbake::testing::testFolder("export_texcoord_continuity");
+  GltfDocument src = irbake::testing::meshDocument({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
+  src.append("materials", {{"name", "lamp"}, {"emissiveFactor", {8.0, 4.0, 2.0}}});
+  src.root["meshes"][0]["primitives"][0]["material"] = 0;
+  irbake::testing::writeDocument(src, dir / "in.gltf");
+  Scene loaded = loadScene(dir / "in.gltf");
+  ASSERT_EQ(loaded.primitives.size(), 1u);
+  loaded.primitives[0].uv1.assign(loaded.primitives[0].positions.size(), glm::vec2(0.5f));
+  loaded.primitives[0].lightmap = {0, 8, 4};
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  exportGltf(loaded, maps, o);
+  const json j = readJson(o.output);
+  const json& at = j["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(at.contains("TEXCOORD_1"));
+  EXPECT_EQ(at["TEXCOORD_0"], at["TEXCOORD_1"]);
+  const json& m = j["materials"][0];
+  EXPECT_EQ(m["emissiveFactor"], json::array({1.0, 0.5, 0.25}));
+  EXPECT_DOUBLE_EQ(m["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 8.0);
+  Scene r = loadScene(o.output);
+  EXPECT_EQ(r.materials[r.primitives[0].material].emission(), glm::vec3(8.0f, 4.0f, 2.0f));
+}
