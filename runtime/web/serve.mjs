@@ -23,3 +23,23 @@ export function serve(roots) {
   });
   return new Promise(resolve => server.listen(0, '127.0.0.1', () => resolve(server)));
 }
+
+// Run directly to look at a bake in a browser:
+//   node runtime/web/serve.mjs --modules build/web --scene out/scene.gltf [--port 8080]
+// then open the printed URL (camera 0; add &camera=N&width=W&height=H).
+import { fileURLToPath } from 'node:url';
+if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) {
+  const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
+  if (!args.modules || !args.scene || !fs.existsSync(args.scene)) {
+    console.error('usage: node serve.mjs --modules BUILD/web --scene SCENE.gltf|.glb [--port N]');
+    process.exit(2);
+  }
+  const server = await serve({
+    web: path.dirname(fileURLToPath(import.meta.url)),
+    three: path.join(path.resolve(args.modules), 'node_modules', 'three'),
+    scene: path.dirname(path.resolve(args.scene)),
+  });
+  if (args.port) { server.close(); server.listen(Number(args.port), '127.0.0.1'); await new Promise(r => server.once('listening', r)); }
+  const port = server.address().port;
+  console.log(`http://127.0.0.1:${port}/web/index.html?scene=/scene/${encodeURIComponent(path.basename(args.scene))}`);
+}
