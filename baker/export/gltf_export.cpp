@@ -200,7 +200,8 @@ class SourceExport {
     if (!pngs_.empty()) doc_.useExtension("MOZ_lightmap");
     repairEmissiveFactors();
     compactDocument(doc_);
-    doc_.root["asset"]["generator"] = "irbake (from " + doc_.root["asset"].value("generator", std::string("unknown")) + ")";
+    const std::string generator = doc_.root["asset"].value("generator", std::string("unknown"));
+    if (generator.rfind("irbake", 0) != 0) doc_.root["asset"]["generator"] = "irbake (from " + generator + ")";
     return std::move(doc_);
   }
 
