@@ -102,6 +102,8 @@ TEST(IrviewCli, UnbakedSceneShowsAlbedoWithAWarning) {
   RunResult r = run(sampleFile("furnace").string() + " --eye 0.1,0.2,0.3 --target 1,0.2,0.3 --fov 90 --width 64 --height 48 --screenshot " + out.string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("albedo only"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("irview: warning: "), 0u) << r.output;  // its own name, not irbake's
+  EXPECT_EQ(r.output.find("irbake:"), std::string::npos) << r.output;
   int w = 0, h = 0;
   auto px = readImage(out, w, h);
   ASSERT_EQ(w, 64);
@@ -136,3 +138,20 @@ TEST(IrviewCli, WindowUnderXvfbRendersTenFramesAndWritesAScreenshot) {
 }
 
 }  // namespace
+
+// Options are checked by range as typed; --help lists them with the exit codes; --version prints one line.
+TEST(IrviewCli, OptionRangesHelpAndVersion) {
+  const std::string scene = sampleFile("furnace").string();
+  for (const char* bad : {"--width 4294967297", "--camera -1", "--fov 180", "--eye 1,2 --target 0,0,0", "--view shiny"}) {
+    RunResult r = run(scene + " " + bad + " --screenshot never.png");
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
+    EXPECT_EQ(r.output.rfind("irview: error: ", 0), 0u) << bad << ": " << r.output;
+  }
+  RunResult help = run("--help");
+  EXPECT_EQ(help.status, 0);
+  for (const char* text : {"--screenshot", "--walkthrough", "exit codes:", "  5  invalid data"})
+    EXPECT_NE(help.output.find(text), std::string::npos) << text << " missing from:\n" << help.output;
+  RunResult version = run("--version");
+  EXPECT_EQ(version.status, 0);
+  EXPECT_EQ(version.output.rfind("irview 0.", 0), 0u) << version.output;
+}

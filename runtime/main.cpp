@@ -13,14 +13,12 @@
 
 int main(int argc, char** argv) {
   using namespace irbake;
+  log::setProgram("irview");
   std::vector<std::string> args(argv + 1, argv + argc);
-  for (const auto& a : args)
-    if (a == "--help" || a == "-h") {
-      std::fputs(view::viewerUsage().c_str(), stdout);
-      return 0;
-    }
   try {
-    view::ViewerOptions options = view::parseViewerOptions(args);
+    std::optional<view::ViewerOptions> parsed = view::parseViewerOptions(args);
+    if (!parsed) return 0;  // --help or --version
+    const view::ViewerOptions& options = *parsed;
     view::ViewerScene scene = view::loadViewerScene(options.scene);
     for (const auto& w : scene.warnings) log::warn(w);
     if (options.headless()) {

@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "imageio/image_io.h"
 
 namespace irbake::view {
 
@@ -39,28 +39,22 @@ void writeScreenshot(const RgbaImage& image, const std::filesystem::path& path, 
       throw Error(ErrorCode::NumericError, path.string(), "rendered image has a non-finite pixel");
   const size_t n = static_cast<size_t>(image.width) * image.height;
   writeAtomically(path, [&](const std::filesystem::path& temp) {
-    // The temp name has no image extension: name the format explicitly.
-    auto out = OIIO::ImageOutput::create(format == ImageFormat::Png ? "png" : "openexr");
-    if (!out) throw Error(ErrorCode::Io, path.string(), "no image writer: " + OIIO::geterror());
-    bool ok = false;
+    imageio::Pixels px;
+    px.width = image.width;
+    px.height = image.height;
+    px.channels = 3;
     if (format == ImageFormat::Exr) {
-      std::vector<float> rgb(n * 3);
+      px.f32.resize(n * 3);
       for (size_t i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = image.pixels[i][c];
-      OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
-      spec.attribute("compression", "zip");
-      ok = out->open(temp.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
+        for (int c = 0; c < 3; ++c) px.f32[i * 3 + c] = image.pixels[i][c];
     } else {
       const float scale = std::exp2(exposure);
-      std::vector<unsigned char> rgb(n * 3);
+      px.u8.resize(n * 3);
       for (size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c)
-          rgb[i * 3 + c] = static_cast<unsigned char>(std::lround(255.0f * encodeSrgb(image.pixels[i][c] * scale)));
-      OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-      ok = out->open(temp.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb.data());
+          px.u8[i * 3 + c] = static_cast<unsigned char>(std::lround(255.0f * encodeSrgb(image.pixels[i][c] * scale)));
     }
-    if (!ok) throw Error(ErrorCode::Io, path.string(), "cannot write image: " + out->geterror());
-    if (!out->close()) throw Error(ErrorCode::Io, path.string(), "cannot write image: " + out->geterror());
+    imageio::api().writeFile(temp.string(), format == ImageFormat::Png ? "png" : "openexr", px, -1, path.string());
   });
 }
 

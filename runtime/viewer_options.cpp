@@ -1,59 +1,76 @@
 #include "viewer_options.h"
 
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/error.h"
+#include "common/version.h"
 
 namespace irbake::view {
 
-std::string viewerUsage() {
-  return "usage: irview SCENE.gltf|.glb [options]\n"
-         "  --camera N             start at glTF camera N (0-based; default: the first, else an overview)\n"
-         "  --eye x,y,z --target x,y,z [--fov deg]   a look-at view instead\n"
-         "  --screenshot OUT.png|OUT.exr   render headless (EGL) and exit; EXR is linear radiance\n"
-         "  --width W --height H   image or window size (default 1280x720)\n"
-         "  --walkthrough N        N frames OUT_0000.png.. along the glTF cameras (or an orbit)\n"
-         "  --view MODE            lit | lightmap | albedo | charts | density | wireframe\n"
-         "  --exposure EV          display exposure in stops (PNG and window)\n"
-         "  --window [--frames N]  open the window even with --screenshot; close after N frames\n"
-         "window keys: mouse drag look, WASD/QE fly (shift: faster), 1-9 glTF cameras, V view mode,\n"
-         "  +/- exposure, F12 screenshot, Esc quit\n";
+namespace {
+
+const char* kWindowKeys =
+    "window keys: mouse drag look, WASD/QE fly (shift: faster), 1-9 glTF cameras, V view mode,\n"
+    "  +/- exposure, F12 screenshot, Esc quit\n";
+
+// The option values as typed on the command line, before the checks that need several of them.
+struct RawOptions {
+  std::vector<std::string> scenes;
+  std::string eye, target, view, screenshot;
+};
+
+std::unique_ptr<CLI::App> viewerApp(ViewerOptions& o, RawOptions& raw) {
+  auto app = cli::makeApp("irview", "Shows a baked glTF (an irbake export) in a window, or renders it headless.");
+  app->footer(std::string(kWindowKeys) + exitCodeHelp());
+  app->set_version_flag("--version", versionLine("irview"), "print the version and exit");
+  app->add_option("SCENE", raw.scenes, "the glTF/GLB to show")->type_name("SCENE.gltf|.glb");
+  app->add_option("--camera", o.camera, "start at glTF camera N (0-based; default: the first, else an overview)")
+      ->transform(cli::integerIn(0, 1 << 20))->type_name("N");
+  app->add_option("--eye", raw.eye, "a look-at view from here (with --target)")->transform(cli::numberList(3))->type_name("X,Y,Z");
+  app->add_option("--target", raw.target, "a look-at view towards here (with --eye)")
+      ->transform(cli::numberList(3))->type_name("X,Y,Z");
+  app->add_option("--fov", o.fovDegrees, "vertical field of view of --eye/--target in degrees (default 50)")
+      ->transform(cli::numberIn(1e-3, 179.999))->type_name("DEG");
+  app->add_option("--screenshot", raw.screenshot, "render headless (EGL) and exit; EXR is linear radiance")
+      ->type_name("OUT.png|OUT.exr");
+  app->add_option("--width", o.width, "image or window width (default 1280)")->transform(cli::integerIn(1, 16384))->type_name("W");
+  app->add_option("--height", o.height, "image or window height (default 720)")->transform(cli::integerIn(1, 16384))->type_name("H");
+  app->add_option("--walkthrough", o.walkthrough, "N frames OUT_0000.png.. along the glTF cameras (or an orbit)")
+      ->transform(cli::integerIn(0, 100000))->type_name("N");
+  app->add_option("--view", raw.view, "view mode")
+      ->check(CLI::IsMember({"lit", "lightmap", "albedo", "charts", "density", "wireframe"}));
+  app->add_option("--exposure", o.exposure, "display exposure in stops (PNG and window)")
+      ->transform(cli::numberIn(-64.0, 64.0))->type_name("EV");
+  app->add_flag("--window", o.window, "open the window even with --screenshot");
+  app->add_option("--frames", o.frames, "window: close after N frames (default 0: until closed)")
+      ->transform(cli::integerIn(0, 1 << 30))->type_name("N");
+  return app;
 }
 
-ViewerOptions parseViewerOptions(const std::vector<std::string>& args) {
-  ArgParser p(args,
-              {"--camera", "--eye", "--target", "--fov", "--screenshot", "--width", "--height", "--walkthrough",
-               "--view", "--exposure", "--frames"},
-              {"--window", "--help", "-h"});
-  if (p.flag("--help") || p.flag("-h")) throw Error(ErrorCode::Usage, "", viewerUsage());
-  if (p.positionals().size() != 1)
-    throw Error(ErrorCode::Usage, "", "expected exactly one scene file\n" + viewerUsage());
+}  // namespace
+
+std::string viewerUsage() {
   ViewerOptions o;
-  o.scene = p.positionals()[0];
-  o.camera = p.intOr("--camera", -1);
-  if (p.value("--camera") && o.camera < 0) throw Error(ErrorCode::Usage, "", "--camera needs an index ≥ 0");
-  if (p.value("--eye") || p.value("--target")) {
-    if (!p.value("--eye") || !p.value("--target"))
-      throw Error(ErrorCode::Usage, "", "--eye and --target go together");
-    auto e = p.numberList("--eye", 3), t = p.numberList("--target", 3);
+  RawOptions raw;
+  return viewerApp(o, raw)->help();
+}
+
+std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& args) {
+  ViewerOptions o;
+  RawOptions raw;
+  auto app = viewerApp(o, raw);
+  if (!cli::parse(*app, args)) return std::nullopt;
+  if (raw.scenes.size() != 1) throw Error(ErrorCode::Usage, "", "expected exactly one scene file (see 'irview --help')");
+  o.scene = raw.scenes[0];
+  o.screenshot = raw.screenshot;
+  if (!raw.eye.empty() || !raw.target.empty()) {
+    if (raw.eye.empty() || raw.target.empty()) throw Error(ErrorCode::Usage, "", "--eye and --target go together");
+    auto e = cli::parseNumberList(raw.eye), t = cli::parseNumberList(raw.target);
     o.eye = glm::vec3(e[0], e[1], e[2]);
     o.target = glm::vec3(t[0], t[1], t[2]);
   }
-  o.fovDegrees = static_cast<float>(p.doubleOr("--fov", o.fovDegrees));
-  if (o.fovDegrees <= 0.0f || o.fovDegrees >= 180.0f) throw Error(ErrorCode::Usage, "", "--fov must be in (0, 180)");
-  o.screenshot = p.valueOr("--screenshot", "");
-  o.width = p.intOr("--width", o.width);
-  o.height = p.intOr("--height", o.height);
-  if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
-    throw Error(ErrorCode::Usage, "", "--width/--height must be in 1..16384");
-  o.walkthrough = p.intOr("--walkthrough", 0);
-  if (o.walkthrough < 0 || o.walkthrough > 100000) throw Error(ErrorCode::Usage, "", "--walkthrough must be in 0..100000");
   if (o.walkthrough > 0 && o.screenshot.empty())
     throw Error(ErrorCode::Usage, "", "--walkthrough needs --screenshot OUT.png|OUT.exr (frames are OUT_0000...)");
-  if (auto v = p.value("--view")) o.mode = parseViewMode(*v);
-  o.exposure = static_cast<float>(p.doubleOr("--exposure", 0.0));
-  o.window = p.flag("--window");
-  o.frames = p.intOr("--frames", 0);
-  if (o.frames < 0) throw Error(ErrorCode::Usage, "", "--frames must be ≥ 0");
+  if (!raw.view.empty()) o.mode = parseViewMode(raw.view);
   return o;
 }
 

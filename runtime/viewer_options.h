@@ -27,9 +27,9 @@ struct ViewerOptions {
   bool headless() const { return !window && (!screenshot.empty() || walkthrough > 0); }
 };
 
-// Throws Error(Usage) naming the option for bad arguments.
-ViewerOptions parseViewerOptions(const std::vector<std::string>& args);
-std::string viewerUsage();
+// Throws Error(Usage) naming the option for bad arguments; nullopt when --help was printed.
+std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& args);
+std::string viewerUsage();  // the generated --help text
 
 // The starting view: --eye/--target, else --camera (or the first glTF camera), else an overview.
 // Throws Error(Usage, scene path) when --camera is out of range.

@@ -18,6 +18,7 @@ packages=(
   libgtest-dev             # GoogleTest
   libbenchmark-dev         # Google Benchmark
   nlohmann-json3-dev       # JSON reports
+  libcli11-dev             # CLI11: command-line options of irbake and irview
   xvfb xauth               # windowed viewer test without a display
   chromium                 # runtime/web: the three.js viewer test in headless Chromium
 )

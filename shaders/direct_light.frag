@@ -5,6 +5,9 @@ layout(binding = 1) uniform sampler2DArray gNormal;
 layout(binding = 2) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
 layout(binding = 3) uniform sampler2D mapDepth;          // spot (perspective) / directional (ortho)
 layout(binding = 4) uniform sampler2DArray gGeomNormal;  // the sample's triangle's normal (bias, self-shadow)
+layout(binding = 5) uniform sampler2DArray glassCube;    // see-through primitives alone: cube faces
+layout(binding = 6) uniform sampler2D glassMap;          // see-through primitives alone: spot / directional map
+uniform int seeThroughMaps;    // 1: the glass maps hold the scene's MASK / BLEND / transmissive primitives
 
 uniform int layers;
 uniform int lightType;         // 0 point, 1 spot, 2 directional
@@ -68,6 +71,11 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
       vec4 d = vec4(texelFetch(cubeMaps, ivec3(t0, face), 0).r, texelFetch(cubeMaps, ivec3(t0 + ivec2(1, 0), face), 0).r,
                     texelFetch(cubeMaps, ivec3(t0 + ivec2(0, 1), face), 0).r, texelFetch(cubeMaps, ivec3(t0 + 1, face), 0).r);
       ambiguous = ambiguous || mixed(lessThanEqual(axisDistance * d, vec4(nearPlane) + bias * d));
+      if (isLit && seeThroughMaps != 0) {  // a see-through surface in front: for the rays
+        float unused;
+        float glass = cubeDepth(glassCube, 0, local, unused);
+        ambiguous = ambiguous || (glass > 0.0 && !cubeLit(glass, axisDistance, nearPlane, bias));
+      }
     }
     return isLit ? 1.0 : 0.0;
   }
@@ -97,6 +105,11 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
     bvec4 l = shadowKind == 1 ? lessThanEqual(c.w * d, vec4(nearPlane) + bias * d)
                               : lessThanEqual(vec4(c.z * orthoDepthRange), d * orthoDepthRange + bias);
     ambiguous = ambiguous || mixed(l);
+    if (isLit && seeThroughMaps != 0) {  // a see-through surface in front: for the rays
+      float glass = texelFetch(glassMap, texel, 0).r;
+      ambiguous = ambiguous || (shadowKind == 1 ? glass > 0.0 && !cubeLit(glass, c.w, nearPlane, bias)
+                                                : glass < 1.0 && c.z * orthoDepthRange > glass * orthoDepthRange + bias);
+    }
   }
   return isLit ? 1.0 : 0.0;
 }

@@ -19,6 +19,9 @@ layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading
 layout(binding = 4) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle
 #if defined(CONTACT_FLAGS)
 layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, raw depths (2×2 filter by textureGather)
+#ifdef SEE_THROUGH
+layout(binding = 5) uniform sampler2D seeThroughDepth;  // the same cubes, see-through primitives only
+#endif
 #elif defined(SHADOW_COMPARE)
 layout(binding = 2) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
 #else
@@ -145,6 +148,13 @@ float vplVisibility(int cube, vec3 v, float bias, vec3 nLocal, out float ambiguo
     float dq = 2.0 / faceSize;
     vec2 q0 = (i0 + 0.5) * dq - 1.0;
     ambiguous = ambiguousWeight(face, nLocal, v, stored, reference, q0, dq, f, sctc / axisDistance);
+#ifdef SEE_THROUGH
+    // A see-through surface in front of the receiver (beyond the bias) on a lit texel: its transmittance,
+    // or its MASK hole, is for the rays to find.
+    vec4 glass = textureGather(seeThroughDepth, (i0 + 1.0 + vec2(tileOrigin(cube, face))) * atlasInvSize);
+    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+    ambiguous = max(ambiguous, dot(litTexel * vec4(greaterThan(glass, vec4(reference))), w));
+#endif
   }
   return visibility;
 #elif defined(SHADOW_COMPARE)

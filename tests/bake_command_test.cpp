@@ -8,11 +8,14 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <iterator>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "common/output_lock.h"
 #include "export/exr_io.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"
@@ -105,6 +108,8 @@ TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
 
   nlohmann::json report = nlohmann::json::parse(std::ifstream(out / "report.json"));
   EXPECT_EQ(report["backend"], "embree");
+  EXPECT_EQ(report["reportSchema"].get<int>(), 1);
+  EXPECT_EQ(report["irbakeVersion"].get<std::string>().rfind("irbake 0.", 0), 0u) << report["irbakeVersion"];
   for (const char* stage : {"load", "atlas", "texels", "vpls", "backend", "post", "bake"})
     EXPECT_TRUE(report["seconds"].contains(stage)) << stage;
   EXPECT_GT(report["memoryPeakMiB"].get<double>(), 1.0);
@@ -197,6 +202,15 @@ TEST(BakeCommand, BadArgumentsGiveTheUsageExitCode) {
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --vpls 0", &log), 2) << log;
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --bounces -3", &log), 2) << log;
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --sun 0,-1,0", &log), 2) << log;
+  EXPECT_NE(log.find("--sun: needs 4 comma-separated numbers"), std::string::npos) << log;
+  // Integers beyond int range are refused as typed, never wrapped (4294967297 used to run 1 path,
+  // 4294967299 to become seed 3).
+  for (const char* option : {"--vpls 4294967297", "--vpls 2147483648", "--seed 4294967299", "--bounces 1e3"}) {
+    EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " " + option, &log), 2) << log;
+    const std::string value = std::string(option).substr(std::string(option).find(' ') + 1);
+    EXPECT_NE(log.find("got '" + value + "'"), std::string::npos) << log;
+    EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+  }
   EXPECT_EQ(runIrbake("diff " + q(dir), &log), 2) << log;
   // No output was left behind by any failed run.
   EXPECT_TRUE(fs::is_empty(dir));
@@ -298,4 +312,136 @@ TEST(BakeCommand, ReferenceBackendReportsItsSamplesAndMatchesTheClosedForm) {
   double s = 0.5 / report["atlas"]["texelsPerUnit"].get<double>();
   EXPECT_LE(peak, 10.0 / M_PI * 1.0001);
   EXPECT_GE(peak, 10.0 / (M_PI * std::pow(1.0 + 2 * s * s, 1.5)) * 0.9999);
+}
+
+// --help is generated (every option, the exit codes); --version names the version and commit.
+TEST(BakeCommand, HelpListsOptionsAndExitCodesAndVersionIsPrinted) {
+  std::string log;
+  ASSERT_EQ(runIrbake("bake --help", &log), 0) << log;
+  for (const char* option : {"--vpls", "--bounces", "--texels-per-unit", "--max-texels", "--seed", "--sun", "--quiet"})
+    EXPECT_NE(log.find(option), std::string::npos) << option;
+  EXPECT_NE(log.find("exit codes:"), std::string::npos) << log;
+  EXPECT_NE(log.find("  2  usage error"), std::string::npos) << log;
+  EXPECT_NE(log.find("  7  no light"), std::string::npos) << log;
+  ASSERT_EQ(runIrbake("--help", &log), 0) << log;
+  EXPECT_NE(log.find("  3  I/O error"), std::string::npos) << log;
+  ASSERT_EQ(runIrbake("--version", &log), 0) << log;
+  EXPECT_EQ(log.rfind("irbake 0.", 0), 0u) << log;
+  EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+}
+
+// --texels-per-unit 1e6 on the Cornell box (570 MB and 16 warnings before) fails at once against the
+// texel budget, naming a density that fits; that density then passes the same budget.
+TEST(BakeCommand, TexelBudgetRefusesAnAtlasTooLargeAndNamesTheDensityThatFits) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("texel_budget");
+  fs::path scene = samplesDir() / "cornell_box.gltf";
+  std::string log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / "out") + " --texels-per-unit 1e6", &log), 2) << log;
+  EXPECT_NE(log.find("cornell_box.gltf"), std::string::npos) << log;
+  EXPECT_NE(log.find("over the budget of 16.78 M (--max-texels 16777216)"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir / "out" / "lightmap_0.exr"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+
+  const std::string budget = " --max-texels 100000";
+  EXPECT_EQ(runIrbake("unwrap " + q(scene) + " -o " + q(dir / "u.gltf") + " --texels-per-unit 1e6" + budget, &log), 2)
+      << log;
+  const std::string marker = "use --texels-per-unit ";
+  const size_t at = log.find(marker);
+  ASSERT_NE(at, std::string::npos) << log;
+  const double fits = std::stod(log.substr(at + marker.size()));
+  // Cornell box: 5 walls of 0.555² m² plus two blocks ≈ 2.1 m²; 1e5 × 0.6 / 2.1 m² → about 170 texels/m.
+  EXPECT_GT(fits, 100.0);
+  EXPECT_LT(fits, 250.0);
+  ASSERT_EQ(runIrbake("unwrap " + q(scene) + " -o " + q(dir / "u.gltf") + " --texels-per-unit " + std::to_string(fits) +
+                          budget + " --report " + q(dir / "u.json"),
+                      &log),
+            0)
+      << log;
+  nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "u.json"));
+  size_t texels = 0;
+  for (const auto& p : report["pages"]) texels += p["width"].get<size_t>() * p["height"].get<size_t>();
+  EXPECT_LE(texels, 100000u);
+  EXPECT_GT(texels, 30000u);  // the named density uses the budget, not a small part of it
+}
+
+// A bake into a folder another bake holds fails at once (exit 3, the folder named) and writes nothing;
+// once the holder is gone the same command bakes and leaves no lock file.
+TEST(BakeCommand, SecondBakeIntoABusyFolderFailsAtOnce) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("busy");
+  fs::path out = dir / "out";
+  fs::path scene = samplesDir() / "point_over_plane.gltf";
+  const std::string command = "bake " + q(scene) + " -o " + q(out) + " --backend embree --texels-per-unit 2 --vpls 16";
+  std::string log;
+  {
+    OutputFolderLock holder(out);  // stands for a bake in progress (flock conflicts across processes)
+    EXPECT_EQ(runIrbake(command, &log), 3) << log;
+    EXPECT_NE(log.find(out.string()), std::string::npos) << log;
+    EXPECT_NE(log.find("output folder is busy"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(out / "lightmap_0.exr"));
+    EXPECT_FALSE(fs::exists(out / "report.json"));
+  }
+  ASSERT_EQ(runIrbake(command, &log), 0) << log;
+  EXPECT_TRUE(fs::exists(out / "lightmap_0.exr"));
+  EXPECT_FALSE(fs::exists(out / OutputFolderLock::kFileName));
+}
+
+// On a terminal (a pty from `script`): a bar for each stage, through compensation, post and writing,
+// and every log line starts at the beginning of a line, never glued onto a bar. --quiet draws none.
+TEST(BakeCommand, ProgressBarsOnATerminalNeverGlueLogLinesAndQuietDrawsNone) {
+  ASSERT_FALSE(samplesDir().empty());
+  if (std::system("command -v script > /dev/null 2>&1") != 0) GTEST_SKIP() << "no `script` (util-linux) to give irbake a terminal";
+  fs::path dir = scratch("terminal");
+  auto runOnTerminal = [&](const std::string& args) {
+    fs::path log = dir / "terminal.txt";
+    std::string inner = std::string(IRBAKE_EXE) + " bake '" + (samplesDir() / "cornell_box.gltf").string() + "' -o '" +
+                        (dir / "out").string() + "' --texels-per-unit 8 --vpls 32 " + args;
+    std::string cmd = "script -qec \"" + inner + "\" /dev/null > \"" + log.string() + "\" 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    std::ifstream in(log);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string shown = runOnTerminal("");
+  for (const char* stage : {"atlas", "compensate", "post", "write"})
+    EXPECT_NE(shown.find(std::string("\r") + stage), std::string::npos) << stage << " has no bar in:\n" << shown;
+  size_t lines = 0;
+  for (size_t at = shown.find("irbake: "); at != std::string::npos; at = shown.find("irbake: ", at + 1), ++lines) {
+    const bool fresh = at == 0 || shown[at - 1] == '\n' || shown.compare(at >= 4 ? at - 4 : 0, 4, "\r\033[K") == 0;
+    EXPECT_TRUE(fresh) << "log line glued onto a bar at byte " << at << ":\n" << shown;
+  }
+  EXPECT_GE(lines, 2u) << shown;  // "GL backend: ..." (during the bars) and "baked ..."
+  const std::string quiet = runOnTerminal("--quiet");
+  EXPECT_EQ(quiet.find("ETA"), std::string::npos) << quiet;
+  EXPECT_NE(quiet.find("lightmap_0.exr"), std::string::npos) << quiet;
+}
+
+// Issue 14: the same scene, options and seed give byte-identical EXR pages, glTF and .bin on either backend
+// and any thread count (twice each).
+TEST(BakeCommand, IdenticalBytesForAnyThreadCountAndRun) {
+  const fs::path scene = samplesDir() / "cornell_box.gltf";
+  const fs::path dir = scratch("identical_bytes");
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  for (const char* backend : {"gl", "embree"}) {
+    std::vector<fs::path> runs;
+    for (int threads : {1, 2})
+      for (int again = 0; again < 2; ++again) {
+        const fs::path out = dir / (std::string(backend) + "_t" + std::to_string(threads) + "_" + std::to_string(again));
+        std::string log;
+        ASSERT_EQ(runIrbake("bake " + q(scene) + " -o " + q(out) + " --backend " + backend +
+                                " --vpls 96 --texels-per-unit 60 --seed 5 --quiet --threads " + std::to_string(threads),
+                            &log),
+                  0)
+            << log;
+        runs.push_back(out);
+      }
+    for (const char* file : {"lightmap_0.exr", "scene.gltf", "scene.bin"}) {
+      const std::string reference = bytes(runs[0] / file);
+      ASSERT_FALSE(reference.empty()) << file;
+      for (size_t r = 1; r < runs.size(); ++r) EXPECT_TRUE(bytes(runs[r] / file) == reference) << runs[r] / file;
+    }
+  }
 }

@@ -4,13 +4,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "common/error.h"
+#include "export/exr_io.h"
 #include "pipeline/bake.h"
 #include "raytrace/ray_tracer.h"
+#include "scene/environment.h"
 #include "scene/gltf_loader.h"
 #include "samples/sample_scenes.h"
 #include "texels/texel_samples.h"
@@ -145,6 +149,54 @@ TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
     }
 }
 
+// Issue 12: a uniform sky over an open plane gives map = L on every backend (its bounces cannot reach the
+// plane again); a plane under a box's overhang gets less, the same on GL and Embree.
+TEST(BakePipeline, UniformSkyOverAnOpenPlaneOnEveryBackend) {
+  for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree, BackendKind::Reference}) {
+    Scene s = samples::makePointOverPlane();
+    s.lights.clear();
+    s.environment = Environment::uniform({0.5f, 0.7f, 1.0f});
+    BakeOptions o;
+    o.backend = backend;
+    o.atlas.texelsPerUnit = 3.0f;
+    o.walk.paths = 256;
+    o.referenceSpp = 16;
+    BakeResult r = bake(std::move(s), o);
+    glm::dvec3 sum(0.0), worst(0.0);
+    size_t n = 0;
+    for (const auto& m : r.maps)
+      for (size_t i = 0; i < m.size(); ++i)
+        if (m.valid[i]) {
+          sum += glm::dvec3(m.texels[i]);
+          worst = glm::max(worst, glm::abs(glm::dvec3(m.texels[i]) - glm::dvec3(0.5, 0.7, 1.0)));
+          ++n;
+        }
+    ASSERT_GT(n, 100u);
+    std::printf("[ figure ] uniform sky, open plane, %s: mean (%.5f %.5f %.5f), exact (0.5 0.7 1), worst |err| %.2e\n",
+                toString(backend), sum.x / n, sum.y / n, sum.z / n, worst.z);
+    EXPECT_NEAR(sum.x / n, 0.5, 1e-4) << toString(backend);
+    EXPECT_NEAR(sum.z / n, 1.0, 2e-4) << toString(backend);
+    EXPECT_LT(worst.z, 1e-3) << toString(backend);
+  }
+}
+
+// --backend auto (the default): GL for a small scene (on llvmpipe too), Embree as soon as a material is
+// see-through (GL's shadow maps would treat it as opaque); the choice and its reason in the report.
+TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
+  BakeOptions o;
+  o.atlas.texelsPerUnit = 4.0f;
+  o.walk.paths = 64;
+  BakeResult small = bake(samples::makeFurnace(), o);
+  EXPECT_EQ(small.report["backendChoice"]["asked"], "auto");
+  EXPECT_EQ(small.report["backend"], "gl");
+  EXPECT_FALSE(small.report["backendChoice"]["reason"].get<std::string>().empty());
+  Scene glass = samples::makeCornellBox();
+  glass.materials[0].alphaMode = AlphaMode::Blend;
+  BakeResult seeThrough = bake(std::move(glass), o);
+  EXPECT_EQ(seeThrough.report["backend"], "embree");
+  EXPECT_NE(seeThrough.report["backendChoice"]["reason"].get<std::string>().find("BLEND"), std::string::npos);
+}
+
 // The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
 // give the same map, bit for bit, as tracing them after it: the trace reads no map.
 TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {
@@ -262,4 +314,40 @@ TEST(BakePipeline, SeamsOfASmoothSphereAreStitched) {
     for (size_t i = 0; i < m.size(); ++i)
       if (m.valid[i]) brightest = std::max(brightest, double(m.texels[i].x));
   EXPECT_NEAR(brightest, exact, 0.03 * exact);
+}
+
+// An equirectangular EXR read through the imageio plugin keeps every texel, its size and its source;
+// a file that is not an image is InvalidData naming it.
+TEST(EnvironmentFile, LoadsThroughTheImagePluginTexelForTexel) {
+  const std::filesystem::path dir = std::filesystem::current_path() / "test_scratch" / "environment_file";
+  std::filesystem::create_directories(dir);
+  Lightmap map;
+  map.width = 4;
+  map.height = 2;
+  for (int i = 0; i < 8; ++i) map.texels.push_back(glm::vec3(0.5f * i, 1.0f + i, 0.25f));
+  map.valid.assign(8, 1);
+  writeExr(map, dir / "sky.exr");
+  const Environment env = loadEnvironment(dir / "sky.exr", 2.0f);
+  ASSERT_EQ(env.width(), 4);
+  ASSERT_EQ(env.height(), 2);
+  EXPECT_EQ(env.source(), (dir / "sky.exr").string());
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const glm::vec3 t = map.texels[size_t(y) * 4 + x] * 2.0f;  // the intensity scales every texel
+      // The direction through the texel's centre (+Y up; φ from -Z towards +X).
+      const double theta = M_PI * (y + 0.5) / 2.0, phi = 2.0 * M_PI * (x + 0.5) / 4.0 - M_PI;
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const glm::vec3 e = env.radiance(d);
+      EXPECT_NEAR(e.x, t.x, 1e-6f);
+      EXPECT_NEAR(e.y, t.y, 1e-6f);
+      EXPECT_NEAR(e.z, t.z, 1e-6f);
+    }
+  std::ofstream(dir / "not_an_image.exr") << "plain text";
+  try {
+    loadEnvironment(dir / "not_an_image.exr");
+    FAIL() << "text accepted as an environment";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("not_an_image.exr"), std::string::npos) << e.what();
+  }
 }

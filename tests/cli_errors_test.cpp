@@ -203,6 +203,38 @@ TEST(CliErrors, OnlyDegenerateTriangles) {
   expectError(file, ErrorCode::EmptyScene, "2 degenerate triangles dropped");
 }
 
+// 200,000 nested arrays in extras overflowed tinygltf's recursive parser (SIGSEGV). The depth scan
+// refuses them first; brackets inside strings (with escaped quotes) do not count.
+TEST(CliErrors, DeeplyNestedExtras) {
+  auto file = validScene("deep_extras");
+  const std::string deep = std::string(200000, '[') + std::string(200000, ']');
+  std::string text;
+  {
+    std::ifstream in(file);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // Shallow brackets inside a string, behind an escaped quote, are data, not nesting.
+  const std::string inString = "\"extras\": {\"note\": \"\\\"" + std::string(100, '[') + "\"}, ";
+  std::ofstream(file, std::ios::trunc) << "{" << inString << text.substr(1);
+  RunResult ok = runIrbake("info " + quoted(file));
+  EXPECT_EQ(ok.exitCode, 0) << ok.output;
+  std::ofstream(file, std::ios::trunc) << "{\"extras\": " << deep << ", " << text.substr(1);
+  expectError(file, ErrorCode::InvalidData, "JSON nests deeper than 64 arrays/objects");
+}
+
+TEST(CliErrors, DeeplyNestedGlbJsonChunk) {
+  auto dir = irbake::testing::testFolder("cli_deep_glb");
+  std::string json = "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(200000, '[') +
+                     std::string(200000, ']') + "}";
+  while (json.size() % 4) json += ' ';
+  const uint32_t header[5] = {0x46546C67u, 2u, uint32_t(20 + json.size()), uint32_t(json.size()), 0x4E4F534Au};
+  std::ofstream out(dir / "deep.glb", std::ios::binary);
+  out.write(reinterpret_cast<const char*>(header), sizeof(header));
+  out << json;
+  out.close();
+  expectError(dir / "deep.glb", ErrorCode::InvalidData, "JSON nests deeper than 64");
+}
+
 TEST(CliInfo, PrintsTheCornellBoxSummary) {
   auto dir = irbake::testing::testFolder("cli_info");
   RunResult w = runIrbake("samples " + quoted(dir) + " --quiet");

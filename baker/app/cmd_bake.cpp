@@ -1,120 +1,156 @@
 // irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR.
 #include <cstdio>
+#include <memory>
 #include <string>
 
+#include <tbb/global_control.h>
+
 #include "app/commands.h"
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/error.h"
 #include "common/log.h"
+#include "common/output_lock.h"
 #include "common/progress.h"
 #include "pipeline/bake.h"
 #include "scene/gltf_loader.h"
 
 namespace irbake::app {
-namespace {
-const char* kBakeHelp =
-    "usage: irbake bake SCENE -o OUTDIR [options]\n"
-    "  --backend gl|embree|reference   evaluator (default gl; embree: ray-traced; reference: path traced)\n"
-    "  --vpls N                 light paths of the quasi-random walk (default 1024)\n"
-    "  --bounces N|auto         diffuse bounces (default auto: follow the energy left)\n"
-    "  --texels-per-unit T      texels per metre (default: fit about one 1024 page)\n"
-    "  --supersample S          S×S samples per texel (default 1)\n"
-    "  --clamp B                geometry-term bound (1/m²); 0 = no clamp (default: derived from the scene)\n"
-    "  --clamp-k K              derived clamp: no VPL adds more than 1/K of the mean (default 256 with\n"
-    "                           bias compensation, 16 without)\n"
-    "  --no-bias-compensation   keep the clamp's bias (default: recovered by a gather into the map,\n"
-    "                           after Kollig & Keller 2004; --comp-rays N, --comp-refine N rays per sample)\n"
-    "  --interleave N|auto      interleaved sampling: each texel of an N×N block sees 1/N² of the VPLs,\n"
-    "                           then a filter on the surface mixes them (default auto: 1..4 from the texel\n"
-    "                           size and the clamp radius; 1 = every VPL everywhere)\n"
-    "  --cube-face N|auto       GL backend: VPL depth-cube face size in texels (default auto: a shadow\n"
-    "                           texel's footprint held to the light-map texel spacing, 128..256)\n"
-    "  --seed K                 walk seed (default 0)\n"
-    "  --spp N                  reference backend: paths per texel sample (default 256)\n"
-    "  --sun DX,DY,DZ,E         add a directional light travelling along D with irradiance E (W/m²)\n"
-    "  --report R.json          report path (default OUTDIR/report.json)\n"
-    "  --no-gltf                write only the EXR pages and the report\n"
-    "  --no-leak-control --no-dilate --no-seams   switch post/texel stages off (diagnostics)\n"
-    "  --quiet                  warnings and errors only\n"
-    "writes OUTDIR/lightmap_<page>.exr (irradiance/pi, linear), OUTDIR/scene.gltf and the report\n";
-
-int positiveInt(const ArgParser& a, const std::string& name, int fallback, int lo, int hi) {
-  int v = a.intOr(name, fallback);
-  if (v < lo || v > hi)
-    throw Error(ErrorCode::Usage, "", "option " + name + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                                          "], got " + std::to_string(v));
-  return v;
-}
-}  // namespace
 
 int runBake(const Args& args) {
-  ArgParser a(args,
-              {"-o", "--output", "--backend", "--vpls", "--bounces", "--texels-per-unit", "--supersample", "--clamp",
-               "--seed", "--spp", "--report", "--sun", "--clamp-k", "--comp-rays", "--comp-refine", "--interleave",
-               "--cube-face"},
-              {"--help", "-h", "--bias-compensation", "--no-bias-compensation", "--no-gltf", "--no-leak-control", "--no-dilate", "--no-seams",
-               "--quiet"});
-  if (a.flag("--help") || a.flag("-h")) {
-    std::fputs(kBakeHelp, stdout);
-    return 0;
-  }
-  if (a.positionals().size() != 1)
-    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.positionals().size()) +
-                                          "); see 'irbake bake --help'");
-  auto out = a.value("-o") ? a.value("-o") : a.value("--output");
-  if (!out || out->empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
-  if (a.flag("--quiet")) log::setLevel(log::Level::Warn);
-
   BakeOptions o;
-  o.backend = parseBackend(a.valueOr("--backend", "gl"));
-  o.walk.paths = positiveInt(a, "--vpls", o.walk.paths, 1, 1 << 26);
-  std::string bounces = a.valueOr("--bounces", "auto");
-  o.walk.maxBounces = bounces == "auto" ? -1 : positiveInt(a, "--bounces", 0, 0, 64);
-  o.walk.seed = static_cast<uint32_t>(positiveInt(a, "--seed", 0, 0, 1 << 30));
-  double tpu = a.doubleOr("--texels-per-unit", 0.0);
-  if (tpu < 0.0 || tpu > 1e6) throw Error(ErrorCode::Usage, "", "option --texels-per-unit must be in [0, 1e6]");
+  std::vector<std::string> scenes;
+  std::string out, backend = "auto", sun, sky, env, report;
+  double envIntensity = 1.0, envRotation = 0.0;
+  long long seed = 0;
+  double tpu = 0.0, clamp = 0.0;
+  int threads = 0;
+  bool quiet = false, noGltf = false, noLeakControl = false, noDilate = false, noSeams = false;
+  bool noBiasCompensation = false, biasCompensation = false;
+
+  auto app = cli::makeApp("irbake bake",
+                          "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
+                          "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
+  app->add_option("SCENE", scenes, "the glTF/GLB scene to bake");
+  app->add_option("-o,--output", out, "output folder (OUTDIR)")->type_name("OUTDIR");
+  app->add_option("--backend", backend,
+                  "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
+                  "else embree; embree: ray-traced; reference: path traced)")
+      ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
+  app->add_option("--vpls", o.walk.paths, "light paths of the quasi-random walk (default 1024)")
+      ->transform(cli::integerIn(1, 1 << 26))->type_name("N");
+  app->add_option("--bounces", o.walk.maxBounces, "diffuse bounces (default auto: follow the energy left)")
+      ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
+  app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page)")
+      ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
+  app->add_option("--max-texels", o.atlas.maxTexels,
+                  "texel budget of all pages together (default 16777216 = 16M);\n"
+                  "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
+      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
+  app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
+      ->transform(cli::integerIn(1, 8))->type_name("S");
+  auto* clampOption =
+      app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
+          ->transform(cli::numberIn(0.0, 1e30))
+          ->type_name("B");
+  app->add_option("--clamp-k", o.clampVplsPerMean,
+                  "derived clamp: no VPL adds more than 1/K of the mean\n"
+                  "(default 256 with bias compensation, 16 without; 0 = automatic)")
+      ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
+  app->add_flag("--no-bias-compensation", noBiasCompensation,
+               "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");
+  app->add_flag("--bias-compensation", biasCompensation, "the default (kept for old scripts)");
+  app->add_option("--comp-rays", o.compensation.rays, "bias compensation: rays per texel sample, first round (default 16)")
+      ->transform(cli::integerIn(1, 4096))->type_name("N");
+  app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
+      ->transform(cli::integerIn(0, 65536))->type_name("N");
+  app->add_option("--interleave", o.interleave,
+                  "interleaved sampling: each texel of an N×N block sees 1/N²\n"
+                  "of the VPLs, then a filter on the surface mixes them\n"
+                  "(default auto: 1..4 from the texel size and the clamp radius;\n1 = every VPL everywhere)")
+      ->transform(cli::integerOrAuto(1, 8, 0))->type_name("N|auto");
+  app->add_option("--cube-face", o.gl.cubeFaceSize,
+                  "GL backend: VPL depth-cube face size in texels\n"
+                  "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, 128..256)")
+      ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
+  app->add_option("--seed", seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
+  app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default 256)")
+      ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
+  app->add_option("--sun", sun, "add a directional light travelling along D with irradiance E (W/m²)")
+      ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
+  app->add_option("--sky", sky, "a uniform sky of that radiance (W/(m² sr)): direct light\ntraced, bounces as VPLs")
+      ->transform(cli::numberList(3))->type_name("R,G,B");
+  app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up, centre\ntowards −Z) instead of --sky")
+      ->type_name("FILE");
+  app->add_option("--env-intensity", envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-rotation", envRotation, "turns --env about +Y (degrees, default 0)")
+      ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
+  app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
+  app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
+  app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
+  app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
+  app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
+  app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
+      ->transform(cli::integerIn(0, 1024))->type_name("N");
+  app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
+  if (!cli::parse(*app, args)) return 0;
+
+  if (scenes.size() != 1)
+    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(scenes.size()) +
+                                          "); see 'irbake bake --help'");
+  if (out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
+  if (quiet) log::setLevel(log::Level::Warn);
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (threads > 0)
+    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+
+  o.backend = parseBackend(backend);
+  o.walk.seed = static_cast<uint32_t>(seed);
   o.atlas.texelsPerUnit = static_cast<float>(tpu);
-  o.texels.supersample = positiveInt(a, "--supersample", 1, 1, 8);
-  o.texels.leakControl = !a.flag("--no-leak-control");
-  if (a.value("--clamp")) {
-    double clamp = a.doubleOr("--clamp", 0.0);
-    if (clamp < 0.0) throw Error(ErrorCode::Usage, "", "option --clamp must be >= 0 (0 = no clamp)");
+  o.texels.leakControl = !noLeakControl;
+  if (clampOption->count() > 0) {
     o.eval.clampBound = static_cast<float>(clamp);
     o.autoClamp = false;
   }
-  o.eval.biasCompensation = !a.flag("--no-bias-compensation");  // on by default; --bias-compensation kept
-  o.clampVplsPerMean = a.doubleOr("--clamp-k", 0.0);
-  if (o.clampVplsPerMean < 0.0 || o.clampVplsPerMean > 1e6)
-    throw Error(ErrorCode::Usage, "", "option --clamp-k must be in [0, 1e6] (0 = automatic)");
-  o.compensation.rays = positiveInt(a, "--comp-rays", o.compensation.rays, 1, 4096);
-  o.compensation.refineRays = positiveInt(a, "--comp-refine", o.compensation.refineRays, 0, 65536);
-  o.referenceSpp = positiveInt(a, "--spp", o.referenceSpp, 1, 1 << 20);
-  o.interleave = a.valueOr("--interleave", "auto") == "auto" ? 0 : positiveInt(a, "--interleave", 0, 1, 8);
-  o.gl.cubeFaceSize = a.valueOr("--cube-face", "auto") == "auto" ? 0 : positiveInt(a, "--cube-face", 0, 16, 2048);
-  o.postDilate = !a.flag("--no-dilate");
-  o.postSeams = !a.flag("--no-seams");
+  o.eval.biasCompensation = !noBiasCompensation;  // on by default; --bias-compensation kept
+  o.postDilate = !noDilate;
+  o.postSeams = !noSeams;
 
-  const std::filesystem::path scenePath = a.positionals()[0];
+  const OutputFolderLock lock(out);  // before any work: a second bake into OUTDIR fails at once
+  const std::filesystem::path scenePath = scenes[0];
   Stopwatch loadTime;
   Scene scene = loadScene(scenePath);
-  if (auto sun = a.numberList("--sun", 4); !sun.empty())
-    scene.lights.push_back(sunLight(glm::vec3(sun[0], sun[1], sun[2]), static_cast<float>(sun[3])));
+  if (!sun.empty()) {
+    const std::vector<double> d = cli::parseNumberList(sun);
+    scene.lights.push_back(sunLight(glm::vec3(d[0], d[1], d[2]), static_cast<float>(d[3])));
+  }
+  if (!sky.empty()) {
+    const std::vector<double> L = cli::parseNumberList(sky);
+    for (double v : L)
+      if (!(v >= 0.0)) throw Error(ErrorCode::Usage, "", "--sky needs three radiances ≥ 0 (R,G,B)");
+    scene.environment = Environment::uniform(glm::vec3(L[0], L[1], L[2]));
+  }
+  if (!env.empty()) {
+    if (!sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
+    scene.environment = loadEnvironment(env, static_cast<float>(envIntensity), static_cast<float>(envRotation));
+  }
   requireLight(scene, scenePath);
   double loadSeconds = loadTime.seconds();
 
   TerminalProgress progress;
   o.progress = progress.callback();
   BakeResult result = bake(std::move(scene), o);
-  progress.finish();
   result.report["seconds"]["load"] = loadSeconds;
 
   OutputOptions oo;
-  oo.outDir = *out;
-  oo.reportPath = a.valueOr("--report", "");
-  oo.writeGltf = !a.flag("--no-gltf");
+  oo.outDir = out;
+  oo.reportPath = report;
+  oo.writeGltf = !noGltf;
   Stopwatch writeTime;
+  o.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
   auto files = writeBakeOutputs(result, oo);
-  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + toString(o.backend) + " in " +
+  o.progress("write", 1.0);
+  progress.finish();
+  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() + " in " +
             std::to_string(result.report["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
             " s writing)");
   for (const auto& f : files) std::printf("%s\n", f.string().c_str());

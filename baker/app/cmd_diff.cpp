@@ -5,34 +5,31 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/error.h"
 #include "pipeline/diff.h"
 
 namespace irbake::app {
-namespace {
-const char* kDiffHelp =
-    "usage: irbake diff A B [--json]\n"
-    "  A, B: bake folders (lightmap_<page>.exr, scene.gltf) or single EXR files; B is the reference.\n"
-    "  Texels are weighted by the surface area they stand for when a folder holds scene.gltf, else\n"
-    "  every texel counts once. relative RMSE = RMSE / RMS(B); bias = mean(A - B).\n"
-    "  --json   print the figures as one JSON object\n";
-}
-
 int runDiff(const Args& args) {
-  ArgParser a(args, {}, {"--help", "-h", "--json"});
-  if (a.flag("--help") || a.flag("-h")) {
-    std::fputs(kDiffHelp, stdout);
-    return 0;
-  }
-  if (a.positionals().size() != 2) throw Error(ErrorCode::Usage, "", "diff needs two bakes A B; see 'irbake diff --help'");
-  BakeOnDisk bakeA = readBakeFromDisk(a.positionals()[0]);
-  BakeOnDisk bakeB = readBakeFromDisk(a.positionals()[1]);
+  std::vector<std::string> bakes;
+  bool json = false;
+  auto app = cli::makeApp(
+      "irbake diff",
+      "Compares bake A with bake B (the reference) on the same atlas.\n"
+      "A, B: bake folders (lightmap_<page>.exr, scene.gltf) or single EXR files. Texels are weighted by the\n"
+      "surface area they stand for when a folder holds scene.gltf, else every texel counts once.\n"
+      "relative RMSE = RMSE / RMS(B); bias = mean(A - B).");
+  app->add_option("A B", bakes, "the bake to score and the reference");
+  app->add_flag("--json", json, "print the figures as one JSON object");
+  if (!cli::parse(*app, args)) return 0;
+  if (bakes.size() != 2) throw Error(ErrorCode::Usage, "", "diff needs two bakes A B; see 'irbake diff --help'");
+  BakeOnDisk bakeA = readBakeFromDisk(bakes[0]);
+  BakeOnDisk bakeB = readBakeFromDisk(bakes[1]);
   const auto& areas = !bakeB.areas.empty() ? bakeB.areas : bakeA.areas;
   MapDifference d = compareMaps(bakeA.pages, bakeB.pages, areas);
-  if (d.texels == 0) throw Error(ErrorCode::InvalidData, a.positionals()[0], "no texel to compare");
+  if (d.texels == 0) throw Error(ErrorCode::InvalidData, bakes[0], "no texel to compare");
   const bool areaWeighted = !areas.empty();
-  if (a.flag("--json")) {
+  if (json) {
     nlohmann::json j = {{"pages", d.pages},         {"texels", d.texels},
                         {"areaWeighted", areaWeighted}, {"weightSum", d.weightSum},
                         {"rmse", d.rmse},           {"relativeRmse", d.relativeRmse},

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "app/commands.h"
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "scene/gltf_loader.h"
@@ -28,18 +28,18 @@ void printVec(const char* label, const glm::vec3& v) { std::printf("%s(%.6g, %.6
 }  // namespace
 
 int runInfo(const Args& args) {
-  ArgParser parser(args, {}, {"--help", "--no-images"});
-  if (parser.flag("--help")) {
-    std::puts("usage: irbake info SCENE [--no-images]\n"
-              "  prints triangles (kept/dropped), materials, textures, lights with power, emitters,\n"
-              "  bounding box and cameras of a glTF/GLB scene\n"
-              "  --no-images   do not decode textures (faster)");
-    return 0;
-  }
-  if (parser.positionals().size() != 1) throw Error(ErrorCode::Usage, "", "info takes exactly one SCENE argument");
-  const std::string file = parser.positionals()[0];
+  std::vector<std::string> scenes;
+  bool noImages = false;
+  auto app = cli::makeApp("irbake info",
+                              "Prints triangles (kept/dropped), materials, textures, lights with power, emitters,\n"
+                              "bounding box and cameras of a glTF/GLB scene.");
+  app->add_option("SCENE", scenes, "the glTF/GLB scene");
+  app->add_flag("--no-images", noImages, "do not decode textures (faster)");
+  if (!cli::parse(*app, args)) return 0;
+  if (scenes.size() != 1) throw Error(ErrorCode::Usage, "", "info takes exactly one SCENE argument");
+  const std::string file = scenes[0];
   LoadOptions options;
-  options.decodeImages = !parser.flag("--no-images");
+  options.decodeImages = !noImages;
   Stopwatch clock;
   Scene scene = loadScene(file, options);
   const double seconds = clock.seconds();

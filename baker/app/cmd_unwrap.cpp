@@ -8,7 +8,7 @@
 
 #include "app/commands.h"
 #include "atlas/atlas.h"
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/progress.h"
@@ -45,34 +45,32 @@ nlohmann::json reportJson(const std::string& input, const AtlasResult& r) {
 }  // namespace
 
 int runUnwrap(const Args& args) {
-  ArgParser parser(args, {"-o", "--texels-per-unit", "--padding", "--max-page", "--target-page", "--report"},
-                   {"--help", "--keep-uv1"});
-  if (parser.flag("--help")) {
-    std::puts("usage: irbake unwrap IN.gltf -o OUT.gltf|OUT.glb [--texels-per-unit T] [--padding P] [--max-page S]\n"
-              "                     [--target-page S] [--keep-uv1] [--report R.json]\n"
-              "  adds a lightmap UV set (TEXCOORD_1) and extras.lightmap {page, width, height} per primitive\n"
-              "  --texels-per-unit T  texel density per metre (default: fit the charts into about one target page)\n"
-              "  --padding P          empty texels between charts (default 2)\n"
-              "  --max-page S         largest page edge in texels (default 2048); more pages when full\n"
-              "  --target-page S      page edge the automatic density aims at (default 1024)\n"
-              "  --keep-uv1           keep an input TEXCOORD_1 and only repack its islands\n"
-              "  --report R.json      write the atlas statistics");
-    return 0;
-  }
-  if (parser.positionals().size() != 1) throw Error(ErrorCode::Usage, "", "unwrap takes exactly one input scene");
-  const auto output = parser.value("-o");
-  if (!output) throw Error(ErrorCode::Usage, "", "unwrap needs -o OUT.gltf");
-  const std::string input = parser.positionals()[0];
+  std::vector<std::string> inputs;
+  std::string output, report;
+  double tpu = 0.0;
   AtlasOptions options;
-  options.texelsPerUnit = float(parser.doubleOr("--texels-per-unit", 0.0));
-  options.padding = parser.intOr("--padding", 2);
-  options.maxPageSize = parser.intOr("--max-page", 2048);
-  options.targetPageSize = parser.intOr("--target-page", 1024);
-  options.keepUv1 = parser.flag("--keep-uv1");
-  if (options.texelsPerUnit < 0.0f) throw Error(ErrorCode::Usage, "", "--texels-per-unit must be > 0");
-  if (options.padding < 0) throw Error(ErrorCode::Usage, "", "--padding must be ≥ 0");
-  if (options.maxPageSize < 16 || options.maxPageSize > 16384) throw Error(ErrorCode::Usage, "", "--max-page must be in 16..16384");
-  if (options.targetPageSize < 16) throw Error(ErrorCode::Usage, "", "--target-page must be ≥ 16");
+  auto app = cli::makeApp("irbake unwrap",
+                              "Adds a lightmap UV set (TEXCOORD_1) and extras.lightmap {page, width, height} per "
+                              "primitive.");
+  app->add_option("IN", inputs, "the glTF/GLB scene to unwrap");
+  app->add_option("-o,--output", output, "the unwrapped scene")->type_name("OUT.gltf|OUT.glb");
+  app->add_option("--texels-per-unit", tpu, "texel density per metre (default: fit the charts into about one target page)")
+      ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
+  app->add_option("--max-texels", options.maxTexels, "texel budget of all pages together (default 16M; 0 = no limit)")
+      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
+  app->add_option("--padding", options.padding, "empty texels between charts (default 2)")
+      ->transform(cli::integerIn(0, 256))->type_name("P");
+  app->add_option("--max-page", options.maxPageSize, "largest page edge in texels (default 2048); more pages when full")
+      ->transform(cli::integerIn(16, 16384))->type_name("S");
+  app->add_option("--target-page", options.targetPageSize, "page edge the automatic density aims at (default 1024)")
+      ->transform(cli::integerIn(16, 16384))->type_name("S");
+  app->add_flag("--keep-uv1", options.keepUv1, "keep an input TEXCOORD_1 and only repack its islands");
+  app->add_option("--report", report, "write the atlas statistics")->type_name("R.json");
+  if (!cli::parse(*app, args)) return 0;
+  if (inputs.size() != 1) throw Error(ErrorCode::Usage, "", "unwrap takes exactly one input scene");
+  if (output.empty()) throw Error(ErrorCode::Usage, "", "unwrap needs -o OUT.gltf");
+  const std::string input = inputs[0];
+  options.texelsPerUnit = float(tpu);
 
   TerminalProgress bar;
   options.progress = bar.callback();
@@ -81,15 +79,15 @@ int runUnwrap(const Args& args) {
   bar.finish();
 
   ExportOptions exportOptions;
-  exportOptions.output = *output;
+  exportOptions.output = output;
   exportOptions.writeExrPages = false;
   exportGltf(scene, {}, exportOptions);
-  if (const auto report = parser.value("--report")) {
+  if (!report.empty()) {
     const std::string text = reportJson(input, result).dump(2) + "\n";
-    writeAtomically(*report, [&](const std::filesystem::path& tmp) {
+    writeAtomically(report, [&](const std::filesystem::path& tmp) {
       std::ofstream out(tmp);
       out << text;
-      if (!out) throw Error(ErrorCode::Io, report->c_str(), "cannot write the report");
+      if (!out) throw Error(ErrorCode::Io, report, "cannot write the report");
     });
   }
   const AtlasStats& s = result.stats;
@@ -97,7 +95,7 @@ int runUnwrap(const Args& args) {
   for (const AtlasPage& p : result.pages) std::printf(" %dx%d", p.width, p.height);
   std::printf(", %.1f texels/unit, centre-utilisation %.1f%%, area stretch p5/p50/p95 %.3f/%.3f/%.3f, overlaps %zu\n",
               s.texelsPerUnit, 100.0 * s.centreUtilisation, s.areaStretchP5, s.areaStretchP50, s.areaStretchP95, s.overlappingTexels);
-  std::printf("wrote %s\n", output->c_str());
+  std::printf("wrote %s\n", output.c_str());
   return 0;
 }
 

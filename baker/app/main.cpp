@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "common/error.h"
+#include "common/version.h"
 
 namespace {
 const char* kUsage =
@@ -17,13 +18,20 @@ const char* kUsage =
     "  bake SCENE -o OUTDIR [options]   bake light maps (EXR) and export glTF with MOZ_lightmap\n"
     "  diff A B                         compare two bakes of the same atlas\n"
     "  samples OUTDIR                   write the built-in sample scenes\n"
+    "  --version                        print the version and exit\n"
     "run 'irbake <command> --help' for a command's options\n";
 }
 
 int main(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    std::FILE* to = argc < 2 ? stderr : stdout;
+    std::fputs(kUsage, to);
+    std::fputs(irbake::exitCodeHelp().c_str(), to);
     return argc < 2 ? 2 : 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::printf("%s\n", irbake::versionLine("irbake").c_str());
+    return 0;
   }
   std::string cmd = argv[1];
   irbake::app::Args args(argv + 2, argv + argc);

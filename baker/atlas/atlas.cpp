@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -75,12 +77,76 @@ std::vector<ChartUv> chartsFromUv1(const Primitive& prim, const AtlasMesh& mesh)
   return charts;
 }
 
+// The texel budget (options.maxTexels). Charts fill about kTypicalFill of the pages they are packed
+// into (the auto-fit below aims at the same figure), so N texels hold area × density² / kTypicalFill.
+constexpr double kTypicalFill = 0.6;
+
+// A density a little under the one that fits, shown with 3 significant digits.
+std::string densityThatFits(double density) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4g", density * 0.97);
+  return text;
+}
+
+[[noreturn]] void overBudget(const Scene& scene, const AtlasOptions& options, double density, double texels,
+                             double densityFits, const char* how) {
+  char message[400];
+  std::snprintf(message, sizeof(message),
+                "at %.6g texels per unit the light-map atlas %s %.4g %stexels, over the budget of %.4g M "
+                "(--max-texels %zu): use --texels-per-unit %s or less, or raise --max-texels",
+                density, how, texels < 1e9 ? texels / 1e6 : texels, texels < 1e9 ? "M " : "", double(options.maxTexels) / 1e6,
+                options.maxTexels,
+                densityThatFits(densityFits).c_str());
+  throw Error(ErrorCode::Usage, scene.sourcePath, message);
+}
+
+// Before any work: the surface area at the requested density.
+void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
+  if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
+  double area = 0.0;
+  for (const Primitive& p : scene.primitives)
+    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      const glm::dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]), c(p.positions[p.indices[t + 2]]);
+      area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+  const double density = options.texelsPerUnit;
+  const double estimate = area * density * density / kTypicalFill;
+  if (estimate > double(options.maxTexels))
+    overBudget(scene, options, density, estimate, std::sqrt(double(options.maxTexels) * kTypicalFill / area),
+               "would need about");
+}
+
+size_t pageTexels(const std::vector<AtlasPage>& pages) {
+  size_t texels = 0;
+  for (const AtlasPage& p : pages) texels += size_t(p.width) * p.height;
+  return texels;
+}
+
+// After packing: the pages as they are. Padding does not shrink with the density, so the density
+// named is one whose packing was tried and fits.
+void checkTexelBudget(const Scene& scene, const AtlasOptions& options, const std::vector<ChartUv>& charts,
+                      atlas::PackOptions packOptions, const std::vector<AtlasPage>& pages) {
+  const size_t texels = pageTexels(pages);
+  if (options.maxTexels == 0 || texels <= options.maxTexels) return;
+  const double density = packOptions.texelsPerUnit;
+  double fits = density, used = double(texels);
+  for (int attempt = 0; attempt < 12 && used > double(options.maxTexels); ++attempt) {
+    fits *= std::sqrt(double(options.maxTexels) / used) * 0.97;
+    packOptions.texelsPerUnit = fits;
+    std::vector<ChartUv> trial = charts;  // packing places (and may scale) the charts it is given
+    used = double(pageTexels(atlas::packCharts(trial, packOptions).pages));
+  }
+  // overBudget names 0.97 × its argument: hand it the density that fitted, over 0.97.
+  overBudget(scene, options, density, double(texels), fits / 0.97, "needs");
+}
+
 }  // namespace
 
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.padding < 0) throw Error(ErrorCode::Usage, "", "atlas padding must be ≥ 0");
   if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
   if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
+  checkTexelEstimate(scene, options);
   AtlasResult result;
   AtlasStats& stats = result.stats;
   auto progress = [&](double f) {
@@ -187,6 +253,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
     stats.warnings.push_back(w);
   }
   result.pages = packed.pages;
+  checkTexelBudget(scene, options, charts, packOptions, result.pages);
   stats.secondsPack = clock.seconds();
   progress(0.85);
 

@@ -14,6 +14,9 @@ struct AtlasOptions {
   int padding = 2;             // empty texels kept around every chart (bilinear-safe)
   int maxPageSize = 2048;      // largest page edge; more pages are opened when one is full
   bool keepUv1 = false;        // keep an input TEXCOORD_1 and only repack its islands
+  size_t maxTexels = size_t(1) << 24;  // budget for all pages together (16M texels, 64 MiB per float RGBA
+                                       // layer); over it buildAtlas fails early naming the density that fits.
+                                       // 0 = no limit
   int maxSplitDepth = 24;      // bisections of one segmented chart before its faces become one planar chart each
   ProgressCallback progress;   // optional
 };

@@ -527,6 +527,47 @@ TEST(Atlas, SameInputGivesIdenticalUv1) {
   }
 }
 
+// The texel budget: checked on the surface area before any work (6 m² at 100 texels/m over 0.6 fill =
+// 100k texels), and on the packed pages after (padding the estimate does not see).
+TEST(Atlas, TexelBudgetIsCheckedBeforeAndAfterPacking) {
+  auto failure = [](AtlasOptions o) -> std::string {
+    Scene s = sceneOf({cube(1.0f)});
+    try {
+      buildAtlas(s, o);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Usage);
+      return e.what();
+    }
+    return "";
+  };
+  auto namedDensity = [](const std::string& message) {
+    const std::string marker = "use --texels-per-unit ";
+    const size_t at = message.find(marker);
+    return at == std::string::npos ? -1.0 : std::stod(message.substr(at + marker.size()));
+  };
+  AtlasOptions o;
+  o.texelsPerUnit = 100.0f;
+  o.maxTexels = 50000;
+  std::string early = failure(o);
+  EXPECT_NE(early.find("would need about 0.1 M texels"), std::string::npos) << early;
+  // sqrt(50000 · 0.6 / 6 m²) = 70.7 texels/m, named 3% under.
+  EXPECT_NEAR(namedDensity(early), 70.71 * 0.97, 0.1) << early;
+  o.maxTexels = 0;  // no limit
+  EXPECT_EQ(failure(o), "");
+
+  o.texelsPerUnit = 10.0f;  // estimate 1000 texels, but 40 texels of padding between the 10×10 faces
+  o.padding = 40;
+  o.maxTexels = 5000;
+  std::string late = failure(o);
+  EXPECT_NE(late.find(" needs "), std::string::npos) << late;
+  // The density named was packed and fits (padding does not shrink with it, so it is well under
+  // the naive 10 · sqrt(5000 / texels)).
+  const double fits = namedDensity(late);
+  ASSERT_GT(fits, 0.0) << late;
+  o.texelsPerUnit = float(fits);
+  EXPECT_EQ(failure(o), "") << late;
+}
+
 TEST(Atlas, RejectsBadOptions) {
   Scene s = sceneOf({cube(1.0f)});
   AtlasOptions o;

@@ -1,13 +1,17 @@
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <set>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
-#include "common/args.h"
+#include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/output_lock.h"
 
 namespace fs = std::filesystem;
 using namespace irbake;
@@ -34,34 +38,119 @@ size_t filesIn(const fs::path& dir) {
 }
 }  // namespace
 
-TEST(ArgParser, PositionalsOptionsAndFlags) {
-  ArgParser p({"scene.gltf", "-o", "out", "--vpls=256", "--bias-compensation", "--clamp", "-0.5"},
-              {"-o", "--vpls", "--clamp"}, {"--bias-compensation"});
-  ASSERT_EQ(p.positionals().size(), 1u);
-  EXPECT_EQ(p.positionals()[0], "scene.gltf");
-  EXPECT_EQ(p.valueOr("-o", ""), "out");
-  EXPECT_EQ(p.intOr("--vpls", 0), 256);
-  EXPECT_DOUBLE_EQ(p.doubleOr("--clamp", 0.0), -0.5);
-  EXPECT_TRUE(p.flag("--bias-compensation"));
-  EXPECT_EQ(p.intOr("--missing", 7), 7);
-}
-
-TEST(ArgParser, RejectsUnknownOptionsAndBadNumbers) {
+namespace {
+// Parses args into a fresh app with the given setup; returns the Error(Usage) message, "" on success.
+std::string parseError(const std::function<void(CLI::App&)>& setup, const std::vector<std::string>& args) {
+  auto app = cli::makeApp("test", "test");
+  setup(*app);
   try {
-    ArgParser({"--nope"}, {}, {});
-    FAIL() << "unknown option accepted";
+    cli::parse(*app, args);
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::Usage);
-    EXPECT_NE(std::string(e.what()).find("--nope"), std::string::npos);
+    return e.what();
   }
-  ArgParser p({"--vpls", "12x", "--sun", "0,-1,nan,3"}, {"--vpls", "--sun"}, {});
-  EXPECT_THROW(p.intOr("--vpls", 0), Error);
-  EXPECT_THROW(p.numberList("--sun", 4), Error);
-  ArgParser q({"--sun", "0,-1,0,3.5"}, {"--sun"}, {});
-  auto v = q.numberList("--sun", 4);
+  return "";
+}
+}  // namespace
+
+TEST(CommandLine, PositionalsOptionsAndFlags) {
+  std::vector<std::string> positionals;
+  std::string out;
+  int vpls = 0;
+  double clamp = 0.0;
+  bool flag = false;
+  auto app = cli::makeApp("test", "test");
+  app->add_option("SCENE", positionals);
+  app->add_option("-o", out);
+  app->add_option("--vpls", vpls)->transform(cli::integerIn(1, 1 << 26));
+  app->add_option("--clamp", clamp)->transform(cli::numberIn(-1.0, 1.0));
+  app->add_flag("--bias-compensation", flag);
+  ASSERT_TRUE(cli::parse(*app, {"scene.gltf", "-o", "out", "--vpls=256", "--bias-compensation", "--clamp", "-0.5"}));
+  ASSERT_EQ(positionals.size(), 1u);
+  EXPECT_EQ(positionals[0], "scene.gltf");
+  EXPECT_EQ(out, "out");
+  EXPECT_EQ(vpls, 256);
+  EXPECT_DOUBLE_EQ(clamp, -0.5);
+  EXPECT_TRUE(flag);
+}
+
+TEST(CommandLine, IntegersOutsideTheirRangeAreRejectedNeverWrapped) {
+  int value = 7;
+  auto setup = [&](CLI::App& app) { app.add_option("--vpls", value)->transform(cli::integerIn(1, 1 << 26)); };
+  // 2^32 + 1 wrapped to 1 and 2^31 to -2^31 through a cast to int: both must be refused as they are.
+  for (const char* text : {"4294967297", "2147483648", "0", "-1", "12x", "", "1e3", "99999999999999999999999"}) {
+    std::string message = parseError(setup, {"--vpls", text});
+    EXPECT_NE(message.find("--vpls"), std::string::npos) << text << ": " << message;
+    EXPECT_NE(message.find("must be an integer in [1, 67108864]"), std::string::npos) << text << ": " << message;
+    EXPECT_EQ(value, 7) << text;
+  }
+  // Leading zeros are decimal (CLI11 alone would read "010" as octal 8).
+  EXPECT_EQ(parseError(setup, {"--vpls", "010"}), "");
+  EXPECT_EQ(value, 10);
+  EXPECT_EQ(parseError(setup, {"--vpls", "67108864"}), "");
+  EXPECT_EQ(value, 67108864);
+}
+
+TEST(CommandLine, AutoNumbersAndLists) {
+  int bounces = 5;
+  double tpu = 0.0;
+  std::string sun;
+  auto setup = [&](CLI::App& app) {
+    app.add_option("--bounces", bounces)->transform(cli::integerOrAuto(0, 64, -1));
+    app.add_option("--tpu", tpu)->transform(cli::numberIn(0.0, 1e6));
+    app.add_option("--sun", sun)->transform(cli::numberList(4));
+  };
+  EXPECT_EQ(parseError(setup, {"--bounces", "auto"}), "");
+  EXPECT_EQ(bounces, -1);
+  EXPECT_EQ(parseError(setup, {"--bounces", "3"}), "");
+  EXPECT_EQ(bounces, 3);
+  EXPECT_NE(parseError(setup, {"--bounces", "65"}).find("'auto' or an integer in [0, 64]"), std::string::npos);
+  EXPECT_NE(parseError(setup, {"--tpu", "nan"}).find("finite number in [0, 1000000]"), std::string::npos);
+  EXPECT_NE(parseError(setup, {"--tpu", "2e6"}).find("got '2e6'"), std::string::npos);
+  EXPECT_NE(parseError(setup, {"--sun", "0,-1,nan,3"}).find("'nan' is not a finite number"), std::string::npos);
+  EXPECT_NE(parseError(setup, {"--sun", "0,-1,0"}).find("needs 4 comma-separated numbers"), std::string::npos);
+  EXPECT_EQ(parseError(setup, {"--sun", "0,-1,0,3.5"}), "");
+  auto v = cli::parseNumberList(sun);
   ASSERT_EQ(v.size(), 4u);
+  EXPECT_DOUBLE_EQ(v[1], -1.0);
   EXPECT_DOUBLE_EQ(v[3], 3.5);
-  EXPECT_THROW(q.numberList("--sun", 3), Error);
+  EXPECT_NE(parseError(setup, {"--nope"}).find("--nope"), std::string::npos);
+}
+
+TEST(CommandLine, HelpListsTheExitCodes) {
+  const std::string help = exitCodeHelp();
+  for (ErrorCode c : {ErrorCode::Usage, ErrorCode::Io, ErrorCode::Parse, ErrorCode::InvalidData, ErrorCode::EmptyScene,
+                      ErrorCode::NoLight, ErrorCode::Gl, ErrorCode::NumericError})
+    EXPECT_NE(help.find("  " + std::to_string(exitCodeFor(c)) + "  " + toString(c) + ":"), std::string::npos) << help;
+  auto app = cli::makeApp("test", "test");
+  EXPECT_NE(app->help().find(help), std::string::npos);
+}
+
+TEST(OutputFolderLock, SecondLockFailsAtOnceAndNothingIsLeftBehind) {
+  fs::path dir = fs::current_path() / "test_scratch" / "common" / "locked_out";
+  fs::remove_all(dir);
+  {
+    OutputFolderLock first(dir);
+    EXPECT_TRUE(fs::exists(dir / OutputFolderLock::kFileName));
+    // flock locks belong to the open file: a second lock in this process conflicts like another process.
+    try {
+      OutputFolderLock second(dir);
+      FAIL() << "two locks on one folder";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Io);
+      const std::string what = e.what();
+      EXPECT_NE(what.find(dir.string()), std::string::npos) << what;
+      EXPECT_NE(what.find("output folder is busy"), std::string::npos) << what;
+      EXPECT_NE(what.find("process " + std::to_string(::getpid())), std::string::npos) << what;
+    }
+  }
+  // Released: the folder this lock created was left empty, so it is gone; a new lock succeeds.
+  EXPECT_FALSE(fs::exists(dir));
+  fs::create_directories(dir);
+  std::ofstream(dir / "kept.txt") << "x";
+  { OutputFolderLock again(dir); }
+  EXPECT_TRUE(fs::exists(dir / "kept.txt"));
+  EXPECT_FALSE(fs::exists(dir / OutputFolderLock::kFileName));
 }
 
 TEST(AtomicFile, WritesFinalNameOnlyOnSuccess) {

@@ -30,4 +30,25 @@ int exitCodeFor(ErrorCode code) {
   return 1;
 }
 
+std::string exitCodeHelp() {
+  struct Row {
+    ErrorCode code;
+    const char* meaning;
+  };
+  const Row rows[] = {
+      {ErrorCode::Usage, "bad command-line arguments, an atlas over --max-texels"},
+      {ErrorCode::Io, "file missing, unreadable or unwritable; output folder busy (locked by another bake)"},
+      {ErrorCode::Parse, "not glTF, malformed JSON, bad GLB container"},
+      {ErrorCode::InvalidData, "bad buffers, accessors, indices, NaN, nesting, URIs or sizes"},
+      {ErrorCode::EmptyScene, "no triangles"},
+      {ErrorCode::NoLight, "no light and no emitter (give --sun)"},
+      {ErrorCode::Gl, "no EGL display / OpenGL 4.5, shader or framebuffer failure"},
+      {ErrorCode::NumericError, "NaN or Inf produced by a computation"},
+  };
+  std::string text = "exit codes:\n  0  success\n  1  unexpected internal error\n";
+  for (const Row& r : rows)
+    text += "  " + std::to_string(exitCodeFor(r.code)) + "  " + toString(r.code) + ": " + r.meaning + "\n";
+  return text;
+}
+
 }  // namespace irbake

@@ -34,4 +34,7 @@ class Error : public std::runtime_error {
 // Process exit code for an error code (distinct per class so scripts can tell them apart).
 int exitCodeFor(ErrorCode code);
 
+// The exit codes as a help footer: "exit codes:\n  0  success\n  2  usage error: ...".
+std::string exitCodeHelp();
+
 }  // namespace irbake

@@ -4,12 +4,16 @@
 #include <mutex>
 #include <unistd.h>
 
+#include "common/log.h"
+
 namespace irbake {
 namespace {
 std::mutex gProgressMutex;
 }
 
-TerminalProgress::TerminalProgress() : enabled_(::isatty(STDERR_FILENO) != 0) {}
+// Bars only on a terminal, and never under --quiet (log level above info).
+TerminalProgress::TerminalProgress()
+    : enabled_(::isatty(STDERR_FILENO) != 0 && log::level() <= log::Level::Info) {}
 TerminalProgress::~TerminalProgress() { finish(); }
 
 ProgressCallback TerminalProgress::callback() {
@@ -21,7 +25,7 @@ void TerminalProgress::update(const char* stage, double fraction) {
   std::lock_guard<std::mutex> lock(gProgressMutex);
   auto now = std::chrono::steady_clock::now();
   if (stage_ != stage) {
-    if (!stage_.empty()) std::fprintf(stderr, "\n");
+    if (!stage_.empty()) log::endStatusLine();
     stage_ = stage;
     stageStart_ = now;
     lastDraw_ = {};
@@ -34,12 +38,13 @@ void TerminalProgress::update(const char* stage, double fraction) {
   char bar[31];
   for (int i = 0; i < 30; ++i) bar[i] = i < filled ? '#' : '.';
   bar[30] = 0;
-  std::fprintf(stderr, "\r%-10s [%s] %5.1f%%  %6.1fs  ETA %6.1fs", stage, bar, fraction * 100.0, elapsed, eta);
-  std::fflush(stderr);
+  char line[160];
+  std::snprintf(line, sizeof(line), "%-10s [%s] %5.1f%%  %6.1fs  ETA %6.1fs", stage, bar, fraction * 100.0, elapsed, eta);
+  log::drawStatusLine(line);
 }
 
 void TerminalProgress::finish() {
-  if (enabled_ && !stage_.empty()) std::fprintf(stderr, "\n");
+  if (enabled_ && !stage_.empty()) log::endStatusLine();
   stage_.clear();
 }
 

@@ -29,13 +29,25 @@ nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y
 // faster; DamagedHelmet, 15k: Embree 1.8× faster; furnished room, 58k: Embree 4–17× faster).
 constexpr size_t kSoftwareGlTriangleHint = 10000;
 
+// The first see-through material (MASK cut-outs, BLEND, transmission) a primitive uses, as a phrase for the
+// log; empty when there is none. The GL backend sends the texels they shade to rays (contact texels).
+std::string seeThroughMaterials(const Scene& scene) {
+  for (const Primitive& p : scene.primitives) {
+    const Material& m = scene.materials[p.material];
+    if (m.alphaMode == AlphaMode::Mask) return "material '" + m.name + "' is alpha MASK";
+    if (m.alphaMode == AlphaMode::Blend) return "material '" + m.name + "' is alpha BLEND (see-through)";
+    if (m.transmission > 0.0f) return "material '" + m.name + "' is transmissive";
+  }
+  return {};
+}
+
 // The backend stage. The GL engineer owns the GL line (options, stats); every backend returns one
 // Lightmap per texel page. glContext: the bake's context (current on this thread) for the GL backend.
-std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& inputs, nlohmann::json& report,
-                                 GlContext* glContext) {
+std::vector<Lightmap> runBackend(BackendKind backend, const BakeOptions& options, const BakeInputs& inputs,
+                                 nlohmann::json& report, GlContext* glContext) {
   const int interleave =
       options.interleave > 0 ? options.interleave : chooseInterleave(inputs.texels, inputs.eval.clampBound);
-  switch (options.backend) {
+  switch (backend) {
     case BackendKind::Gl: {
       // One context for every call (interleaved sampling makes n² + 1 of them).
       GlBakeStats total;
@@ -67,6 +79,8 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
       report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
       return maps;
     }
+    case BackendKind::Auto:
+      break;  // resolved by bake() before this stage
     case BackendKind::Reference: {
       ReferenceOptions ref;
       ref.spp = options.referenceSpp;
@@ -92,14 +106,16 @@ std::vector<Lightmap> runBackend(const BakeOptions& options, const BakeInputs& i
 }  // namespace
 
 BackendKind parseBackend(const std::string& name) {
+  if (name == "auto") return BackendKind::Auto;
   if (name == "gl") return BackendKind::Gl;
   if (name == "embree") return BackendKind::Embree;
   if (name == "reference") return BackendKind::Reference;
-  throw Error(ErrorCode::Usage, "", "unknown backend '" + name + "' (gl, embree or reference)");
+  throw Error(ErrorCode::Usage, "", "unknown backend '" + name + "' (auto, gl, embree or reference)");
 }
 
 const char* toString(BackendKind kind) {
   switch (kind) {
+    case BackendKind::Auto: return "auto";
     case BackendKind::Gl: return "gl";
     case BackendKind::Embree: return "embree";
     case BackendKind::Reference: return "reference";
@@ -170,9 +186,40 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   }
 
   stage.reset();
+  // --backend auto: GL where it is both right and fast, Embree otherwise (the choice and why in the report).
+  std::unique_ptr<GlContext> glContext;
+  BackendKind backend = options.backend;
+  std::string backendReason = "asked for";
+  if (backend == BackendKind::Auto) {
+    backend = BackendKind::Embree;
+    if (std::string why = seeThroughMaterials(s); !why.empty()) {
+      backendReason = why + ": the GL backend would trace most texels it shades anyway (red pane test: 64%)";
+    } else {
+      try {
+        glContext = std::make_unique<GlContext>();
+        if (!glContext->softwareRenderer()) {
+          backend = BackendKind::Gl;
+          backendReason = "hardware GL renderer";
+        } else if (s.triangleCount() <= kSoftwareGlTriangleHint) {
+          backend = BackendKind::Gl;
+          backendReason = "software GL renderer, " + std::to_string(s.triangleCount()) + " triangles (≤ " +
+                          std::to_string(kSoftwareGlTriangleHint) + ": GL as fast as Embree)";
+        } else {
+          backendReason = "software GL renderer with " + std::to_string(s.triangleCount()) +
+                          " triangles: its shadow pass draws them for every VPL cube (docs/performance.md)";
+        }
+      } catch (const Error& e) {
+        backendReason = std::string("no GL context: ") + e.what();
+      }
+      if (backend != BackendKind::Gl) glContext.reset();
+    }
+    log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
+  }
+  report["backendChoice"] = {{"asked", toString(options.backend)}, {"used", toString(backend)}, {"reason", backendReason}};
+
   // Bias compensation is its own stage after either VPL backend (backend/compensation), so the backends
   // evaluate the clamped sum only.
-  const bool compensate = eval.biasCompensation && options.backend != BackendKind::Reference;
+  const bool compensate = eval.biasCompensation && backend != BackendKind::Reference;
   VplEvalOptions backendEval = eval;
   if (compensate) backendEval.biasCompensation = false;
   BakeInputs inputs{s, rt, texels, r.vpls, backendEval, options.progress};
@@ -181,9 +228,8 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
   // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and the
   // rasteriser waits for its slowest thread (Cornell box: bake 1.95 → 2.43 s). Embree uses every core itself.
-  std::unique_ptr<GlContext> glContext;
-  if (options.backend == BackendKind::Gl) {
-    glContext = std::make_unique<GlContext>();
+  if (backend == BackendKind::Gl) {
+    if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
     // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/performance.md).
     if (glContext->softwareRenderer() && s.triangleCount() > kSoftwareGlTriangleHint && r.vpls.vpls.size() > 0)
@@ -198,7 +244,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   if (overlap)
     gather = std::async(std::launch::async, [&inputs, co] { return std::make_unique<ClampGather>(inputs, co); });
   report["compensationOverlapped"] = overlap;
-  r.maps = runBackend(options, inputs, report, glContext.get());
+  r.maps = runBackend(backend, options, inputs, report, glContext.get());
   if (r.maps.size() != texels.size())
     throw Error(ErrorCode::InvalidData, s.sourcePath, "the backend returned " + std::to_string(r.maps.size()) +
                                                           " pages for " + std::to_string(texels.size()));
@@ -208,11 +254,27 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   }
   seconds["backend"] = stage.seconds();
 
+  // The sky's direct light, traced (every VPL backend; the reference integrator finds the sky itself).
+  // Before the compensation, whose gather reads the map as the light leaving each surface.
+  if (s.environment.present() && backend != BackendKind::Reference) {
+    stage.reset();
+    SkyLightOptions so = options.sky;
+    so.seed = options.walk.seed;
+    SkyLightStats ss;
+    addSkyLight(inputs, r.maps, so, &ss);
+    seconds["sky"] = stage.seconds();
+    report["sky"] = {{"rays", ss.rays}, {"raysPerSample", ss.raysPerSample},
+                     {"uniform", s.environment.isUniform()}, {"source", s.environment.source()},
+                     {"integral", rgb(s.environment.integral())}};
+  }
+
   if (compensate) {
     stage.reset();
     ClampCompensationStats cs;
+    if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
     std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(inputs, co);
     g->apply(r.maps, &cs);
+    if (options.progress) options.progress("compensate", 1.0);
     seconds["compensation"] = stage.seconds();  // with the GL backend: the sweeps (and any trace not yet done)
     seconds["compensationTrace"] = g->traceSeconds();
     report["compensation"] = {{"rays", cs.raysTraced},
@@ -228,7 +290,9 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   PostOptions post;
   post.dilate = options.postDilate;
   post.stitchSeams = options.postSeams;
+  if (options.progress) options.progress("post", 0.0);
   PostStats postStats = postProcess(s, r.maps, post);
+  if (options.progress) options.progress("post", 1.0);
   seconds["post"] = stage.seconds();
   seconds["bake"] = total.seconds();
 
@@ -248,7 +312,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
     vplPower += pw;
     perBounce.push_back({{"bounce", b}, {"count", r.vpls.countPerBounce[b]}, {"power", rgb(pw)}});
   }
-  report["backend"] = toString(options.backend);
+  report["backend"] = toString(backend);
   report["scene"] = {{"source", s.sourcePath},
                      {"triangles", s.triangleCount()},
                      {"primitives", s.primitives.size()},
@@ -274,7 +338,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
                     {"clampVplsPerMean", clampK},
                     {"clampDerived", clampDerived},
                     {"biasCompensation", eval.biasCompensation}};
-  if (options.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
+  if (backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
   report["post"] = {{"texelsFilled", postStats.texelsFilled},
                     {"seamEdges", postStats.seamEdges},
                     {"seamMismatchBefore", postStats.seamMismatchBefore},

@@ -10,6 +10,7 @@
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/gl/gl_backend.h"
+#include "backend/sky/sky_light.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
@@ -17,7 +18,10 @@
 
 namespace irbake {
 
-enum class BackendKind { Gl, Embree, Reference };
+// Auto: GL on a hardware renderer, or on a software one for small scenes (≤ 10k triangles); Embree for
+// larger scenes on a software renderer, without a GL context, or with see-through materials (MASK, BLEND,
+// transmission), whose texels the GL backend would mostly trace with rays anyway.
+enum class BackendKind { Auto, Gl, Embree, Reference };
 
 // The default evaluation: derived clamp, bias compensation on, direct and VPLs.
 inline VplEvalOptions compensatedEval() {
@@ -27,12 +31,13 @@ inline VplEvalOptions compensatedEval() {
 }
 
 struct BakeOptions {
-  BackendKind backend = BackendKind::Gl;  // gl (default), embree, reference
+  BackendKind backend = BackendKind::Auto;  // auto (default), gl, embree, reference
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
   VplEvalOptions eval = compensatedEval();  // clamp (0 = derived from the scene), bias compensation (on)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
+  SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)
@@ -59,7 +64,7 @@ struct BakeResult {
 // Runs the whole bake on a loaded scene. Throws Error on failure.
 BakeResult bake(Scene scene, const BakeOptions& options);
 
-// "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
+// "auto" | "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
 BackendKind parseBackend(const std::string& name);
 const char* toString(BackendKind kind);
 

@@ -6,6 +6,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/log.h"
+#include "common/version.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
@@ -53,6 +54,8 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
 
   fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   nlohmann::json report = result.report;
+  report["reportSchema"] = 1;  // bumped when a field changes meaning or goes away
+  report["irbakeVersion"] = versionLine("irbake");
   report["outputs"] = nlohmann::json::array();
   for (const auto& p : written) report["outputs"].push_back(p.string());
   std::string text = report.dump(2) + "\n";

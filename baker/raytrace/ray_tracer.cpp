@@ -30,6 +30,12 @@ void alphaMaskFilter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// See-through surfaces (BLEND, KHR_materials_transmission) never occlude: occlusion queries skip them
+// and callers multiply by RayTracer::transmittance() along the unoccluded ray. Intersections see them.
+void seeThroughOcclusionFilter(const RTCFilterFunctionNArguments* args) {
+  for (unsigned i = 0; i < args->N; ++i) args->valid[i] = 0;
+}
+
 void errorCallback(void*, RTCError code, const char* str) {
   // Embree errors during construction are turned into exceptions by the checks below; log nothing here.
   (void)code;
@@ -103,11 +109,16 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()), scen
       vb[3 * v + 2] = prim.positions[v].z;
     }
     std::copy(prim.indices.begin(), prim.indices.end(), ib);
-    if (scene.materials[prim.material].alphaMode == AlphaMode::Mask) {
+    const Material& material = scene.materials[prim.material];
+    if (material.alphaMode == AlphaMode::Mask) {
       I.masks[p] = MaskGeometry{&scene, &prim};
       rtcSetGeometryUserData(g, &I.masks[p]);
       rtcSetGeometryIntersectFilterFunction(g, alphaMaskFilter);
       rtcSetGeometryOccludedFilterFunction(g, alphaMaskFilter);
+    }
+    if (material.isTransmissive()) {
+      rtcSetGeometryOccludedFilterFunction(g, seeThroughOcclusionFilter);
+      hasTransmission_ = true;
     }
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(I.scene, g, static_cast<unsigned>(p));  // geomID = primitive index
@@ -174,6 +185,23 @@ bool RayTracer::occluded(const glm::vec3& origin, const glm::vec3& dir, float tm
   ray.flags = 0;
   rtcOccluded1(impl_->scene, &ctx, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on an occlusion
+}
+
+glm::vec3 RayTracer::transmittance(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const {
+  glm::vec3 t(1.0f);
+  if (!hasTransmission_) return t;
+  float start = tmin;
+  for (int layer = 0; layer < 64 && start < tmax; ++layer) {
+    const RayHit hit = intersect(origin, dir, start, tmax);
+    if (!hit.hit) return t;
+    const Primitive& prim = scene_.primitives[hit.primitive];
+    const SurfaceTransmission s = scene_.transmissionAt(prim, hit.triangle, hit.barycentric);
+    if (s.fraction <= 0.0f) return glm::vec3(0.0f);  // an opaque surface after all (rounding at tmax)
+    t *= s.transmittance();
+    if (glm::max(t.x, glm::max(t.y, t.z)) <= 0.0f) return t;
+    start = hit.t + epsilon_;
+  }
+  return t;
 }
 
 bool RayTracer::visibilityRay(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb,

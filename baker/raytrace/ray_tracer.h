@@ -36,7 +36,12 @@ class RayTracer {
   RayTracer& operator=(const RayTracer&) = delete;
 
   RayHit intersect(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
+  // Opaque occlusion: see-through surfaces (Material::isTransmissive) are skipped, MASK holes too.
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
+  // The product of the see-through surfaces' transmittances along a ray that occluded() found clear
+  // (RGB; 1 in scenes without see-through materials).
+  glm::vec3 transmittance(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
+  bool hasTransmission() const { return hasTransmission_; }
   // Mutual visibility of two surface points, offset along their normals by epsilon().
   bool visible(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) const;
   // The shadow ray visible() traces; false when the points are closer than epsilon() (always visible).
@@ -62,6 +67,7 @@ class RayTracer {
   std::unique_ptr<Impl> impl_;
   const Scene& scene_;
   float epsilon_ = 1e-4f;
+  bool hasTransmission_ = false;
 };
 
 }  // namespace irbake

@@ -756,6 +756,8 @@ class Loader {
     const json* mj = element(src_.json, "materials", index);
     if (mj) {
       m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
+      m.transmission = static_cast<float>(
+          std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
       if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) {
         const json* ti = child(*moz, "index");
         // irbake's PNG is sRGB-encoded and says so in MOZ_lightmap.extras.colorSpace (docs/export.md).

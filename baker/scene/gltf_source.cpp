@@ -201,6 +201,32 @@ bool uriStaysInFolder(const std::string& uri) {
   return uri.find('\0') == std::string::npos;
 }
 
+// Arrays and objects nested deeper than this are refused before any JSON parser sees them: tinygltf
+// parses recursively and overflows the stack (SIGSEGV) on an `extras` that nests 200,000 arrays.
+// Real glTF nests about 8 levels; 64 leaves room for generous extras.
+constexpr int kMaxJsonDepth = 64;
+
+// One pass over the JSON text counting brackets outside strings (escapes inside strings skipped).
+void checkJsonDepth(const GltfSource& s, const char* text, size_t size) {
+  int depth = 0;
+  bool inString = false;
+  for (size_t i = 0; i < size; ++i) {
+    const char c = text[i];
+    if (inString) {
+      if (c == '\\') ++i;  // the escaped character cannot end the string
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        fail(ErrorCode::InvalidData, s, "JSON nests deeper than " + std::to_string(kMaxJsonDepth) +
+                                            " arrays/objects (at byte " + std::to_string(s.jsonOffset + i) + ")");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
 GltfSource readGltfSource(const std::filesystem::path& path) {
   GltfSource s;
   s.path = path;
@@ -233,6 +259,7 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
     s.jsonSize = s.bytes.size() - first;
   }
   const char* text = reinterpret_cast<const char*>(s.bytes.data()) + s.jsonOffset;
+  checkJsonDepth(s, text, s.jsonSize);
   try {
     s.json = nlohmann::json::parse(text, text + s.jsonSize);
   } catch (const nlohmann::json::parse_error& e) {

@@ -5,14 +5,10 @@
 #include <cmath>
 #include <cstring>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include "common/error.h"
+#include "imageio/image_io.h"
 
 namespace irbake {
-
-namespace OIIO = OIIO_NAMESPACE;
 
 float srgbToLinear(float c) {
   c = std::clamp(c, 0.0f, 1.0f);
@@ -34,7 +30,7 @@ ImageFormat sniffImageFormat(const uint8_t* b, size_t n) {
 
 namespace {
 
-// OIIO reader names: create() with a file name would try to open that file, a format name does not.
+// OpenImageIO reader names: create() with a file name would try to open that file, a format name does not.
 const char* nameForFormat(ImageFormat f) {
   switch (f) {
     case ImageFormat::Png: return "png";
@@ -61,33 +57,20 @@ Texture decodeImageToTexture(const uint8_t* bytes, size_t size, bool srgb, const
   ImageFormat format = sniffImageFormat(bytes, size);
   if (format == ImageFormat::Unknown)
     throw Error(ErrorCode::InvalidData, name, "image is not PNG, JPEG, EXR or HDR");
-  OIIO::Filesystem::IOMemReader reader(bytes, size);
-  // The memory proxy must be attached before open().
-  auto in = OIIO::ImageInput::create(nameForFormat(format));
-  if (!in || !in->supports("ioproxy") || !in->set_ioproxy(&reader))
-    throw Error(ErrorCode::InvalidData, name, "no OpenImageIO reader decodes this image from memory");
-  OIIO::ImageSpec spec;
-  if (!in->open(nameForFormat(format), spec)) throw Error(ErrorCode::InvalidData, name, "cannot decode image: " + in->geterror());
-  const int w = spec.width, h = spec.height, nc = spec.nchannels;
-  if (w <= 0 || h <= 0 || nc <= 0 || static_cast<int64_t>(w) * h > (int64_t(1) << 28))
-    throw Error(ErrorCode::InvalidData, name, "image has an absurd size " + std::to_string(w) + "x" + std::to_string(h));
+  const imageio::Pixels px = imageio::api().decodeMemory(bytes, size, nameForFormat(format), name);
+  const int w = px.width, h = px.height, nc = px.channels;
   Texture tex;
   tex.name = name;
   tex.width = w;
   tex.height = h;
   tex.texels.resize(static_cast<size_t>(w) * h);
-  const bool isFloat = spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
-                       spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const bool is8bit = spec.format.basetype == OIIO::TypeDesc::UINT8;
+  const bool isFloat = px.floatSource;
   const int gray = nc <= 2 ? 1 : 0;  // grey (+alpha): replicate the first channel
   const int alphaChannel = nc == 2 ? 1 : (nc >= 4 ? 3 : -1);
-  if (is8bit) {
-    std::vector<uint8_t> px(static_cast<size_t>(w) * h * nc);
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()))
-      throw Error(ErrorCode::InvalidData, name, "cannot decode image: " + in->geterror());
+  if (!px.u8.empty()) {
     const auto& lut = srgbTable();
     for (size_t i = 0; i < tex.texels.size(); ++i) {
-      const uint8_t* p = &px[i * nc];
+      const uint8_t* p = &px.u8[i * nc];
       glm::vec4 t;
       for (int c = 0; c < 3; ++c) {
         uint8_t v = p[gray ? 0 : c];
@@ -97,11 +80,8 @@ Texture decodeImageToTexture(const uint8_t* bytes, size_t size, bool srgb, const
       tex.texels[i] = t;
     }
   } else {
-    std::vector<float> px(static_cast<size_t>(w) * h * nc);
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data()))
-      throw Error(ErrorCode::InvalidData, name, "cannot decode image: " + in->geterror());
     for (size_t i = 0; i < tex.texels.size(); ++i) {
-      const float* p = &px[i * nc];
+      const float* p = &px.f32[i * nc];
       glm::vec4 t;
       for (int c = 0; c < 3; ++c) {
         float v = p[gray ? 0 : c];
@@ -112,7 +92,6 @@ Texture decodeImageToTexture(const uint8_t* bytes, size_t size, bool srgb, const
       tex.texels[i] = t;
     }
   }
-  in->close();
   return tex;
 }
 
@@ -130,15 +109,7 @@ std::vector<uint8_t> encodePng(const Texture& texture, bool srgb, float scale) {
     }
     px[i * 4 + 3] = quantise(std::isfinite(t.a) ? t.a : 1.0f);
   }
-  std::vector<unsigned char> out;
-  OIIO::Filesystem::IOVecOutput writer(out);
-  // The PNG writer takes the memory proxy through create(); the name only selects the format.
-  auto png = OIIO::ImageOutput::create("png", &writer);
-  if (!png || !png->open("image.png", OIIO::ImageSpec(w, h, 4, OIIO::TypeDesc::UINT8)))
-    throw Error(ErrorCode::Io, texture.name, "cannot encode PNG: " + OIIO::geterror());
-  if (!png->write_image(OIIO::TypeDesc::UINT8, px.data()) || !png->close())
-    throw Error(ErrorCode::Io, texture.name, "cannot encode PNG: " + png->geterror());
-  return std::vector<uint8_t>(out.begin(), out.end());
+  return imageio::api().encodePngMemory(px.data(), w, h, texture.name);
 }
 
 }  // namespace irbake

@@ -110,7 +110,7 @@ glm::vec3 Scene::emitterPower() const {
 }
 
 bool Scene::hasLightOrEmitter() const {
-  if (!lights.empty()) return true;
+  if (!lights.empty() || environment.present()) return true;
   for (const auto& p : primitives)
     if (materials[p.material].isEmissive()) return true;
   return false;
@@ -134,6 +134,21 @@ glm::vec3 Scene::emissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 
     e *= glm::vec3(sampleBilinear(textures[m.emissiveTexture], interpolate(uv, prim, triangle, b)));
   }
   return e;
+}
+
+}  // namespace irbake
+
+namespace irbake {
+
+SurfaceTransmission Scene::transmissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const {
+  SurfaceTransmission t;
+  const Material& m = materials[prim.material];
+  if (!m.isTransmissive()) return t;
+  const glm::vec4 c = baseColorAt(prim, triangle, barycentric);
+  t.fraction = m.alphaMode == AlphaMode::Blend ? std::clamp(1.0f - c.a, 0.0f, 1.0f) : 0.0f;
+  if (m.transmission > 0.0f) t.fraction = std::max(t.fraction, m.transmission);
+  t.tint = glm::vec3(c);
+  return t;
 }
 
 }  // namespace irbake

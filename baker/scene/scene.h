@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/environment.h"
+
 namespace irbake {
 
 struct Bounds3 {
@@ -42,12 +44,15 @@ struct Material {
   int emissiveTexCoord = 0;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
+  float transmission = 0.0f;        // KHR_materials_transmission transmissionFactor (texture not read)
   bool doubleSided = false;
   int gltfMaterial = -1;            // source index, -1 for the default material
   int lightmapTexture = -1;         // MOZ_lightmap texture (index into Scene::textures), -1 none
   float lightmapIntensity = 1.0f;   // MOZ_lightmap intensity: map value = PNG value × intensity
   // Emitted radiance scale (W/(m² sr)) before the emissive texture: factor × strength.
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
+  // Light passes through (docs/units.md, "See-through surfaces"): BLEND (fraction 1 − α) or transmission.
+  bool isTransmissive() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
   bool isEmissive() const { return glm::max(emissiveFactor.x, glm::max(emissiveFactor.y, emissiveFactor.z)) * emissiveStrength > 0.0f; }
 };
 
@@ -119,6 +124,14 @@ struct LoadStats {
   std::vector<std::string> warnings;
 };
 
+// What a see-through surface lets pass at a point: `fraction` of the light goes straight through, tinted by
+// the base colour (transmittance fraction × tint); the rest meets a Lambertian surface of that colour.
+struct SurfaceTransmission {
+  float fraction = 0.0f;
+  glm::vec3 tint{1.0f};
+  glm::vec3 transmittance() const { return tint * fraction; }
+};
+
 struct Scene {
   std::string sourcePath;          // the glTF it came from ("" for generated scenes)
   std::vector<Primitive> primitives;
@@ -126,6 +139,7 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
+  Environment environment;         // the sky (none unless --sky / --env)
   LoadStats stats;
   // Baked float pages named in the root extras of an irbake export ("lightmapPages": [uri, ...]),
   // resolved to paths beside the glTF; empty for other scenes.
@@ -138,6 +152,8 @@ struct Scene {
   bool hasLightOrEmitter() const;
   // Base colour (linear RGBA) at a point of a triangle: factor × texture(bilinear, wrap) at its UV.
   glm::vec4 baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;
+  // The see-through part of a surface at a point (fraction 0 for opaque and MASK materials).
+  SurfaceTransmission transmissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;
   // Emitted radiance (W/(m² sr)) at a point of a triangle: emissiveFactor × strength × texture.
   glm::vec3 emissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;
 };

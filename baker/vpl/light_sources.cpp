@@ -55,6 +55,14 @@ LightSources collectLightSources(const Scene& scene) {
     weights.push_back(channelMean(power));
     out.totalPower += power;
   }
+  if (scene.environment.present()) {
+    out.skyPower = scene.environment.integral() * (kPi * out.sceneRadius * out.sceneRadius);
+    out.hasSky = channelMean(out.skyPower) > 0.0;
+    if (out.hasSky) {
+      weights.push_back(channelMean(out.skyPower));
+      out.totalPower += out.skyPower;
+    }
+  }
   if (!weights.empty()) out.all = AliasTable(weights);
   if (!areaWeights.empty()) out.areaOnly = AliasTable(areaWeights);
   return out;

@@ -139,6 +139,20 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
         vpls.push_back(Vpl{origin, normal, glm::vec3(pathPower), 0});
         dir = cosineHemisphere(normal, halton.sample(2, i), halton.sample(3, i));
         surfaceStart = true;
+      } else if (sources.hasSky && s == numTriangles + scene.lights.size()) {
+        // The sky: a direction towards it by luminance, a point on a disc covering the bounding sphere
+        // upstream; the path carries L(ω)/p(ω) · π R² / N (its colour included).
+        double pdf = 0.0;
+        const glm::vec3 toSky = scene.environment.sample(halton.sample(2, i), halton.sample(3, i), pdf);
+        dir = -toSky;
+        glm::vec3 t, b;
+        orthonormalBasis(dir, t, b);
+        const double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
+        origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+                 b * float(r * std::sin(phi));
+        const double R = sources.sceneRadius;
+        pathPower = pdf > 0.0 ? glm::dvec3(scene.environment.radiance(toSky)) * (kPi * R * R / (pdf * p * static_cast<double>(N)))
+                              : glm::dvec3(0.0);
       } else {
         const Light& l = scene.lights[s - numTriangles];
         pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
@@ -168,6 +182,17 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
       for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
         glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
         RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+        // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
+        // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
+        // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
+        for (int layer = 0; hit.hit && layer < 64; ++layer) {
+          const SurfaceTransmission st = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+          if (st.fraction <= 0.0f) break;
+          Rng pass(hashSeed(options.seed, i, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
+          if (pass.uniform() >= st.fraction) break;
+          throughput *= glm::dvec3(st.tint);
+          hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
+        }
         if (!hit.hit) break;  // escaped: its energy leaves the scene
         throughput *= glm::dvec3(rt.albedoAt(hit));
         glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side

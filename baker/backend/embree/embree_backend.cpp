@@ -46,8 +46,11 @@ void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, co
   size_t count = 0;
   auto flush = [&]() {
     in.rayTracer.occludedPackets(rays, count, blocked);
+    const bool seeThrough = in.rayTracer.hasTransmission();
     for (size_t i = 0; i < count; ++i)
-      if (!blocked[i]) acc.add(values[i]);
+      if (!blocked[i])
+        acc.add(seeThrough ? values[i] * in.rayTracer.transmittance(rays[i].origin, rays[i].dir, 0.0f, rays[i].tmax)
+                           : values[i]);
     count = 0;
   };
   for (size_t k = begin; k < end; ++k) {
@@ -72,7 +75,11 @@ void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm
     const Vpl& v = vpls[k];
     glm::vec3 value;
     if (!unshadowedVplValue(v, bound, x, n, value)) continue;
-    if (!in.rayTracer.visible(x, n, v.position, v.normal)) continue;
+    ShadowRay ray;
+    if (in.rayTracer.visibilityRay(x, n, v.position, v.normal, ray)) {
+      if (in.rayTracer.occluded(ray.origin, ray.dir, 0.0f, ray.tmax)) continue;
+      value *= in.rayTracer.transmittance(ray.origin, ray.dir, 0.0f, ray.tmax);
+    }
     acc.add(value);
   }
 }
@@ -86,7 +93,7 @@ glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n)
     glm::vec3 origin = x + n * eps;
     float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
     if (tmax > 0.0f && in.rayTracer.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-    sum += c.mapValue;
+    sum += tmax > 0.0f ? c.mapValue * in.rayTracer.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
   }
   return sum;
 }

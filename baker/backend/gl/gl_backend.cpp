@@ -75,10 +75,20 @@ uint32_t morton3(glm::vec3 u) {
   return (spread(q.x) << 2) | (spread(q.y) << 1) | spread(q.z);
 }
 
-void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g) {
+// See-through primitives (MASK holes, BLEND, transmission) are drawn into shadow maps of their own: a
+// lookup that finds one in front of the receiver cannot be answered by depth alone, and its texel is
+// resolved with rays (contact texels), which model them.
+bool seeThrough(const Scene& scene, const Primitive& prim) {
+  const Material& m = scene.materials[prim.material];
+  return m.alphaMode == AlphaMode::Mask || m.isTransmissive();
+}
+
+// The scene's opaque primitives (or, with seeThroughOnly, the see-through ones) as one vertex/index buffer.
+void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g, bool seeThroughOnly = false) {
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;
   for (const Primitive& prim : scene.primitives) {
+    if (seeThrough(scene, prim) != seeThroughOnly) continue;
     const uint32_t base = static_cast<uint32_t>(positions.size());
     positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
     for (uint32_t i : prim.indices) indices.push_back(base + i);
@@ -289,6 +299,7 @@ class GlBaker {
   void drawView(const ShadowView& view, GLuint fbo, int size, bool reversedZ);
   void drawCulled(const ShadowView& view, int size);
   void renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas);
+  void renderVplCubes(size_t first, size_t count, const DepthAtlas& atlas, const GpuGeometry& geometry);
   void accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas);
   void bakeDirect(const Light& light);
   void bindGBuffer(const GpuPage& page) const;
@@ -304,7 +315,9 @@ class GlBaker {
   GlBakeStats& stats_;
   GlProgramCache& programs_;  // the context's: programs outlive this call, so later calls skip compiling
   ShadowScale scale_;
-  std::unique_ptr<GpuGeometry> geometry_;
+  std::unique_ptr<GpuGeometry> geometry_;            // opaque primitives
+  std::unique_ptr<GpuGeometry> seeThroughGeometry_;  // MASK / BLEND / transmissive primitives (null: none)
+  const GpuGeometry* drawing_ = nullptr;             // what drawCulled draws
   std::vector<std::unique_ptr<GpuPage>> pages_;
   const GlProgram* depthProgram_ = nullptr;
   GLint shadowViewLocation_ = -1;  // depthProgram_'s shadowView[5]
@@ -313,6 +326,7 @@ class GlBaker {
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
   std::vector<std::vector<uint8_t>> contactTexels_;
+  std::unique_ptr<DepthAtlas> seeThroughAtlas_;  // the same cubes of the see-through primitives alone
   std::unique_ptr<DepthAtlas> atlas_;  // VPL depth cubes of one batch (created before the programs: its layout is compiled in)
 };
 
@@ -366,8 +380,8 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
   glUniform4fv(shadowViewLocation_, 5, &data[0][0]);
   drawCounts_.clear();
   drawOffsets_.clear();
-  cullClusters(view, geometry_->clusters, drawCounts_, drawOffsets_, stats_.trianglesDrawn);
-  stats_.trianglesBeforeCulling += geometry_->triangles;
+  cullClusters(view, drawing_->clusters, drawCounts_, drawOffsets_, stats_.trianglesDrawn);
+  stats_.trianglesBeforeCulling += drawing_->triangles;
   ++stats_.facesRendered;
   if (!drawCounts_.empty())
     glMultiDrawElements(GL_TRIANGLES, drawCounts_.data(), GL_UNSIGNED_INT, drawOffsets_.data(),
@@ -384,8 +398,18 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
 // at ~100k triangles per cube it serialises binning and rasterising (measured 13 ms/VPL wall, CPU 20,
 // against ≈ 10.5 / 17 with the flush).
 void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
+  drawing_ = geometry_.get();
+  renderVplCubes(first, count, atlas, *geometry_);
+  if (seeThroughAtlas_) {  // the see-through primitives' own cubes (contact texels)
+    drawing_ = seeThroughGeometry_.get();
+    renderVplCubes(first, count, *seeThroughAtlas_, *seeThroughGeometry_);
+    drawing_ = geometry_.get();
+  }
+}
+
+void GlBaker::renderVplCubes(size_t first, size_t count, const DepthAtlas& atlas, const GpuGeometry& geometry) {
   depthProgram_->use();
-  glBindVertexArray(geometry_->vao);
+  glBindVertexArray(geometry.vao);
   glBindFramebuffer(GL_FRAMEBUFFER, atlas.fbo);
   glDisable(GL_SCISSOR_TEST);  // the clear covers the whole atlas
   glClearDepthf(0.0f);
@@ -432,6 +456,7 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& a
   if (count > 0) glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
   glBindTextureUnit(3, vplTable_);
   glBindTextureUnit(2, atlas.texture);
+  if (seeThroughAtlas_) glBindTextureUnit(5, seeThroughAtlas_->texture);
   glBindVertexArray(emptyVao_);
   for (auto& page : pages_) {
     const GlProgram& program = vplProgram(page->samples->supersample * page->samples->supersample);
@@ -449,6 +474,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   std::vector<std::string> defines{"#define LAYERS " + std::to_string(layers)};
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
   if (contactFlags()) defines.push_back("#define CONTACT_FLAGS 1");
+  if (seeThroughGeometry_) defines.push_back("#define SEE_THROUGH 1");
   auto constant = [&](const char* name, float value) {
     char text[64];
     std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
@@ -509,6 +535,22 @@ void GlBaker::bakeDirect(const Light& light) {
     texelAngle = texelSize;
     shadowKind = 2;
   }
+  // The see-through primitives into maps of their own, with the same views (contact texels).
+  std::unique_ptr<DepthTargets> glassMaps;
+  if (seeThroughGeometry_) {
+    drawing_ = seeThroughGeometry_.get();
+    glBindVertexArray(seeThroughGeometry_->vao);
+    glassMaps = std::make_unique<DepthTargets>(maps->target, maps->size, static_cast<int>(maps->fbos.size()));
+    if (cube) {
+      const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+      for (int face = 0; face < kFaces; ++face)
+        drawView(*cubeFaceView(light.position, identity, face, glassMaps->size, scale_.nearPlane, false),
+                 glassMaps->fbos[face], glassMaps->size, true);
+    } else {
+      drawView(*view2d, glassMaps->fbos[0], glassMaps->size, shadowKind == 1);
+    }
+    drawing_ = geometry_.get();
+  }
   finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
 
   lightMapPassState();  // blended: added to the VPL partial sums not yet folded
@@ -532,6 +574,8 @@ void GlBaker::bakeDirect(const Light& light) {
   glUniform1f(p.uniform("orthoDepthRange"), orthoRange);
   glUniform1f(p.uniform("texelAngle"), texelAngle);
   glBindTextureUnit(cube ? 2 : 3, maps->texture);
+  glUniform1i(p.uniform("seeThroughMaps"), glassMaps ? 1 : 0);
+  if (glassMaps) glBindTextureUnit(cube ? 5 : 6, glassMaps->texture);
   glBindVertexArray(emptyVao_);
   for (auto& page : pages_) {
     glBindFramebuffer(GL_FRAMEBUFFER, page->fbo);
@@ -552,6 +596,12 @@ std::vector<Lightmap> GlBaker::run() {
 
   geometry_ = std::make_unique<GpuGeometry>();
   uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
+  drawing_ = geometry_.get();
+  if (contactFlags() && std::any_of(in_.scene.primitives.begin(), in_.scene.primitives.end(),
+                                    [&](const Primitive& p) { return seeThrough(in_.scene, p); })) {
+    seeThroughGeometry_ = std::make_unique<GpuGeometry>();
+    uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *seeThroughGeometry_, true);
+  }
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels));
 
   const int K = std::clamp(opt_.vplsPerPass, 1, 256);
@@ -578,6 +628,7 @@ std::vector<Lightmap> GlBaker::run() {
                                    .size;
     stats_.cubeFaceSize = faceSize;
     atlas_ = std::make_unique<DepthAtlas>(faceSize, K);
+    if (seeThroughGeometry_) seeThroughAtlas_ = std::make_unique<DepthAtlas>(faceSize, K);
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
   }
   glCreateBuffers(1, &vplBuffer_);

@@ -27,7 +27,7 @@ glm::vec3 punctualAt(const Scene& scene, const RayTracer& rt, const glm::vec3& o
     if (c.mapValue == glm::vec3(0.0f)) continue;
     float tmax = std::isinf(c.distance) ? 1e30f : c.distance - rt.epsilon();
     if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-    sum += c.mapValue;
+    sum += tmax > 0.0f ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
   }
   return sum;
 }
@@ -58,10 +58,13 @@ glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const Lig
         float r = std::sqrt(r2);
         glm::vec3 w = d / r;
         float cosX = glm::dot(n, w), cosY = -glm::dot(e.normal, w);
-        if (cosX > 0.0f && cosY > 0.0f && rt.visible(x, n, y, e.normal)) {
+        ShadowRay ray;
+        const bool clear = !rt.visibilityRay(x, n, y, e.normal, ray) || !rt.occluded(ray.origin, ray.dir, 0.0f, ray.tmax);
+        if (cosX > 0.0f && cosY > 0.0f && clear) {
           double pdfLight = lights.areaOnly.pdf(k) / e.area * r2 / cosY;  // solid angle
           double pdfHemi = cosX / kPi;
           glm::dvec3 Le(scene.emissionAt(prim, e.triangle, b));
+          if (rt.hasTransmission() && ray.tmax > 0.0f) Le *= glm::dvec3(rt.transmittance(ray.origin, ray.dir, 0.0f, ray.tmax));
           value += beta * Le * (cosX / (kPi * pdfLight) * powerHeuristic(pdfLight, pdfHemi));
         }
       }
@@ -69,14 +72,33 @@ glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const Lig
     // Hemisphere sample: emission found here is MIS-weighted; reflection continues the path.
     glm::vec3 dir = cosineHemisphere(n, rng.uniform(), rng.uniform());
     RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
-    if (!hit.hit) break;
-    const Primitive& prim = scene.primitives[hit.primitive];
-    if (!hit.backFace && scene.materials[prim.material].isEmissive()) {
-      glm::dvec3 Le(scene.emissionAt(prim, hit.triangle, hit.barycentric));
+    if (!hit.hit) {  // escaped: the sky, found by the hemisphere sample alone (no sky sampling here)
+      if (scene.environment.present()) value += beta * glm::dvec3(scene.environment.radiance(dir));
+      break;
+    }
+    // A see-through surface: with probability `fraction` the path goes straight on, tinted (the hemisphere
+    // direction is kept, so emission and the sky behind it are found as before); else it meets the
+    // surface's Lambertian part below.
+    glm::vec3 straightOrigin;
+    while (hit.hit) {
+      const SurfaceTransmission st = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+      if (st.fraction <= 0.0f || rng.uniform() >= st.fraction) break;
+      beta *= glm::dvec3(st.tint);
+      straightOrigin = hit.position + dir * rt.epsilon();
+      hit = rt.intersect(straightOrigin, dir, 0.0f, 1e30f);
+    }
+    if (!hit.hit) {
+      if (scene.environment.present()) value += beta * glm::dvec3(scene.environment.radiance(dir));
+      break;
+    }
+    const Primitive& hitPrim = scene.primitives[hit.primitive];
+    if (!hit.backFace && scene.materials[hitPrim.material].isEmissive()) {
+      glm::dvec3 Le(scene.emissionAt(hitPrim, hit.triangle, hit.barycentric));
       double weight = 1.0;
       if (haveEmitters) {
         double cosY = -glm::dot(hit.geometricNormal, dir);
-        double pdfLight = cosY > 0.0 ? lights.areaPdf(hit.primitive, hit.triangle) * double(hit.t) * hit.t / cosY : 0.0;
+        const double dist = glm::length(hit.position - x);  // through any see-through surfaces on the way
+        double pdfLight = cosY > 0.0 ? lights.areaPdf(hit.primitive, hit.triangle) * dist * dist / cosY : 0.0;
         weight = powerHeuristic(glm::dot(n, dir) / kPi, pdfLight);
       }
       value += beta * Le * weight;

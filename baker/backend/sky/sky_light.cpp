@@ -1,0 +1,109 @@
+#include "backend/sky/sky_light.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "common/progress.h"
+#include "texels/texel_filter.h"
+#include "vpl/sampling.h"
+
+namespace irbake {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
+}  // namespace
+
+glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2) {
+  const Environment& sky = in.scene.environment;
+  const RayTracer& rt = in.rayTracer;
+  const glm::vec3 origin = x + n * rt.epsilon();
+  glm::dvec3 sum(0.0);
+  if (sky.isUniform()) {
+    // Cosine rays: (L cosθ / p) / π = L for p = cosθ/π, so the value is L × the visible fraction.
+    glm::vec3 visible(0.0f);  // Σ transmittance over the rays (1 per clear ray without see-through surfaces)
+    for (int i = 0; i < rays; ++i) {
+      const double u = std::fmod((i + 0.5) / rays + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
+      const glm::vec3 dir = cosineHemisphere(n, u, v);
+      if (!rt.occluded(origin, dir, 0.0f, 1e30f)) visible += rt.transmittance(origin, dir, 0.0f, 1e30f);
+    }
+    return sky.uniformRadiance() * visible / static_cast<float>(std::max(1, rays));
+  }
+  // Two strategies, half the rays each, balance heuristic: f / (n_c p_c + n_e p_e) summed over all rays.
+  const int half = std::max(1, rays / 2);
+  for (int i = 0; i < 2 * half; ++i) {
+    const int k = i % half;
+    const double u = std::fmod((k + 0.5) / half + r1, 1.0), v = std::fmod(k * kGolden + r2, 1.0);
+    glm::vec3 dir;
+    if (i < half) {
+      dir = cosineHemisphere(n, u, v);
+    } else {
+      double pdf;
+      dir = sky.sample(u, v, pdf);
+    }
+    const double cosTheta = glm::dot(n, dir);
+    if (!(cosTheta > 0.0)) continue;
+    const double pdfCosine = cosTheta / kPi, pdfSky = sky.pdf(dir);
+    const glm::vec3 L = sky.radiance(dir);
+    if (L == glm::vec3(0.0f) || rt.occluded(origin, dir, 0.0f, 1e30f)) continue;
+    sum += glm::dvec3(L * rt.transmittance(origin, dir, 0.0f, 1e30f)) * (cosTheta / (half * (pdfCosine + pdfSky)));
+  }
+  return glm::vec3(sum / kPi);
+}
+
+void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLightOptions& options,
+                 SkyLightStats* stats) {
+  if (!in.scene.environment.present()) return;
+  Stopwatch watch;
+  size_t slotsWithWeight = 0;
+  for (const TexelSamples& ts : in.texels)
+    for (const glm::vec4& pw : ts.positionWeight) slotsWithWeight += pw.w > 0.0f;
+  const int rays = std::max(8, std::min(options.raysPerSample,
+                                        static_cast<int>(options.maxRays / std::max<size_t>(1, slotsWithWeight))));
+  std::atomic<size_t> traced{0};
+  for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
+    const TexelSamples& ts = in.texels[p];
+    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      size_t count = 0;
+      for (size_t s = r.begin(); s != r.end(); ++s) {
+        if (!(ts.positionWeight[s].w > 0.0f)) continue;
+        glm::vec3 x(ts.positionWeight[s]);
+        const glm::vec3 n(ts.normal[s]);
+        if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
+          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+        Rng rng(hashSeed(options.seed, 0x5c7ull << 8 | static_cast<uint64_t>(ts.page), s));
+        const double r1 = rng.uniform(), r2 = rng.uniform();
+        slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
+        count += static_cast<size_t>(rays);
+      }
+      traced += count;
+    });
+    std::vector<glm::vec3> texelValue(ts.layerSize(), glm::vec3(0.0f));
+    std::vector<uint8_t> valid(ts.layerSize(), 0);
+    for (size_t t = 0; t < ts.layerSize(); ++t) {
+      glm::vec3 v;
+      if (t < maps[p].valid.size() && maps[p].valid[t] && texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, v)) {
+        texelValue[t] = v;
+        valid[t] = 1;
+      }
+    }
+    if (options.filterRadius > 0) {
+      TexelFilterOptions fo;
+      fo.radius = options.filterRadius;
+      texelValue = filterOnSurface(ts, texelValue, valid, fo);
+    }
+    for (size_t t = 0; t < ts.layerSize(); ++t)
+      if (valid[t]) maps[p].texels[t] += texelValue[t];
+  }
+  if (stats) {
+    stats->rays = traced;
+    stats->raysPerSample = rays;
+    stats->seconds = watch.seconds();
+  }
+}
+
+}  // namespace irbake

@@ -1,0 +1,37 @@
+// The sky's direct light (Scene::environment), traced with rays into the maps after either VPL backend:
+//   E(x)/π = (1/π) ∫_H L(ω) cosθ V(x, ω) dω.
+// A uniform sky is sampled by cosine (each ray then contributes L·V exactly, so an open plane gets L with
+// no noise); an environment map by multiple importance sampling, half the rays by cosine and half by the
+// map's luminance, balance heuristic (a sun-like texel is found by the second strategy, a broad sky by
+// the first). Rays per sample follow a rotated Fibonacci lattice; the result is smoothed on the surface
+// by the texel filter. The sky's bounces are VPLs from the walk (vpl/walk.cpp), not this stage.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "backend/bake_inputs.h"
+
+namespace irbake {
+
+struct SkyLightOptions {
+  int raysPerSample = 64;    // per texel sample (halved per strategy for a map)
+  int maxRays = 8 << 20;     // budget over all samples: fewer rays per sample on big pages (never below 8)
+  int filterRadius = 1;      // (2r+1)² window of the texel filter on the same surface; 0: none
+  uint32_t seed = 0;         // rotates the per-sample lattices
+};
+
+struct SkyLightStats {
+  size_t rays = 0;
+  int raysPerSample = 0;
+  double seconds = 0.0;
+};
+
+// Adds the sky's direct light to every valid texel of `maps` (one per in.texels page). No sky: no-op.
+void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLightOptions& options = {},
+                 SkyLightStats* stats = nullptr);
+
+// The value one texel sample at (x, n) receives from the sky with `rays` rays (for tests and tools).
+glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2);
+
+}  // namespace irbake
