@@ -425,6 +425,17 @@ bool isGlbPath(const std::filesystem::path& p) {
 
 }  // namespace
 
+bool namesGltfFile(const std::filesystem::path& output) {
+  std::string ext = output.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb" || ext == ".gltf";
+}
+
+std::filesystem::path outputFolderOf(const std::filesystem::path& output) {
+  if (!namesGltfFile(output)) return output;
+  return output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
+}
+
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options) {
   const std::string file = options.output.string();
   if (options.output.empty()) throw Error(ErrorCode::Usage, "", "export needs an output path");

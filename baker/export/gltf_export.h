@@ -19,6 +19,11 @@ struct ExportOptions {
   LightmapPngOptions png;             // the 8-bit MOZ_lightmap PNG's encoding (sRGB, range at a percentile)
 };
 
+// True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.
+bool namesGltfFile(const std::filesystem::path& output);
+// The folder a command writes into: -o's parent when it names a glTF file ("." when it has none), else -o.
+std::filesystem::path outputFolderOf(const std::filesystem::path& output);
+
 // Writes `scene` (after the atlas: uv1 and primitive.lightmap set) with `maps` (one per page, may be
 // empty: then only TEXCOORD_1 and extras.lightmap are added, as `irbake unwrap` does). Every file is
 // written to a temp name and renamed only when all succeeded. Throws Error(Io) naming the file.

@@ -1,5 +1,4 @@
 // Writing a finished bake: EXR pages, glTF with the maps attached, the JSON report.
-#include <cctype>
 #include <fstream>
 #include <string>
 
@@ -16,11 +15,8 @@ namespace irbake {
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
   namespace fs = std::filesystem;
   // -o OUT.glb / OUT.gltf names the glTF itself (a GLB embeds its images); its folder takes the rest.
-  std::string ext = options.outDir.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const bool namesGltf = ext == ".glb" || ext == ".gltf";
-  const fs::path outDir = namesGltf ? (options.outDir.has_parent_path() ? options.outDir.parent_path() : fs::path(".")) : options.outDir;
-  const fs::path gltfPath = namesGltf ? options.outDir : outDir / "scene.gltf";
+  const fs::path outDir = outputFolderOf(options.outDir);
+  const fs::path gltfPath = namesGltfFile(options.outDir) ? options.outDir : outDir / "scene.gltf";
   std::error_code ec;
   fs::create_directories(outDir, ec);
   if (!fs::is_directory(outDir))
