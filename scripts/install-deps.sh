@@ -20,7 +20,12 @@ packages=(
   nlohmann-json3-dev       # JSON reports
   libcli11-dev             # CLI11: command-line options of irbake and irview
   xvfb xauth               # windowed viewer test without a display
+  chromium                 # runtime/web: the three.js viewer test in headless Chromium
 )
+# node + npm for runtime/web's tests (npm modules: scripts/install-web-deps.sh). Debian's nodejs and
+# npm, unless a node with its own npm is already there (NodeSource's nodejs conflicts with Debian npm).
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(python3-matplotlib python3-numpy python3-openimageio)   # openimageio: bench/cycles reads EXRs
 fi

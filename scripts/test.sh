@@ -4,5 +4,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+bash scripts/install-web-deps.sh build
 cd build
 ctest --output-on-failure -j"$(nproc)" --timeout 600

@@ -139,6 +139,38 @@ TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
   EXPECT_LT(worst, 5e-3);
 }
 
+// -o OUT.glb: one GLB with the light-map PNG embedded (no .gltf/.bin/.png beside it), the EXR page
+// and the report beside it; the embedded PNG × intensity is the EXR within the 8-bit encoding's error.
+TEST(BakeCommand, GlbOutputEmbedsTheLightMap) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path out = scratch("glb");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(out / "plane.glb") +
+                       " --backend embree --texels-per-unit 4 --vpls 64 --quiet",
+                   &log),
+            0)
+      << log;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"lightmap_0.exr", "plane.glb", "report.json"}));
+  Scene baked = loadScene(out / "plane.glb");
+  Lightmap map = readExr(out / "lightmap_0.exr");
+  ASSERT_FALSE(baked.primitives.empty());
+  const Material& m = baked.materials.at(baked.primitives[0].material);
+  ASSERT_GE(m.lightmapTexture, 0);
+  const Texture& png = baked.textures.at(m.lightmapTexture);
+  ASSERT_EQ(png.width, map.width);
+  ASSERT_EQ(png.height, map.height);
+  double sumPng = 0.0, sumExr = 0.0;
+  for (size_t i = 0; i < map.texels.size(); ++i) {
+    sumPng += png.texels[i].r * m.lightmapIntensity;
+    sumExr += std::min(map.texels[i].r, m.lightmapIntensity);  // the PNG clips at its range
+  }
+  EXPECT_GT(sumExr, 0.0);
+  EXPECT_NEAR(sumPng / sumExr, 1.0, 0.01);
+}
+
 TEST(BakeCommand, SunFromTheCommandLineLightsAnUnlitScene) {
   fs::path dir = scratch("sun");
   fs::path scene = writeUnlitTriangle(dir);

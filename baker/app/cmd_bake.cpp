@@ -11,6 +11,7 @@
 #include "common/log.h"
 #include "common/output_lock.h"
 #include "common/progress.h"
+#include "export/gltf_export.h"
 #include "pipeline/bake.h"
 #include "scene/gltf_loader.h"
 
@@ -35,7 +36,7 @@ int runBake(const Args& args) {
                           "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
                           "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
   app->add_option("SCENE", scenes, "the glTF/GLB scene to bake");
-  app->add_option("-o,--output", out, "output folder (OUTDIR)")->type_name("OUTDIR");
+  app->add_option("-o,--output", out, "output folder (OUTDIR), or OUT.glb / OUT.gltf: that glTF, the rest beside it")->type_name("OUTDIR");
   app->add_option("--backend", backend,
                   "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
@@ -119,7 +120,7 @@ int runBake(const Args& args) {
   o.postDilate = !noDilate;
   o.postSeams = !noSeams;
 
-  const OutputFolderLock lock(out);  // before any work: a second bake into OUTDIR fails at once
+  const OutputFolderLock lock(outputFolderOf(out));  // before any work: a second bake into OUTDIR fails at once
   const std::filesystem::path scenePath = scenes[0];
   Stopwatch loadTime;
   Scene scene = loadScene(scenePath);

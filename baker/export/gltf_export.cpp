@@ -1,22 +1,30 @@
 // glTF/GLB export with light maps. Two sources of the document:
-//  - the scene came from a glTF (Scene::sourcePath): its JSON is kept (materials, textures, cameras,
-//    lights, unknown extensions), its buffers merged into one and its images embedded, and every
-//    baked primitive is added as a new world-space mesh on an identity root node (the atlas split
-//    vertices, so the source accessors no longer fit); the source nodes lose their mesh.
+//  - the scene came from a glTF (Scene::sourcePath): the source document is written back with only the
+//    light-map data added. Nodes, names, transforms, cameras, lights, materials and unknown extensions
+//    stay as they were; each baked mesh primitive is rewritten in its local space over the vertex set
+//    the atlas made (every source attribute and morph target gathered through Primitive::sourceVertex,
+//    TEXCOORD_1 added, one glTF primitive per light-map page). A mesh used by several nodes keeps its
+//    index for the first node; every further node gets a copy of the mesh with its own light-map
+//    region. Materials get MOZ_lightmap in place (a copy per further page). Whatever nothing references
+//    any more (the replaced accessors, their views) is dropped and buffer 0 rebuilt (gltf_compact.h).
 //  - a generated scene: written by our writer from a copy whose materials carry the light maps.
-// Materials are duplicated per page (MOZ_lightmap names one texture). Every file is written to a
-// temp name and renamed only when all succeeded (common/atomic_file.h).
+// A .glb embeds every image; a .gltf gets its .bin and the images as files beside it. Every file is
+// written to a temp name and renamed only when all succeeded (common/atomic_file.h).
 #include "export/gltf_export.h"
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/log.h"
 #include "export/exr_io.h"
+#include "export/gltf_compact.h"
+#include "export/lightmap_png.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
@@ -26,27 +34,6 @@ namespace irbake {
 using json = nlohmann::json;
 
 namespace {
-
-// One baked page as the 8-bit linear PNG of MOZ_lightmap: value = PNG × intensity, intensity = the
-// page's largest texel value so the PNG spans the full 0..255 range.
-struct PngPage {
-  Texture texture;
-  float intensity = 1.0f;
-};
-
-PngPage pngPage(const Lightmap& map) {
-  PngPage p;
-  float peak = 0.0f;
-  for (const auto& t : map.texels) peak = std::max(peak, std::max(t.x, std::max(t.y, t.z)));
-  p.intensity = peak > 0.0f ? peak : 1.0f;
-  p.texture.name = "lightmap_" + std::to_string(map.page);
-  p.texture.width = map.width;
-  p.texture.height = map.height;
-  p.texture.wrapS = p.texture.wrapT = WrapMode::ClampToEdge;
-  p.texture.texels.resize(map.texels.size());
-  for (size_t i = 0; i < map.texels.size(); ++i) p.texture.texels[i] = glm::vec4(glm::max(map.texels[i], glm::vec3(0.0f)) / p.intensity, 1.0f);
-  return p;
-}
 
 void checkMaps(const std::vector<Lightmap>& maps, const std::string& file) {
   for (const auto& m : maps) {
@@ -137,6 +124,7 @@ GltfDocument documentFromSource(const std::filesystem::path& sourcePath) {
       if (bytes.empty()) continue;  // unreadable (the loader warned): leave the reference as it was
       std::string mime = mimeFor(bytes, image.value("mimeType", std::string()));
       int view = doc.addBufferView(bytes.data(), bytes.size());
+      image[kSourceUriKey] = image["uri"];  // a folder output writes it back under this name
       image.erase("uri");
       image["bufferView"] = view;
       image["mimeType"] = mime;
@@ -146,107 +134,347 @@ GltfDocument documentFromSource(const std::filesystem::path& sourcePath) {
 
 std::string pageUri(const ExportOptions& options, int page) { return options.exrPrefix + "_" + std::to_string(page) + ".exr"; }
 
+// The light-map record of one output primitive (extras.lightmap), kept beside the source extras.
+void setLightmapRecord(json& prim, const LightmapRef& ref) {
+  if (ref.page < 0) return;
+  if (!prim.contains("extras") || !prim["extras"].is_object()) prim["extras"] = json::object();
+  prim["extras"]["lightmap"] = {{"page", ref.page}, {"width", ref.width}, {"height", ref.height}};
+}
+
+// MOZ_lightmap of one page: the texture, TEXCOORD_1, the intensity, and our documented extra saying the
+// PNG is sRGB-encoded (docs/export.md).
+json mozLightmap(int texture, const LightmapPng& png) {
+  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", png.intensity}};
+  if (png.srgb) moz["extras"] = {{"colorSpace", "srgb"}};
+  return moz;
+}
+
+// True when a material's texture (core or extension) reads TEXCOORD_1.
+bool readsTexcoord1(const json& j) {
+  if (j.is_object()) {
+    if (j.contains("texCoord") && j["texCoord"] == 1) return true;
+    for (const auto& [k, v] : j.items())
+      if (v.is_structured() && readsTexcoord1(v)) return true;
+  } else if (j.is_array()) {
+    for (const auto& v : j)
+      if (readsTexcoord1(v)) return true;
+  }
+  return false;
+}
+
+// The source document with only the light-map data added (see the file comment).
+class SourceExport {
+ public:
+  SourceExport(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<LightmapPng>& pngs, const std::string& file)
+      : scene_(scene), pngs_(pngs), file_(file), doc_(documentFromSource(scene.sourcePath)) {
+    for (size_t i = 0; i < maps.size(); ++i) pngOfPage_[maps[i].page] = i;
+    sourceMaterials_ = doc_.root.value("materials", json::array());
+    sourceMeshes_ = doc_.root.value("meshes", json::array());
+  }
+
+  GltfDocument run() {
+    // Scene primitives grouped per (node, mesh, source primitive), in scene order; the atlas may have
+    // split one source primitive into one part per page.
+    std::map<int, std::map<int, std::vector<const Primitive*>>> partsOfNode;  // node → source primitive → parts
+    std::vector<int> nodeOrder;
+    for (const auto& p : scene_.primitives) {
+      if (p.node < 0 || p.gltfMesh < 0 || p.gltfPrimitive < 0) continue;
+      if (!partsOfNode.count(p.node)) nodeOrder.push_back(p.node);
+      partsOfNode[p.node][p.gltfPrimitive].push_back(&p);
+    }
+    std::set<int> meshesTaken;  // source meshes already rewritten for their first instance
+    json& nodes = doc_.root["nodes"];
+    for (int node : nodeOrder) {
+      if (node >= static_cast<int>(nodes.size())) continue;
+      const int mesh = nodes[node].value("mesh", -1);
+      if (mesh < 0 || mesh >= static_cast<int>(sourceMeshes_.size())) continue;
+      json rewritten = rewriteMesh(mesh, partsOfNode[node]);
+      // Instancing rule: the first node keeps the mesh index; every further instance gets its own
+      // copy of the mesh (its own light-map region, TEXCOORD_1 and split vertices).
+      if (meshesTaken.insert(mesh).second) {
+        doc_.root["meshes"][mesh] = std::move(rewritten);
+      } else {
+        nodes[node]["mesh"] = doc_.append("meshes", std::move(rewritten));
+      }
+    }
+    if (!pngs_.empty()) doc_.useExtension("MOZ_lightmap");
+    repairEmissiveFactors();
+    compactDocument(doc_);
+    const std::string generator = doc_.root["asset"].value("generator", std::string("unknown"));
+    if (generator.rfind("irbake", 0) != 0) doc_.root["asset"]["generator"] = "irbake (from " + generator + ")";
+    return std::move(doc_);
+  }
+
+ private:
+  json rewriteMesh(int mesh, const std::map<int, std::vector<const Primitive*>>& parts) {
+    json out = sourceMeshes_[mesh];
+    const json sourcePrims = out.value("primitives", json::array());
+    json prims = json::array();
+    for (int pi = 0; pi < static_cast<int>(sourcePrims.size()); ++pi) {
+      auto it = parts.find(pi);
+      if (it == parts.end()) {  // not baked (points, lines, all degenerate): kept as it was
+        prims.push_back(sourcePrims[pi]);
+        continue;
+      }
+      for (const Primitive* part : it->second) prims.push_back(rewritePrimitive(sourcePrims[pi], *part));
+    }
+    out["primitives"] = std::move(prims);
+    return out;
+  }
+
+  // The source primitive over the part's vertex set: every source attribute (and morph target)
+  // gathered through sourceVertex, TEXCOORD_1 = the atlas UVs, the part's triangles, its material.
+  json rewritePrimitive(const json& source, const Primitive& part) {
+    const size_t n = part.positions.size();
+    std::vector<uint32_t> at = part.sourceVertex;
+    if (at.empty()) {
+      at.resize(n);
+      for (size_t i = 0; i < n; ++i) at[i] = static_cast<uint32_t>(i);
+    }
+    if (at.size() != n) throw Error(ErrorCode::InvalidData, file_, "primitive " + part.name + " lost track of its source vertices");
+    json prim = source;
+    auto gather = [&](const json& attributes, bool isTarget) {
+      json outAttrs = json::object();
+      for (const auto& [name, index] : attributes.items()) {
+        if (name == "TEXCOORD_1" && !isTarget) continue;  // replaced by the light-map UVs
+        if (!index.is_number_integer()) continue;
+        const AccessorBytes bytes = accessorBytes(index.get<int>());
+        for (uint32_t v : at)
+          if (v >= bytes.count)
+            throw Error(ErrorCode::InvalidData, file_, "mesh " + std::to_string(part.gltfMesh) + " attribute " + name + " is shorter than POSITION");
+        outAttrs[name] = addGatheredAccessor(doc_, bytes, at, name == "POSITION" || isTarget);
+      }
+      return outAttrs;
+    };
+    if (!warnedTexcoord1_ && source.contains("material") && source["material"].is_number_integer() &&
+        source["material"].get<int>() < static_cast<int>(sourceMaterials_.size())) {
+      json mat = sourceMaterials_[source["material"].get<int>()];
+      if (mat.contains("extensions") && mat["extensions"].is_object()) mat["extensions"].erase("MOZ_lightmap");
+      if (readsTexcoord1(mat)) {
+        warnedTexcoord1_ = true;
+        log::warn(file_ + ": a material reads textures with TEXCOORD_1, which the export replaces by the light-map UVs");
+      }
+    }
+    prim["attributes"] = gather(source.value("attributes", json::object()), false);
+    if (part.uv1.size() == n) {
+      const int uv1 = doc_.addVec2(part.uv1);
+      prim["attributes"]["TEXCOORD_1"] = uv1;
+      // glTF numbers TEXCOORD sets from 0 without gaps: a primitive without TEXCOORD_0 shares the
+      // light-map UVs as its set 0 (MOZ_lightmap keeps texCoord 1 for every primitive).
+      if (!prim["attributes"].contains("TEXCOORD_0")) prim["attributes"]["TEXCOORD_0"] = uv1;
+    }
+    if (source.contains("targets") && source["targets"].is_array()) {
+      json targets = json::array();
+      for (const auto& t : source["targets"]) targets.push_back(gather(t, true));
+      prim["targets"] = std::move(targets);
+    }
+    // The loader swapped two corners under a mirroring node (world space is counter-clockwise);
+    // in the node's local space the source winding comes back.
+    std::vector<uint32_t> indices = part.indices;
+    if (glm::determinant(glm::mat3(part.nodeToWorld)) < 0.0f)
+      for (size_t t = 0; t + 2 < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
+    prim["indices"] = doc_.addIndices(indices);
+    prim["mode"] = 4;  // strips and fans arrive as triangle lists
+    const int material = outputMaterial(part);
+    if (material >= 0) prim["material"] = material;
+    else prim.erase("material");
+    setLightmapRecord(prim, part.lightmap);
+    return prim;
+  }
+
+  // glTF keeps emissiveFactor in [0, 1]; a source above that (the loader took it as factor × strength)
+  // is written as factor / peak with KHR_materials_emissive_strength × peak: the same emission, valid.
+  void repairEmissiveFactors() {
+    if (!doc_.root.contains("materials")) return;
+    for (auto& mat : doc_.root["materials"]) {
+      if (!mat.contains("emissiveFactor") || !mat["emissiveFactor"].is_array() || mat["emissiveFactor"].size() != 3) continue;
+      double peak = 0.0;
+      for (const auto& c : mat["emissiveFactor"])
+        if (c.is_number()) peak = std::max(peak, c.get<double>());
+      if (!(peak > 1.0)) continue;
+      for (auto& c : mat["emissiveFactor"])
+        if (c.is_number()) c = c.get<double>() / peak;
+      if (!mat.contains("extensions") || !mat["extensions"].is_object()) mat["extensions"] = json::object();
+      json& ext = mat["extensions"]["KHR_materials_emissive_strength"];
+      const double strength = ext.is_object() && ext.contains("emissiveStrength") ? ext["emissiveStrength"].get<double>() : 1.0;
+      ext = {{"emissiveStrength", strength * peak}};
+      doc_.useExtension("KHR_materials_emissive_strength");
+      if (!warnedEmissive_) {
+        warnedEmissive_ = true;
+        log::warn(file_ + ": emissiveFactor above 1 written as KHR_materials_emissive_strength (glTF keeps the factor in [0, 1])");
+      }
+    }
+  }
+
+  const AccessorBytes& accessorBytes(int index) {
+    auto it = accessorCache_.find(index);
+    if (it != accessorCache_.end()) return it->second;
+    return accessorCache_.emplace(index, readAccessor(doc_, index, file_)).first->second;
+  }
+
+  int pageWithMap(const Primitive& p) const { return pngOfPage_.count(p.lightmap.page) ? p.lightmap.page : -1; }
+
+  // Material of a part: its source material with MOZ_lightmap for the part's page. The first page a
+  // source material meets is written into it in place (same index, same name); further pages get a
+  // copy named <name>_lightmap<page>.
+  int outputMaterial(const Primitive& part) {
+    const Material& m = scene_.materials.at(part.material);
+    const int source = (m.gltfMaterial >= 0 && m.gltfMaterial < static_cast<int>(sourceMaterials_.size())) ? m.gltfMaterial : -1;
+    const int page = pageWithMap(part);
+    auto key = std::make_pair(source, page);
+    auto it = materialFor_.find(key);
+    if (it != materialFor_.end()) return it->second;
+    if (source < 0 && page < 0) return materialFor_[key] = -1;
+    json mat = source >= 0 ? sourceMaterials_[source] : json::object({{"name", "default"}});
+    if (page >= 0) {
+      if (!mat.contains("extensions") || !mat["extensions"].is_object()) mat["extensions"] = json::object();
+      mat["extensions"]["MOZ_lightmap"] = mozLightmap(lightmapTexture(page), pngs_[pngOfPage_.at(page)]);
+    }
+    int index;
+    if (source >= 0 && sourceMaterialsTaken_.insert(source).second) {
+      index = source;
+      doc_.root["materials"][source] = std::move(mat);
+    } else {
+      if (page >= 0 && mat.contains("name")) mat["name"] = mat["name"].get<std::string>() + "_lightmap" + std::to_string(page);
+      index = doc_.append("materials", std::move(mat));
+    }
+    return materialFor_[key] = index;
+  }
+
+  int lightmapTexture(int page) {
+    auto it = pageTexture_.find(page);
+    if (it != pageTexture_.end()) return it->second;
+    const LightmapPng& png = pngs_[pngOfPage_.at(page)];
+    const int image = doc_.addPngImage(png.png, png.texture.name);
+    const int tex = doc_.addTexture(image, doc_.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
+    return pageTexture_[page] = tex;
+  }
+
+  const Scene& scene_;
+  const std::vector<LightmapPng>& pngs_;
+  const std::string file_;
+  GltfDocument doc_;
+  json sourceMaterials_, sourceMeshes_;
+  std::map<int, size_t> pngOfPage_;
+  std::map<int, AccessorBytes> accessorCache_;
+  std::map<std::pair<int, int>, int> materialFor_;
+  std::set<int> sourceMaterialsTaken_;
+  std::map<int, int> pageTexture_;
+  bool warnedTexcoord1_ = false;
+  bool warnedEmissive_ = false;
+};
+
+// Generated scene (no source document): our writer from a copy whose materials carry the light maps.
+GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<LightmapPng>& pngs,
+                               const std::vector<std::string>& pageUris) {
+  std::map<int, size_t> pngOfPage;
+  for (size_t i = 0; i < maps.size(); ++i) pngOfPage[maps[i].page] = i;
+  Scene copy = scene;
+  copy.materials.clear();
+  std::map<std::pair<int, int>, int> materialFor;
+  std::map<int, int> pageTexture;
+  std::vector<const LightmapPng*> pngOfTexture;  // scene texture → its light-map PNG (nullptr: none)
+  for (auto& prim : copy.primitives) {
+    const int page = pngOfPage.count(prim.lightmap.page) ? prim.lightmap.page : -1;
+    auto key = std::make_pair(prim.material, page);
+    if (!materialFor.count(key)) {
+      Material m = scene.materials.at(prim.material);
+      m.lightmapTexture = -1;
+      if (page >= 0) {
+        if (!pageTexture.count(page)) {
+          pageTexture[page] = static_cast<int>(copy.textures.size());
+          copy.textures.push_back(pngs[pngOfPage.at(page)].texture);
+        }
+        m.lightmapTexture = pageTexture[page];
+        m.lightmapIntensity = pngs[pngOfPage.at(page)].intensity;
+        m.name += "_lightmap" + std::to_string(page);
+      }
+      materialFor[key] = static_cast<int>(copy.materials.size());
+      copy.materials.push_back(m);
+    }
+    prim.material = materialFor[key];
+  }
+  GltfWriteOptions wo;
+  wo.lightmapPages = pageUris;
+  GltfDocument doc = gltfFromScene(copy, wo);
+  // gltfFromScene encodes light-map textures linearly: put the sRGB-encoded PNGs and their marker in.
+  if (doc.root.contains("materials"))
+    for (size_t i = 0; i < copy.materials.size(); ++i) {
+      const Material& m = copy.materials[i];
+      if (m.lightmapTexture < 0) continue;
+      json& moz = doc.root["materials"][i]["extensions"]["MOZ_lightmap"];
+      const int tex = moz["index"].get<int>();
+      const int image = doc.root["textures"][tex]["source"].get<int>();
+      for (const auto& [page, t] : pageTexture)
+        if (t == m.lightmapTexture) {
+          const LightmapPng& png = pngs[pngOfPage.at(page)];
+          const int view = doc.addBufferView(png.png.data(), png.png.size());
+          doc.root["images"][image]["bufferView"] = view;
+          moz = mozLightmap(tex, png);
+        }
+    }
+  compactDocument(doc);
+  return doc;
+}
+
+bool isGlbPath(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb";
+}
+
 }  // namespace
+
+bool namesGltfFile(const std::filesystem::path& output) {
+  std::string ext = output.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".glb" || ext == ".gltf";
+}
+
+std::filesystem::path outputFolderOf(const std::filesystem::path& output) {
+  if (!namesGltfFile(output)) return output;
+  return output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
+}
 
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options) {
   const std::string file = options.output.string();
   if (options.output.empty()) throw Error(ErrorCode::Usage, "", "export needs an output path");
   checkMaps(maps, file);
-  std::map<int, size_t> mapOfPage;  // page → index in maps
-  for (size_t i = 0; i < maps.size(); ++i) mapOfPage[maps[i].page] = i;
-  std::vector<PngPage> pngs;
-  for (const auto& m : maps) pngs.push_back(pngPage(m));
+  std::vector<LightmapPng> pngs;
+  for (const auto& m : maps) pngs.push_back(encodeLightmapPng(m, options.png));
   std::vector<std::string> pageUris;
   if (options.writeExrPages)
     for (const auto& m : maps) pageUris.push_back(pageUri(options, m.page));
 
-  // (scene material, page) → material of the written document; page −1: no light map.
-  auto pageWithMap = [&](const Primitive& p) { return mapOfPage.count(p.lightmap.page) ? p.lightmap.page : -1; };
-
-  GltfDocument doc;
   const bool fromSource = !scene.sourcePath.empty() && std::filesystem::exists(scene.sourcePath);
-  if (fromSource) {
-    doc = documentFromSource(scene.sourcePath);
-    std::map<int, int> pageTexture;  // page → document texture
-    auto lightmapTexture = [&](int page) {
-      auto it = pageTexture.find(page);
-      if (it != pageTexture.end()) return it->second;
-      const PngPage& png = pngs[mapOfPage.at(page)];
-      int image = doc.addPngImage(encodePng(png.texture, false), png.texture.name);
-      int tex = doc.addTexture(image, doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
-      pageTexture[page] = tex;
-      return tex;
-    };
-    const json sourceMaterials = doc.root.value("materials", json::array());
-    std::map<std::pair<int, int>, int> materialFor;
-    std::set<int> bakedNodes;
-    json newRoots = json::array();
-    for (const auto& prim : scene.primitives) {
-      const Material& m = scene.materials.at(prim.material);
-      int page = pageWithMap(prim);
-      auto key = std::make_pair(prim.material, page);
-      if (!materialFor.count(key)) {
-        json mat = (m.gltfMaterial >= 0 && m.gltfMaterial < static_cast<int>(sourceMaterials.size())) ? sourceMaterials[m.gltfMaterial]
-                                                                                                      : json::object({{"name", m.name}});
-        if (page >= 0) {
-          mat["extensions"]["MOZ_lightmap"] = {{"index", lightmapTexture(page)}, {"texCoord", 1}, {"intensity", pngs[mapOfPage.at(page)].intensity}};
-          if (mat.contains("name")) mat["name"] = mat["name"].get<std::string>() + "_lightmap" + std::to_string(page);
-          doc.useExtension("MOZ_lightmap");
-        }
-        materialFor[key] = doc.append("materials", std::move(mat));
-      }
-      int mesh = addPrimitiveMesh(doc, prim, materialFor[key]);
-      newRoots.push_back(doc.append("nodes", {{"mesh", mesh}, {"name", prim.name}}));
-      if (prim.node >= 0) bakedNodes.insert(prim.node);
-    }
-    for (int n : bakedNodes)
-      if (doc.root.contains("nodes") && n < static_cast<int>(doc.root["nodes"].size())) doc.root["nodes"][n].erase("mesh");
-    if (!doc.root.contains("scenes") || doc.root["scenes"].empty()) {
-      doc.root["scenes"] = json::array({json::object({{"nodes", json::array()}})});
-      doc.root["scene"] = 0;
-    }
-    int sceneIndex = doc.root.value("scene", 0);
-    auto& rootNodes = doc.root["scenes"][sceneIndex]["nodes"];
-    if (!rootNodes.is_array()) rootNodes = json::array();
-    for (const auto& n : newRoots) rootNodes.push_back(n);
-    if (!pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
-    // The document changed under the generator's name.
-    doc.root["asset"]["generator"] = "irbake (from " + doc.root["asset"].value("generator", std::string("unknown")) + ")";
-  } else {
-    // Generated scene: materials duplicated per page with the page's PNG as MOZ_lightmap texture.
-    Scene copy = scene;
-    copy.materials.clear();
-    std::map<std::pair<int, int>, int> materialFor;
-    std::map<int, int> pageTexture;
-    for (auto& prim : copy.primitives) {
-      int page = pageWithMap(prim);
-      auto key = std::make_pair(prim.material, page);
-      if (!materialFor.count(key)) {
-        Material m = scene.materials.at(prim.material);
-        if (page >= 0) {
-          if (!pageTexture.count(page)) {
-            pageTexture[page] = static_cast<int>(copy.textures.size());
-            copy.textures.push_back(pngs[mapOfPage.at(page)].texture);
-          }
-          m.lightmapTexture = pageTexture[page];
-          m.lightmapIntensity = pngs[mapOfPage.at(page)].intensity;
-          m.name += "_lightmap" + std::to_string(page);
-        } else {
-          m.lightmapTexture = -1;
-        }
-        materialFor[key] = static_cast<int>(copy.materials.size());
-        copy.materials.push_back(m);
-      }
-      prim.material = materialFor[key];
-    }
-    GltfWriteOptions wo;
-    wo.lightmapPages = pageUris;
-    doc = gltfFromScene(copy, wo);
-  }
+  GltfDocument doc = fromSource ? SourceExport(scene, maps, pngs, file).run() : documentFromScene(scene, maps, pngs, pageUris);
+  if (fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
 
-  std::vector<PendingFile> files = doc.files(options.output);
+  std::vector<PendingFile> files;
+  const std::filesystem::path folder = options.output.parent_path();
+  if (!isGlbPath(options.output)) {
+    // A folder output: images as files beside the .gltf (a GLB keeps them embedded).
+    std::vector<std::string> taken = {options.output.filename().string(), options.output.stem().string() + ".bin"};
+    taken.insert(taken.end(), pageUris.begin(), pageUris.end());
+    auto images = externalizeImages(doc, taken);
+    compactDocument(doc);
+    for (auto& [name, bytes] : images) {
+      auto data = std::make_shared<std::vector<uint8_t>>(std::move(bytes));
+      const std::string finalName = (folder / name).string();
+      files.push_back({folder / name, [data, finalName](const std::filesystem::path& temp) {
+                         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+                         if (!out) throw Error(ErrorCode::Io, finalName, "cannot open for writing");
+                         out.write(reinterpret_cast<const char*>(data->data()), static_cast<std::streamsize>(data->size()));
+                         out.close();
+                         if (!out) throw Error(ErrorCode::Io, finalName, "write failed (disk full?)");
+                       }});
+    }
+  }
+  if (doc.root.contains("images"))
+    for (auto& image : doc.root["images"]) image.erase(kSourceUriKey);
+  std::vector<PendingFile> docFiles = doc.files(options.output);
+  files.insert(files.begin(), docFiles.begin(), docFiles.end());
   if (options.writeExrPages) {
-    const std::filesystem::path folder = options.output.parent_path();
     for (size_t i = 0; i < maps.size(); ++i) {
       const Lightmap* map = &maps[i];
       files.push_back({folder / pageUris[i], [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});

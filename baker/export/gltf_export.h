@@ -1,11 +1,13 @@
-// glTF/GLB export of a baked scene: the input glTF with TEXCOORD_1, extras.lightmap page records and
-// MOZ_lightmap materials (PNG × intensity inside the glTF, float EXR pages beside it).
+// glTF/GLB export of a baked scene: the input glTF kept as it was, with TEXCOORD_1, extras.lightmap page
+// records and MOZ_lightmap materials added (sRGB PNG × intensity, float EXR pages beside it); see
+// docs/export.md for the convention a client follows.
 #pragma once
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "backend/lightmap.h"
+#include "export/lightmap_png.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -14,7 +16,13 @@ struct ExportOptions {
   std::filesystem::path output;       // .gltf (JSON + .bin beside) or .glb (one file), chosen by extension
   bool writeExrPages = true;          // float EXR pages beside the glTF, listed in root extras
   std::string exrPrefix = "lightmap"; // EXR names: <prefix>_<page>.exr
+  LightmapPngOptions png;             // the 8-bit MOZ_lightmap PNG's encoding (sRGB, range at a percentile)
 };
+
+// True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.
+bool namesGltfFile(const std::filesystem::path& output);
+// The folder a command writes into: -o's parent when it names a glTF file ("." when it has none), else -o.
+std::filesystem::path outputFolderOf(const std::filesystem::path& output);
 
 // Writes `scene` (after the atlas: uv1 and primitive.lightmap set) with `maps` (one per page, may be
 // empty: then only TEXCOORD_1 and extras.lightmap are added, as `irbake unwrap` does). Every file is

@@ -1,7 +1,9 @@
 // Export with light maps: reload through our loader (TEXCOORD_1, extras.lightmap, MOZ_lightmap, PNG
 // values × intensity, EXR pages), the source-scene path (images, cameras, lights kept), the unwrap
 // case without maps, and atomicity when a write fails half way.
+#include <cstring>
 #include <fstream>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -10,6 +12,7 @@
 #include "export/gltf_export.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_loader.h"
+#include "scene/image_codec.h"
 #include "scene/test_gltf_builder.h"
 
 using namespace irbake;
@@ -80,9 +83,12 @@ TEST(GltfExport, GeneratedSceneReloadsWithTexcoord1MozLightmapAndPng) {
   ExportOptions o;
   o.output = dir / "baked.gltf";
   exportGltf(s, maps, o);
-  EXPECT_EQ(filesIn(dir), (std::vector<std::string>{"baked.bin", "baked.gltf", "lightmap_0.exr", "lightmap_1.exr"}));
+  // A folder output: the images are files beside the .gltf.
+  EXPECT_EQ(filesIn(dir), (std::vector<std::string>{"baked.bin", "baked.gltf", "lightmap_0.exr", "lightmap_0.png", "lightmap_1.exr",
+                                                    "lightmap_1.png"}));
   json j = readJson(o.output);
   EXPECT_NE(std::find(j["extensionsUsed"].begin(), j["extensionsUsed"].end(), "MOZ_lightmap"), j["extensionsUsed"].end());
+  EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["extras"]["colorSpace"], "srgb");
 
   Scene r = loadScene(o.output);
   ASSERT_EQ(r.primitives.size(), 2u);
@@ -103,11 +109,16 @@ TEST(GltfExport, GeneratedSceneReloadsWithTexcoord1MozLightmapAndPng) {
     const Texture& png = r.textures[m.lightmapTexture];
     ASSERT_EQ(png.width, 8);
     ASSERT_EQ(png.height, 4);
-    // PNG × intensity reproduces the map within half an 8-bit step of the intensity.
-    float step = m.lightmapIntensity / 255.0f;
+    // sRGB-decoded PNG × intensity reproduces the map within half an 8-bit step of the sRGB code,
+    // i.e. 0.5/255 × the decode's slope (largest over that half step) × intensity.
     for (size_t i = 0; i < 32; ++i)
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(png.texels[i][c] * m.lightmapIntensity, maps[page].texels[i][c], 0.5f * step + 1e-6f);
-    EXPECT_NEAR(png.texels[31].r, 1.0f, 1e-6f);  // the brightest texel uses the full range
+      for (int c = 0; c < 3; ++c) {
+        const float v = maps[page].texels[i][c];
+        const float s = std::min(1.0f, linearToSrgb(v / m.lightmapIntensity) + 0.5f / 255.0f);
+        const float slope = s <= 0.04045f ? 1.0f / 12.92f : 2.4f / 1.055f * std::pow((s + 0.055f) / 1.055f, 1.4f);
+        EXPECT_NEAR(png.texels[i][c] * m.lightmapIntensity, v, 0.5f / 255.0f * slope * m.lightmapIntensity + 1e-6f) << i << " " << c;
+      }
+    EXPECT_NEAR(png.texels[31].r, 1.0f, 1e-6f);  // 32 texels: the 99.9th percentile is the brightest
     Lightmap exr = readExr(r.lightmapExrPaths[page]);
     ASSERT_EQ(exr.texels.size(), 32u);
     for (size_t i = 0; i < 32; ++i) EXPECT_EQ(exr.texels[i], maps[page].texels[i]);
@@ -169,6 +180,22 @@ TEST(GltfExport, SourceSceneKeepsImagesCamerasLightsAndReplacesMeshes) {
   }
   ASSERT_EQ(r.lightmapExrPaths.size(), 2u);
   EXPECT_TRUE(std::filesystem::exists(r.lightmapExrPaths[1]));
+
+  // Baking the export again replaces its light maps: the old PNGs, their textures and samplers go.
+  Scene again = loadScene(o.output);
+  for (int i = 0; i < 2; ++i) {
+    again.primitives[i].uv1 = {{0.1f, 0.1f}, {0.9f, 0.1f}, {0.9f, 0.9f}, {0.1f, 0.9f}};
+    again.primitives[i].lightmap = {i, 8, 4};
+  }
+  ExportOptions o2;
+  o2.output = dir / "again" / "baked.gltf";
+  exportGltf(again, ramps(), o2);
+  const json j = readJson(o2.output);
+  EXPECT_EQ(j["images"].size(), 3u);    // albedo + two pages
+  EXPECT_EQ(j["textures"].size(), 3u);
+  EXPECT_EQ(j["materials"].size(), 2u);  // "grey" for page 0 in place, its page-1 copy
+  EXPECT_EQ(filesIn(dir / "again"), (std::vector<std::string>{"albedo.png", "baked.bin", "baked.gltf", "lightmap_0.exr", "lightmap_0.png",
+                                                              "lightmap_1.exr", "lightmap_1.png"}));
 }
 
 TEST(GltfExport, UnwrapExportWithoutMapsHasOnlyTexcoord1AndRecords) {
@@ -214,4 +241,252 @@ TEST(GltfExport, NanMapIsRefusedBeforeWritingAnything) {
     EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos);
   }
   EXPECT_TRUE(filesIn(dir).empty());
+}
+
+namespace {
+
+// A hand-made source document an asset pipeline might hand us: a node tree (root → body, root →
+// mirrored twin, both instancing mesh "box", a camera and a light under root), names, TRS and matrix
+// transforms, COLOR_0 as normalised unsigned bytes (3-byte elements: stride padding), TEXCOORD_0,
+// an unknown extension on a node, a material and the root, extras, and one mesh no node uses.
+GltfDocument instancedSource() {
+  GltfDocument doc;
+  // A unit square in z = 0 facing +Z, two triangles.
+  const std::vector<glm::vec3> pos = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::vector<glm::vec3> nrm(4, glm::vec3(0, 0, 1));
+  const std::vector<glm::vec2> uv0 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const uint8_t colour[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 0};
+  std::vector<uint8_t> padded;  // 3-byte elements on a 4-byte stride
+  for (int i = 0; i < 4; ++i) padded.insert(padded.end(), {colour[3 * i], colour[3 * i + 1], colour[3 * i + 2], 0});
+  const int colourView = doc.addBufferView(padded.data(), padded.size(), 34962);
+  doc.root["bufferViews"][colourView]["byteStride"] = 4;
+  const int colourAccessor =
+      doc.append("accessors", {{"bufferView", colourView}, {"componentType", 5121}, {"normalized", true}, {"count", 4}, {"type", "VEC3"}});
+  json attributes = {{"POSITION", doc.addPositions(pos)}, {"NORMAL", doc.addVec3(nrm)}, {"TEXCOORD_0", doc.addVec2(uv0)}, {"COLOR_0", colourAccessor}};
+  const int indices = doc.addIndices({0, 1, 2, 0, 2, 3});
+  doc.append("materials", {{"name", "paint"},
+                           {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}}}},
+                           {"extensions", {{"EXT_vendor_paint", {{"gloss", 0.25}}}}}});
+  doc.append("meshes", {{"name", "box"}, {"primitives", json::array({{{"attributes", attributes}, {"indices", indices}, {"material", 0}}})}});
+  const int unusedPositions = doc.addPositions(pos);
+  doc.append("meshes", {{"name", "orphan"}, {"primitives", json::array({{{"attributes", {{"POSITION", unusedPositions}}}}})}});
+  doc.append("cameras", {{"name", "eye"}, {"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.05}}}});
+  doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"name", "bulb"}, {"type", "point"}, {"intensity", 4.0}}});
+  doc.root["extensions"]["EXT_vendor_root"] = {{"answer", 42}};
+  doc.useExtension("KHR_lights_punctual");
+  doc.useExtension("EXT_vendor_paint");
+  doc.useExtension("EXT_vendor_root");
+  doc.append("nodes", {{"name", "root"}, {"translation", {1.0, 2.0, 3.0}}, {"children", {1, 2, 3, 4}}, {"extras", {{"tag", "keep me"}}}});
+  doc.append("nodes", {{"name", "body"}, {"mesh", 0}, {"rotation", {0.0, 0.70710678, 0.0, 0.70710678}},
+                       {"extensions", {{"EXT_vendor_node", {{"id", 7}}}}}});
+  doc.append("nodes", {{"name", "twin"}, {"mesh", 0}, {"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1}}});
+  doc.append("nodes", {{"name", "camera"}, {"camera", 0}, {"translation", {0.0, 0.5, 4.0}}});
+  doc.append("nodes", {{"name", "lamp"}, {"translation", {0.0, 3.0, 0.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  doc.useExtension("EXT_vendor_node");
+  doc.root["scenes"] = json::array({{{"name", "main"}, {"nodes", {0}}}});
+  doc.root["scene"] = 0;
+  return doc;
+}
+
+// Indices into root[key] that something references, found by walking every reference glTF defines.
+std::set<int> referencedAccessors(const json& j) {
+  std::set<int> used;
+  for (const auto& m : j["meshes"])
+    for (const auto& p : m["primitives"]) {
+      for (const auto& [k, a] : p["attributes"].items()) used.insert(a.get<int>());
+      if (p.contains("indices")) used.insert(p["indices"].get<int>());
+    }
+  return used;
+}
+
+// Bytes of one accessor element (tight) from a written .gltf + .bin.
+std::vector<uint8_t> element(const json& j, const std::vector<uint8_t>& bin, int accessor, size_t i, size_t size) {
+  const json& a = j["accessors"][accessor];
+  const json& v = j["bufferViews"][a["bufferView"].get<int>()];
+  const size_t stride = v.value("byteStride", size);
+  const size_t at = v.value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0)) + i * stride;
+  return std::vector<uint8_t>(bin.begin() + static_cast<long>(at), bin.begin() + static_cast<long>(at + size));
+}
+
+}  // namespace
+
+// Issue 13 item 1: the export is the source document with only the light-map data added, nothing
+// unused left behind, and one light-map region per instance of a shared mesh.
+TEST(GltfExport, KeepsTheSourceDocumentAndGivesEachInstanceItsOwnRegion) {
+  auto dir = irbake::testing::testFolder("export_keeps_source");
+  std::filesystem::create_directories(dir / "in");
+  irbake::testing::writeDocument(instancedSource(), dir / "in" / "source.gltf");
+  const json source = readJson(dir / "in" / "source.gltf");
+
+  // What the atlas hands over: every corner its own vertex (the vertex set grows from 4 to 6 per
+  // instance), instance k's TEXCOORD_1 inside its own half of page 0.
+  Scene loaded = loadScene(dir / "in" / "source.gltf");
+  ASSERT_EQ(loaded.primitives.size(), 2u);
+  for (size_t k = 0; k < loaded.primitives.size(); ++k) {
+    Primitive& p = loaded.primitives[k];
+    Primitive split = p;
+    split.positions.clear();
+    split.normals.clear();
+    split.uv0.clear();
+    split.indices.clear();
+    split.sourceVertex.clear();
+    for (size_t c = 0; c < p.indices.size(); ++c) {
+      const uint32_t v = p.indices[c];
+      split.positions.push_back(p.positions[v]);
+      split.normals.push_back(p.normals[v]);
+      split.uv0.push_back(p.uv0[v]);
+      split.sourceVertex.push_back(p.sourceVertex.empty() ? v : p.sourceVertex[v]);
+      split.uv1.push_back(glm::vec2(0.05f + 0.4f * p.uv0[v].x + 0.5f * float(k), 0.1f + 0.8f * p.uv0[v].y));
+      split.indices.push_back(static_cast<uint32_t>(c));
+    }
+    split.lightmap = {0, 8, 4};
+    p = split;
+  }
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  exportGltf(loaded, maps, o);
+  const json j = readJson(o.output);
+  std::ifstream binFile(dir / "out" / "baked.bin", std::ios::binary);
+  const std::vector<uint8_t> bin((std::istreambuf_iterator<char>(binFile)), std::istreambuf_iterator<char>());
+
+  // Same node tree, names, transforms, cameras, lights, scene, unknown extensions and extras.
+  ASSERT_EQ(j["nodes"].size(), source["nodes"].size());
+  for (size_t n = 0; n < source["nodes"].size(); ++n) {
+    json a = source["nodes"][n], b = j["nodes"][n];
+    a.erase("mesh");
+    b.erase("mesh");
+    EXPECT_EQ(a, b) << "node " << n;
+  }
+  EXPECT_EQ(j["cameras"], source["cameras"]);
+  EXPECT_EQ(j["scenes"], source["scenes"]);
+  EXPECT_EQ(j["extensions"], source["extensions"]);
+  for (const auto& e : source["extensionsUsed"])
+    EXPECT_NE(std::find(j["extensionsUsed"].begin(), j["extensionsUsed"].end(), e), j["extensionsUsed"].end()) << e;
+  // The material keeps its name, factor and unknown extension, and gains MOZ_lightmap.
+  ASSERT_EQ(j["materials"].size(), 1u);
+  EXPECT_EQ(j["materials"][0]["name"], "paint");
+  EXPECT_EQ(j["materials"][0]["extensions"]["EXT_vendor_paint"], source["materials"][0]["extensions"]["EXT_vendor_paint"]);
+  EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["texCoord"], 1);
+  EXPECT_NEAR(j["materials"][0]["extensions"]["MOZ_lightmap"]["intensity"].get<double>(), 2.5, 1e-6);
+
+  // Instancing: body keeps mesh 0, twin gets a copy with the same name; nothing else is left.
+  ASSERT_EQ(j["meshes"].size(), 2u);  // "orphan" (unused in the source) is gone
+  const int bodyMesh = j["nodes"][1]["mesh"].get<int>(), twinMesh = j["nodes"][2]["mesh"].get<int>();
+  EXPECT_EQ(bodyMesh, 0);
+  EXPECT_NE(twinMesh, bodyMesh);
+  EXPECT_EQ(j["meshes"][twinMesh]["name"], "box");
+  // Nothing unused: every accessor, buffer view and image is referenced, the buffer holds only them.
+  const std::set<int> accessors = referencedAccessors(j);
+  EXPECT_EQ(accessors.size(), j["accessors"].size());
+  std::set<int> views;
+  for (const auto& a : j["accessors"]) views.insert(a["bufferView"].get<int>());
+  EXPECT_EQ(views.size(), j["bufferViews"].size());
+  size_t viewBytes = 0;
+  for (const auto& v : j["bufferViews"]) viewBytes += v["byteLength"].get<size_t>();
+  EXPECT_LE(bin.size(), viewBytes + 4 * j["bufferViews"].size());
+  EXPECT_EQ(j["buffers"][0]["byteLength"].get<size_t>(), bin.size());
+  ASSERT_EQ(j["images"].size(), 1u);  // the light map, as a file beside the glTF
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / j["images"][0]["uri"].get<std::string>()));
+
+  // Each instance: 6 vertices in local space (the source square), every attribute carried over
+  // through the split (COLOR_0 bytes included), winding as in the source (the twin's mirror is undone),
+  // and its own TEXCOORD_1 region: the two regions do not overlap.
+  const std::vector<uint32_t> sourceCorners = {0, 1, 2, 0, 2, 3};
+  const uint8_t colour[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+  const glm::vec3 square[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  float uMax[2] = {-1, -1}, uMin[2] = {2, 2};
+  for (int k = 0; k < 2; ++k) {
+    const json& prim = j["meshes"][k == 0 ? bodyMesh : twinMesh]["primitives"][0];
+    EXPECT_EQ(prim["material"], 0);
+    EXPECT_EQ(prim["extras"]["lightmap"]["page"], 0);
+    const json& at = prim["attributes"];
+    for (const char* name : {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0", "TEXCOORD_1"}) ASSERT_TRUE(at.contains(name)) << name;
+    EXPECT_EQ(j["accessors"][at["POSITION"].get<int>()]["count"], 6);
+    EXPECT_EQ(j["accessors"][at["COLOR_0"].get<int>()]["componentType"], 5121);
+    EXPECT_EQ(j["accessors"][at["COLOR_0"].get<int>()]["normalized"], true);
+    const int idx = prim["indices"].get<int>();
+    ASSERT_EQ(j["accessors"][idx]["count"], 6);
+    for (size_t c = 0; c < 6; ++c) {
+      uint32_t v;
+      std::memcpy(&v, element(j, bin, idx, c, 4).data(), 4);
+      ASSERT_LT(v, 6u);
+      glm::vec3 p;
+      std::memcpy(&p, element(j, bin, at["POSITION"].get<int>(), v, 12).data(), 12);
+      EXPECT_EQ(p, square[sourceCorners[c]]) << "instance " << k << " corner " << c;
+      const std::vector<uint8_t> rgb = element(j, bin, at["COLOR_0"].get<int>(), v, 3);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(rgb[ch], colour[sourceCorners[c]][ch]);
+      glm::vec2 uv1;
+      std::memcpy(&uv1, element(j, bin, at["TEXCOORD_1"].get<int>(), v, 8).data(), 8);
+      uMin[k] = std::min(uMin[k], uv1.x);
+      uMax[k] = std::max(uMax[k], uv1.x);
+    }
+  }
+  EXPECT_LT(uMax[0], uMin[1]);
+
+  // Reloaded, the world-space geometry is the input's (transforms and local positions agree).
+  Scene r = loadScene(o.output);
+  ASSERT_EQ(r.primitives.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_EQ(r.primitives[k].positions.size(), 6u);
+    for (size_t v = 0; v < 6; ++v) EXPECT_LT(glm::length(r.primitives[k].positions[v] - loaded.primitives[k].positions[v]), 1e-5f);
+    EXPECT_EQ(r.primitives[k].indices, loaded.primitives[k].indices);  // same world winding
+  }
+  ASSERT_EQ(r.cameras.size(), 1u);
+  ASSERT_EQ(r.lights.size(), 1u);
+  EXPECT_NEAR(r.lights[0].position.y, 5.0f, 1e-6f);
+}
+
+// A .glb embeds every image: one file beside the EXR pages, the images in buffer views.
+TEST(GltfExport, GlbEmbedsImages) {
+  auto dir = irbake::testing::testFolder("export_glb");
+  std::filesystem::create_directories(dir / "in");
+  irbake::testing::writeDocument(instancedSource(), dir / "in" / "source.gltf");
+  Scene loaded = loadScene(dir / "in" / "source.gltf");
+  for (auto& p : loaded.primitives) {
+    p.uv1 = p.uv0;
+    p.lightmap = {0, 8, 4};
+  }
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  ExportOptions o;
+  o.output = dir / "baked.glb";
+  o.writeExrPages = false;
+  exportGltf(loaded, maps, o);
+  EXPECT_EQ(filesIn(dir), (std::vector<std::string>{"baked.glb", "source.bin", "source.gltf"}));
+  Scene r = loadScene(o.output);
+  ASSERT_EQ(r.primitives.size(), 2u);
+  const Material& m = r.materials[r.primitives[0].material];
+  ASSERT_GE(m.lightmapTexture, 0);
+  EXPECT_EQ(r.textures[m.lightmapTexture].width, 8);
+}
+
+// glTF numbers TEXCOORD sets from 0 without gaps: a source primitive without TEXCOORD_0 shares the
+// light-map UVs as set 0 (the validator's MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY error otherwise);
+// an emissiveFactor above 1 (invalid glTF the loader accepts) moves into KHR_materials_emissive_strength.
+TEST(GltfExport, PrimitiveWithoutTexcoord0AndEmissiveAboveOneStayValid) {
+  auto dir = irbake::testing::testFolder("export_texcoord_continuity");
+  GltfDocument src = irbake::testing::meshDocument({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
+  src.append("materials", {{"name", "lamp"}, {"emissiveFactor", {8.0, 4.0, 2.0}}});
+  src.root["meshes"][0]["primitives"][0]["material"] = 0;
+  irbake::testing::writeDocument(src, dir / "in.gltf");
+  Scene loaded = loadScene(dir / "in.gltf");
+  ASSERT_EQ(loaded.primitives.size(), 1u);
+  loaded.primitives[0].uv1.assign(loaded.primitives[0].positions.size(), glm::vec2(0.5f));
+  loaded.primitives[0].lightmap = {0, 8, 4};
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  exportGltf(loaded, maps, o);
+  const json j = readJson(o.output);
+  const json& at = j["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(at.contains("TEXCOORD_1"));
+  EXPECT_EQ(at["TEXCOORD_0"], at["TEXCOORD_1"]);
+  const json& m = j["materials"][0];
+  EXPECT_EQ(m["emissiveFactor"], json::array({1.0, 0.5, 0.25}));
+  EXPECT_DOUBLE_EQ(m["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 8.0);
+  Scene r = loadScene(o.output);
+  EXPECT_EQ(r.materials[r.primitives[0].material].emission(), glm::vec3(8.0f, 4.0f, 2.0f));
 }

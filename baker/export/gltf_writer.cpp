@@ -253,7 +253,11 @@ int addPrimitiveMesh(GltfDocument& doc, const Primitive& prim, int material) {
   json attributes = {{"POSITION", doc.addPositions(prim.positions)}};
   if (prim.normals.size() == prim.positions.size()) attributes["NORMAL"] = doc.addVec3(prim.normals);
   if (prim.uv0.size() == prim.positions.size()) attributes["TEXCOORD_0"] = doc.addVec2(prim.uv0);
-  if (prim.uv1.size() == prim.positions.size()) attributes["TEXCOORD_1"] = doc.addVec2(prim.uv1);
+  if (prim.uv1.size() == prim.positions.size()) {
+    attributes["TEXCOORD_1"] = doc.addVec2(prim.uv1);
+    // TEXCOORD sets are numbered from 0 without gaps: without its own set 0 it shares the light-map UVs.
+    if (!attributes.contains("TEXCOORD_0")) attributes["TEXCOORD_0"] = attributes["TEXCOORD_1"];
+  }
   json p = {{"attributes", attributes}, {"indices", doc.addIndices(prim.indices)}, {"mode", 4}};
   if (material >= 0) p["material"] = material;
   if (prim.lightmap.page >= 0)

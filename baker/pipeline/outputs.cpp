@@ -14,18 +14,21 @@ namespace irbake {
 
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
   namespace fs = std::filesystem;
+  // -o OUT.glb / OUT.gltf names the glTF itself (a GLB embeds its images); its folder takes the rest.
+  const fs::path outDir = outputFolderOf(options.outDir);
+  const fs::path gltfPath = namesGltfFile(options.outDir) ? options.outDir : outDir / "scene.gltf";
   std::error_code ec;
-  fs::create_directories(options.outDir, ec);
-  if (!fs::is_directory(options.outDir))
-    throw Error(ErrorCode::Io, options.outDir.string(), "cannot create the output folder");
+  fs::create_directories(outDir, ec);
+  if (!fs::is_directory(outDir))
+    throw Error(ErrorCode::Io, outDir.string(), "cannot create the output folder");
   std::vector<fs::path> written;
   std::vector<fs::path> exrs;
-  for (const Lightmap& m : result.maps) exrs.push_back(options.outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
+  for (const Lightmap& m : result.maps) exrs.push_back(outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
 
   if (options.writeGltf) {
     // The export writes the glTF, its PNG maps and the EXR pages as one atomic set.
     ExportOptions ex;
-    ex.output = options.outDir / "scene.gltf";
+    ex.output = gltfPath;
     ex.writeExrPages = true;
     ex.exrPrefix = "lightmap";
     exportGltf(result.scene, result.maps, ex);
@@ -39,13 +42,13 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   // Pages of an earlier bake into the same folder that this bake does not have would be read as
   // part of it (irbake diff, the viewer): remove them.
   for (size_t page = result.maps.size();; ++page) {
-    fs::path stale = options.outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
     if (!fs::exists(stale)) break;
     fs::remove(stale, ec);
     log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
   }
 
-  fs::path reportPath = options.reportPath.empty() ? options.outDir / "report.json" : options.reportPath;
+  fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   nlohmann::json report = result.report;
   report["reportSchema"] = 1;  // bumped when a field changes meaning or goes away
   report["irbakeVersion"] = versionLine("irbake");

@@ -760,7 +760,10 @@ class Loader {
           std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
       if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) {
         const json* ti = child(*moz, "index");
-        if (ti && ti->is_number_integer()) m.lightmapTexture = textureIndex(ti->get<int>(), false, m.name);
+        // irbake's PNG is sRGB-encoded and says so in MOZ_lightmap.extras.colorSpace (docs/export.md).
+        const json* cs = path(*moz, {"extras", "colorSpace"});
+        const bool srgb = cs && cs->is_string() && cs->get<std::string>() == "srgb";
+        if (ti && ti->is_number_integer()) m.lightmapTexture = textureIndex(ti->get<int>(), srgb, m.name);
         m.lightmapIntensity = static_cast<float>(numberOr(child(*moz, "intensity"), 1.0));
       }
     }

@@ -1,0 +1,89 @@
+// Renders a baked glTF in headless Chromium (three.js, the MOZ_lightmap plugin) from one of its
+// cameras and compares it with a reference PNG (irview --camera N --screenshot): prints the mean
+// absolute difference over RGB in 8-bit units and exits 1 when it exceeds --max-mean-abs.
+// Usage: node render_compare.mjs --modules DIR --scene FILE.gltf --camera N --width W --height H
+//          --reference REF.png --out WEB.png [--max-mean-abs 2] [--chromium /usr/bin/chromium]
+import fs from 'node:fs';
+import path from 'node:path';
+import { createRequire } from 'node:module';
+import { fileURLToPath } from 'node:url';
+import { serve } from './serve.mjs';
+
+const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
+const fail = msg => { console.error(`render_compare: ${msg}`); process.exit(2); };
+for (const k of ['modules', 'scene', 'reference', 'out']) if (!args[k]) fail(`--${k} is required`);
+const width = Number(args.width ?? 256), height = Number(args.height ?? 256), camera = Number(args.camera ?? 0);
+const maxMeanAbs = Number(args['max-mean-abs'] ?? 2);
+if (!fs.existsSync(args.scene)) fail(`${args.scene}: no such file`);
+if (!fs.existsSync(args.reference)) fail(`${args.reference}: no such file`);
+
+const require = createRequire(path.join(path.resolve(args.modules), 'package.json'));
+const puppeteer = require('puppeteer-core');
+const here = path.dirname(fileURLToPath(import.meta.url));
+const server = await serve({
+  web: here,
+  three: path.join(path.resolve(args.modules), 'node_modules', 'three'),
+  scene: path.dirname(path.resolve(args.scene)),
+  ref: path.dirname(path.resolve(args.reference)),
+});
+const port = server.address().port;
+const browser = await puppeteer.launch({
+  executablePath: args.chromium ?? '/usr/bin/chromium',
+  headless: true,
+  // WebGL without a GPU: ANGLE on SwiftShader (software Vulkan/GL inside Chromium).
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist',
+         '--force-color-profile=srgb', `--window-size=${width},${height}`],
+});
+let code = 0;
+try {
+  const page = await browser.newPage();
+  const log = [];
+  page.on('console', m => log.push(`${m.type()}: ${m.text()}`));
+  page.on('pageerror', e => log.push(`pageerror: ${e.message}`));
+  await page.setViewport({ width, height, deviceScaleFactor: 1 });
+  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height });
+  await page.goto(`http://127.0.0.1:${port}/web/index.html?${q}`);
+  await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
+  const error = await page.evaluate('window.viewerError');
+  if (error) throw new Error(`viewer: ${error}\n${log.join('\n')}`);
+  const result = await page.evaluate(async (refUrl) => {
+    const { canvasPixels } = await import('/web/viewer.js');
+    const web = canvasPixels();
+    const blob = await (await fetch(refUrl)).blob();
+    const bitmap = await createImageBitmap(blob, { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+    const c = new OffscreenCanvas(bitmap.width, bitmap.height);
+    const ctx = c.getContext('2d');
+    ctx.drawImage(bitmap, 0, 0);
+    const ref = ctx.getImageData(0, 0, bitmap.width, bitmap.height).data;
+    const w = document.querySelector('canvas').width, h = document.querySelector('canvas').height;
+    if (bitmap.width !== w || bitmap.height !== h) return { error: `reference is ${bitmap.width}×${bitmap.height}, render ${w}×${h}` };
+    let sum = 0, worst = 0, over8 = 0, webSum = 0, refSum = 0;
+    for (let i = 0; i < w * h; ++i)
+      for (let ch = 0; ch < 3; ++ch) {
+        const d = Math.abs(web[4 * i + ch] - ref[4 * i + ch]);
+        sum += d;
+        worst = Math.max(worst, d);
+        if (d > 8) ++over8;
+        webSum += web[4 * i + ch];
+        refSum += ref[4 * i + ch];
+      }
+    const n = w * h * 3;
+    return { meanAbs: sum / n, max: worst, fractionOver8: over8 / n, webMean: webSum / n, refMean: refSum / n,
+             png: document.querySelector('canvas').toDataURL('image/png') };
+  }, `/ref/${encodeURIComponent(path.basename(args.reference))}`);
+  if (result.error) throw new Error(result.error);
+  fs.writeFileSync(args.out, Buffer.from(result.png.split(',')[1], 'base64'));
+  delete result.png;
+  console.log(JSON.stringify(result));
+  if (!(result.meanAbs <= maxMeanAbs)) {
+    console.error(`render_compare: mean absolute difference ${result.meanAbs.toFixed(3)} > ${maxMeanAbs} (web ${args.out}, irview ${args.reference})`);
+    code = 1;
+  }
+} catch (e) {
+  console.error(`render_compare: ${e.stack ?? e}`);
+  code = 2;
+} finally {
+  await browser.close();
+  server.close();
+}
+process.exit(code);

@@ -1,0 +1,52 @@
+// Runs the Khronos glTF-Validator (npm gltf-validator, validateBytes) on an export and, when given,
+// on its input. Passes (exit 0) when the export has 0 errors, no warning the input did not already
+// have (compared by code and count), and no UNUSED_OBJECT for a mesh or an accessor. Prints the counts.
+// Usage: node validate.mjs --modules DIR --output OUT.gltf|.glb [--input IN.gltf|.glb]
+import fs from 'node:fs';
+import path from 'node:path';
+import { createRequire } from 'node:module';
+
+const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
+const fail = msg => { console.error(`validate: ${msg}`); process.exit(2); };
+if (!args.modules || !args.output) fail('--modules and --output are required');
+const require = createRequire(path.join(path.resolve(args.modules), 'package.json'));
+const validator = require('gltf-validator');
+
+async function validate(file) {
+  if (!fs.existsSync(file)) fail(`${file}: no such file`);
+  const folder = path.dirname(file);
+  const report = await validator.validateBytes(new Uint8Array(fs.readFileSync(file)), {
+    uri: path.basename(file),
+    maxIssues: 0,
+    externalResourceFunction: uri => new Promise((resolve, reject) => {
+      try { resolve(new Uint8Array(fs.readFileSync(path.join(folder, decodeURIComponent(uri))))); } catch (e) { reject(String(e)); }
+    }),
+  });
+  const byCode = severity => {
+    const counts = {};
+    for (const m of report.issues.messages) if (m.severity === severity) counts[m.code] = (counts[m.code] ?? 0) + 1;
+    return counts;
+  };
+  return { report, errors: report.issues.numErrors, warnings: report.issues.numWarnings, infos: report.issues.numInfos,
+           warningCodes: byCode(1), infoCodes: byCode(2) };
+}
+
+const out = await validate(args.output);
+const input = args.input ? await validate(args.input) : null;
+const problems = [];
+if (out.errors > 0)
+  for (const m of out.report.issues.messages.filter(m => m.severity === 0)) problems.push(`error ${m.code} at ${m.pointer}: ${m.message}`);
+for (const [code, n] of Object.entries(out.warningCodes)) {
+  const before = input ? (input.warningCodes[code] ?? 0) : 0;
+  if (n > before) problems.push(`warning ${code}: ${n} (input: ${before})`);
+}
+for (const m of out.report.issues.messages)
+  if (m.code === 'UNUSED_OBJECT' && /^\/(meshes|accessors)\/\d+$/.test(m.pointer ?? '')) problems.push(`unused ${m.pointer}`);
+const summary = { file: args.output, errors: out.errors, warnings: out.warnings, infos: out.infos, warningCodes: out.warningCodes,
+                  infoCodes: out.infoCodes };
+if (input) summary.input = { errors: input.errors, warnings: input.warnings, infos: input.infos, warningCodes: input.warningCodes };
+console.log(JSON.stringify(summary));
+if (problems.length) {
+  console.error(`validate: ${args.output}:\n  ${problems.join('\n  ')}`);
+  process.exit(1);
+}

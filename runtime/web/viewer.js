@@ -1,0 +1,42 @@
+// Loads a baked glTF and renders it once from one of its cameras, the way irview does.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { MozLightmapExtension } from './moz_lightmap.js';
+
+export async function showBakedScene({ scene, camera = 0, width, height }) {
+  const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(1);
+  renderer.setSize(width, height);
+  renderer.outputColorSpace = THREE.SRGBColorSpace;  // irview: exact sRGB encode, clamp, exposure 0
+  renderer.toneMapping = THREE.NoToneMapping;
+  document.body.appendChild(renderer.domElement);
+
+  const loader = new GLTFLoader();
+  loader.register(parser => new MozLightmapExtension(parser));
+  const gltf = await loader.loadAsync(scene);
+  // The light maps hold the punctual lights' light already: drop the lights GLTFLoader made.
+  const lights = [];
+  gltf.scene.traverse(o => { if (o.isLight) lights.push(o); });
+  for (const l of lights) l.parent.remove(l);
+  gltf.scene.updateMatrixWorld(true);
+
+  const cam = gltf.cameras[camera];
+  if (!cam) throw new Error(`${scene}: no camera ${camera}`);
+  cam.aspect = width / height;  // irview uses the viewport's aspect
+  cam.updateProjectionMatrix();
+  renderer.setClearColor(0x000000, 1);
+  renderer.render(gltf.scene, cam);
+  return { width, height, lights: lights.length };
+}
+
+// RGBA bytes of the canvas, top row first (as a PNG), for comparisons.
+export function canvasPixels() {
+  const canvas = document.querySelector('canvas');
+  const gl = canvas.getContext('webgl2');
+  const w = canvas.width, h = canvas.height;
+  const px = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  const flipped = new Uint8Array(px.length);
+  for (let y = 0; y < h; ++y) flipped.set(px.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+  return flipped;
+}

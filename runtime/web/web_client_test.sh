@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Real-client test (issue 13): bake the Cornell box, render it from its glTF camera with irview and
+# with three.js in headless Chromium (runtime/web), and require a mean absolute difference ≤ 2 (8-bit).
+# Usage (from ctest): web_client_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
+set -euo pipefail
+irbake="$1" irview="$2" modules="$3" work="$4"
+here="$(cd "$(dirname "$0")" && pwd)"
+source "$here/web_tests_common.sh"
+need_node_modules "$modules" three puppeteer-core
+[[ -x /usr/bin/chromium ]] || skip "/usr/bin/chromium not found (scripts/install-deps.sh installs Debian chromium)"
+rm -rf "$work" && mkdir -p "$work"
+"$irbake" samples "$work/samples" > "$work/samples.log"
+"$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 512 --texels-per-unit 120 --quiet > "$work/bake.log" 2>&1
+w=320 h=320
+"$irview" "$work/bake/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/irview.png" > "$work/irview.log" 2>&1
+node "$here/render_compare.mjs" --modules "$modules" --scene "$work/bake/scene.gltf" --camera 0 --width $w --height $h \
+  --reference "$work/irview.png" --out "$work/web.png" --max-mean-abs 2

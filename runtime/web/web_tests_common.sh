@@ -1,0 +1,10 @@
+# Shared by the web tests (sourced): checks for node, Chromium and the node modules, and skips (exit 77,
+# ctest's SKIP_RETURN_CODE) with a message naming what is missing and how to get it.
+skip() { echo "SKIPPED: $*"; exit 77; }
+need_node_modules() {
+  local modules="$1"; shift
+  command -v node >/dev/null 2>&1 || skip "node not found (scripts/install-deps.sh installs Debian nodejs and npm)"
+  for m in "$@"; do
+    [[ -d "$modules/node_modules/$m" ]] || skip "$modules/node_modules/$m missing (run scripts/install-web-deps.sh BUILD_DIR)"
+  done
+}
