@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
 #include "vpl/sampling.h"
@@ -276,7 +277,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   double mapTotal = 0.0;
   for (size_t p = 0; p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t)
-      if (maps[p].valid[t]) mapTotal += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
+      if (maps[p].valid[t]) mapTotal += channelMean(base[p][t]);
   double lastAdded = 0.0;
   int sweepsDone = 0;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
@@ -308,7 +309,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
         if (m.valid[t]) {
           next[p][t] += residual[t];
-          added += (residual[t].x + residual[t].y + residual[t].z) / 3.0;
+          added += channelMean(residual[t]);
         }
     }
     current.swap(next);
@@ -326,8 +327,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       if (!maps[p].valid[t]) continue;
       glm::vec3 c = current[p][t];
       if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;  // post's finite check reports
-      before += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
-      added += ((c - base[p][t]).x + (c - base[p][t]).y + (c - base[p][t]).z) / 3.0;
+      before += channelMean(base[p][t]);
+      added += channelMean(c - base[p][t]);
       maps[p].texels[t] = c;
     }
   }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "backend/embree/geometry_term.h"
+#include "common/maths.h"
 #include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
 #include "vpl/light_sources.h"
@@ -16,7 +17,6 @@ using namespace irbake;
 using namespace irbake::testing;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 struct Baked {
   std::vector<Lightmap> maps;

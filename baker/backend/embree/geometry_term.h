@@ -19,13 +19,11 @@
 
 #include <glm/glm.hpp>
 
+#include "common/maths.h"
 #include "scene/scene.h"
 #include "vpl/vpl.h"
 
 namespace irbake {
-
-constexpr float kPiF = 3.14159265358979323846f;
-constexpr float kInvPi2F = 1.0f / (kPiF * kPiF);
 
 // Unclamped geometry term G between a receiver (x, nx) and a VPL (y, ny); 0 when either faces away.
 inline float vplGeometryTerm(const glm::vec3& x, const glm::vec3& nx, const glm::vec3& y, const glm::vec3& ny) {

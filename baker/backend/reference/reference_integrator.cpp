@@ -13,11 +13,11 @@
 
 #include "backend/embree/geometry_term.h"
 #include "common/error.h"
+#include "common/maths.h"
 
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 glm::vec3 punctualAt(const Scene& scene, const RayTracer& rt, const glm::vec3& origin, const glm::vec3& x,
                      const glm::vec3& n) {

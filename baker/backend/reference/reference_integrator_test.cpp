@@ -7,13 +7,13 @@
 
 #include "backend/embree/embree_backend.h"
 #include "backend/embree/geometry_term.h"
+#include "common/maths.h"
 #include "raytrace/test_scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 struct RefResult {
   std::vector<Lightmap> maps, err;
