@@ -11,7 +11,7 @@
 
 #include "atlas/atlas.h"
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "backend/gl/gl_backend.h"
 #include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"

@@ -7,7 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "common/error.h"
 
 namespace irbake {

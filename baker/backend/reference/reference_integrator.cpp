@@ -11,7 +11,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "common/error.h"
 #include "common/maths.h"
 

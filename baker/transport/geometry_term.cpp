@@ -1,4 +1,4 @@
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 
 #include <cmath>
 #include <limits>
