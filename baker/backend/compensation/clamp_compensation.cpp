@@ -12,6 +12,7 @@
 #include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
+#include "transport/geometry_term.h"
 #include "vpl/sampling.h"
 
 namespace irbake {
@@ -174,11 +175,8 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
     glm::vec3 dir = cosineHemisphere(n, u, v);
     RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
     if (!hit.hit || hit.backFace) continue;
-    float cosX = glm::dot(n, dir), cosY = -glm::dot(hit.geometricNormal, dir);
-    glm::vec3 d = hit.position - x;
-    float r2 = glm::dot(d, d);
-    if (!(r2 > 0.0f) || cosX <= 0.0f || cosY <= 0.0f) continue;
-    float g = cosX * cosY / r2;
+    // The same G as the clamp the VPL sum applied (0 when either surface faces away, so never kept).
+    const float g = vplGeometryTerm(x, n, hit.position, hit.geometricNormal);
     if (g <= bound) continue;
     KeptHit kept;
     kept.slot = static_cast<uint32_t>(s);
