@@ -140,6 +140,185 @@ void checkTexelBudget(const Scene& scene, const AtlasOptions& options, const std
   overBudget(scene, options, density, double(texels), fits / 0.97, "needs");
 }
 
+// Parameterises every chart of `work`; a chart that fails a check is bisected and both halves redone.
+// Bounded: a chart bisected maxSplitDepth times and still failing falls back to one planar chart per face
+// (a single triangle always projects validly). Appends to charts; returns the faces that fell back.
+size_t parameterizeWithBisection(const AtlasMesh& mesh, std::vector<atlas::ChartFaces> work, const AtlasOptions& options,
+                                 AtlasStats& stats, std::vector<ChartUv>& charts) {
+  const atlas::ParamOptions paramOptions;
+  std::vector<int> depth(work.size(), 0);
+  size_t fallbackFaces = 0;
+  while (!work.empty()) {
+    std::vector<ChartUv> done(work.size());
+    std::vector<atlas::ChartCheck> checks(work.size());
+    tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
+      if (work[i].faces.size() > 1 && !work[i].planarRegion &&
+          atlas::absoluteCurvature(mesh, work[i].faces) > paramOptions.maxAbsCurvature) {
+        checks[i] = atlas::ChartCheck::Stretched;  // hopeless: split without solving
+        return;
+      }
+      checks[i] = atlas::parameterizeChart(mesh, work[i].faces, paramOptions, done[i]);
+    });
+    std::vector<atlas::ChartFaces> again;
+    std::vector<int> againDepth;
+    for (size_t i = 0; i < work.size(); ++i) {
+      if (checks[i] == atlas::ChartCheck::Valid) {
+        charts.push_back(std::move(done[i]));
+        continue;
+      }
+      if (work[i].faces.size() > 1 && depth[i] >= std::max(0, options.maxSplitDepth)) {
+        // Safe fallback: every face its own planar chart, solved right here (no further rounds).
+        for (uint32_t f : work[i].faces) {
+          ChartUv single;
+          atlas::parameterizeChart(mesh, {f}, paramOptions, single);
+          charts.push_back(std::move(single));
+        }
+        fallbackFaces += work[i].faces.size();
+        continue;
+      }
+      auto halves = atlas::bisectChart(mesh, work[i]);
+      if (halves.size() < 2) {  // a single face always projects validly; keep it whatever the check said
+        charts.push_back(std::move(done[i]));
+        continue;
+      }
+      ++stats.chartsSplit;
+      for (auto& h : halves) {
+        again.push_back(std::move(h));
+        againDepth.push_back(depth[i] + 1);
+      }
+    }
+    work = std::move(again);
+    depth = std::move(againDepth);
+  }
+  return fallbackFaces;
+}
+
+// The charts of one primitive, appended to charts: its TEXCOORD_1 islands (keepUv1) or segmented and
+// parameterised here.
+void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOptions& options, AtlasStats& stats,
+                    std::vector<ChartUv>& charts) {
+  Stopwatch clock;
+  if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
+    for (ChartUv& c : chartsFromUv1(prim, mesh)) charts.push_back(std::move(c));
+    stats.secondsParam += clock.seconds();
+    return;
+  }
+  std::vector<atlas::ChartFaces> work = atlas::segmentCharts(mesh);
+  stats.secondsCharts += clock.seconds();
+  clock.reset();
+  const size_t fallbackFaces = parameterizeWithBisection(mesh, std::move(work), options, stats, charts);
+  stats.secondsParam += clock.seconds();
+  if (fallbackFaces) {
+    const std::string w = std::to_string(fallbackFaces) + " faces of \"" + prim.name + "\" still failed the chart checks after " +
+                          std::to_string(options.maxSplitDepth) + " bisections: mapped as one planar chart per face";
+    log::warn("atlas: " + w);
+    stats.warnings.push_back(w);
+  }
+}
+
+// Texels per unit length: given, or chosen so the charts' area fills about 60% of one target page.
+double chooseDensity(const std::vector<ChartUv>& charts, const AtlasOptions& options, const Scene& scene) {
+  double totalArea = 0.0;
+  for (const ChartUv& c : charts) totalArea += c.area3d;
+  double density = options.texelsPerUnit;
+  if (!(density > 0.0)) density = totalArea > 0.0 ? std::sqrt(0.6 * double(options.targetPageSize) * options.targetPageSize / totalArea) : 1.0;
+  if (!std::isfinite(density) || density <= 0.0) throw Error(ErrorCode::InvalidData, scene.sourcePath, "atlas: no surface area to unwrap");
+  return density;
+}
+
+// Which chart holds each face of a primitive, and where faces no chart holds (degenerate ones) sit.
+struct FaceCharts {
+  std::vector<uint32_t> chartOfFace, localFace;  // kNone where no chart holds the face
+  // A degenerate face sits on a point of a chart that holds one of its corners (zero UV area): (chart, local vertex).
+  std::vector<std::pair<uint32_t, uint32_t>> degenerateAnchor;
+  uint32_t chartOf(uint32_t t) const { return chartOfFace[t] != kNone ? chartOfFace[t] : degenerateAnchor[t].first; }
+};
+
+FaceCharts faceChartsOf(const Primitive& src, const PrimitiveCharts& range, const std::vector<ChartUv>& charts) {
+  const AtlasMesh& mesh = range.mesh;
+  const size_t first = range.firstChart, count = range.chartCount;
+  FaceCharts fc;
+  fc.chartOfFace.assign(src.triangleCount(), kNone);
+  fc.localFace.assign(src.triangleCount(), kNone);
+  std::unordered_map<uint32_t, std::pair<uint32_t, uint32_t>> anchorOfVertex;  // welded vertex -> (chart, local)
+  for (size_t c = first; c < first + count; ++c)
+    for (size_t i = 0; i < charts[c].faces.size(); ++i) {
+      fc.chartOfFace[charts[c].faces[i]] = uint32_t(c);
+      fc.localFace[charts[c].faces[i]] = uint32_t(i);
+      for (int k = 0; k < 3; ++k) anchorOfVertex.try_emplace(mesh.faceVertex[charts[c].faces[i]][k], uint32_t(c), charts[c].corner[i][k]);
+    }
+  fc.degenerateAnchor.assign(src.triangleCount(), {kNone, kNone});
+  for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+    if (fc.chartOfFace[t] != kNone) continue;
+    for (int k = 0; k < 3 && fc.degenerateAnchor[t].first == kNone; ++k) {
+      auto it = anchorOfVertex.find(mesh.faceVertex[t][k]);
+      if (it != anchorOfVertex.end()) fc.degenerateAnchor[t] = it->second;
+    }
+    if (fc.degenerateAnchor[t].first == kNone && count > 0) fc.degenerateAnchor[t] = {uint32_t(first), 0};
+  }
+  return fc;
+}
+
+// The part of src whose charts landed on `page`: a vertex per (chart, input vertex), TEXCOORD_1 in [0, 1].
+Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& charts, const FaceCharts& fc,
+                          const atlas::PackResult& packed, int page, const AtlasPage& pg, bool nameThePage) {
+  Primitive dst;
+  dst.name = nameThePage ? src.name + "#page" + std::to_string(page) : src.name;
+  dst.material = src.material;
+  dst.node = src.node;
+  dst.gltfMesh = src.gltfMesh;
+  dst.gltfPrimitive = src.gltfPrimitive;
+  dst.nodeToWorld = src.nodeToWorld;
+  dst.normalsComputed = src.normalsComputed;
+  dst.lightmap = {page, pg.width, pg.height};
+  const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);
+  std::unordered_map<uint64_t, uint32_t> vertexOf;
+  auto emit = [&](uint32_t inputVertex, glm::dvec2 texelUv) {
+    dst.positions.push_back(src.positions[inputVertex]);
+    if (src.normals.size() == src.positions.size()) dst.normals.push_back(src.normals[inputVertex]);
+    if (src.uv0.size() == src.positions.size()) dst.uv0.push_back(src.uv0[inputVertex]);
+    dst.uv1.push_back(glm::vec2(texelUv * toUnit));
+    dst.sourceVertex.push_back(src.sourceVertex.empty() ? inputVertex : src.sourceVertex[inputVertex]);
+    return uint32_t(dst.positions.size() - 1);
+  };
+  for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+    const bool mapped = fc.chartOfFace[t] != kNone;
+    const uint32_t c = fc.chartOf(t);
+    if (c == kNone || packed.chartPage[c] != page) continue;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = src.indices[3 * t + k];
+      if (!mapped) {
+        dst.indices.push_back(emit(v, charts[c].uv[fc.degenerateAnchor[t].second]));
+        continue;
+      }
+      const uint64_t key = (uint64_t(c) << 32) | v;
+      auto [it, added] = vertexOf.try_emplace(key, 0u);
+      if (added) it->second = emit(v, charts[c].uv[charts[c].corner[fc.localFace[t]][k]]);
+      dst.indices.push_back(it->second);
+    }
+  }
+  return dst;
+}
+
+// Output: a primitive per page its charts landed on (src itself when it has no faces to map).
+void emitOnPages(const Primitive& src, const PrimitiveCharts& range, const std::vector<ChartUv>& charts,
+                 const atlas::PackResult& packed, const std::vector<AtlasPage>& pages, std::vector<Primitive>& out) {
+  const FaceCharts fc = faceChartsOf(src, range, charts);
+  std::vector<int> pagesUsed;
+  for (uint32_t t = 0; t < src.triangleCount(); ++t) {
+    const uint32_t c = fc.chartOf(t);
+    if (c != kNone) pagesUsed.push_back(packed.chartPage[c]);
+  }
+  std::sort(pagesUsed.begin(), pagesUsed.end());
+  pagesUsed.erase(std::unique(pagesUsed.begin(), pagesUsed.end()), pagesUsed.end());
+  if (pagesUsed.empty()) {  // nothing to map (no faces at all)
+    out.push_back(src);
+    return;
+  }
+  for (int page : pagesUsed)
+    out.push_back(primitiveOnPage(src, charts, fc, packed, page, pages[size_t(page)], pagesUsed.size() > 1));
+}
+
 }  // namespace
 
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
@@ -155,96 +334,24 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   Stopwatch clock;
   std::vector<PrimitiveCharts> prims(scene.primitives.size());
   std::vector<ChartUv> charts;
-  atlas::ParamOptions paramOptions;
   for (size_t p = 0; p < scene.primitives.size(); ++p) {
-    const Primitive& prim = scene.primitives[p];
     clock.reset();
-    prims[p].mesh = atlas::buildAtlasMesh(prim);
+    prims[p].mesh = atlas::buildAtlasMesh(scene.primitives[p]);
     const AtlasMesh& mesh = prims[p].mesh;
     stats.degenerateFaces += mesh.degenerateFaces;
     stats.nonManifoldFaces += mesh.nonManifoldFaces;
     stats.secondsMesh += clock.seconds();
     prims[p].firstChart = charts.size();
-    if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
-      clock.reset();
-      for (ChartUv& c : chartsFromUv1(prim, mesh)) charts.push_back(std::move(c));
-      stats.secondsParam += clock.seconds();
-    } else {
-      clock.reset();
-      std::vector<atlas::ChartFaces> work = atlas::segmentCharts(mesh);
-      stats.secondsCharts += clock.seconds();
-      clock.reset();
-      // Parameterise every chart; a chart that fails a check is bisected and both halves redone.
-      // Bounded: a chart bisected maxSplitDepth times and still failing falls back to one planar
-      // chart per face (a single triangle always projects validly), with a warning.
-      std::vector<int> depth(work.size(), 0);
-      size_t fallbackFaces = 0;
-      while (!work.empty()) {
-        std::vector<ChartUv> done(work.size());
-        std::vector<atlas::ChartCheck> checks(work.size());
-        tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
-          if (work[i].faces.size() > 1 && !work[i].planarRegion &&
-              atlas::absoluteCurvature(mesh, work[i].faces) > paramOptions.maxAbsCurvature) {
-            checks[i] = atlas::ChartCheck::Stretched;  // hopeless: split without solving
-            return;
-          }
-          checks[i] = atlas::parameterizeChart(mesh, work[i].faces, paramOptions, done[i]);
-        });
-        std::vector<atlas::ChartFaces> again;
-        std::vector<int> againDepth;
-        for (size_t i = 0; i < work.size(); ++i) {
-          if (checks[i] == atlas::ChartCheck::Valid) {
-            charts.push_back(std::move(done[i]));
-            continue;
-          }
-          if (work[i].faces.size() > 1 && depth[i] >= std::max(0, options.maxSplitDepth)) {
-            // Safe fallback: every face its own planar chart, solved right here (no further rounds).
-            for (uint32_t f : work[i].faces) {
-              ChartUv single;
-              atlas::parameterizeChart(mesh, {f}, paramOptions, single);
-              charts.push_back(std::move(single));
-            }
-            fallbackFaces += work[i].faces.size();
-            continue;
-          }
-          auto halves = atlas::bisectChart(mesh, work[i]);
-          if (halves.size() < 2) {  // a single face always projects validly; keep it whatever the check said
-            charts.push_back(std::move(done[i]));
-            continue;
-          }
-          ++stats.chartsSplit;
-          for (auto& h : halves) {
-            again.push_back(std::move(h));
-            againDepth.push_back(depth[i] + 1);
-          }
-        }
-        work = std::move(again);
-        depth = std::move(againDepth);
-      }
-      stats.secondsParam += clock.seconds();
-      if (fallbackFaces) {
-        const std::string w = std::to_string(fallbackFaces) + " faces of \"" + prim.name + "\" still failed the chart checks after " +
-                              std::to_string(options.maxSplitDepth) + " bisections: mapped as one planar chart per face";
-        log::warn("atlas: " + w);
-        stats.warnings.push_back(w);
-      }
-    }
+    chartPrimitive(scene.primitives[p], mesh, options, stats, charts);
     prims[p].chartCount = charts.size() - prims[p].firstChart;
     progress(0.6 * double(p + 1) / double(scene.primitives.size()));
   }
   for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
-
-  // Density: given, or chosen so the charts' area fills about 60% of one target page.
-  double totalArea = 0.0;
-  for (const ChartUv& c : charts) totalArea += c.area3d;
-  double density = options.texelsPerUnit;
-  if (!(density > 0.0)) density = totalArea > 0.0 ? std::sqrt(0.6 * double(options.targetPageSize) * options.targetPageSize / totalArea) : 1.0;
-  if (!std::isfinite(density) || density <= 0.0) throw Error(ErrorCode::InvalidData, scene.sourcePath, "atlas: no surface area to unwrap");
-  stats.texelsPerUnit = density;
+  stats.texelsPerUnit = chooseDensity(charts, options, scene);
 
   clock.reset();
   atlas::PackOptions packOptions;
-  packOptions.texelsPerUnit = density;
+  packOptions.texelsPerUnit = stats.texelsPerUnit;
   packOptions.padding = options.padding;
   packOptions.maxPageSize = options.maxPageSize;
   atlas::PackResult packed = atlas::packCharts(charts, packOptions);
@@ -257,83 +364,11 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   stats.secondsPack = clock.seconds();
   progress(0.85);
 
-  // Output: a vertex per (chart, input vertex); a primitive per page its charts landed on.
   clock.reset();
   std::vector<Primitive> out;
   out.reserve(scene.primitives.size());
-  for (size_t p = 0; p < scene.primitives.size(); ++p) {
-    const Primitive& src = scene.primitives[p];
-    const AtlasMesh& mesh = prims[p].mesh;
-    const size_t first = prims[p].firstChart, count = prims[p].chartCount;
-    std::vector<uint32_t> chartOfFace(src.triangleCount(), kNone), localFace(src.triangleCount(), kNone);
-    std::unordered_map<uint32_t, std::pair<uint32_t, uint32_t>> anchorOfVertex;  // welded vertex -> (chart, local)
-    for (size_t c = first; c < first + count; ++c)
-      for (size_t i = 0; i < charts[c].faces.size(); ++i) {
-        chartOfFace[charts[c].faces[i]] = uint32_t(c);
-        localFace[charts[c].faces[i]] = uint32_t(i);
-        for (int k = 0; k < 3; ++k) anchorOfVertex.try_emplace(mesh.faceVertex[charts[c].faces[i]][k], uint32_t(c), charts[c].corner[i][k]);
-      }
-    // A degenerate face sits on a point of a chart that holds one of its corners (zero UV area).
-    std::vector<std::pair<uint32_t, uint32_t>> degenerateAnchor(src.triangleCount(), {kNone, kNone});
-    for (uint32_t t = 0; t < src.triangleCount(); ++t) {
-      if (chartOfFace[t] != kNone) continue;
-      for (int k = 0; k < 3 && degenerateAnchor[t].first == kNone; ++k) {
-        auto it = anchorOfVertex.find(mesh.faceVertex[t][k]);
-        if (it != anchorOfVertex.end()) degenerateAnchor[t] = it->second;
-      }
-      if (degenerateAnchor[t].first == kNone && count > 0) degenerateAnchor[t] = {uint32_t(first), 0};
-    }
-    std::vector<int> pagesUsed;
-    for (uint32_t t = 0; t < src.triangleCount(); ++t) {
-      const uint32_t c = chartOfFace[t] != kNone ? chartOfFace[t] : degenerateAnchor[t].first;
-      if (c != kNone) pagesUsed.push_back(packed.chartPage[c]);
-    }
-    std::sort(pagesUsed.begin(), pagesUsed.end());
-    pagesUsed.erase(std::unique(pagesUsed.begin(), pagesUsed.end()), pagesUsed.end());
-    if (pagesUsed.empty()) {  // nothing to map (no faces at all)
-      out.push_back(src);
-      continue;
-    }
-    for (int page : pagesUsed) {
-      Primitive dst;
-      dst.name = pagesUsed.size() > 1 ? src.name + "#page" + std::to_string(page) : src.name;
-      dst.material = src.material;
-      dst.node = src.node;
-      dst.gltfMesh = src.gltfMesh;
-      dst.gltfPrimitive = src.gltfPrimitive;
-      dst.nodeToWorld = src.nodeToWorld;
-      dst.normalsComputed = src.normalsComputed;
-      const AtlasPage& pg = result.pages[size_t(page)];
-      dst.lightmap = {page, pg.width, pg.height};
-      const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);
-      std::unordered_map<uint64_t, uint32_t> vertexOf;
-      auto emit = [&](uint32_t inputVertex, glm::dvec2 texelUv) {
-        dst.positions.push_back(src.positions[inputVertex]);
-        if (src.normals.size() == src.positions.size()) dst.normals.push_back(src.normals[inputVertex]);
-        if (src.uv0.size() == src.positions.size()) dst.uv0.push_back(src.uv0[inputVertex]);
-        dst.uv1.push_back(glm::vec2(texelUv * toUnit));
-        dst.sourceVertex.push_back(src.sourceVertex.empty() ? inputVertex : src.sourceVertex[inputVertex]);
-        return uint32_t(dst.positions.size() - 1);
-      };
-      for (uint32_t t = 0; t < src.triangleCount(); ++t) {
-        const bool mapped = chartOfFace[t] != kNone;
-        const uint32_t c = mapped ? chartOfFace[t] : degenerateAnchor[t].first;
-        if (c == kNone || packed.chartPage[c] != page) continue;
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t v = src.indices[3 * t + k];
-          if (!mapped) {
-            dst.indices.push_back(emit(v, charts[c].uv[degenerateAnchor[t].second]));
-            continue;
-          }
-          const uint64_t key = (uint64_t(c) << 32) | v;
-          auto [it, added] = vertexOf.try_emplace(key, 0u);
-          if (added) it->second = emit(v, charts[c].uv[charts[c].corner[localFace[t]][k]]);
-          dst.indices.push_back(it->second);
-        }
-      }
-      out.push_back(std::move(dst));
-    }
-  }
+  for (size_t p = 0; p < scene.primitives.size(); ++p)
+    emitOnPages(scene.primitives[p], prims[p], charts, packed, result.pages, out);
   scene.primitives = std::move(out);
   stats.secondsOutput = clock.seconds();
   progress(0.95);

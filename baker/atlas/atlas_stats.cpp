@@ -79,10 +79,10 @@ void measureAtlas(const Scene& scene, const std::vector<AtlasPage>& pages, Atlas
         ratios.push_back({areaUv / area3d, area3d});
         uvSum += areaUv;
         areaSum += area3d;
-        if (areaUv > 0.0) {  // Sander et al.'s L2 stretch of the map UV -> 3D
-          const glm::dvec3 ss = (q[0] * (uv[1].y - uv[2].y) + q[1] * (uv[2].y - uv[0].y) + q[2] * (uv[0].y - uv[1].y)) / (2.0 * areaUv);
-          const glm::dvec3 st = (q[0] * (uv[2].x - uv[1].x) + q[1] * (uv[0].x - uv[2].x) + q[2] * (uv[1].x - uv[0].x)) / (2.0 * areaUv);
-          l2Sum += area3d * 0.5 * (glm::dot(ss, ss) + glm::dot(st, st));
+        if (areaUv > 0.0) {  // Sander et al.'s L2 stretch of the map UV -> 3D, from ∂p/∂s and ∂p/∂t
+          const glm::dvec3 dPds = (q[0] * (uv[1].y - uv[2].y) + q[1] * (uv[2].y - uv[0].y) + q[2] * (uv[0].y - uv[1].y)) / (2.0 * areaUv);
+          const glm::dvec3 dPdt = (q[0] * (uv[2].x - uv[1].x) + q[1] * (uv[0].x - uv[2].x) + q[2] * (uv[1].x - uv[0].x)) / (2.0 * areaUv);
+          l2Sum += area3d * 0.5 * (glm::dot(dPds, dPds) + glm::dot(dPdt, dPdt));
         }
       }
       const glm::dvec2 lo = glm::min(uv[0], glm::min(uv[1], uv[2])), hi = glm::max(uv[0], glm::max(uv[1], uv[2]));

@@ -13,6 +13,7 @@
 #include "atlas/atlas.h"
 #include "atlas/atlas_mesh.h"
 #include "common/error.h"
+#include "common/maths.h"
 #include "export/gltf_export.h"
 #include "scene/gltf_loader.h"
 #include "scene/test_gltf_builder.h"
@@ -20,7 +21,6 @@
 namespace irbake {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
 
 // ---------- meshes ----------
 Scene sceneOf(std::vector<Primitive> prims) {
@@ -78,13 +78,13 @@ Primitive gridSurface(const char* name, int nu, int nv, bool wrapU, bool wrapV, 
 Primitive cylinder(float r, float h, int segments) {
   // Side (open tube, outward) plus two fan caps as separate vertices (hard edge).
   Primitive p = gridSurface("cylinder", segments, 4, true, false, [&](float u, float v) {
-    return glm::vec3(r * std::cos(2 * kPi * u), v * h, -r * std::sin(2 * kPi * u));
+    return glm::vec3(r * std::cos(2 * kPiF * u), v * h, -r * std::sin(2 * kPiF * u));
   });
   for (int cap = 0; cap < 2; ++cap) {
     const uint32_t centre = uint32_t(p.positions.size());
     const float y = cap ? h : 0.0f;
     p.positions.push_back({0, y, 0});
-    for (int i = 0; i < segments; ++i) p.positions.push_back({r * std::cos(2 * kPi * i / segments), y, -r * std::sin(2 * kPi * i / segments)});
+    for (int i = 0; i < segments; ++i) p.positions.push_back({r * std::cos(2 * kPiF * i / segments), y, -r * std::sin(2 * kPiF * i / segments)});
     for (int i = 0; i < segments; ++i) {
       const uint32_t a = centre + 1 + i, b = centre + 1 + (i + 1) % segments;
       for (uint32_t k : cap ? std::array<uint32_t, 3>{centre, a, b} : std::array<uint32_t, 3>{centre, b, a}) p.indices.push_back(k);
@@ -95,7 +95,7 @@ Primitive cylinder(float r, float h, int segments) {
 
 Primitive uvSphere(float r, int nu, int nv) {
   Primitive p = gridSurface("sphere", nu, nv, true, false, [&](float u, float v) {
-    const float theta = kPi * v, phi = 2 * kPi * u;
+    const float theta = kPiF * v, phi = 2 * kPiF * u;
     return glm::vec3(r * std::sin(theta) * std::cos(phi), r * std::cos(theta), -r * std::sin(theta) * std::sin(phi));
   });
   return p;  // poles are rings of coincident vertices: welding turns their triangles degenerate
@@ -103,7 +103,7 @@ Primitive uvSphere(float r, int nu, int nv) {
 
 Primitive torus(float R, float r, int nu, int nv) {
   return gridSurface("torus", nu, nv, true, true, [&](float u, float v) {
-    const float a = 2 * kPi * u, b = 2 * kPi * v;
+    const float a = 2 * kPiF * u, b = 2 * kPiF * v;
     return glm::vec3((R + r * std::cos(b)) * std::cos(a), r * std::sin(b), -(R + r * std::cos(b)) * std::sin(a));
   });
 }

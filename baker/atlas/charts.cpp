@@ -30,52 +30,91 @@ double edgeLength(const AtlasMesh& mesh, uint32_t f, int k) {
 using Entry = std::pair<double, uint32_t>;
 using MinHeap = std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>>;
 
-}  // namespace
+constexpr uint32_t kFree = kNone;  // chartOf of a face no chart holds yet
 
-std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions& options) {
-  const size_t n = mesh.faceCount();
-  const double planarCos = std::cos(glm::radians(options.planarDegrees));
-  const double coneCos = std::cos(glm::radians(options.coneDegrees));
-  const double creaseCos = std::cos(glm::radians(options.creaseDegrees));
-  const double mergeCos = std::cos(glm::radians(options.mergeConeDegrees));
-  const double softCos = std::cos(glm::radians(options.softBendDegrees));
-  constexpr uint32_t kFree = kNone;
+// A chart while it grows.
+struct GrowingChart {
+  std::vector<uint32_t> faces;
+  glm::dvec3 normalSum{0.0};
+  double area = 0.0;
+  bool planar = false;
+  bool alive = true;  // false once merged into another
+};
 
-  std::vector<uint32_t> order;
-  double totalArea = 0.0;
-  for (uint32_t f = 0; f < n; ++f) {
-    if (mesh.degenerate[f]) continue;
-    order.push_back(f);
-    totalArea += mesh.faceArea[f];
+// The state segmentCharts builds up phase by phase: the charts so far and which chart holds each face.
+class Segmenter {
+ public:
+  Segmenter(const AtlasMesh& mesh, const ChartOptions& options)
+      : mesh_(mesh), options_(options), creaseCos_(std::cos(glm::radians(options.creaseDegrees))),
+        chartOf_(mesh.faceCount(), kFree) {
+    for (uint32_t f = 0; f < mesh.faceCount(); ++f) {
+      if (mesh.degenerate[f]) continue;
+      order_.push_back(f);
+      totalArea_ += mesh.faceArea[f];
+    }
+    // Largest faces seed first: on architecture they are the big flat pieces. Ties by index keep it deterministic.
+    std::stable_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) { return mesh.faceArea[a] > mesh.faceArea[b]; });
   }
-  // Largest faces seed first: on architecture they are the big flat pieces. Ties by index keep it deterministic.
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return mesh.faceArea[a] > mesh.faceArea[b]; });
 
-  struct Work {
-    std::vector<uint32_t> faces;
-    glm::dvec3 normalSum{0.0};
-    double area = 0.0;
-    bool planar = false;
-    bool alive = true;
-  };
-  std::vector<Work> charts;
-  std::vector<uint32_t> chartOf(n, kFree);
+  void findPlanarRegions();
+  void smoothNormals();
+  void growCurvedCharts();
+  void mergeSmallCharts();
+  std::vector<ChartFaces> finish();
 
-  // Phase 1: planar regions (flood fill within a small angle of the seed's normal).
+ private:
+  double planarBoundarySoftness(const std::vector<uint32_t>& region, uint32_t seed, std::vector<uint32_t>& regionOf,
+                                double& boundary) const;
+  void growChartFrom(uint32_t seed, std::deque<uint32_t>& seeds);
+  bool mergeIntoNeighbour(uint32_t c, double maxArea);
+
+  const AtlasMesh& mesh_;
+  const ChartOptions& options_;
+  const double creaseCos_;
+  std::vector<uint32_t> order_;  // non-degenerate faces, largest first
+  double totalArea_ = 0.0;
+  std::vector<GrowingChart> charts_;
+  std::vector<uint32_t> chartOf_;
+  std::vector<glm::dvec3> smooth_;  // face normals averaged over a few rings (smoothNormals)
+};
+
+// Length of the region's boundary that a soft bend crosses (growth could go on there), and in `boundary`
+// the whole boundary's length.
+double Segmenter::planarBoundarySoftness(const std::vector<uint32_t>& region, uint32_t seed,
+                                         std::vector<uint32_t>& regionOf, double& boundary) const {
+  const double softCos = std::cos(glm::radians(options_.softBendDegrees));
+  double softBoundary = 0.0;
+  for (uint32_t f : region) regionOf[f] = seed;
+  for (uint32_t f : region)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = mesh_.faceNeighbour[f][k];
+      if (g != kNone && regionOf[g] == seed) continue;
+      const double len = edgeLength(mesh_, f, k);
+      boundary += len;
+      const uint32_t h = crossable(mesh_, f, k, creaseCos_);
+      if (h != kNone && glm::dot(mesh_.faceNormal[h], mesh_.faceNormal[f]) > softCos) softBoundary += len;
+    }
+  return softBoundary;
+}
+
+// Phase 1: planar regions (flood fill within a small angle of the seed's normal).
+void Segmenter::findPlanarRegions() {
+  const double planarCos = std::cos(glm::radians(options_.planarDegrees));
+  const size_t n = mesh_.faceCount();
   std::vector<uint8_t> tried(n, 0);
   std::vector<uint32_t> region, regionOf(n, kNone);
-  for (uint32_t seed : order) {
-    if (chartOf[seed] != kFree || tried[seed]) continue;
+  for (uint32_t seed : order_) {
+    if (chartOf_[seed] != kFree || tried[seed]) continue;
     region.assign(1, seed);
     tried[seed] = 1;
     double area = 0.0;
     for (size_t i = 0; i < region.size(); ++i) {
       const uint32_t f = region[i];
-      area += mesh.faceArea[f];
+      area += mesh_.faceArea[f];
       for (int k = 0; k < 3; ++k) {
-        const uint32_t g = crossable(mesh, f, k, creaseCos);
-        if (g == kNone || tried[g] || chartOf[g] != kFree) continue;
-        if (glm::dot(mesh.faceNormal[g], mesh.faceNormal[seed]) < planarCos) continue;
+        const uint32_t g = crossable(mesh_, f, k, creaseCos_);
+        if (g == kNone || tried[g] || chartOf_[g] != kFree) continue;
+        if (glm::dot(mesh_.faceNormal[g], mesh_.faceNormal[seed]) < planarCos) continue;
         tried[g] = 1;
         region.push_back(g);
       }
@@ -83,157 +122,182 @@ std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions&
     // A flat strip of a finely faceted curved surface (a cylinder's side) is not a flat region:
     // lock only regions whose boundary is mostly hard (seams, creases or a clear bend).
     double softBoundary = 0.0, boundary = 0.0;
-    if (region.size() >= 2 && area >= options.planarMinAreaFraction * totalArea) {
-      for (uint32_t f : region) regionOf[f] = seed;
-      for (uint32_t f : region)
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t g = mesh.faceNeighbour[f][k];
-          if (g != kNone && regionOf[g] == seed) continue;
-          const double len = edgeLength(mesh, f, k);
-          boundary += len;
-          const uint32_t h = crossable(mesh, f, k, creaseCos);
-          if (h != kNone && glm::dot(mesh.faceNormal[h], mesh.faceNormal[f]) > softCos) softBoundary += len;
-        }
-    }
-    if (region.size() >= 2 && area >= options.planarMinAreaFraction * totalArea && softBoundary <= 0.5 * boundary) {
-      Work w;
-      w.faces = region;
-      w.area = area;
-      w.planar = true;
+    const bool bigEnough = region.size() >= 2 && area >= options_.planarMinAreaFraction * totalArea_;
+    if (bigEnough) softBoundary = planarBoundarySoftness(region, seed, regionOf, boundary);
+    if (bigEnough && softBoundary <= 0.5 * boundary) {
+      GrowingChart chart;
+      chart.faces = region;
+      chart.area = area;
+      chart.planar = true;
       for (uint32_t f : region) {
-        chartOf[f] = uint32_t(charts.size());
-        w.normalSum += mesh.faceNormal[f] * mesh.faceArea[f];
+        chartOf_[f] = uint32_t(charts_.size());
+        chart.normalSum += mesh_.faceNormal[f] * mesh_.faceArea[f];
       }
-      charts.push_back(std::move(w));
+      charts_.push_back(std::move(chart));
     } else {
       for (uint32_t f : region) tried[f] = (f == seed) ? 1 : 0;  // others may still seed their own region
     }
   }
+}
 
-  // Scanned surfaces are noisy: curved growth compares normals averaged over a few rings of faces
-  // (never across seams or creases), so one bumpy face does not end a chart.
-  std::vector<glm::dvec3> smooth(mesh.faceNormal), next(n);
-  for (int it = 0; it < options.normalSmoothing; ++it) {
+// Scanned surfaces are noisy: curved growth compares normals averaged over a few rings of faces
+// (never across seams or creases), so one bumpy face does not end a chart.
+void Segmenter::smoothNormals() {
+  const size_t n = mesh_.faceCount();
+  smooth_ = mesh_.faceNormal;
+  std::vector<glm::dvec3> next(n);
+  for (int it = 0; it < options_.normalSmoothing; ++it) {
     for (uint32_t f = 0; f < n; ++f) {
-      glm::dvec3 sum = smooth[f] * mesh.faceArea[f];
+      glm::dvec3 sum = smooth_[f] * mesh_.faceArea[f];
       for (int k = 0; k < 3; ++k) {
-        const uint32_t g = crossable(mesh, f, k, creaseCos);
-        if (g != kNone) sum += smooth[g] * mesh.faceArea[g];
+        const uint32_t g = crossable(mesh_, f, k, creaseCos_);
+        if (g != kNone) sum += smooth_[g] * mesh_.faceArea[g];
       }
       const double len = glm::length(sum);
-      next[f] = len > 0.0 ? sum / len : smooth[f];
+      next[f] = len > 0.0 ? sum / len : smooth_[f];
     }
-    smooth.swap(next);
+    smooth_.swap(next);
   }
+}
 
-  const double maxArea = options.maxAreaFraction * totalArea;
+// One curved chart grown from seed, nearest faces first, while every face stays inside the cone around
+// the chart's mean normal; the faces it rejected go to the back of `seeds`.
+void Segmenter::growChartFrom(uint32_t seed, std::deque<uint32_t>& seeds) {
+  const double coneCos = std::cos(glm::radians(options_.coneDegrees));
+  const double maxArea = options_.maxAreaFraction * totalArea_;
+  const uint32_t id = uint32_t(charts_.size());
+  GrowingChart chart;
+  const glm::dvec3 seedCentre = centroidOf(mesh_, seed);
+  MinHeap heap;
+  heap.push({0.0, seed});
+  std::vector<uint32_t> rejected;
+  while (!heap.empty()) {
+    const uint32_t f = heap.top().second;
+    heap.pop();
+    if (chartOf_[f] != kFree) continue;
+    if (chart.area >= maxArea) {
+      rejected.push_back(f);
+      continue;
+    }
+    const glm::dvec3 mean = chart.area > 0.0 ? glm::normalize(chart.normalSum) : smooth_[f];
+    if (glm::dot(smooth_[f], mean) < coneCos) {
+      rejected.push_back(f);
+      continue;
+    }
+    chartOf_[f] = id;
+    chart.faces.push_back(f);
+    chart.normalSum += smooth_[f] * mesh_.faceArea[f];
+    chart.area += mesh_.faceArea[f];
+    const glm::dvec3 now = glm::normalize(chart.normalSum);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = crossable(mesh_, f, k, creaseCos_);
+      if (g == kNone || chartOf_[g] != kFree) continue;
+      const double deviation = 1.0 - glm::dot(smooth_[g], now);
+      heap.push({glm::length(centroidOf(mesh_, g) - seedCentre) * (1.0 + 4.0 * deviation), g});
+    }
+  }
+  for (uint32_t f : rejected)
+    if (chartOf_[f] == kFree) seeds.push_back(f);
+  charts_.push_back(std::move(chart));
+}
 
-  // Phase 2: curved charts grown one at a time from a front of rejected faces, nearest faces first,
-  // while every face stays inside the cone around the chart's mean normal.
+// Phase 2: curved charts grown one at a time, each seeded from the front of faces the previous ones
+// rejected, then from the largest free face.
+void Segmenter::growCurvedCharts() {
   std::deque<uint32_t> seeds;
   size_t nextOrdered = 0;
   for (;;) {
     uint32_t seed = kFree;
     while (!seeds.empty() && seed == kFree) {
-      if (chartOf[seeds.front()] == kFree) seed = seeds.front();
+      if (chartOf_[seeds.front()] == kFree) seed = seeds.front();
       seeds.pop_front();
     }
-    while (seed == kFree && nextOrdered < order.size()) {
-      if (chartOf[order[nextOrdered]] == kFree) seed = order[nextOrdered];
+    while (seed == kFree && nextOrdered < order_.size()) {
+      if (chartOf_[order_[nextOrdered]] == kFree) seed = order_[nextOrdered];
       ++nextOrdered;
     }
     if (seed == kFree) break;
-    const uint32_t id = uint32_t(charts.size());
-    Work w;
-    const glm::dvec3 seedCentre = centroidOf(mesh, seed);
-    MinHeap heap;
-    heap.push({0.0, seed});
-    std::vector<uint32_t> rejected;
-    while (!heap.empty()) {
-      const uint32_t f = heap.top().second;
-      heap.pop();
-      if (chartOf[f] != kFree) continue;
-      if (w.area >= maxArea) {
-        rejected.push_back(f);
-        continue;
-      }
-      const glm::dvec3 mean = w.area > 0.0 ? glm::normalize(w.normalSum) : smooth[f];
-      if (glm::dot(smooth[f], mean) < coneCos) {
-        rejected.push_back(f);
-        continue;
-      }
-      chartOf[f] = id;
-      w.faces.push_back(f);
-      w.normalSum += smooth[f] * mesh.faceArea[f];
-      w.area += mesh.faceArea[f];
-      const glm::dvec3 now = glm::normalize(w.normalSum);
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t g = crossable(mesh, f, k, creaseCos);
-        if (g == kNone || chartOf[g] != kFree) continue;
-        const double deviation = 1.0 - glm::dot(smooth[g], now);
-        heap.push({glm::length(centroidOf(mesh, g) - seedCentre) * (1.0 + 4.0 * deviation), g});
-      }
-    }
-    for (uint32_t f : rejected)
-      if (chartOf[f] == kFree) seeds.push_back(f);
-    charts.push_back(std::move(w));
+    growChartFrom(seed, seeds);
   }
+}
 
-  // Phase 3: small curved charts join the neighbour they share the longest boundary with.
+// Chart c joins the curved neighbour it shares the longest boundary with, if the union stays inside the
+// merge cone and under maxArea; true if it did.
+bool Segmenter::mergeIntoNeighbour(uint32_t c, double maxArea) {
+  const double mergeCos = std::cos(glm::radians(options_.mergeConeDegrees));
+  std::map<uint32_t, double> shared;
+  for (uint32_t f : charts_[c].faces)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t g = crossable(mesh_, f, k, creaseCos_);
+      if (g == kNone || chartOf_[g] == c || charts_[chartOf_[g]].planar) continue;
+      shared[chartOf_[g]] += edgeLength(mesh_, f, k);
+    }
+  std::vector<std::pair<double, uint32_t>> byLength;
+  for (auto& [other, length] : shared) byLength.push_back({-length, other});
+  std::sort(byLength.begin(), byLength.end());
+  for (auto& [negLength, other] : byLength) {
+    if (charts_[c].area + charts_[other].area > maxArea) continue;
+    const glm::dvec3 mean = glm::normalize(charts_[c].normalSum + charts_[other].normalSum);
+    bool inside = true;
+    for (const GrowingChart* chart : {&charts_[c], &charts_[other]})
+      for (uint32_t f : chart->faces)
+        if (glm::dot(smooth_[f], mean) < mergeCos) { inside = false; break; }
+    if (!inside) continue;
+    GrowingChart& into = charts_[other];
+    for (uint32_t f : charts_[c].faces) {
+      chartOf_[f] = other;
+      into.faces.push_back(f);
+    }
+    into.normalSum += charts_[c].normalSum;
+    into.area += charts_[c].area;
+    charts_[c].alive = false;
+    charts_[c].faces.clear();
+    return true;
+  }
+  return false;
+}
+
+// Phase 3: small curved charts join the neighbour they share the longest boundary with.
+void Segmenter::mergeSmallCharts() {
   std::vector<double> curvedAreas;
-  for (const Work& w : charts)
-    if (!w.planar) curvedAreas.push_back(w.area);
-  if (!curvedAreas.empty()) {
-    std::nth_element(curvedAreas.begin(), curvedAreas.begin() + curvedAreas.size() / 2, curvedAreas.end());
-    const double smallArea = options.mergeAreaFraction * curvedAreas[curvedAreas.size() / 2];
-    std::vector<uint32_t> small;
-    for (uint32_t c = 0; c < charts.size(); ++c)
-      if (!charts[c].planar && charts[c].area < smallArea) small.push_back(c);
-    std::stable_sort(small.begin(), small.end(), [&](uint32_t a, uint32_t b) { return charts[a].area < charts[b].area; });
-    for (uint32_t c : small) {
-      if (!charts[c].alive || charts[c].area >= smallArea) continue;
-      std::map<uint32_t, double> shared;
-      for (uint32_t f : charts[c].faces)
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t g = crossable(mesh, f, k, creaseCos);
-          if (g == kNone || chartOf[g] == c || charts[chartOf[g]].planar) continue;
-          shared[chartOf[g]] += edgeLength(mesh, f, k);
-        }
-      std::vector<std::pair<double, uint32_t>> byLength;
-      for (auto& [other, length] : shared) byLength.push_back({-length, other});
-      std::sort(byLength.begin(), byLength.end());
-      for (auto& [negLength, other] : byLength) {
-        if (charts[c].area + charts[other].area > maxArea) continue;
-        const glm::dvec3 mean = glm::normalize(charts[c].normalSum + charts[other].normalSum);
-        bool inside = true;
-        for (const Work* w : {&charts[c], &charts[other]})
-          for (uint32_t f : w->faces)
-            if (glm::dot(smooth[f], mean) < mergeCos) { inside = false; break; }
-        if (!inside) continue;
-        Work& into = charts[other];
-        for (uint32_t f : charts[c].faces) {
-          chartOf[f] = other;
-          into.faces.push_back(f);
-        }
-        into.normalSum += charts[c].normalSum;
-        into.area += charts[c].area;
-        charts[c].alive = false;
-        charts[c].faces.clear();
-        break;
-      }
-    }
+  for (const GrowingChart& chart : charts_)
+    if (!chart.planar) curvedAreas.push_back(chart.area);
+  if (curvedAreas.empty()) return;
+  const double maxArea = options_.maxAreaFraction * totalArea_;
+  std::nth_element(curvedAreas.begin(), curvedAreas.begin() + curvedAreas.size() / 2, curvedAreas.end());
+  const double smallArea = options_.mergeAreaFraction * curvedAreas[curvedAreas.size() / 2];
+  std::vector<uint32_t> small;
+  for (uint32_t c = 0; c < charts_.size(); ++c)
+    if (!charts_[c].planar && charts_[c].area < smallArea) small.push_back(c);
+  std::stable_sort(small.begin(), small.end(), [&](uint32_t a, uint32_t b) { return charts_[a].area < charts_[b].area; });
+  for (uint32_t c : small) {
+    if (!charts_[c].alive || charts_[c].area >= smallArea) continue;
+    mergeIntoNeighbour(c, maxArea);
   }
+}
 
+std::vector<ChartFaces> Segmenter::finish() {
   std::vector<ChartFaces> out;
-  for (Work& w : charts) {
-    if (!w.alive) continue;
+  for (GrowingChart& chart : charts_) {
+    if (!chart.alive) continue;
     ChartFaces c;
-    c.faces = std::move(w.faces);
+    c.faces = std::move(chart.faces);
     std::sort(c.faces.begin(), c.faces.end());
-    c.planarRegion = w.planar;
+    c.planarRegion = chart.planar;
     out.push_back(std::move(c));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<ChartFaces> segmentCharts(const AtlasMesh& mesh, const ChartOptions& options) {
+  Segmenter segmenter(mesh, options);
+  segmenter.findPlanarRegions();
+  segmenter.smoothNormals();
+  segmenter.growCurvedCharts();
+  segmenter.mergeSmallCharts();
+  return segmenter.finish();
 }
 
 std::vector<ChartFaces> bisectChart(const AtlasMesh& mesh, const ChartFaces& chart) {

@@ -7,6 +7,8 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
+#include "common/maths.h"
+
 namespace irbake::atlas {
 
 double uvArea(const ChartUv& chart, size_t face) {
@@ -286,7 +288,7 @@ double absoluteCurvature(const AtlasMesh& mesh, const std::vector<uint32_t>& fac
   }
   double total = 0.0;
   for (const auto& [v, sum] : angleSum)
-    if (!onBoundary.count(v)) total += std::abs(2.0 * 3.14159265358979323846 - sum);
+    if (!onBoundary.count(v)) total += std::abs(2.0 * kPi - sum);
   return total;
 }
 

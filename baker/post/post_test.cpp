@@ -154,11 +154,11 @@ TEST(Post, DilatesStitchesAndRejectsNaN) {
   Scene s = twoChartPlane(false);
   std::vector<Lightmap> maps{halvesMap()};
   for (int x = 0; x < 16; ++x) maps[0].valid[15 * 16 + x] = 0, maps[0].texels[15 * 16 + x] = glm::vec3(0.0f);
-  PostStats st = postProcess(s, maps);
-  EXPECT_EQ(st.texelsFilled, 16u);
-  EXPECT_EQ(st.seamEdges, 1u);
-  EXPECT_NEAR(st.seamMismatchBefore, 2.0, 1e-9);
-  EXPECT_LT(st.seamMismatchAfter, 0.02);
+  PostStats stats = postProcess(s, maps);
+  EXPECT_EQ(stats.texelsFilled, 16u);
+  EXPECT_EQ(stats.seamEdges, 1u);
+  EXPECT_NEAR(stats.seamMismatchBefore, 2.0, 1e-9);
+  EXPECT_LT(stats.seamMismatchAfter, 0.02);
   EXPECT_FLOAT_EQ(maps[0].texels[15 * 16 + 0].x, 1.0f);  // filled from the row above
   maps[0].texels[0].x = std::nanf("");
   EXPECT_THROW(postProcess(s, maps), Error);

@@ -9,6 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "common/maths.h"
+
 namespace irbake {
 namespace {
 
@@ -109,7 +111,7 @@ void leakDirections(const glm::vec3& n, glm::vec3 out[kLeakRays]) {
   out[0] = n;
   const float elevation = 0.25f;  // ~14°: low enough to find walls that cut the texel
   for (int k = 0; k < kLeakRays - 1; ++k) {
-    float phi = 2.0f * 3.14159265f * (k + 0.5f) / (kLeakRays - 1);
+    float phi = 2.0f * kPiF * (k + 0.5f) / (kLeakRays - 1);
     out[k + 1] = glm::normalize(std::cos(phi) * t + std::sin(phi) * b + elevation * n);
   }
 }

@@ -9,8 +9,10 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
+#include "transport/geometry_term.h"
 #include "vpl/sampling.h"
 
 namespace irbake {
@@ -66,12 +68,48 @@ struct Tile {
   std::vector<KeptHit> hits;
 };
 
+// Ray counts of the two rounds, after the budget.
+struct RayPlan {
+  int baseRays = 0;    // first round, per active sample
+  int extraRays = 0;   // second round, per refined sample (before the budget of that round)
+  int refineHits = 0;  // first-round hits inside the clamp radius that make a sample a refinement candidate
+};
+
+RayPlan planRays(const std::vector<TexelSamples>& texels, const ClampCompensationOptions& options) {
+  size_t activeSamples = 0;
+  for (const TexelSamples& ts : texels)
+    for (size_t s = 0; s < ts.slotCount(); ++s) activeSamples += ts.positionWeight[s].w > 0.0f;
+  RayPlan plan;
+  plan.baseRays = std::max(1, options.rays);
+  if (options.rayBudget > 0 && activeSamples > 0)
+    plan.baseRays = static_cast<int>(std::clamp<size_t>(options.rayBudget / activeSamples,
+                                                        static_cast<size_t>(std::max(1, options.minRays)),
+                                                        static_cast<size_t>(plan.baseRays)));
+  const double rayScale = static_cast<double>(plan.baseRays) / std::max(1, options.rays);
+  plan.extraRays = static_cast<int>(std::lround(std::max(0, options.refineRays) * rayScale));
+  plan.refineHits = static_cast<int>(std::ceil(options.refineFraction * plan.baseRays));
+  return plan;
+}
+
+// Light-map page number → index of its texel page (= its map, in the same order); −1 where none.
+std::vector<int32_t> mapIndexOfPages(const std::vector<TexelSamples>& texels) {
+  std::vector<int32_t> mapOfPage;
+  for (size_t i = 0; i < texels.size(); ++i) {
+    int page = texels[i].page;
+    if (page < 0) continue;
+    if (static_cast<size_t>(page) >= mapOfPage.size()) mapOfPage.resize(page + 1, -1);
+    mapOfPage[page] = static_cast<int32_t>(i);
+  }
+  return mapOfPage;
+}
+
 }  // namespace
 
 struct ClampGather::Impl {
   const BakeInputs& in;
   ClampCompensationOptions options;
   bool enabled = false;
+  float bound = 0.0f;              // the clamp bound B (1/m²)
   std::vector<int32_t> mapOfPage;  // light-map page number → index of its texel page (= its map)
   std::vector<Tile> tiles;         // kept hits, by tile of slots
   std::vector<std::vector<uint16_t>> raysOf;  // rays traced per slot
@@ -81,58 +119,30 @@ struct ClampGather::Impl {
   size_t rays = 0, refined = 0;
   double traceSeconds = 0.0;
   Impl(const BakeInputs& i, const ClampCompensationOptions& o) : in(i), options(o) {}
+
+  void makeTiles();
+  void chooseFilters();
+  int traceSlot(size_t page, size_t slot, int count, uint64_t round, std::vector<KeptHit>& out) const;
+  std::vector<std::vector<uint16_t>> traceFirstRound();
+  void traceRefinement(const std::vector<std::vector<uint16_t>>& firstHits, const RayPlan& plan);
+  void divideByRaysOfSlot();
 };
 
-ClampGather::~ClampGather() = default;
-double ClampGather::traceSeconds() const { return impl_->traceSeconds; }
-
-ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& options)
-    : impl_(std::make_unique<Impl>(in, options)) {
-  Stopwatch clock;
-  Impl& g = *impl_;
-  const float bound = in.eval.clampBound;
-  g.enabled = in.eval.includeVpls && bound > 0.0f;
-  if (!g.enabled) return;
-  const Scene& scene = in.scene;
-  const RayTracer& rt = in.rayTracer;
-
-  // Light-map page number → index of its texel page (= its map, in the same order).
-  std::vector<int32_t>& mapOfPage = g.mapOfPage;
-  for (size_t i = 0; i < in.texels.size(); ++i) {
-    int page = in.texels[i].page;
-    if (page < 0) continue;
-    if (static_cast<size_t>(page) >= mapOfPage.size()) mapOfPage.resize(page + 1, -1);
-    mapOfPage[page] = static_cast<int32_t>(i);
-  }
-
-  // Round 1: trace, keep hits with w > 0. Per page, per tile of slots, one list (tiles own their slots).
-  std::vector<Tile>& tiles = g.tiles;
+// Per page, per tile of slots, one list of kept hits (tiles own their slots, so they trace in parallel).
+void ClampGather::Impl::makeTiles() {
   constexpr size_t kTile = 256;
   for (size_t p = 0; p < in.texels.size(); ++p)
     for (size_t b = 0; b < in.texels[p].slotCount(); b += kTile)
       tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}});
+}
 
-  std::atomic<size_t> rays{0}, refined{0};
-  size_t activeSamples = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (size_t s = 0; s < ts.slotCount(); ++s) activeSamples += ts.positionWeight[s].w > 0.0f;
-  int baseRays = std::max(1, options.rays);
-  if (options.rayBudget > 0 && activeSamples > 0)
-    baseRays = static_cast<int>(std::clamp<size_t>(options.rayBudget / activeSamples,
-                                                   static_cast<size_t>(std::max(1, options.minRays)),
-                                                   static_cast<size_t>(baseRays)));
-  const double rayScale = static_cast<double>(baseRays) / std::max(1, options.rays);
-  const int extraRays = static_cast<int>(std::lround(std::max(0, options.refineRays) * rayScale));
-  const int refineHits = static_cast<int>(std::ceil(options.refineFraction * baseRays));
-  // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
-  // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
-  // per-sample ray count is low. Radius and texel geometry per page, once for all sweeps.
+// Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
+// on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
+// per-sample ray count is low. Radius and texel geometry per page, once for all sweeps.
+void ClampGather::Impl::chooseFilters() {
   const float clampRadius = 1.0f / std::sqrt(bound);
-  std::vector<int>& radii = g.radii;
-  std::vector<std::unique_ptr<SurfaceFilter>>& filters = g.filters;
   radii.assign(in.texels.size(), 0);
   filters.resize(in.texels.size());
-  int& filterRadius = g.filterRadius;
   for (size_t p = 0; p < in.texels.size(); ++p) {
     if (options.filterRadius == 0 || (options.filterRadius < 0 && baseRays >= 32)) continue;
     auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
@@ -143,111 +153,140 @@ ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& o
     filterRadius = std::max(filterRadius, radii[p]);
     if (radii[p] > 0) filters[p] = std::move(filter);
   }
-  // Traces `count` cosine rays from slot s of page p (a rotated Fibonacci lattice: well stratified over
-  // the hemisphere for any count) and appends the hits inside the clamp radius, not yet divided by the
-  // slot's ray count.
-  auto traceSlot = [&](size_t p, size_t s, int count, uint64_t round, std::vector<KeptHit>& out) {
-    const TexelSamples& ts = in.texels[p];
-    glm::vec3 n(ts.normal[s]);
-    glm::vec3 x(ts.positionWeight[s]);
-    if (s < ts.primitive.size() && ts.primitive[s] < scene.primitives.size())
-      x = rt.insetPoint(ts.primitive[s], ts.triangle[s], x);
-    const glm::vec3 origin = x + n * rt.epsilon();
-    Rng rng(hashSeed(options.seed, (static_cast<uint64_t>(ts.page) << 8) | round, s));
-    const double r1 = rng.uniform(), r2 = rng.uniform();
-    int kept = 0;
-    for (int i = 0; i < count; ++i) {
-      double u = std::fmod((i + 0.5) / count + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
-      glm::vec3 dir = cosineHemisphere(n, u, v);
-      RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
-      if (!hit.hit || hit.backFace) continue;
-      float cosX = glm::dot(n, dir), cosY = -glm::dot(hit.geometricNormal, dir);
-      glm::vec3 d = hit.position - x;
-      float r2 = glm::dot(d, d);
-      if (!(r2 > 0.0f) || cosX <= 0.0f || cosY <= 0.0f) continue;
-      float g = cosX * cosY / r2;
-      if (g <= bound) continue;
-      KeptHit k;
-      k.slot = static_cast<uint32_t>(s);
-      float w = 1.0f - bound / g;
-      const Primitive& prim = scene.primitives[hit.primitive];
-      k.emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
-      k.albedo = w * rt.albedoAt(hit);
-      int page = prim.lightmap.page;
-      if (page >= 0 && static_cast<size_t>(page) < mapOfPage.size() && mapOfPage[page] >= 0 &&
-          prim.uv1.size() == prim.positions.size()) {
-        const uint32_t* idx = &prim.indices[3 * static_cast<size_t>(hit.triangle)];
-        float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
-        glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
-        const TexelSamples& m = in.texels[mapOfPage[page]];
-        k.map = mapOfPage[page];
-        k.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
-      }
-      out.push_back(k);
-      ++kept;
-    }
-    return kept;
-  };
+}
 
-  // Round 1: every sample, baseRays each. raysOf = rays traced per slot (0: empty slot).
-  std::vector<std::vector<uint16_t>>& raysOf = g.raysOf;
+// Traces `count` cosine rays from slot s of page p (a rotated Fibonacci lattice: well stratified over
+// the hemisphere for any count) and appends the hits inside the clamp radius, not yet divided by the
+// slot's ray count. Returns how many it kept.
+int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, std::vector<KeptHit>& out) const {
+  const Scene& scene = in.scene;
+  const RayTracer& rt = in.rayTracer;
+  const TexelSamples& ts = in.texels[p];
+  glm::vec3 n(ts.normal[s]);
+  glm::vec3 x(ts.positionWeight[s]);
+  if (s < ts.primitive.size() && ts.primitive[s] < scene.primitives.size())
+    x = rt.insetPoint(ts.primitive[s], ts.triangle[s], x);
+  const glm::vec3 origin = x + n * rt.epsilon();
+  Rng rng(hashSeed(options.seed, (static_cast<uint64_t>(ts.page) << 8) | round, s));
+  const double r1 = rng.uniform(), r2 = rng.uniform();
+  int keptCount = 0;
+  for (int i = 0; i < count; ++i) {
+    double u = std::fmod((i + 0.5) / count + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
+    glm::vec3 dir = cosineHemisphere(n, u, v);
+    RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
+    if (!hit.hit || hit.backFace) continue;
+    // The same G as the clamp the VPL sum applied (0 when either surface faces away, so never kept).
+    const float g = vplGeometryTerm(x, n, hit.position, hit.geometricNormal);
+    if (g <= bound) continue;
+    KeptHit kept;
+    kept.slot = static_cast<uint32_t>(s);
+    float w = 1.0f - bound / g;
+    const Primitive& prim = scene.primitives[hit.primitive];
+    kept.emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
+    kept.albedo = w * rt.albedoAt(hit);
+    int page = prim.lightmap.page;
+    if (page >= 0 && static_cast<size_t>(page) < mapOfPage.size() && mapOfPage[page] >= 0 &&
+        prim.uv1.size() == prim.positions.size()) {
+      const uint32_t* idx = &prim.indices[3 * static_cast<size_t>(hit.triangle)];
+      float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
+      glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
+      const TexelSamples& m = in.texels[mapOfPage[page]];
+      kept.map = mapOfPage[page];
+      kept.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
+    }
+    out.push_back(kept);
+    ++keptCount;
+  }
+  return keptCount;
+}
+
+// Round 1: every sample, baseRays each. Fills raysOf (rays traced per slot, 0: empty slot) and returns the
+// hits each slot kept, which choose the samples of round 2.
+std::vector<std::vector<uint16_t>> ClampGather::Impl::traceFirstRound() {
   raysOf.resize(in.texels.size());
   std::vector<std::vector<uint16_t>> firstHits(in.texels.size());
   for (size_t p = 0; p < in.texels.size(); ++p) {
     raysOf[p].assign(in.texels[p].slotCount(), 0);
     firstHits[p].assign(in.texels[p].slotCount(), 0);
   }
+  std::atomic<size_t> traced{0};
   tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
     Tile& tile = tiles[ti];
     const TexelSamples& ts = in.texels[tile.page];
-    size_t traced = 0;
+    size_t tracedHere = 0;
     for (size_t s = tile.begin; s < tile.end; ++s) {
       if (!(ts.positionWeight[s].w > 0.0f)) continue;
-      int k = traceSlot(tile.page, s, baseRays, 0, tile.hits);
-      traced += baseRays;
+      int keptCount = traceSlot(tile.page, s, baseRays, 0, tile.hits);
+      tracedHere += baseRays;
       raysOf[tile.page][s] = static_cast<uint16_t>(baseRays);
-      firstHits[tile.page][s] = static_cast<uint16_t>(std::min(k, 65535));
+      firstHits[tile.page][s] = static_cast<uint16_t>(std::min(keptCount, 65535));
     }
-    rays += traced;
+    traced += tracedHere;
   });
+  rays += traced;
+  return firstHits;
+}
 
-  // Round 2: more rays where many first rays found clamped transport, within the same budget again.
+// Round 2: more rays where many first rays found clamped transport, within the same budget again.
+void ClampGather::Impl::traceRefinement(const std::vector<std::vector<uint16_t>>& firstHits, const RayPlan& plan) {
   size_t candidates = 0;
   for (size_t p = 0; p < in.texels.size(); ++p)
-    for (size_t s = 0; s < firstHits[p].size(); ++s) candidates += firstHits[p][s] > 0 && firstHits[p][s] >= refineHits;
-  int extra = std::min(extraRays, 65535 - baseRays);
+    for (size_t s = 0; s < firstHits[p].size(); ++s)
+      candidates += firstHits[p][s] > 0 && firstHits[p][s] >= plan.refineHits;
+  int extra = std::min(plan.extraRays, 65535 - baseRays);
   if (options.rayBudget > 0 && candidates > 0)
     extra = static_cast<int>(std::min<size_t>(static_cast<size_t>(std::max(extra, 0)), options.rayBudget / candidates));
-  if (extra > 0 && candidates > 0) {
-    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
-      Tile& tile = tiles[ti];
-      size_t traced = 0, refinedHere = 0;
-      for (size_t s = tile.begin; s < tile.end; ++s) {
-        const uint16_t h = firstHits[tile.page][s];
-        if (h == 0 || h < refineHits) continue;
-        traceSlot(tile.page, s, extra, 1, tile.hits);
-        traced += extra;
-        raysOf[tile.page][s] = static_cast<uint16_t>(raysOf[tile.page][s] + extra);
-        ++refinedHere;
-      }
-      rays += traced;
-      refined += refinedHere;
-    });
-  }
-  // Each hit stands for 1 / (rays of its slot) of the hemisphere.
+  if (extra <= 0 || candidates == 0) return;
+  std::atomic<size_t> traced{0}, refinedSamples{0};
   tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
     Tile& tile = tiles[ti];
-    for (KeptHit& k : tile.hits) {
-      const float inv = 1.0f / static_cast<float>(std::max<uint16_t>(1, raysOf[tile.page][k.slot]));
-      k.emitted *= inv;
-      k.albedo *= inv;
+    size_t tracedHere = 0, refinedHere = 0;
+    for (size_t s = tile.begin; s < tile.end; ++s) {
+      const uint16_t h = firstHits[tile.page][s];
+      if (h == 0 || h < plan.refineHits) continue;
+      traceSlot(tile.page, s, extra, 1, tile.hits);
+      tracedHere += extra;
+      raysOf[tile.page][s] = static_cast<uint16_t>(raysOf[tile.page][s] + extra);
+      ++refinedHere;
+    }
+    traced += tracedHere;
+    refinedSamples += refinedHere;
+  });
+  rays += traced;
+  refined += refinedSamples;
+}
+
+// Each hit stands for 1 / (rays of its slot) of the hemisphere.
+void ClampGather::Impl::divideByRaysOfSlot() {
+  tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+    Tile& tile = tiles[ti];
+    for (KeptHit& kept : tile.hits) {
+      const float inv = 1.0f / static_cast<float>(std::max<uint16_t>(1, raysOf[tile.page][kept.slot]));
+      kept.emitted *= inv;
+      kept.albedo *= inv;
     }
   });
+}
 
-  g.baseRays = baseRays;
-  g.rays = rays;
-  g.refined = refined;
-  g.traceSeconds = clock.seconds();
+ClampGather::~ClampGather() = default;
+double ClampGather::traceSeconds() const { return impl_->traceSeconds; }
+
+ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& options)
+    : impl_(std::make_unique<Impl>(in, options)) {
+  Stopwatch clock;
+  Impl& gather = *impl_;
+  gather.bound = in.eval.clampBound;
+  gather.enabled = in.eval.includeVpls && gather.bound > 0.0f;
+  if (!gather.enabled) return;
+  gather.mapOfPage = mapIndexOfPages(in.texels);
+  gather.makeTiles();
+  const RayPlan plan = planRays(in.texels, options);
+  gather.baseRays = plan.baseRays;
+  gather.chooseFilters();
+  const std::vector<std::vector<uint16_t>> firstHits = gather.traceFirstRound();
+  gather.traceRefinement(firstHits, plan);
+  gather.divideByRaysOfSlot();
+  gather.traceSeconds = clock.seconds();
 }
 
 void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats) const {
@@ -276,7 +315,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   double mapTotal = 0.0;
   for (size_t p = 0; p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t)
-      if (maps[p].valid[t]) mapTotal += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
+      if (maps[p].valid[t]) mapTotal += channelMean(base[p][t]);
   double lastAdded = 0.0;
   int sweepsDone = 0;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
@@ -284,10 +323,10 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
       for (size_t s = tile.begin; s < tile.end; ++s) res[s] = glm::vec3(0.0f);
-      for (const KeptHit& k : tile.hits) {
-        glm::vec3 L = k.emitted;
-        if (k.map >= 0) L += k.albedo * lookup(maps[k.map], current[k.map], k.texel);
-        res[k.slot] += L;
+      for (const KeptHit& kept : tile.hits) {
+        glm::vec3 L = kept.emitted;
+        if (kept.map >= 0) L += kept.albedo * lookup(maps[kept.map], current[kept.map], kept.texel);
+        res[kept.slot] += L;
       }
     });
     std::vector<std::vector<glm::vec3>> next = base;
@@ -301,14 +340,14 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
       if (filters[p]) {
-        TexelFilterOptions fo;
-        fo.radius = radii[p];
-        residual = filters[p]->apply(residual, m.valid, fo);
+        TexelFilterOptions filterOptions;
+        filterOptions.radius = radii[p];
+        residual = filters[p]->apply(residual, m.valid, filterOptions);
       }
       for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
         if (m.valid[t]) {
           next[p][t] += residual[t];
-          added += (residual[t].x + residual[t].y + residual[t].z) / 3.0;
+          added += channelMean(residual[t]);
         }
     }
     current.swap(next);
@@ -326,8 +365,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       if (!maps[p].valid[t]) continue;
       glm::vec3 c = current[p][t];
       if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;  // post's finite check reports
-      before += (base[p][t].x + base[p][t].y + base[p][t].z) / 3.0;
-      added += ((c - base[p][t]).x + (c - base[p][t]).y + (c - base[p][t]).z) / 3.0;
+      before += channelMean(base[p][t]);
+      added += channelMean(c - base[p][t]);
       maps[p].texels[t] = c;
     }
   }

@@ -11,7 +11,7 @@
 
 #include "atlas/atlas.h"
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "backend/gl/gl_backend.h"
 #include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
@@ -42,10 +42,10 @@ TEST(ClampCompensation, NoClampAddsNothing) {
   const VplSet vpls = generateVpls(s, rt, walk);
   BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};  // clampBound 0
   std::vector<Lightmap> maps = bakeEmbree(in), before = maps;
-  ClampCompensationStats st;
-  compensateClamp(in, maps, {}, &st);
+  ClampCompensationStats stats;
+  compensateClamp(in, maps, {}, &stats);
   for (size_t p = 0; p < maps.size(); ++p) EXPECT_EQ(maps[p].texels, before[p].texels);
-  EXPECT_EQ(st.raysTraced, 0u);
+  EXPECT_EQ(stats.raysTraced, 0u);
 }
 
 // A unit emitter square (Le = 1) 5 cm over a black floor: all the floor receives is direct emission,
@@ -68,10 +68,10 @@ TEST(ClampCompensation, EmitterCloseToFloorMatchesFormFactor) {
   BakeInputs in{s, rt, texels, vpls, eval, {}};
   std::vector<Lightmap> maps = bakeEmbree(in);
   const std::vector<Lightmap> clamped = maps;
-  ClampCompensationOptions co;
-  co.rays = 64;
-  co.refineRays = 448;
-  compensateClamp(in, maps, co);
+  ClampCompensationOptions options;
+  options.rays = 64;
+  options.refineRays = 448;
+  compensateClamp(in, maps, options);
   const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
   double se = 0, se0 = 0, ref2 = 0;
   for (size_t i = 0; i < maps[0].size(); ++i) {
@@ -111,8 +111,8 @@ struct FurnaceBake {
 // the compensated one is within 1% on average (measured −0.2%) and within 7% at 99% of the texels.
 void expectFurnaceCompensated(const std::vector<Lightmap>& clamped, std::vector<Lightmap> maps, const BakeInputs& in,
                               const char* backend) {
-  ClampCompensationStats st;
-  compensateClamp(in, maps, {}, &st);
+  ClampCompensationStats stats;
+  compensateClamp(in, maps, {}, &stats);
   std::vector<double> err;
   for (const auto& m : maps)
     for (size_t i = 0; i < m.size(); ++i)
@@ -122,8 +122,8 @@ void expectFurnaceCompensated(const std::vector<Lightmap>& clamped, std::vector<
   const double mc = validMean(clamped), mk = validMean(maps);
   std::printf("[ figure ] furnace %s k=256: clamped mean %.4f (%+.2f%%), compensated %.4f (%+.2f%%), p99 |err| %.2f%%, "
               "%zu rays, %zu refined samples, %.2f s\n",
-              backend, mc, 100 * (mc / 2 - 1), mk, 100 * (mk / 2 - 1), 100 * p99, st.raysTraced, st.samplesRefined,
-              st.seconds);
+              backend, mc, 100 * (mc / 2 - 1), mk, 100 * (mk / 2 - 1), 100 * p99, stats.raysTraced, stats.samplesRefined,
+              stats.seconds);
   EXPECT_LT(mc, 1.9);  // the tight clamp removes > 5%
   EXPECT_NEAR(mk / 2.0, 1.0, 0.01);
   EXPECT_LT(p99, 0.07);  // VPL noise at the clamp-radius scale (measured 5.2%), not bias
@@ -148,9 +148,9 @@ TEST(ClampCompensation, SweepsStopWhenAnotherBounceNoLongerChangesTheMap) {
     ClampCompensationOptions o;
     o.sweeps = sweeps;
     o.sweepTolerance = tolerance;
-    ClampCompensationStats st;
-    compensateClamp(in, maps, o, &st);
-    if (done) *done = st.sweeps;
+    ClampCompensationStats stats;
+    compensateClamp(in, maps, o, &stats);
+    if (done) *done = stats.sweeps;
     return validMean(maps);
   };
   int byDefault = 0, full = 0, one = 0;
@@ -169,10 +169,10 @@ TEST(ClampCompensation, SweepsStopWhenAnotherBounceNoLongerChangesTheMap) {
 TEST(ClampCompensation, FurnaceGlWithinOnePercent) {
   FurnaceBake f(2048, 256.0);
   const BakeInputs in = f.inputs();
-  GlBackendOptions go;
-  go.cubeFaceSize = 64;  // a convex box: nothing to shadow, small cubes keep the test quick
-  go.vplsPerPass = 64;
-  const auto maps = bakeGl(in, go);
+  GlBackendOptions glOptions;
+  glOptions.cubeFaceSize = 64;  // a convex box: nothing to shadow, small cubes keep the test quick
+  glOptions.vplsPerPass = 64;
+  const auto maps = bakeGl(in, glOptions);
   expectFurnaceCompensated(maps, maps, in, "gl");
 }
 

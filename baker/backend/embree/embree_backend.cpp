@@ -7,7 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "common/error.h"
 
 namespace irbake {
@@ -105,35 +105,6 @@ glm::vec3 vplSumAt(const BakeInputs& in, float bound, const glm::vec3& x, const 
   return acc.sum;
 }
 
-// Kollig & Keller 2004: the energy the clamp removed, as a map value. From x a cosine direction finds y;
-// where G(x, y) exceeds the bound B, the fraction w = 1 − B/G of the radiance leaving y towards x was
-// lost: L(y→x) = Le(y) + ρ(y) · (direct(y) + clampedVpl(y) + residual(y)) in map units. With cosine
-// sampling (pdf cosθ/π) the estimator of the lost irradiance / π is w · L(y→x).
-glm::vec3 residualAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, Rng& rng, int depth,
-                     bool packets) {
-  if (depth <= 0 || bound <= 0.0f) return glm::vec3(0.0f);
-  const RayTracer& rt = in.rayTracer;
-  glm::vec3 dir = cosineHemisphere(n, rng.uniform(), rng.uniform());
-  RayHit hit = rt.intersect(x + n * rt.epsilon(), dir, 0.0f, 1e30f);
-  if (!hit.hit) return glm::vec3(0.0f);
-  float cosX = glm::dot(n, dir), cosY = std::abs(glm::dot(hit.geometricNormal, dir));
-  float r = glm::length(hit.position - x);
-  if (!(r > 0.0f)) return glm::vec3(0.0f);
-  float g = cosX * cosY / (r * r);
-  if (g <= bound) return glm::vec3(0.0f);
-  float w = 1.0f - bound / g;
-  const Primitive& prim = in.scene.primitives[hit.primitive];
-  glm::vec3 Le(0.0f);
-  if (!hit.backFace) Le = in.scene.emissionAt(prim, hit.triangle, hit.barycentric);  // emitters emit from the front
-  glm::vec3 ny = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;        // the side facing x
-  glm::vec3 albedo = rt.albedoAt(hit);
-  glm::vec3 reflected(0.0f);
-  if (albedo != glm::vec3(0.0f))
-    reflected = directAt(in, hit.position, ny) + vplSumAt(in, bound, hit.position, ny, packets) +
-                residualAt(in, bound, hit.position, ny, rng, depth - 1, packets);
-  return w * (Le + albedo * reflected);
-}
-
 float clampBoundFor(const BakeInputs& in) { return in.eval.includeVpls ? in.eval.clampBound : 0.0f; }
 
 // A texel sample's position moved ε into its triangle: samples snapped onto an edge (a texel centre
@@ -149,21 +120,16 @@ glm::vec3 samplePosition(const BakeInputs& in, const TexelSamples& ts, size_t s)
 
 }  // namespace
 
-PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Rng& rng,
-                              const EmbreeOptions& options) {
+PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, const EmbreeOptions& options) {
   PointShading s;
   if (in.eval.includeDirect) s.direct = directAt(in, x, n);
-  if (in.eval.includeVpls) {
-    float bound = clampBoundFor(in);
-    s.vpl = vplSumAt(in, bound, x, n, options.packets);
-    if (in.eval.biasCompensation && bound > 0.0f) {
-      int k = std::max(1, options.compensationRays);
-      for (int i = 0; i < k; ++i)
-        s.compensation += residualAt(in, bound, x, n, rng, options.compensationDepth, options.packets);
-      s.compensation /= static_cast<float>(k);
-    }
-  }
+  if (in.eval.includeVpls) s.vpl = vplSumAt(in, clampBoundFor(in), x, n, options.packets);
   return s;
+}
+
+PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Rng& /*unused*/,
+                              const EmbreeOptions& options) {
+  return shadePointEmbree(in, x, n, options);
 }
 
 std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& options) {
@@ -205,13 +171,6 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
         glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
         glm::vec3 v = acc[a].sum;
         if (in.eval.includeDirect) v += directAt(in, x, n);
-        if (in.eval.includeVpls && in.eval.biasCompensation && bound > 0.0f) {
-          Rng rng(hashSeed(options.seed, static_cast<uint64_t>(ts.page), s));
-          glm::vec3 c(0.0f);
-          int k = std::max(1, options.compensationRays);
-          for (int i = 0; i < k; ++i) c += residualAt(in, bound, x, n, rng, options.compensationDepth, options.packets);
-          v += c / static_cast<float>(k);
-        }
         slotValue[s] = v;
       }
       size_t d = progressSlots.fetch_add(r.size()) + r.size();

@@ -7,16 +7,17 @@
 #include <cstdlib>
 #include <string>
 
-#include "backend/embree/geometry_term.h"
+#include "backend/compensation/test_probe_bake.h"
+#include "common/maths.h"
 #include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
+#include "transport/geometry_term.h"
 #include "vpl/light_sources.h"
 
 using namespace irbake;
 using namespace irbake::testing;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 struct Baked {
   std::vector<Lightmap> maps;
@@ -24,13 +25,24 @@ struct Baked {
 };
 
 Baked bakeWith(const Scene& s, const std::vector<TexelSamples>& texels, const WalkOptions& walk, VplEvalOptions eval,
-               bool autoClamp, const EmbreeOptions& eo = {}) {
+               bool autoClamp, const EmbreeOptions& embreeOptions = {}) {
   RayTracer rt(s);
   Baked b;
   b.vpls = generateVpls(s, rt, walk);
   if (autoClamp) eval.clampBound = deriveClampBound(s, b.vpls);
   BakeInputs in{s, rt, texels, b.vpls, eval, {}};
-  b.maps = bakeEmbree(in, eo);
+  b.maps = bakeEmbree(in, embreeOptions);
+  return b;
+}
+
+// The probes baked with the derived clamp and ClampGather's compensation.
+Baked bakeCompensated(Scene s, const std::vector<TexelSamples>& probes, const WalkOptions& walk) {
+  const AtlasedScene atlased(std::move(s), 64);
+  Baked b;
+  b.vpls = generateVpls(atlased.scene, *atlased.rayTracer, walk);
+  VplEvalOptions eval;
+  eval.clampBound = deriveClampBound(atlased.scene, b.vpls);
+  b.maps = bakeProbesCompensated(atlased, probes, b.vpls, eval).compensated;
   return b;
 }
 
@@ -66,46 +78,6 @@ double quadRelativeRmse(const Lightmap& m, const TexelSamples& t, float h) {
 }
 
 }  // namespace
-
-TEST(GeometryTerm, ClosedFormsAndClamp) {
-  // Receiver at origin facing +z, VPL at (0,0,2) facing down: G = 1/4.
-  EXPECT_FLOAT_EQ(vplGeometryTerm(glm::vec3(0), glm::vec3(0, 0, 1), glm::vec3(0, 0, 2), glm::vec3(0, 0, -1)), 0.25f);
-  // 45° offsets: cos = 1/√2 both, r² = 2 → G = 1/4.
-  EXPECT_NEAR(vplGeometryTerm(glm::vec3(0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 1), glm::vec3(0, 0, -1)), 0.25f, 1e-6f);
-  // Facing away on either end: 0.
-  EXPECT_EQ(vplGeometryTerm(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 0, 2), glm::vec3(0, 0, -1)), 0.0f);
-  EXPECT_EQ(vplGeometryTerm(glm::vec3(0), glm::vec3(0, 0, 1), glm::vec3(0, 0, 2), glm::vec3(0, 0, 1)), 0.0f);
-  EXPECT_EQ(clampGeometryTerm(5.0f, 2.0f), 2.0f);
-  EXPECT_EQ(clampGeometryTerm(5.0f, 0.0f), 5.0f);
-  EXPECT_NEAR(vplMapValue(glm::vec3(kPi * kPi), 0.5f).x, 0.5f, 1e-6f);
-  // Clamp bound: π N / (k A) for a 2×3 plane and 10 VPLs.
-  Scene s;
-  addQuad(s, addMaterial(s, glm::vec3(0.5f)), glm::vec3(0), glm::vec3(2, 0, 0), glm::vec3(0, 3, 0));
-  VplSet v;
-  v.vpls.resize(10, Vpl{glm::vec3(0), glm::vec3(0, 0, 1), glm::vec3(1.0f), 1});
-  v.vpls.push_back(Vpl{});  // zero power: not counted
-  EXPECT_NEAR(deriveClampBound(s, v), kPi * 10 / (kClampVplsPerMean * 6.0), 1e-5);
-  // Spot light: full inside the inner cone, zero outside the outer cone, squared linear ramp between.
-  Light spot;
-  spot.type = LightType::Spot;
-  spot.position = glm::vec3(0, 0, 1);
-  spot.intensity = 3.0f;
-  spot.innerConeAngle = 0.2f;
-  spot.outerConeAngle = 0.4f;
-  PunctualContribution c = punctualDirect(spot, glm::vec3(0), glm::vec3(0, 0, 1));
-  EXPECT_NEAR(c.mapValue.x, 3.0 / kPi, 1e-6);
-  EXPECT_NEAR(c.distance, 1.0f, 1e-6f);
-  EXPECT_EQ(punctualDirect(spot, glm::vec3(1, 0, 0), glm::vec3(0, 0, 1)).mapValue.x, 0.0f);  // 45° > outer
-  float midCos = 0.5f * (std::cos(0.2f) + std::cos(0.4f));
-  glm::vec3 mid(std::sqrt(1 - midCos * midCos) / midCos, 0, 0);
-  double r2 = 1.0 / (midCos * midCos);
-  EXPECT_NEAR(punctualDirect(spot, mid, glm::vec3(0, 0, 1)).mapValue.x, 3.0 * 0.25 * midCos / r2 / kPi, 1e-5);
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(1, 0, -1));
-  sun.intensity = 2.0f;
-  EXPECT_NEAR(punctualDirect(sun, glm::vec3(5), glm::vec3(0, 0, 1)).mapValue.x, 2.0 / std::sqrt(2.0) / kPi, 1e-6);
-}
 
 // Issue item 9: point light over a black plane, every texel within 0.5% of I cosθ / (π r²).
 TEST(EmbreeBackend, PointLightOverPlaneMatchesInverseSquareEverywhere) {
@@ -168,8 +140,10 @@ Scene furnace(float rho, float Le) {
   return s;
 }
 
+// The Embree backend's clamped sum with ClampGather's compensation, on probe grids of a furnace.
 void runFurnace(float rho, int paths, int grid, float fixedBound = 0.0f) {
-  Scene s = furnace(rho, 1.0f);
+  const AtlasedScene room(furnace(rho, 1.0f), 32);
+  const Scene& s = room.scene;
   // Floor and one wall (its grid faces +x, into the room); the outer rows of texels lie within the
   // clamp radius of the neighbouring faces, where the clamp bites.
   std::vector<TexelSamples> texels = {gridSamples(glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), grid, grid),
@@ -178,16 +152,13 @@ void runFurnace(float rho, int paths, int grid, float fixedBound = 0.0f) {
   w.paths = paths;
   // Default auto depth: the VPL budget binds at ρ = 0.9 and the geometric tail carries the rest.
   w.seed = std::getenv("IRBAKE_TEST_SEED") ? std::atoi(std::getenv("IRBAKE_TEST_SEED")) : 0;
-  RayTracer rt(s);
-  VplSet vpls = generateVpls(s, rt, w);
+  VplSet vpls = generateVpls(s, *room.rayTracer, w);
   VplEvalOptions eval;
   eval.clampBound = fixedBound > 0.0f ? fixedBound : deriveClampBound(s, vpls);
-  BakeInputs in{s, rt, texels, vpls, eval, {}};
   auto both = [&](const std::vector<Lightmap>& m) { return 0.5 * (mean(m[0]) + mean(m[1])); };
-  double mc = both(bakeEmbree(in));
-  in.eval.biasCompensation = true;
-  double mk = both(bakeEmbree(in));
-  in.eval.biasCompensation = false;
+  const ProbeBake probes = bakeProbesCompensated(room, texels, vpls, eval);
+  double mc = both(probes.clamped), mk = both(probes.compensated);
+  BakeInputs in{s, *room.rayTracer, texels, vpls, eval, {}};
   in.eval.clampBound = 0.0f;
   double mu = both(bakeEmbree(in));
   double exact = 1.0 / (1.0 - rho);
@@ -202,7 +173,7 @@ void runFurnace(float rho, int paths, int grid, float fixedBound = 0.0f) {
 }
 }  // namespace
 
-// Issue item 9: furnace, mean within 1% of Le/(1−ρ) with bias compensation; clamped-only bias printed.
+// Issue item 9: furnace, mean within 1% of Le/(1−ρ) with the clamp compensation; clamped-only bias printed.
 TEST(EmbreeBackend, FurnaceHalfAlbedo) { runFurnace(0.5f, 4096, 16); }
 TEST(EmbreeBackend, FurnaceHighAlbedo) { runFurnace(0.9f, 1024, 12); }
 // A deliberately coarse clamp (B = 25/m², r_c = 0.2 m: a fifth of the room) removes a large part of the
@@ -213,7 +184,7 @@ TEST(EmbreeBackend, FurnaceCoarseClampIsCompensated) {
 }
 
 // Issue item 9: thin wall. Light on one side; the floor on the other side, right against the wall,
-// stays dark (< 1e-3 of the lit side) with VPL bounces and bias compensation on.
+// stays dark (< 1e-3 of the lit side) with VPL bounces and the clamp compensation on.
 TEST(EmbreeBackend, ThinWallDoesNotLeak) {
   Scene s;
   int grey = addMaterial(s, glm::vec3(0.7f));
@@ -227,9 +198,7 @@ TEST(EmbreeBackend, ThinWallDoesNotLeak) {
                                       gridSamples(glm::vec3(0.0015f, -1, 0), glm::vec3(0.05f, 0, 0), glm::vec3(0, 2, 0), 8, 16)};
   WalkOptions w;
   w.paths = 1024;
-  VplEvalOptions e;
-  e.biasCompensation = true;
-  Baked b = bakeWith(s, texels, w, e, true);
+  const Baked b = bakeCompensated(std::move(s), texels, w);
   double lit = mean(b.maps[0]), darkMax = 0.0;
   for (const glm::vec3& v : b.maps[1].texels) darkMax = std::max(darkMax, double(std::max(v.x, std::max(v.y, v.z))));
   std::printf("[ figure ] thin wall: lit mean %.4f, dark max %.3e (ratio %.1e)\n", lit, darkMax, darkMax / lit);
@@ -280,7 +249,7 @@ TEST(EmbreeBackend, HundredThousandVplsSumLikeDouble) {
 
 // The project's thin-wall sample: two closed rooms sharing a zero-thickness partition (coincident
 // quads facing −X and +X). Floor strips hugging the partition on both sides: the dark room stays
-// dark with bounces and bias compensation.
+// dark with bounces and the clamp compensation.
 TEST(EmbreeBackend, ZeroThicknessPartitionDoesNotLeak) {
   Scene s = samples::makeThinWall();  // y up, partition at x = 0, light at (−1, 1, 0)
   // Floor (y = 0, normal +Y = Z × X): texel centres 0.5 mm … 5 cm from the partition.
@@ -288,9 +257,7 @@ TEST(EmbreeBackend, ZeroThicknessPartitionDoesNotLeak) {
                                       gridSamples(glm::vec3(0.0005f, 0, -1), glm::vec3(0, 0, 2), glm::vec3(0.05f, 0, 0), 16, 8)};
   WalkOptions w;
   w.paths = 2048;
-  VplEvalOptions e;
-  e.biasCompensation = true;
-  Baked b = bakeWith(s, texels, w, e, true);
+  const Baked b = bakeCompensated(std::move(s), texels, w);
   double lit = mean(b.maps[0]), darkMax = 0.0;
   for (const glm::vec3& v : b.maps[1].texels) darkMax = std::max(darkMax, double(std::max(v.x, std::max(v.y, v.z))));
   std::printf("[ figure ] zero-thickness partition: lit mean %.4f, dark max %.3e, %zu VPLs\n", lit, darkMax, b.vpls.vpls.size());

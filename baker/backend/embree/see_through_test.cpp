@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "backend/embree/embree_backend.h"
+#include "common/maths.h"
 #include "backend/reference/reference_integrator.h"
 #include "raytrace/test_scenes.h"
 #include "vpl/vpl.h"
@@ -50,7 +51,7 @@ struct PaneScene {
       const glm::vec3 x(pages[0].positionWeight[i]);
       const glm::vec3 d = glm::vec3(0, 0, 2) - x;
       const double r2 = glm::dot(d, d);
-      sum += 4.0 * (2.0 / std::sqrt(r2)) / (r2 * 3.14159265358979323846);
+      sum += 4.0 * (2.0 / std::sqrt(r2)) / (r2 * kPi);
     }
     return sum / static_cast<double>(pages[0].layerSize());
   }
@@ -110,7 +111,7 @@ TEST(SeeThrough, WalkThroughAClearPaneKeepsTheEnergy) {
   w.paths = 1024;
   w.maxBounces = 6;
   const VplSet set = generateVpls(scene, rt, w);
-  const double Phi = 3.14159265358979323846 * 6.0;
+  const double Phi = kPi * 6.0;
   for (int j = 0; j <= 6; ++j) EXPECT_NEAR(set.powerPerBounce[j].x, Phi * std::pow(0.5, j), 1e-4 * Phi) << j;
 }
 

@@ -11,13 +11,13 @@
 
 #include <tbb/parallel_for.h>
 
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "common/error.h"
+#include "common/maths.h"
 
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 glm::vec3 punctualAt(const Scene& scene, const RayTracer& rt, const glm::vec3& origin, const glm::vec3& x,
                      const glm::vec3& n) {
@@ -81,9 +81,9 @@ glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const Lig
     // surface's Lambertian part below.
     glm::vec3 straightOrigin;
     while (hit.hit) {
-      const SurfaceTransmission st = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
-      if (st.fraction <= 0.0f || rng.uniform() >= st.fraction) break;
-      beta *= glm::dvec3(st.tint);
+      const SurfaceTransmission transmission = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+      if (transmission.fraction <= 0.0f || rng.uniform() >= transmission.fraction) break;
+      beta *= glm::dvec3(transmission.tint);
       straightOrigin = hit.position + dir * rt.epsilon();
       hit = rt.intersect(straightOrigin, dir, 0.0f, 1e30f);
     }

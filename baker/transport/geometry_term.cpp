@@ -1,4 +1,4 @@
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 
 #include <cmath>
 #include <limits>
@@ -40,7 +40,7 @@ float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMea
       area += 0.5 * glm::length(glm::cross(p.positions[p.indices[3 * t + 1]] - a, p.positions[p.indices[3 * t + 2]] - a));
     }
   if (n == 0 || area <= 0.0) return 0.0f;
-  return static_cast<float>(3.14159265358979323846 * static_cast<double>(n) / (vplsPerMean * area));
+  return static_cast<float>(kPi * static_cast<double>(n) / (vplsPerMean * area));
 }
 
 }  // namespace irbake
