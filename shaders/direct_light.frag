@@ -59,13 +59,10 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
         ambiguous = inFrontOfPlane(stored, p, ng, length(stored - lightPosition), footprint);
       }
       // The 2×2 texels around the lookup in its face (as cubeDepth's table).
-      vec3 a = abs(local);
-      bool xMajor = a.x >= a.y && a.x >= a.z;
-      bool yMajor = !xMajor && a.y >= a.z;
-      int face = xMajor ? (local.x >= 0.0 ? 0 : 1) : (yMajor ? (local.y >= 0.0 ? 2 : 3) : (local.z >= 0.0 ? 4 : 5));
-      vec2 sctc = xMajor ? vec2(local.x >= 0.0 ? -local.z : local.z, -local.y)
-                         : (yMajor ? vec2(local.x, local.y >= 0.0 ? local.z : -local.z)
-                                   : vec2(local.z >= 0.0 ? local.x : -local.x, -local.y));
+      int face;
+      vec2 sctc;
+      float axisUnused;
+      cubeFaceCoords(local, face, sctc, axisUnused);
       int size = textureSize(cubeMaps, 0).x;
       ivec2 t0 = clamp(ivec2(floor((sctc / axisDistance * 0.5 + 0.5) * float(size) - 0.5)), ivec2(0), ivec2(size - 2));
       vec4 d = vec4(texelFetch(cubeMaps, ivec3(t0, face), 0).r, texelFetch(cubeMaps, ivec3(t0 + ivec2(1, 0), face), 0).r,

@@ -14,18 +14,26 @@ float vplGeometryTerm(vec3 d, vec3 nx, vec3 ny, float clampBound) {
   return clampBound > 0.0 ? min(g, clampBound) : g;
 }
 
+// The GL cube-map face table (OpenGL 4.5 table 8.19) for a lookup vector v: its face (+X −X +Y −Y +Z −Z),
+// the face coordinates (sc, tc) before division, and the major-axis distance |ma|.
+void cubeFaceCoords(vec3 v, out int face, out vec2 sctc, out float axisDistance) {
+  vec3 a = abs(v);
+  bool xMajor = a.x >= a.y && a.x >= a.z;
+  bool yMajor = !xMajor && a.y >= a.z;
+  axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
+  face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
+  sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
+                : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+}
+
 // Depth cubes are stored as 6 layers of a 2D array per cube (GL face order +X −X +Y −Y +Z −Z) and
 // looked up by hand with the GL cube-map face table (OpenGL 4.5 table 8.19): on llvmpipe a texelFetch
 // is cheaper than a cube-array sample. Returns the stored reversed-Z depth (near / occluder axis
 // distance; 0 where nothing was drawn) and the lookup point's own axis distance in axisDistance.
 float cubeDepth(sampler2DArray cubes, int cube, vec3 v, out float axisDistance) {
-  vec3 a = abs(v);
-  bool xMajor = a.x >= a.y && a.x >= a.z;
-  bool yMajor = !xMajor && a.y >= a.z;
-  axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
-  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
-  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
-                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  int face;
+  vec2 sctc;
+  cubeFaceCoords(v, face, sctc, axisDistance);
   int size = textureSize(cubes, 0).x;
   ivec2 texel = clamp(ivec2((sctc / axisDistance * 0.5 + 0.5) * float(size)), ivec2(0), ivec2(size - 1));
   return texelFetch(cubes, ivec3(texel, 6 * cube + face), 0).r;
@@ -34,13 +42,10 @@ float cubeDepth(sampler2DArray cubes, int cube, vec3 v, out float axisDistance) 
 // The direction (axis component ±1) of the centre of the cube texel that the lookup point v reads in
 // cubeDepth: the inverse of the face table, so a stored depth can be put back where it was rendered.
 vec3 cubeTexelCentreDirection(vec3 v, int size) {
-  vec3 a = abs(v);
-  bool xMajor = a.x >= a.y && a.x >= a.z;
-  bool yMajor = !xMajor && a.y >= a.z;
-  float axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
-  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
-  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
-                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  int face;
+  vec2 sctc;
+  float axisDistance;
+  cubeFaceCoords(v, face, sctc, axisDistance);
   ivec2 texel = clamp(ivec2((sctc / axisDistance * 0.5 + 0.5) * float(size)), ivec2(0), ivec2(size - 1));
   vec2 q = (vec2(texel) + 0.5) / float(size) * 2.0 - 1.0;
   return face == 0 ? vec3(1.0, -q.y, -q.x)
@@ -55,13 +60,10 @@ vec3 cubeTexelCentreDirection(vec3 v, int size) {
 // the lookup point v see the cube's centre: shadow edges become fractional instead of one texel of
 // all-or-nothing, which halves the edge error against ray-traced visibility at the same map size.
 float cubeVisibilityPcf(sampler2DArray cubes, int cube, vec3 v, float nearPlane, float bias) {
-  vec3 a = abs(v);
-  bool xMajor = a.x >= a.y && a.x >= a.z;
-  bool yMajor = !xMajor && a.y >= a.z;
-  float axisDistance = xMajor ? a.x : (yMajor ? a.y : a.z);
-  int face = xMajor ? (v.x >= 0.0 ? 0 : 1) : (yMajor ? (v.y >= 0.0 ? 2 : 3) : (v.z >= 0.0 ? 4 : 5));
-  vec2 sctc = xMajor ? vec2(v.x >= 0.0 ? -v.z : v.z, -v.y)
-                     : (yMajor ? vec2(v.x, v.y >= 0.0 ? v.z : -v.z) : vec2(v.z >= 0.0 ? v.x : -v.x, -v.y));
+  int face;
+  vec2 sctc;
+  float axisDistance;
+  cubeFaceCoords(v, face, sctc, axisDistance);
   int size = textureSize(cubes, 0).x;
   vec2 st = (sctc / axisDistance * 0.5 + 0.5) * float(size) - 0.5;
   vec2 f = fract(st);

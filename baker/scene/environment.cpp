@@ -61,16 +61,22 @@ Environment Environment::fromEquirect(int width, int height, std::vector<glm::ve
   return e;
 }
 
-glm::vec3 Environment::radiance(const glm::vec3& d) const {
-  if (texels_.empty()) return uniform_;
+Environment::Texel Environment::texelOf(const glm::vec3& d) const {
   // Into the map's frame: undo the rotation about +Y.
   const float c = std::cos(rotation_), s = std::sin(rotation_);
   const glm::vec3 m(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
-  const double theta = std::acos(std::clamp(static_cast<double>(m.y), -1.0, 1.0));
+  Texel t;
+  t.theta = std::acos(std::clamp(static_cast<double>(m.y), -1.0, 1.0));
   const double phi = std::atan2(static_cast<double>(m.x), -static_cast<double>(m.z));
-  const int x = std::clamp(static_cast<int>((phi + kPi) / (2.0 * kPi) * width_), 0, width_ - 1);
-  const int y = std::clamp(static_cast<int>(theta / kPi * height_), 0, height_ - 1);
-  return lookup(x, y);
+  t.x = std::clamp(static_cast<int>((phi + kPi) / (2.0 * kPi) * width_), 0, width_ - 1);
+  t.y = std::clamp(static_cast<int>(t.theta / kPi * height_), 0, height_ - 1);
+  return t;
+}
+
+glm::vec3 Environment::radiance(const glm::vec3& d) const {
+  if (texels_.empty()) return uniform_;
+  const Texel t = texelOf(d);
+  return lookup(t.x, t.y);
 }
 
 glm::vec3 Environment::sample(double u1, double u2, double& pdf) const {
@@ -93,12 +99,9 @@ glm::vec3 Environment::sample(double u1, double u2, double& pdf) const {
 
 double Environment::pdf(const glm::vec3& d) const {
   if (texels_.empty() || total_ <= 0.0) return 1.0 / (4.0 * kPi);
-  const float c = std::cos(rotation_), s = std::sin(rotation_);
-  const glm::vec3 m(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
-  const double theta = std::acos(std::clamp(static_cast<double>(m.y), -1.0, 1.0));
-  const double phi = std::atan2(static_cast<double>(m.x), -static_cast<double>(m.z));
-  const int x = std::clamp(static_cast<int>((phi + kPi) / (2.0 * kPi) * width_), 0, width_ - 1);
-  const int y = std::clamp(static_cast<int>(theta / kPi * height_), 0, height_ - 1);
+  const Texel t = texelOf(d);
+  const int x = t.x, y = t.y;
+  const double theta = t.theta;
   // The texel's probability, uniform over its (u, v) rectangle; dω = 2π² sinθ du dv at the direction itself.
   const double sinCentre = std::sin(kPi * (y + 0.5) / height_), sinTheta = std::sin(theta);
   if (sinTheta <= 0.0) return 0.0;

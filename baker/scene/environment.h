@@ -42,6 +42,11 @@ class Environment {
 
  private:
   glm::vec3 lookup(int x, int y) const { return texels_[static_cast<size_t>(y) * width_ + x]; }
+  struct Texel {
+    int x = 0, y = 0;
+    double theta = 0.0;  // polar angle from +Y of the direction itself
+  };
+  Texel texelOf(const glm::vec3& towardSky) const;  // the map texel a direction reads
   glm::vec3 uniform_{0.0f};
   int width_ = 0, height_ = 0;
   std::vector<glm::vec3> texels_;
