@@ -16,6 +16,7 @@ std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const Viewe
   DrawSettings settings;
   settings.mode = o.mode;
   settings.exposure = o.exposure;
+  settings.background = skyBackground(v.scene);
   std::vector<std::filesystem::path> written;
   if (o.walkthrough > 0) {
     for (int i = 0; i < o.walkthrough; ++i) {

@@ -9,6 +9,7 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "screenshot.h"
 #include "glcontext/gl_program.h"
 
 namespace irbake::view {
@@ -345,7 +346,11 @@ ViewRenderer::~ViewRenderer() {
 void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const DrawSettings& settings) {
   Impl& I = *impl_;
   glViewport(0, 0, width, height);
-  glClearColor(settings.background.r, settings.background.g, settings.background.b, 1.0f);
+  // The background as the scene's pixels are: linear radiance offscreen, exposed and sRGB-encoded on screen.
+  glm::vec3 background = settings.background;
+  if (settings.encodeSrgb)
+    for (int c = 0; c < 3; ++c) background[c] = encodeSrgb(std::min(1.0f, background[c] * std::exp2(settings.exposure)));
+  glClearColor(background.r, background.g, background.b, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);

@@ -21,7 +21,7 @@ struct DrawSettings {
   ViewMode mode = ViewMode::Lit;   // what to show
   float exposure = 0.0f;           // EV stops, display only (×2^EV before the sRGB encode)
   bool encodeSrgb = false;         // true: exposure + sRGB in the shader (window); false: linear out
-  glm::vec3 background{0.0f};      // clear colour (linear)
+  glm::vec3 background{0.0f};      // clear colour (linear radiance; exposed and encoded like the scene)
 };
 
 // Linear RGBA float image, row 0 at the top.
@@ -69,5 +69,12 @@ class ViewRenderer {
   std::unique_ptr<Impl> impl_;
   size_t triangles_ = 0;
 };
+
+// The background for a scene: its sky's radiance (a map's mean radiance), black without a sky.
+inline glm::vec3 skyBackground(const Scene& scene) {
+  if (!scene.environment.present()) return glm::vec3(0.0f);
+  if (scene.environment.isUniform()) return scene.environment.uniformRadiance();
+  return glm::vec3(scene.environment.integral() / (4.0 * 3.14159265358979323846));
+}
 
 }  // namespace irbake::view

@@ -339,6 +339,27 @@ TEST(ViewRenderer, SceneWithoutLightmapShowsAlbedoAndWarns) {
   EXPECT_EQ(img.at(0, 0), glm::vec4(0, 0, 0, 1));  // background outside the quad
 }
 
+// Issue 12: the sky is drawn behind the scene, as linear radiance (screenshots) and, on screen, exposed and
+// sRGB-encoded like the scene's pixels.
+TEST(ViewRenderer, SkyIsTheBackground) {
+  GlContext gl;
+  Scene s;
+  Material m;
+  m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  s.materials.push_back(m);
+  addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0, -1, 0);
+  s.environment = Environment::uniform({0.25f, 0.5f, 1.0f});
+  ViewerScene v = makeViewerScene(std::move(s), {});
+  ViewRenderer r(v);
+  DrawSettings settings;
+  settings.background = skyBackground(v.scene);
+  RgbaImage img = r.render(lookAt({0, 2, 0.01f}, {0, 0, 0}, 90.0f, v.scene.bounds()), 32, 32, settings);
+  EXPECT_NEAR(img.at(0, 0).r, 0.25f, 1e-3f);
+  EXPECT_NEAR(img.at(0, 0).g, 0.5f, 1e-3f);
+  EXPECT_NEAR(img.at(0, 0).b, 1.0f, 1e-3f);
+  EXPECT_EQ(skyBackground(Scene{}), glm::vec3(0.0f));  // no sky: black
+}
+
 TEST(ViewRenderer, DebugViewsDifferFromLitAndStayFinite) {
   GlContext gl;
   PlaneCase c = texturedPlane();

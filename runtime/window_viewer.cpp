@@ -112,6 +112,7 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   s.options = &o;
   s.settings.mode = o.mode;
   s.settings.exposure = o.exposure;
+  s.settings.background = skyBackground(v.scene);
   s.settings.encodeSrgb = true;
   s.fly.setFrom(startCamera(o, v.scene));
   s.speed = std::max(0.25f * v.scene.bounds().diagonal(), 1e-3f);

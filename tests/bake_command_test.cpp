@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iterator>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -451,4 +451,22 @@ TEST(BakeCommand, IdenticalBytesForAnyThreadCountAndRun) {
     firstBin[backend] = bytes(runs[0] / "scene.bin");
   }
   EXPECT_TRUE(firstBin["gl"] == firstBin["embree"]);  // the geometry written does not depend on the backend
+}
+
+// Issue 12: --sky lights a bake and travels with the export (root extras "irbakeSky"), so the loader (and
+// irview, which draws it behind the scene) get it back.
+TEST(BakeCommand, SkyTravelsWithTheExport) {
+  const fs::path dir = scratch("sky_export");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir) +
+                          " --vpls 64 --texels-per-unit 2 --quiet --sky 0.25,0.5,1",
+                      &log),
+            0)
+      << log;
+  const Scene back = loadScene(dir / "scene.gltf");
+  ASSERT_TRUE(back.environment.present());
+  ASSERT_TRUE(back.environment.isUniform());
+  EXPECT_EQ(back.environment.uniformRadiance(), glm::vec3(0.25f, 0.5f, 1.0f));
+  EXPECT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir / "bad") + " --sky 1,-1,1", &log), 2)
+      << log;
 }

@@ -449,6 +449,8 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   const bool fromSource = !scene.sourcePath.empty() && std::filesystem::exists(scene.sourcePath);
   GltfDocument doc = fromSource ? SourceExport(scene, maps, pngs, file).run() : documentFromScene(scene, maps, pngs, pageUris);
   if (fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
+  // The sky the bake used, for viewers (irview draws it behind the scene) and for a bake of this export.
+  if (scene.environment.present()) doc.root["extras"]["irbakeSky"] = skyJson(scene.environment);
 
   std::vector<PendingFile> files;
   const std::filesystem::path folder = options.output.parent_path();
@@ -481,6 +483,15 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
     }
   }
   writeAllAtomically(files);
+}
+
+nlohmann::json skyJson(const Environment& sky) {
+  if (sky.isUniform()) {
+    const glm::vec3 L = sky.uniformRadiance();
+    return {{"radiance", {L.x, L.y, L.z}}};
+  }
+  const glm::dvec3 mean = sky.integral() / (4.0 * 3.14159265358979323846);
+  return {{"environment", sky.source()}, {"meanRadiance", {mean.x, mean.y, mean.z}}, {"rotation", sky.rotation()}};
 }
 
 }  // namespace irbake

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "backend/lightmap.h"
 #include "export/lightmap_png.h"
 #include "scene/scene.h"
@@ -28,5 +30,9 @@ std::filesystem::path outputFolderOf(const std::filesystem::path& output);
 // empty: then only TEXCOORD_1 and extras.lightmap are added, as `irbake unwrap` does). Every file is
 // written to a temp name and renamed only when all succeeded. Throws Error(Io) naming the file.
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options);
+
+// The scene's sky as the export's root extras "irbakeSky": {"radiance": [r, g, b]} for a uniform sky,
+// {"environment": file, "meanRadiance": [...], "rotation": radians} for a map (its file is not copied).
+nlohmann::json skyJson(const Environment& sky);
 
 }  // namespace irbake

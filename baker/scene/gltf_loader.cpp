@@ -179,6 +179,7 @@ class Loader {
     }
     decodeTextures();
     readLightmapPages();
+    readSky();
     for (const auto& w : scene_.stats.warnings) log::warn(file_ + ": " + w);
     return std::move(scene_);
   }
@@ -835,6 +836,34 @@ class Loader {
     for (auto& t : pool) t.join();
     for (const auto& f : failures)
       if (!f.empty()) warn(f);
+  }
+
+  // An irbake export's sky (root extras "irbakeSky", export/gltf_export.h): a uniform sky is restored; for a
+  // map the mean radiance stands in (the viewer's background) unless the file is still there.
+  void readSky() {
+    const json* sky = path(src_.json, {"extras", "irbakeSky"});
+    if (!sky || !sky->is_object()) return;
+    auto rgb = [](const json* a, glm::vec3& out) {
+      if (!a || !a->is_array() || a->size() != 3) return false;
+      for (int c = 0; c < 3; ++c) {
+        if (!(*a)[c].is_number()) return false;
+        out[c] = (*a)[c].get<float>();
+        if (!(out[c] >= 0.0f) || !std::isfinite(out[c])) return false;
+      }
+      return true;
+    };
+    glm::vec3 L(0.0f);
+    if (rgb(child(*sky, "radiance"), L)) {
+      scene_.environment = Environment::uniform(L);
+      return;
+    }
+    const json* file = child(*sky, "environment");
+    if (file && file->is_string() && std::filesystem::exists(file->get<std::string>())) {
+      scene_.environment = loadEnvironment(file->get<std::string>(), 1.0f,
+                                           static_cast<float>(numberOr(child(*sky, "rotation"), 0.0) * 180.0 / 3.14159265358979323846));
+      return;
+    }
+    if (rgb(child(*sky, "meanRadiance"), L)) scene_.environment = Environment::uniform(L);
   }
 
   void readLightmapPages() {
