@@ -144,7 +144,7 @@ int runBake(const Args& args) {
   TerminalProgress progress;
   o.progress = progress.callback();
   BakeResult result = bake(std::move(scene), o);
-  result.report["seconds"]["load"] = loadSeconds;
+  result.report["timings"]["seconds"]["load"] = loadSeconds;
 
   OutputOptions oo;
   oo.outDir = out;
@@ -156,7 +156,7 @@ int runBake(const Args& args) {
   o.progress("write", 1.0);
   progress.finish();
   log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() + " in " +
-            std::to_string(result.report["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
+            std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
             " s writing)");
   for (const auto& f : files) std::printf("%s\n", f.string().c_str());
   return 0;

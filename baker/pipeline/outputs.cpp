@@ -50,7 +50,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
 
   fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   nlohmann::json report = result.report;
-  report["reportSchema"] = 1;  // bumped when a field changes meaning or goes away
+  report["reportSchema"] = 2;  // bumped when a field changes meaning or goes away (2: timings in one object)
   report["irbakeVersion"] = versionLine("irbake");
   report["outputs"] = nlohmann::json::array();
   for (const auto& p : written) report["outputs"].push_back(p.string());

@@ -389,9 +389,9 @@ def main():
         out, wall, rep = our_bake(args, opts)
         row = {"date": datetime.datetime.utcnow().strftime("%Y-%m-%dT%H:%MZ"), "commit": commit,
                "scene": args.name, "our_options": opts.strip(), "our_wall_s": round(wall, 2),
-               "our_bake_s": round(rep["seconds"]["bake"], 2), "texels": rep["texels"]["valid"]}
+               "our_bake_s": round(rep.get("timings", rep)["seconds"]["bake"], 2), "texels": rep["texels"]["valid"]}
         log("ours %s: %.2f s wall (bake %.2f s), %d valid texels, pages %s" % (
-            opts or "default", wall, rep["seconds"]["bake"], rep["texels"]["valid"], rep["atlas"]["pages"]))
+            opts or "default", wall, rep.get("timings", rep)["seconds"]["bake"], rep["texels"]["valid"], rep["atlas"]["pages"]))
         if args.maps:
             map_mode(args, out, rep, row, rows)
         if args.views:
