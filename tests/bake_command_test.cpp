@@ -479,3 +479,19 @@ TEST(BakeCommand, SkyTravelsWithTheExport) {
   EXPECT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir / "bad") + " --sky 1,-1,1", &log), 2)
       << log;
 }
+
+// Issue 14: the report is part of the all-or-nothing set: when it cannot be written, neither are the glTF,
+// its .bin and PNG, nor the EXR pages.
+TEST(BakeCommand, ReportIsWrittenWithTheOutputsOrNotAtAll) {
+  const fs::path dir = scratch("report_atomic");
+  fs::create_directories(dir / "a_folder" / "r.json");  // the report's name is taken by a folder
+  std::string log;
+  EXPECT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir / "out") +
+                          " --vpls 32 --texels-per-unit 2 --quiet --report " + q(dir / "a_folder" / "r.json"),
+                      &log),
+            3)
+      << log;  // Io
+  EXPECT_NE(log.find("r.json"), std::string::npos) << log;
+  for (const char* file : {"scene.gltf", "scene.bin", "lightmap_0.exr", "lightmap_0.png"})
+    EXPECT_FALSE(fs::exists(dir / "out" / file)) << file;
+}

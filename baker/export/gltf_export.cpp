@@ -482,6 +482,7 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
       files.push_back({folder / pageUris[i], [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});
     }
   }
+  files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
   writeAllAtomically(files);
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/lightmap.h"
+#include "common/atomic_file.h"
 #include "export/lightmap_png.h"
 #include "scene/scene.h"
 
@@ -19,6 +20,7 @@ struct ExportOptions {
   bool writeExrPages = true;          // float EXR pages beside the glTF, listed in root extras
   std::string exrPrefix = "lightmap"; // EXR names: <prefix>_<page>.exr
   LightmapPngOptions png;             // the 8-bit MOZ_lightmap PNG's encoding (sRGB, range at a percentile)
+  std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
 };
 
 // True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.

@@ -21,46 +21,53 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   fs::create_directories(outDir, ec);
   if (!fs::is_directory(outDir))
     throw Error(ErrorCode::Io, outDir.string(), "cannot create the output folder");
-  std::vector<fs::path> written;
   std::vector<fs::path> exrs;
   for (const Lightmap& m : result.maps) exrs.push_back(outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
+  const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
+  std::vector<fs::path> written;
+  if (options.writeGltf) written.push_back(gltfPath);
+  written.insert(written.end(), exrs.begin(), exrs.end());
 
-  if (options.writeGltf) {
-    // The export writes the glTF, its PNG maps and the EXR pages as one atomic set.
-    ExportOptions ex;
-    ex.output = gltfPath;
-    ex.writeExrPages = true;
-    ex.exrPrefix = "lightmap";
-    exportGltf(result.scene, result.maps, ex);
-    written.push_back(ex.output);
-  }
-  for (size_t i = 0; i < result.maps.size(); ++i) {
-    if (!options.writeGltf || !fs::exists(exrs[i])) writeExr(result.maps[i], exrs[i]);
-    written.push_back(exrs[i]);
-  }
-
-  // Pages of an earlier bake into the same folder that this bake does not have would be read as
-  // part of it (irbake diff, the viewer): remove them.
-  for (size_t page = result.maps.size();; ++page) {
-    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
-    if (!fs::exists(stale)) break;
-    fs::remove(stale, ec);
-    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
-  }
-
-  fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
+  // The report names what is written, and is written with it: glTF (+ .bin, PNG), EXR pages and report are
+  // one all-or-nothing set, so a failed bake leaves the previous outputs, report included, untouched.
   nlohmann::json report = result.report;
   report["reportSchema"] = 2;  // bumped when a field changes meaning or goes away (2: timings in one object)
   report["irbakeVersion"] = versionLine("irbake");
   report["outputs"] = nlohmann::json::array();
   for (const auto& p : written) report["outputs"].push_back(p.string());
-  std::string text = report.dump(2) + "\n";
-  writeAtomically(reportPath, [&](const fs::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw Error(ErrorCode::Io, reportPath.string(), "cannot write the report");
-  });
+  const std::string text = report.dump(2) + "\n";
+  PendingFile reportFile{reportPath, [&text, reportPath](const fs::path& temp) {
+                           std::ofstream out(temp, std::ios::binary);
+                           out << text;
+                           out.close();
+                           if (!out) throw Error(ErrorCode::Io, reportPath.string(), "cannot write the report");
+                         }};
+  if (options.writeGltf) {
+    ExportOptions ex;
+    ex.output = gltfPath;
+    ex.writeExrPages = true;
+    ex.exrPrefix = "lightmap";
+    ex.alsoWrite = {reportFile};
+    exportGltf(result.scene, result.maps, ex);
+  } else {
+    std::vector<PendingFile> files;
+    for (size_t i = 0; i < result.maps.size(); ++i) {
+      const Lightmap* map = &result.maps[i];
+      files.push_back({exrs[i], [map](const fs::path& temp) { writeExr(*map, temp); }});
+    }
+    files.push_back(reportFile);
+    writeAllAtomically(files);
+  }
+
+  // Pages of an earlier bake into the same folder that this bake does not have would be read as
+  // part of it (irbake diff, the viewer): remove them.
+  std::error_code removeError;
+  for (size_t page = result.maps.size();; ++page) {
+    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    if (!fs::exists(stale)) break;
+    fs::remove(stale, removeError);
+    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
+  }
   written.push_back(reportPath);
   return written;
 }
