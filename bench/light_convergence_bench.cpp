@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "backend/reference/reference_integrator.h"
 #include "common/atomic_file.h"
 #include "raytrace/test_scenes.h"

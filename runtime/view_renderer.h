@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/constants.hpp>
 
 #include "view_camera.h"
 #include "viewer_scene.h"
@@ -74,7 +75,7 @@ class ViewRenderer {
 inline glm::vec3 skyBackground(const Scene& scene) {
   if (!scene.environment.present()) return glm::vec3(0.0f);
   if (scene.environment.isUniform()) return scene.environment.uniformRadiance();
-  return glm::vec3(scene.environment.integral() / (4.0 * 3.14159265358979323846));
+  return glm::vec3(scene.environment.integral() / (4.0 * glm::pi<double>()));
 }
 
 }  // namespace irbake::view

@@ -1,5 +1,5 @@
 // Light transport shared by the GL passes; the same formulas as the Embree backend
-// (baker/backend/embree/geometry_term.h). A map value is irradiance/π.
+// (baker/transport/geometry_term.h). A map value is irradiance/π.
 const float kPi = 3.14159265358979;
 const float kInvPi2 = 1.0 / (kPi * kPi);
 

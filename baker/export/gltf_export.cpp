@@ -11,6 +11,7 @@
 // A .glb embeds every image; a .gltf gets its .bin and the images as files beside it. Every file is
 // written to a temp name and renamed only when all succeeded (common/atomic_file.h).
 #include "export/gltf_export.h"
+#include "common/maths.h"
 
 #include <algorithm>
 #include <cmath>
@@ -491,7 +492,7 @@ nlohmann::json skyJson(const Environment& sky) {
     const glm::vec3 L = sky.uniformRadiance();
     return {{"radiance", {L.x, L.y, L.z}}};
   }
-  const glm::dvec3 mean = sky.integral() / (4.0 * 3.14159265358979323846);
+  const glm::dvec3 mean = sky.integral() / (4.0 * kPi);
   return {{"environment", sky.source()}, {"meanRadiance", {mean.x, mean.y, mean.z}}, {"rotation", sky.rotation()}};
 }
 

@@ -9,7 +9,7 @@
 
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "backend/gl/gl_backend.h"
 #include "backend/interleave/interleaved_sampling.h"
 #include "glcontext/gl_context.h"

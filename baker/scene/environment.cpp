@@ -5,12 +5,12 @@
 #include <string>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "imageio/image_io.h"
 
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 double luminance(const glm::vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 

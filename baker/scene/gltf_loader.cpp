@@ -2,6 +2,7 @@
 // tinygltf reads anything; tinygltf then parses the document (images kept as encoded bytes), and
 // this file flattens nodes to world space while validating accessors, indices and values.
 #include "scene/gltf_loader.h"
+#include "common/maths.h"
 
 #include <algorithm>
 #include <atomic>
@@ -860,7 +861,7 @@ class Loader {
     const json* file = child(*sky, "environment");
     if (file && file->is_string() && std::filesystem::exists(file->get<std::string>())) {
       scene_.environment = loadEnvironment(file->get<std::string>(), 1.0f,
-                                           static_cast<float>(numberOr(child(*sky, "rotation"), 0.0) * 180.0 / 3.14159265358979323846));
+                                           static_cast<float>(numberOr(child(*sky, "rotation"), 0.0) * 180.0 / kPi));
       return;
     }
     if (rgb(child(*sky, "meanRadiance"), L)) scene_.environment = Environment::uniform(L);

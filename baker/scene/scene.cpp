@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/maths.h"
+
 namespace irbake {
 
 namespace {
-constexpr float kPi = 3.14159265358979323846f;
 
 float wrapCoord(float t, WrapMode mode) {
   switch (mode) {
@@ -65,13 +66,13 @@ glm::vec3 Light::intensityToward(const glm::vec3& dirFromLight) const {
 glm::vec3 Light::power() const {
   glm::vec3 I = color * intensity;
   switch (type) {
-    case LightType::Point: return 4.0f * kPi * I;
+    case LightType::Point: return 4.0f * kPiF * I;
     case LightType::Spot: {
       // ∫ over the cone of t(cosθ)² dω with t linear in cosθ: full inside the inner cone,
       // (cosI − cosO)/3 of the band between the cones (exact when cosI − cosO ≥ 0.001).
       double cosO = std::cos(outerConeAngle), cosI = std::cos(innerConeAngle);
       double band = std::max(0.0, cosI - cosO);
-      double solid = 2.0 * M_PI * ((1.0 - cosI) + band / 3.0);
+      double solid = 2.0 * kPi * ((1.0 - cosI) + band / 3.0);
       return static_cast<float>(solid) * I;
     }
     case LightType::Directional: return glm::vec3(0.0f);
@@ -103,7 +104,7 @@ glm::vec3 Scene::emitterPower() const {
       const glm::vec3& c = p.positions[p.indices[3 * t + 2]];
       double area = 0.5 * glm::length(glm::cross(b - a, c - a));
       glm::vec3 Le = emissionAt(p, t, glm::vec2(1.0f / 3.0f));  // texture at the centroid
-      total += glm::dvec3(Le) * (kPi * area);
+      total += glm::dvec3(Le) * (kPiF * area);
     }
   }
   return glm::vec3(total);

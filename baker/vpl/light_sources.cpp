@@ -3,11 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace irbake {
+#include "common/maths.h"
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}
+namespace irbake {
 
 double LightSources::areaPdf(uint32_t primitive, uint32_t triangle) const {
   if (primitive >= firstSlot.size() || firstSlot[primitive] < 0) return 0.0;

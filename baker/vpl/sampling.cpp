@@ -4,10 +4,11 @@
 #include <cmath>
 #include <numeric>
 
+#include "common/maths.h"
+
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 std::vector<uint32_t> firstPrimes(int count) {
   std::vector<uint32_t> primes;

@@ -22,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "vpl/light_sources.h"
 #include "vpl/sampling.h"
 #include "vpl/vpl.h"
@@ -29,7 +30,6 @@
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Direction from a spot light distributed like its intensity t(cosθ)² (t linear in cosθ between the
 // outer and inner cone, 1 inside), so every path carries the same power.

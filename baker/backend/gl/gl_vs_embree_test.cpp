@@ -10,7 +10,7 @@
 
 #include "atlas/atlas.h"
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "backend/gl/gl_backend.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"

@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "backend/embree/embree_backend.h"
-#include "backend/embree/geometry_term.h"
+#include "transport/geometry_term.h"
 #include "raytrace/test_scenes.h"
 #include "vpl/vpl.h"
 

@@ -6,6 +6,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
 #include "vpl/sampling.h"
@@ -13,7 +14,6 @@
 namespace irbake {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
 }  // namespace
 
