@@ -201,3 +201,37 @@ TEST(TexelSamples, DoubleSidedPlaneAboveIsNotALeak) {
   RayTracer rt2(s);
   EXPECT_EQ(count(buildTexelSamples(s, rt2, {})[0].valid), 64u);
 }
+
+TEST(TexelSamples, GapUnderAOneSidedSheetIsLitNearItsEdge) {
+  // A one-sided sheet (an emitter under a ceiling, seen from above) 3 cm over the floor, over x, y ∈
+  // [0.25, 0.75], its back towards the floor. Texels under it within two texels (3.1 cm) of its edge see
+  // the room through the gap (up to 45° elevation) and are computed; texels more than 12 cm inside,
+  // where even the 14° leak rays meet the sheet's back, are inside and dropped; every texel outside is
+  // valid.
+  const int size = 64;
+  Primitive sheet;
+  sheet.positions = {{0.25f, 0.25f, 0.03f}, {0.25f, 0.75f, 0.03f}, {0.75f, 0.75f, 0.03f}, {0.75f, 0.25f, 0.03f}};
+  sheet.indices = {0, 2, 1, 0, 3, 2};
+  Scene s = sceneOf({floorPrimitive(size), sheet});
+  RayTracer rt(s);
+  const TexelSamples ts = buildTexelSamples(s, rt, {})[0];
+  int nearEdge = 0, nearEdgeValid = 0, deep = 0, deepValid = 0, outside = 0, outsideValid = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const float px = (x + 0.5f) / size, py = (y + 0.5f) / size;
+      const float inside = std::min(std::min(px - 0.25f, 0.75f - px), std::min(py - 0.25f, 0.75f - py));
+      const bool valid = ts.valid[y * size + x] != 0;
+      if (inside < 0.0f) {
+        ++outside, outsideValid += valid;
+      } else if (inside < 2.0f / size) {
+        ++nearEdge, nearEdgeValid += valid;
+      } else if (inside > 0.12f) {
+        ++deep, deepValid += valid;
+      }
+    }
+  EXPECT_EQ(outsideValid, outside);
+  EXPECT_GT(nearEdge, 0);
+  EXPECT_EQ(nearEdgeValid, nearEdge);
+  EXPECT_GT(deep, 0);
+  EXPECT_EQ(deepValid, 0);
+}
