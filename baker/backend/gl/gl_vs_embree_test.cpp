@@ -32,6 +32,7 @@ Comparison compareBackends(Scene scene, int pageSize, int paths, int supersample
   AtlasOptions atlas;
   atlas.targetPageSize = pageSize;
   atlas.maxPageSize = pageSize;
+  atlas.texelsPerTriangle = 0.0f;  // one page of pageSize², also for Sponza
   buildAtlas(scene, atlas);
   RayTracer rt(scene);
   TexelSampleOptions to;
