@@ -1,10 +1,14 @@
-// irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR.
+// irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR; or one shard of it (--shard),
+// or the rest of one that was killed (--resume).
+#include <algorithm>
 #include <cstdio>
+#include <sstream>
 #include <memory>
 #include <string>
 
 #include <tbb/global_control.h>
 
+#include "app/bake_command.h"
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/error.h"
@@ -13,23 +17,27 @@
 #include "common/progress.h"
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
+#include "pipeline/vpl_sum_file.h"
 #include "scene/gltf_loader.h"
 
 namespace irbake::app {
 
-int runBake(const Args& args) {
-  BakeOptions o;
+std::optional<BakeCommand> parseBakeCommand(const Args& args) {
+  BakeCommand command;
+  BakeOptions& o = command.options;
   // The command's default light paths: 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
   // sample Cornell box is 4.0% at 1024 paths (3.9 s) and 2.0% at 4096 (7.3 s); the library's 1024 stays for
   // callers that choose their own budget.
   o.walk.paths = 4096;
   std::vector<std::string> scenes;
-  std::string out, backend = "auto", sun, sky, env, report;
-  double envIntensity = 1.0, envRotation = 0.0;
+  std::string backend = "auto", shard;
+  std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
+  double &envIntensity = command.envIntensity, &envRotation = command.envRotation;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0;
-  int threads = 0;
-  bool quiet = false, noGltf = false, noLeakControl = false, noDilate = false, noSeams = false;
+  int& threads = command.threads;
+  bool &quiet = command.quiet, &noGltf = command.noGltf;
+  bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
 
   auto app = cli::makeApp("irbake bake",
@@ -97,17 +105,49 @@ int runBake(const Args& args) {
   app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
-  if (!cli::parse(*app, args)) return 0;
+  app->add_option("--shard", shard,
+                  "evaluate share K of N of the VPL blocks and write the exact partial\n"
+                  "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
+      ->type_name("K/N");
+  app->add_flag("--resume", command.resume,
+                "continue from OUTDIR's checkpoint (left by a bake that was killed);\n"
+                "the outputs are byte-identical to an uninterrupted bake");
+  app->add_option("--checkpoint-seconds", command.checkpointSeconds,
+                  "at most this long between checkpoints of the VPL sums (default 5;\n0: after every VPL block)")
+      ->transform(cli::numberIn(0.0, 1e9))->type_name("S");
+  app->add_option("--vpl-block", o.vplBlock,
+                  "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default 512)")
+      ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
+  if (!cli::parse(*app, args)) return std::nullopt;
+
+  // The options that change the result, as CLI11 parsed them (so "--vpls=96" and "--vpls 96" agree):
+  // partials and checkpoints carry their hash. Not the scene (hashed from its files) nor what only says
+  // where and how fast to write.
+  {
+    std::istringstream config(app->config_to_str(true, false));
+    std::string line, kept;
+    const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "no-gltf",
+                                                "shard", "resume", "checkpoint-seconds"};
+    while (std::getline(config, line)) {
+      const std::string key = line.substr(0, line.find('='));
+      if (std::find(notResult.begin(), notResult.end(), key) == notResult.end()) kept += line + "\n";
+    }
+    command.optionsHash = hashText(kept);
+  }
+  if (!shard.empty()) {
+    int k = 0, n = 0;
+    char tail = 0;
+    if (std::sscanf(shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || n > 1000000 || k < 1 || k > n)
+      throw Error(ErrorCode::Usage, "", "--shard needs K/N with 1 ≤ K ≤ N ≤ 1000000 (got '" + shard + "')");
+    command.shardIndex = k;
+    command.shardCount = n;
+  }
 
   if (scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(scenes.size()) +
                                           "); see 'irbake bake --help'");
   if (out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
-  if (quiet) log::setLevel(log::Level::Warn);
-  std::unique_ptr<tbb::global_control> threadLimit;
-  if (threads > 0)
-    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-
+  command.scene = scenes[0];
   o.backend = parseBackend(backend);
   o.walk.seed = static_cast<uint32_t>(seed);
   o.atlas.texelsPerUnit = static_cast<float>(tpu);
@@ -119,47 +159,179 @@ int runBake(const Args& args) {
   o.eval.biasCompensation = !noBiasCompensation;  // on by default; --bias-compensation kept
   o.postDilate = !noDilate;
   o.postSeams = !noSeams;
+  if (command.shardIndex > 0 && namesGltfFile(out))
+    throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
+  if (command.shardIndex > 0 && o.backend == BackendKind::Reference)
+    throw Error(ErrorCode::Usage, "", "--shard splits the VPLs: the reference backend has none (use gl, embree or auto)");
+  return command;
+}
 
-  const OutputFolderLock lock(outputFolderOf(out));  // before any work: a second bake into OUTDIR fails at once
-  const std::filesystem::path scenePath = scenes[0];
-  Stopwatch loadTime;
+Scene loadBakeScene(const BakeCommand& command) {
+  const std::filesystem::path scenePath = command.scene;
   Scene scene = loadScene(scenePath);
-  if (!sun.empty()) {
-    const std::vector<double> d = cli::parseNumberList(sun);
+  if (!command.sun.empty()) {
+    const std::vector<double> d = cli::parseNumberList(command.sun);
     scene.lights.push_back(sunLight(glm::vec3(d[0], d[1], d[2]), static_cast<float>(d[3])));
   }
-  if (!sky.empty()) {
-    const std::vector<double> L = cli::parseNumberList(sky);
+  if (!command.sky.empty()) {
+    const std::vector<double> L = cli::parseNumberList(command.sky);
     for (double v : L)
       if (!(v >= 0.0)) throw Error(ErrorCode::Usage, "", "--sky needs three radiances ≥ 0 (R,G,B)");
     scene.environment = Environment::uniform(glm::vec3(L[0], L[1], L[2]));
   }
-  if (!env.empty()) {
-    if (!sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
-    scene.environment = loadEnvironment(env, static_cast<float>(envIntensity), static_cast<float>(envRotation));
+  if (!command.env.empty()) {
+    if (!command.sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
+    scene.environment = loadEnvironment(command.env, static_cast<float>(command.envIntensity),
+                                        static_cast<float>(command.envRotation));
   }
   requireLight(scene, scenePath);
-  double loadSeconds = loadTime.seconds();
+  return scene;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The checkpoint of a bake under way (removed when it finishes) and a shard's share, inside OUTDIR.
+constexpr const char* kCheckpointName = ".irbake.checkpoint";
+std::string partialName(int k, int n) {
+  return "partial_" + std::to_string(k) + "_of_" + std::to_string(n) + ".vplsum";
+}
+
+// Temp files a killed bake left mid-write in this folder: we hold its lock, so no writer is alive.
+void removeStaleTemps(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const size_t at = name.rfind(".tmp");
+    if (at == std::string::npos || at + 4 >= name.size() ||
+        name.find_first_not_of("0123456789_", at + 4) != std::string::npos)
+      continue;
+    std::error_code removeError;
+    fs::remove(entry.path(), removeError);
+  }
+}
+
+// The scene's identity: its files, and the environment map's when --env names one.
+std::string sceneIdentity(const BakeCommand& c) {
+  std::string hash = hashSceneFiles(c.scene);
+  if (!c.env.empty()) hash = hashText(hash + hashSceneFiles(c.env));
+  return hash;
+}
+
+}  // namespace
+
+std::string bakeSceneIdentity(const BakeCommand& c) { return sceneIdentity(c); }
+
+int runBake(const Args& args) {
+  std::optional<BakeCommand> parsed = parseBakeCommand(args);
+  if (!parsed) return 0;
+  BakeCommand& c = *parsed;
+  if (c.quiet) log::setLevel(log::Level::Warn);
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (c.threads > 0)
+    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);
+
+  const fs::path outDir = outputFolderOf(c.out);
+  const OutputFolderLock lock(outDir);  // before any work: a second bake into OUTDIR fails at once
+  removeStaleTemps(outDir);
+  Stopwatch loadTime;
+  Scene scene = loadBakeScene(c);
+  const double loadSeconds = loadTime.seconds();
 
   TerminalProgress progress;
-  o.progress = progress.callback();
-  BakeResult result = bake(std::move(scene), o);
-  result.report["timings"]["seconds"]["load"] = loadSeconds;
+  c.options.progress = progress.callback();
+  StagedBake staged(std::move(scene), c.options);
 
-  OutputOptions oo;
-  oo.outDir = out;
-  oo.reportPath = report;
-  oo.writeGltf = !noGltf;
-  Stopwatch writeTime;
-  o.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
-  auto files = writeBakeOutputs(result, oo);
-  o.progress("write", 1.0);
-  progress.finish();
-  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() + " in " +
-            std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
-            " s writing)");
-  for (const auto& f : files) std::printf("%s\n", f.string().c_str());
+  // The blocks this process adds: all, or share K of N.
+  const size_t blocks = staged.blockCount();
+  const size_t begin = c.shardIndex ? blocks * (c.shardIndex - 1) / c.shardCount : 0;
+  const size_t end = c.shardIndex ? blocks * c.shardIndex / c.shardCount : blocks;
+  VplSumHeader header;
+  header.sceneHash = sceneIdentity(c);
+  header.optionsHash = c.optionsHash;
+  header.seed = c.options.walk.seed;
+  header.backend = toString(staged.backend());
+  header.blockCount = blocks;
+  header.firstBlock = begin;
+  header.shardIndex = c.shardIndex;
+  header.shardCount = c.shardCount;
+  header.command = {{"scene", fs::absolute(c.scene).string()},
+                    {"env", c.env.empty() ? std::string() : fs::absolute(c.env).string()},
+                    {"args", args}};
+
+  ExactVplSums sums = staged.emptySums();
+  size_t next = begin;
+  const fs::path checkpoint = outDir / kCheckpointName;
+  if (fs::exists(checkpoint)) {
+    if (c.resume) {
+      VplSumFile saved = readVplSumFile(checkpoint);
+      std::string differs = header.mismatch(saved.header);
+      if (differs.empty() && (saved.header.firstBlock != begin || saved.header.endBlock > end))
+        differs = "share of the VPL blocks";
+      if (differs.empty() && !saved.sums.sameLayout(sums)) differs = "page layout";
+      if (!differs.empty())
+        throw Error(ErrorCode::Usage, checkpoint.string(),
+                    "this checkpoint belongs to another bake (different " + differs +
+                        "): delete it, or bake without --resume");
+      sums = std::move(saved.sums);
+      next = saved.header.endBlock;
+      staged.addBackendCounts(saved.header.backendCounts);
+      log::info("resuming at VPL block " + std::to_string(next) + " of " + std::to_string(end) + " (" +
+                checkpoint.string() + ")");
+    } else {
+      log::warn("ignoring the checkpoint " + checkpoint.string() + " of an earlier bake (--resume would continue it)");
+    }
+  } else if (c.resume) {
+    log::info("no checkpoint in " + outDir.string() + ": baking from the start");
+  }
+
+  Stopwatch sinceCheckpoint;
+  staged.evaluateBlocks(next, end, sums, [&](size_t done) {
+    if (done >= end || sinceCheckpoint.seconds() < c.checkpointSeconds) return;
+    VplSumHeader h = header;
+    h.kind = "checkpoint";
+    h.endBlock = done;
+    h.backendCounts = staged.backendCounts();
+    writeVplSumFile(checkpoint, h, sums);
+    sinceCheckpoint.reset();
+  });
+
+  std::error_code ec;
+  if (c.shardIndex > 0) {
+    header.kind = "partial";
+    header.endBlock = end;
+    header.backendCounts = staged.backendCounts();
+    const fs::path partial = outDir / partialName(c.shardIndex, c.shardCount);
+    writeVplSumFile(partial, header, sums);
+    fs::remove(checkpoint, ec);
+    progress.finish();
+    log::info("shard " + std::to_string(c.shardIndex) + "/" + std::to_string(c.shardCount) + ": VPL blocks " +
+              std::to_string(begin) + ".." + std::to_string(end) + " of " + std::to_string(blocks));
+    std::printf("%s\n", partial.string().c_str());
+    return 0;
+  }
+
+  BakeResult result = staged.finish(sums);
+  result.report["timings"]["seconds"]["load"] = loadSeconds;
+  writeFinishedBake(c, result, progress);
+  fs::remove(checkpoint, ec);
   return 0;
 }
 
+void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress) {
+  OutputOptions oo;
+  oo.outDir = c.out;
+  oo.reportPath = c.report;
+  oo.writeGltf = !c.noGltf;
+  Stopwatch writeTime;
+  c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
+  auto files = writeBakeOutputs(result, oo);
+  c.options.progress("write", 1.0);
+  progress.finish();
+  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() +
+            " in " + std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " +
+            std::to_string(writeTime.seconds()) + " s writing)");
+  for (const auto& f : files) std::printf("%s\n", f.string().c_str());
+}
 }  // namespace irbake::app
