@@ -129,6 +129,7 @@ struct StagedBake::State {
   std::vector<VplBlock> blocks;
   GlBakeStats glStats;
   InterleaveStats interleaveStats;
+  std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
   std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
   bool compensate = false, overlap = false;
   nlohmann::json seconds = nlohmann::json::object();
@@ -166,6 +167,8 @@ struct StagedBake::State {
       vpls = generateVpls(scene, *rayTracer, o);
     });
     deriveClamp();
+    // The gather keeps a reference to its inputs, so they live as long as the bake.
+    wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
     chooseBackend();
     planBlocks();
   }
@@ -351,7 +354,7 @@ struct StagedBake::State {
       SkyLightOptions o = options.sky;
       o.seed = options.walk.seed;
       SkyLightStats stats;
-      addSkyLight(inputs(texels, vpls, eval), maps, o, &stats);
+      addSkyLight(*wholeInputs, maps, o, &stats);
       report["sky"] = stats.toJson();
       report["sky"]["uniform"] = scene.environment.isUniform();
       report["sky"]["source"] = scene.environment.source();
@@ -360,14 +363,14 @@ struct StagedBake::State {
   }
 
   // Bias compensation: the clamp's lost near-field light gathered back from the baked map.
-  void compensationStage(std::vector<Lightmap>& maps, const BakeInputs& in, nlohmann::json& report) {
+  void compensationStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
     if (!compensate) return;
     timed("compensation", [&] {  // with an overlapped trace: the sweeps (and any trace not yet done)
       ClampCompensationOptions o = options.compensation;
       o.seed = options.walk.seed;
       ClampCompensationStats stats;
       if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
-      std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(in, o);
+      std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(*wholeInputs, o);
       g->apply(maps, &stats);
       if (options.progress) options.progress("compensate", 1.0);
       seconds["compensationTrace"] = g->traceSeconds();
@@ -460,9 +463,7 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
       return c;
     }();
     // The gather reads the pages' texel samples and the geometry only: it runs while the GL backend bakes.
-    s.gather = std::async(std::launch::async, [&s, o] {
-      return std::make_unique<ClampGather>(s.inputs(s.texels, s.vpls, s.eval), o);
-    });
+    s.gather = std::async(std::launch::async, [&s, o] { return std::make_unique<ClampGather>(*s.wholeInputs, o); });
   }
   s.timed("backend", [&] {
     for (size_t b = begin; b < end; ++b) {
@@ -496,9 +497,8 @@ BakeResult StagedBake::finish(const ExactVplSums& sums) {
   BakeResult r;
   nlohmann::json& report = r.report;
   s.timed("backend", [&] { r.maps = s.backendMaps(sums, report); });
-  const BakeInputs in = s.inputs(s.texels, s.vpls, s.eval);
   s.skyStage(r.maps, report);
-  s.compensationStage(r.maps, in, report);
+  s.compensationStage(r.maps, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();
   s.describe(report, post);
@@ -509,6 +509,7 @@ BakeResult StagedBake::finish(const ExactVplSums& sums) {
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);
   s.gather = {};
+  s.wholeInputs.reset();
   s.rayTracer.reset();  // it refers to the scene, which moves into the result
   r.scene = std::move(s.scene);
   return r;
