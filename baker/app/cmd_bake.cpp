@@ -312,7 +312,7 @@ int runBake(const Args& args) {
     return 0;
   }
 
-  BakeResult result = staged.finish(sums);
+  BakeResult result = staged.finish(std::move(sums));
   result.report["timings"]["seconds"]["load"] = loadSeconds;
   writeFinishedBake(c, result, progress);
   fs::remove(checkpoint, ec);

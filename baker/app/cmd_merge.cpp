@@ -150,7 +150,8 @@ int runMerge(const Args& args) {
     sums.add(partials[i].sums);
     staged.addBackendCounts(partials[i].header.backendCounts);
   }
-  BakeResult result = staged.finish(sums);
+  partials.clear();
+  BakeResult result = staged.finish(std::move(sums));
   result.report["shards"] = first.shardCount;
   writeFinishedBake(c, result, progress);
   return 0;

@@ -125,7 +125,8 @@ struct StagedBake::State {
   GlBackendOptions gl;        // with the cube face size fixed for every block
   int interleave = 1;
   std::vector<VplSet> classVpls;                    // per interleave class
-  std::vector<std::vector<TexelSamples>> classPages;  // per class (empty when interleave is 1: the pages)
+  int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
+  std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
   GlBakeStats glStats;
   InterleaveStats interleaveStats;
@@ -232,9 +233,6 @@ struct StagedBake::State {
     if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
     interleave = options.interleave > 0 ? options.interleave : chooseInterleave(texels, eval.clampBound);
     classVpls = classVplSubsets(vpls, interleave);
-    if (interleave > 1)
-      for (int c = 0; c < interleave * interleave; ++c)
-        classPages.push_back(interleaveClass(texels, interleave, c % interleave, c / interleave));
     const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
     for (size_t c = 0; c < classVpls.size(); ++c)
       for (size_t b0 = 0; b0 < classVpls[c].vpls.size(); b0 += blockSize)
@@ -247,8 +245,14 @@ struct StagedBake::State {
     interleaveStats.classes = static_cast<int>(classVpls.size());
   }
 
-  const std::vector<TexelSamples>& pagesOf(int vplClass) const {
-    return classPages.empty() ? texels : classPages[static_cast<size_t>(vplClass)];
+  // The texel samples of an interleave class as pages of their own (interleave 1: the pages themselves).
+  const std::vector<TexelSamples>& pagesOf(int vplClass) {
+    if (interleave <= 1) return texels;
+    if (pagesClass != vplClass) {
+      classPages = interleaveClass(texels, interleave, vplClass % interleave, vplClass / interleave);
+      pagesClass = vplClass;
+    }
+    return classPages;
   }
 
   // One call of the GL or Embree backend.
@@ -447,9 +451,11 @@ size_t StagedBake::blockCount() const { return state_->blocks.size(); }
 BackendKind StagedBake::backend() const { return state_->backend; }
 
 ExactVplSums StagedBake::emptySums() const {
-  std::vector<size_t> sizes;
-  for (const TexelSamples& ts : state_->texels) sizes.push_back(ts.layerSize());
-  return ExactVplSums::zeros(sizes);
+  // Receivers: the texels a backend can return valid (GL and Embree keep the samples' valid flags).
+  std::vector<std::vector<uint8_t>> receivers;
+  for (const TexelSamples& ts : state_->texels)
+    receivers.push_back(ts.valid.size() == ts.layerSize() ? ts.valid : std::vector<uint8_t>(ts.layerSize(), 1));
+  return ExactVplSums::zeros(receivers);
 }
 
 void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
@@ -492,11 +498,13 @@ void StagedBake::addBackendCounts(const nlohmann::json& counts) {
   state_->interleaveStats.backendCalls += counts.value("backendCalls", 0);
 }
 
-BakeResult StagedBake::finish(const ExactVplSums& sums) {
+BakeResult StagedBake::finish(ExactVplSums sums) {
   State& s = *state_;
   BakeResult r;
   nlohmann::json& report = r.report;
+  s.classPages = {};
   s.timed("backend", [&] { r.maps = s.backendMaps(sums, report); });
+  sums = {};  // rounded into the maps: its memory is not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, report);
   const PostStats post = s.postStage(r.maps);
@@ -519,7 +527,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   StagedBake staged(std::move(scene), options);
   ExactVplSums sums = staged.emptySums();
   staged.evaluateBlocks(0, staged.blockCount(), sums);
-  return staged.finish(sums);
+  return staged.finish(std::move(sums));
 }
 
 }  // namespace irbake

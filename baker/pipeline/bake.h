@@ -93,8 +93,8 @@ class StagedBake {
   // addBackendCounts adds a shard's.
   nlohmann::json backendCounts() const;
   void addBackendCounts(const nlohmann::json& counts);
-  // Everything after the VPL blocks; sums must hold every block. Call once.
-  BakeResult finish(const ExactVplSums& sums);
+  // Everything after the VPL blocks; sums must hold every block (moved in: freed once rounded). Call once.
+  BakeResult finish(ExactVplSums sums);
 
  private:
   struct State;

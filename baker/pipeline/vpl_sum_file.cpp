@@ -87,12 +87,16 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
     put(out, static_cast<uint64_t>(text.size()));
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     put(out, static_cast<uint64_t>(sums.pages.size()));
+    // Per page: texel count, then per texel 0 (no sums), 1 (receiver, no block found it valid: zero sums
+    // not written) or 2 (valid: its three sums follow at the end of the page, in texel order).
     for (const ExactVplSums::Page& page : sums.pages) {
-      put(out, static_cast<uint64_t>(page.valid.size()));
-      out.write(reinterpret_cast<const char*>(page.valid.data()), static_cast<std::streamsize>(page.valid.size()));
-      for (size_t t = 0; t < page.valid.size(); ++t)
-        if (page.valid[t])
-          out.write(reinterpret_cast<const char*>(&page.rgb[3 * t]), 3 * sizeof(ExactInt));
+      put(out, static_cast<uint64_t>(page.slot.size()));
+      std::vector<uint8_t> state(page.slot.size(), 0);
+      for (size_t t = 0; t < state.size(); ++t)
+        state[t] = page.slot[t] == ExactVplSums::kNoSum ? 0 : page.valid[t] ? 2 : 1;
+      out.write(reinterpret_cast<const char*>(state.data()), static_cast<std::streamsize>(state.size()));
+      for (size_t t = 0; t < state.size(); ++t)
+        if (state[t] == 2) out.write(reinterpret_cast<const char*>(&page.rgb[3 * size_t(page.slot[t])]), 3 * sizeof(ExactInt));
     }
     out.write(kEnd, sizeof kEnd);
     out.close();
@@ -136,12 +140,19 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   for (uint64_t p = 0; p < pageCount; ++p) {
     const uint64_t texels = in.get<uint64_t>();
     if (texels > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
-    ExactVplSums::Page page;
-    page.valid.resize(texels);
-    in.take(page.valid.data(), texels);
-    page.rgb.assign(3 * texels, 0);
-    for (size_t t = 0; t < texels; ++t)
-      if (page.valid[t]) in.take(&page.rgb[3 * t], 3 * sizeof(ExactInt));
+    std::vector<uint8_t> state(texels);
+    in.take(state.data(), texels);
+    std::vector<uint8_t> receivers(texels);
+    for (size_t t = 0; t < texels; ++t) {
+      if (state[t] > 2) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is damaged (bad texel state)");
+      receivers[t] = state[t] != 0;
+    }
+    ExactVplSums::Page page = std::move(ExactVplSums::zeros({receivers}).pages[0]);
+    for (size_t t = 0; t < texels; ++t) {
+      if (state[t] != 2) continue;
+      in.take(&page.rgb[3 * size_t(page.slot[t])], 3 * sizeof(ExactInt));
+      page.valid[t] = 1;
+    }
     file.sums.pages.push_back(std::move(page));
   }
   char end[sizeof kEnd];

@@ -15,12 +15,16 @@ float fromFixed(ExactInt s) {
 }
 }  // namespace
 
-ExactVplSums ExactVplSums::zeros(const std::vector<size_t>& texelsPerPage) {
+ExactVplSums ExactVplSums::zeros(const std::vector<std::vector<uint8_t>>& receivers) {
   ExactVplSums sums;
-  for (size_t n : texelsPerPage) {
+  for (const std::vector<uint8_t>& mask : receivers) {
     Page p;
-    p.rgb.assign(3 * n, 0);
-    p.valid.assign(n, 0);
+    p.slot.assign(mask.size(), kNoSum);
+    uint32_t slots = 0;
+    for (size_t t = 0; t < mask.size(); ++t)
+      if (mask[t]) p.slot[t] = slots++;
+    p.rgb.assign(3 * size_t(slots), 0);
+    p.valid.assign(mask.size(), 0);
     sums.pages.push_back(std::move(p));
   }
   return sums;
@@ -30,7 +34,8 @@ bool ExactVplSums::add(size_t page, size_t texel, const glm::vec3& value) {
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(value[c]) || std::fabs(value[c]) >= kMaxBlockValue) return false;
   Page& p = pages[page];
-  for (int c = 0; c < 3; ++c) p.rgb[3 * texel + c] += toFixed(value[c]);
+  if (p.slot[texel] == kNoSum) return false;
+  for (int c = 0; c < 3; ++c) p.rgb[3 * size_t(p.slot[texel]) + c] += toFixed(value[c]);
   p.valid[texel] = 1;
   return true;
 }
@@ -45,14 +50,15 @@ void ExactVplSums::add(const ExactVplSums& other) {
 
 glm::vec3 ExactVplSums::value(size_t page, size_t texel) const {
   const Page& p = pages[page];
-  return glm::vec3(fromFixed(p.rgb[3 * texel]), fromFixed(p.rgb[3 * texel + 1]), fromFixed(p.rgb[3 * texel + 2]));
+  if (p.slot[texel] == kNoSum) return glm::vec3(0.0f);
+  const size_t s = 3 * size_t(p.slot[texel]);
+  return glm::vec3(fromFixed(p.rgb[s]), fromFixed(p.rgb[s + 1]), fromFixed(p.rgb[s + 2]));
 }
 
 bool ExactVplSums::sameLayout(const ExactVplSums& other) const {
   if (pages.size() != other.pages.size()) return false;
   for (size_t p = 0; p < pages.size(); ++p)
-    if (pages[p].valid.size() != other.pages[p].valid.size() || pages[p].rgb.size() != other.pages[p].rgb.size())
-      return false;
+    if (pages[p].slot != other.pages[p].slot) return false;
   return true;
 }
 

@@ -31,14 +31,14 @@ bool sameBits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &
 
 TEST(ExactVplSums, AnyOrderAndSplitGivesTheSameBitsAndTheDoubleSum) {
   const std::vector<glm::vec3> values = blockValues(1000, 7);
-  ExactVplSums forward = ExactVplSums::zeros({1});
+  ExactVplSums forward = ExactVplSums::zeros({{1}});
   for (const auto& v : values) ASSERT_TRUE(forward.add(0, 0, v));
   // Backwards, and as three "shards" summed separately then added in another order.
-  ExactVplSums backward = ExactVplSums::zeros({1});
+  ExactVplSums backward = ExactVplSums::zeros({{1}});
   for (auto it = values.rbegin(); it != values.rend(); ++it) ASSERT_TRUE(backward.add(0, 0, *it));
-  std::vector<ExactVplSums> shards(3, ExactVplSums::zeros({1}));
+  std::vector<ExactVplSums> shards(3, ExactVplSums::zeros({{1}}));
   for (size_t i = 0; i < values.size(); ++i) ASSERT_TRUE(shards[i * 3 / values.size()].add(0, 0, values[i]));
-  ExactVplSums merged = ExactVplSums::zeros({1});
+  ExactVplSums merged = ExactVplSums::zeros({{1}});
   for (int s : {2, 0, 1}) merged.add(shards[s]);
   EXPECT_TRUE(sameBits(forward.value(0, 0), backward.value(0, 0)));
   EXPECT_TRUE(sameBits(forward.value(0, 0), merged.value(0, 0)));
@@ -55,7 +55,7 @@ TEST(ExactVplSums, AnyOrderAndSplitGivesTheSameBitsAndTheDoubleSum) {
 }
 
 TEST(ExactVplSums, RefusesValuesItCannotAddExactly) {
-  ExactVplSums sums = ExactVplSums::zeros({2});
+  ExactVplSums sums = ExactVplSums::zeros({{1, 1}});
   EXPECT_FALSE(sums.add(0, 0, glm::vec3(NAN, 0.0f, 0.0f)));
   EXPECT_FALSE(sums.add(0, 0, glm::vec3(0.0f, INFINITY, 0.0f)));
   EXPECT_FALSE(sums.add(0, 1, glm::vec3(0.0f, 0.0f, 2e12f)));  // ≥ 2⁴⁰
@@ -63,14 +63,17 @@ TEST(ExactVplSums, RefusesValuesItCannotAddExactly) {
   EXPECT_TRUE(sums.add(0, 1, glm::vec3(1e12f)));
   EXPECT_FLOAT_EQ(sums.value(0, 1).x, 1e12f);
   EXPECT_EQ(sums.value(0, 0), glm::vec3(0.0f));  // untouched texel
-  EXPECT_THROW(sums.add(ExactVplSums::zeros({3})), std::invalid_argument);
+  EXPECT_THROW(sums.add(ExactVplSums::zeros({{1, 1, 1}})), std::invalid_argument);
+  ExactVplSums someReceive = ExactVplSums::zeros({{1, 0}});
+  EXPECT_FALSE(someReceive.add(0, 1, glm::vec3(1.0f)));  // not a receiver: no sums there
+  EXPECT_EQ(someReceive.pages[0].rgb.size(), 3u);
 }
 
 TEST(VplSumFile, RoundTripsAndRefusesDamage) {
   const fs::path dir = fs::current_path() / "test_scratch" / "vpl_sum_file";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  ExactVplSums sums = ExactVplSums::zeros({5, 3});
+  ExactVplSums sums = ExactVplSums::zeros({{0, 1, 1, 0, 1}, {1, 1, 0}});
   const std::vector<glm::vec3> values = blockValues(4, 3);
   sums.add(0, 1, values[0]);
   sums.add(0, 4, values[1]);
@@ -100,6 +103,7 @@ TEST(VplSumFile, RoundTripsAndRefusesDamage) {
   ASSERT_TRUE(back.sums.sameLayout(sums));
   for (size_t p = 0; p < 2; ++p) {
     EXPECT_EQ(back.sums.pages[p].valid, sums.pages[p].valid);
+    EXPECT_EQ(back.sums.pages[p].slot, sums.pages[p].slot);
     EXPECT_TRUE(back.sums.pages[p].rgb == sums.pages[p].rgb);
   }
   VplSumHeader other = h;
