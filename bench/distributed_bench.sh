@@ -18,26 +18,29 @@ mkdir -p "$work" "$src/bench/results"
 "$irbake" samples "$work/samples" --quiet
 scene="$work/samples/cornell_box.gltf"
 
-# A bake's wall time and peak memory (/usr/bin/time) and its backend seconds (report).
+# A bake's wall time, CPU time (user + system: less sensitive to a shared machine's load) and peak memory
+# (/usr/bin/time), and its backend seconds (report).
 timed_bake() {  # LABEL RUN BINARY OUT [options...]
   local label="$1" run="$2" bin="$3" out="$4"
   shift 4
   local t0 t1
   t0=$(date +%s.%N)
-  /usr/bin/time -f "%M" -o "$out.mem" "$bin" bake "$scene" -o "$out" --quiet "$@" >/dev/null
+  /usr/bin/time -f "%M %U %S" -o "$out.mem" "$bin" bake "$scene" -o "$out" --quiet "$@" >/dev/null
   t1=$(date +%s.%N)
   python3 - "$label" "$run" "$t0" "$t1" "$out" <<'PY'
 import json, sys
 label, run, t0, t1, out = sys.argv[1:]
 r = json.load(open(out + "/report.json"))
-mem = int(open(out + ".mem").read().split()[-1]) / 1024
+mem_kb, user, system = open(out + ".mem").read().split()[-3:]
+mem = int(mem_kb) / 1024
+cpu = float(user) + float(system)
 load = open("/proc/loadavg").read().split()[0]
-print(f"{label},{run},{float(t1) - float(t0):.2f},{mem:.0f},{r['timings']['seconds']['backend']:.2f},{r['interleave'].get('vplBlocks', '')},{load}")
+print(f"{label},{run},{float(t1) - float(t0):.2f},{cpu:.2f},{mem:.0f},{r['timings']['seconds']['backend']:.2f},{r['interleave'].get('vplBlocks', '')},{load}")
 PY
 }
 
 csv="$src/bench/results/vpl_blocks.csv"
-echo "binary,run,wall_s,peak_mib,backend_s,vpl_blocks,load1" > "$csv"
+echo "binary,run,wall_s,cpu_s,peak_mib,backend_s,vpl_blocks,load1" > "$csv"
 for run in $(seq 1 "$runs"); do
   [[ -n "$baseline" ]] && timed_bake baseline "$run" "$baseline" "$work/base_$run" >> "$csv"
   timed_bake blocks "$run" "$irbake" "$work/blocks_$run" >> "$csv"

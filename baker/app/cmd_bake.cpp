@@ -22,24 +22,36 @@
 
 namespace irbake::app {
 
-std::optional<BakeCommand> parseBakeCommand(const Args& args) {
-  BakeCommand command;
+namespace {
+
+// What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
+struct BakeArguments {
+  std::vector<std::string> scenes;
+  std::string backend = "auto", shard;
+  long long seed = 0;
+  double tpu = 0.0, clamp = 0.0;
+  bool noLeakControl = false, noDilate = false, noSeams = false;
+  bool noBiasCompensation = false, biasCompensation = false;
+  CLI::Option* clampOption = nullptr;
+};
+
+// Every option of `irbake bake`, with its range and help.
+std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
   // The command's default light paths: 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
   // sample Cornell box is 4.0% at 1024 paths (3.9 s) and 2.0% at 4096 (7.3 s); the library's 1024 stays for
   // callers that choose their own budget.
   o.walk.paths = 4096;
-  std::vector<std::string> scenes;
-  std::string backend = "auto", shard;
+  std::vector<std::string>& scenes = a.scenes;
+  std::string &backend = a.backend, &shard = a.shard;
   std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
   double &envIntensity = command.envIntensity, &envRotation = command.envRotation;
-  long long seed = 0;
-  double tpu = 0.0, clamp = 0.0;
+  long long& seed = a.seed;
+  double &tpu = a.tpu, &clamp = a.clamp;
   int& threads = command.threads;
   bool &quiet = command.quiet, &noGltf = command.noGltf;
-  bool noLeakControl = false, noDilate = false, noSeams = false;
-  bool noBiasCompensation = false, biasCompensation = false;
-
+  bool &noLeakControl = a.noLeakControl, &noDilate = a.noDilate, &noSeams = a.noSeams;
+  bool &noBiasCompensation = a.noBiasCompensation, &biasCompensation = a.biasCompensation;
   auto app = cli::makeApp("irbake bake",
                           "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
                           "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
@@ -61,7 +73,7 @@ std::optional<BakeCommand> parseBakeCommand(const Args& args) {
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
       ->transform(cli::integerIn(1, 8))->type_name("S");
-  auto* clampOption =
+  a.clampOption =
       app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
           ->transform(cli::numberIn(0.0, 1e30))
           ->type_name("B");
@@ -118,51 +130,67 @@ std::optional<BakeCommand> parseBakeCommand(const Args& args) {
   app->add_option("--vpl-block", o.vplBlock,
                   "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default 512)")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
-  if (!cli::parse(*app, args)) return std::nullopt;
+  return app;
+}
 
-  // The options that change the result, as CLI11 parsed them (so "--vpls=96" and "--vpls 96" agree):
-  // partials and checkpoints carry their hash. Not the scene (hashed from its files) nor what only says
-  // where and how fast to write.
-  {
-    std::istringstream config(app->config_to_str(true, false));
-    std::string line, kept;
-    const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "no-gltf",
-                                                "shard", "resume", "checkpoint-seconds"};
-    while (std::getline(config, line)) {
-      const std::string key = line.substr(0, line.find('='));
-      if (std::find(notResult.begin(), notResult.end(), key) == notResult.end()) kept += line + "\n";
-    }
-    command.optionsHash = hashText(kept);
+// The options that change the result, as CLI11 parsed them (so "--vpls=96" and "--vpls 96" agree):
+// partials and checkpoints carry their hash. Not the scene (hashed from its files) nor what only says
+// where and how fast to write.
+std::string resultOptionsHash(const CLI::App& app) {
+  std::istringstream config(app.config_to_str(true, false));
+  std::string line, kept;
+  const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "no-gltf",
+                                              "shard", "resume", "checkpoint-seconds"};
+  while (std::getline(config, line)) {
+    const std::string key = line.substr(0, line.find('='));
+    if (std::find(notResult.begin(), notResult.end(), key) == notResult.end()) kept += line + "\n";
   }
-  if (!shard.empty()) {
+  return hashText(kept);
+}
+
+// The parsed arguments as options; throws Error(Usage) for combinations CLI11 cannot check.
+void applyArguments(BakeCommand& command, const BakeArguments& a) {
+  BakeOptions& o = command.options;
+  if (!a.shard.empty()) {
     int k = 0, n = 0;
     char tail = 0;
-    if (std::sscanf(shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || n > 1000000 || k < 1 || k > n)
-      throw Error(ErrorCode::Usage, "", "--shard needs K/N with 1 ≤ K ≤ N ≤ 1000000 (got '" + shard + "')");
+    if (std::sscanf(a.shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || n > 1000000 || k < 1 || k > n)
+      throw Error(ErrorCode::Usage, "", "--shard needs K/N with 1 ≤ K ≤ N ≤ 1000000 (got '" + a.shard + "')");
     command.shardIndex = k;
     command.shardCount = n;
   }
 
-  if (scenes.size() != 1)
-    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(scenes.size()) +
+  if (a.scenes.size() != 1)
+    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
-  if (out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
-  command.scene = scenes[0];
-  o.backend = parseBackend(backend);
-  o.walk.seed = static_cast<uint32_t>(seed);
-  o.atlas.texelsPerUnit = static_cast<float>(tpu);
-  o.texels.leakControl = !noLeakControl;
-  if (clampOption->count() > 0) {
-    o.eval.clampBound = static_cast<float>(clamp);
+  if (command.out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
+  command.scene = a.scenes[0];
+  o.backend = parseBackend(a.backend);
+  o.walk.seed = static_cast<uint32_t>(a.seed);
+  o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
+  o.texels.leakControl = !a.noLeakControl;
+  if (a.clampOption->count() > 0) {
+    o.eval.clampBound = static_cast<float>(a.clamp);
     o.autoClamp = false;
   }
-  o.eval.biasCompensation = !noBiasCompensation;  // on by default; --bias-compensation kept
-  o.postDilate = !noDilate;
-  o.postSeams = !noSeams;
-  if (command.shardIndex > 0 && namesGltfFile(out))
+  o.eval.biasCompensation = !a.noBiasCompensation;  // on by default; --bias-compensation kept
+  o.postDilate = !a.noDilate;
+  o.postSeams = !a.noSeams;
+  if (command.shardIndex > 0 && namesGltfFile(command.out))
     throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
   if (command.shardIndex > 0 && o.backend == BackendKind::Reference)
     throw Error(ErrorCode::Usage, "", "--shard splits the VPLs: the reference backend has none (use gl, embree or auto)");
+}
+
+}  // namespace
+
+std::optional<BakeCommand> parseBakeCommand(const Args& args) {
+  BakeCommand command;
+  BakeArguments arguments;
+  const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
+  if (!cli::parse(*app, args)) return std::nullopt;
+  command.optionsHash = resultOptionsHash(*app);
+  applyArguments(command, arguments);
   return command;
 }
 
