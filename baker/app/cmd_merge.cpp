@@ -132,10 +132,9 @@ int runMerge(const Args& args) {
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");
 
   const OutputFolderLock lock(outputFolderOf(out));
-  const std::string sceneHash = bakeSceneIdentity(c);
-  if (sceneHash != first.sceneHash)
+  Scene scene = loadBakeScene(c);  // first: the loader refuses what the hash's JSON parse should not see
+  if (bakeSceneIdentity(c) != first.sceneHash)
     throw Error(ErrorCode::InvalidData, c.scene, "the scene changed since the shards baked it (" + files[0].string() + ")");
-  Scene scene = loadBakeScene(c);
   TerminalProgress progress;
   c.options.progress = progress.callback();
   StagedBake staged(std::move(scene), c.options);

@@ -170,8 +170,10 @@ struct StagedBake::State {
     deriveClamp();
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
-    chooseBackend();
-    planBlocks();
+    timed("backend", [&] {  // the GL context is made here: its time counts to the backend, as it did
+      chooseBackend();
+      planBlocks();
+    });
   }
 
   void deriveClamp() {

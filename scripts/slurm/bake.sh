@@ -44,7 +44,8 @@ scene=$(realpath "$scene")
 irbake=$(realpath "$irbake")
 mkdir -p "$out/shards"
 out=$(realpath "$out")
-quoted_args=$(printf ' %q' "${bake_args[@]+"${bake_args[@]}"}")
+quoted_args=""
+[[ ${#bake_args[@]} -gt 0 ]] && quoted_args=$(printf ' %q' "${bake_args[@]}")
 
 # Each task: its own folder (a bake locks its output folder), its share, resumable.
 array_id=$(sbatch --parsable --job-name=irbake-shard --array="1-$shards" \

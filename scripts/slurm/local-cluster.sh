@@ -7,6 +7,11 @@
 
 local_cluster_stop() {
   local dir="$1" pidfile
+  # Jobs first: a job step outlives slurmd (slurmstepd), and would go on writing into the folder.
+  if [[ -s "$dir/slurmctld.pid" ]]; then
+    SLURM_CONF="$dir/slurm.conf" scancel --full --user=root 2>/dev/null || true
+    sleep 1
+  fi
   for pidfile in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munge/munged.pid"; do
     [[ -s "$pidfile" ]] && kill "$(cat "$pidfile")" 2>/dev/null || true
   done
