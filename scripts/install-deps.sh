@@ -21,6 +21,7 @@ packages=(
   libcli11-dev             # CLI11: command-line options of irbake and irview
   xvfb xauth               # windowed viewer test without a display
   chromium                 # runtime/web: the three.js viewer test in headless Chromium
+  slurm-wlm munge          # tests/slurm: a single-node Slurm on localhost bakes in shards (scripts/slurm)
 )
 # node + npm for runtime/web's tests (npm modules: scripts/install-web-deps.sh). Debian's nodejs and
 # npm, unless a node with its own npm is already there (NodeSource's nodejs conflicts with Debian npm).

@@ -1,10 +1,14 @@
-// irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR.
+// irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR; or one shard of it (--shard),
+// or the rest of one that was killed (--resume).
+#include <algorithm>
 #include <cstdio>
+#include <sstream>
 #include <memory>
 #include <string>
 
 #include <tbb/global_control.h>
 
+#include "app/bake_command.h"
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/error.h"
@@ -13,25 +17,41 @@
 #include "common/progress.h"
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
+#include "pipeline/vpl_sum_file.h"
 #include "scene/gltf_loader.h"
 
 namespace irbake::app {
 
-int runBake(const Args& args) {
-  BakeOptions o;
+namespace {
+
+// What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
+struct BakeArguments {
+  std::vector<std::string> scenes;
+  std::string backend = "auto", shard;
+  long long seed = 0;
+  double tpu = 0.0, clamp = 0.0;
+  bool noLeakControl = false, noDilate = false, noSeams = false;
+  bool noBiasCompensation = false, biasCompensation = false;
+  CLI::Option* clampOption = nullptr;
+};
+
+// Every option of `irbake bake`, with its range and help.
+std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
+  BakeOptions& o = command.options;
   // The command's default light paths: 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
   // sample Cornell box is 4.0% at 1024 paths (3.9 s) and 2.0% at 4096 (7.3 s); the library's 1024 stays for
   // callers that choose their own budget.
   o.walk.paths = 4096;
-  std::vector<std::string> scenes;
-  std::string out, backend = "auto", sun, sky, env, report;
-  double envIntensity = 1.0, envRotation = 0.0;
-  long long seed = 0;
-  double tpu = 0.0, clamp = 0.0;
-  int threads = 0;
-  bool quiet = false, noGltf = false, noLeakControl = false, noDilate = false, noSeams = false;
-  bool noBiasCompensation = false, biasCompensation = false;
-
+  std::vector<std::string>& scenes = a.scenes;
+  std::string &backend = a.backend, &shard = a.shard;
+  std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
+  double &envIntensity = command.envIntensity, &envRotation = command.envRotation;
+  long long& seed = a.seed;
+  double &tpu = a.tpu, &clamp = a.clamp;
+  int& threads = command.threads;
+  bool &quiet = command.quiet, &noGltf = command.noGltf;
+  bool &noLeakControl = a.noLeakControl, &noDilate = a.noDilate, &noSeams = a.noSeams;
+  bool &noBiasCompensation = a.noBiasCompensation, &biasCompensation = a.biasCompensation;
   auto app = cli::makeApp("irbake bake",
                           "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
                           "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
@@ -53,7 +73,7 @@ int runBake(const Args& args) {
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
       ->transform(cli::integerIn(1, 8))->type_name("S");
-  auto* clampOption =
+  a.clampOption =
       app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
           ->transform(cli::numberIn(0.0, 1e30))
           ->type_name("B");
@@ -97,69 +117,249 @@ int runBake(const Args& args) {
   app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
-  if (!cli::parse(*app, args)) return 0;
+  app->add_option("--shard", shard,
+                  "evaluate share K of N of the VPL blocks and write the exact partial\n"
+                  "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
+      ->type_name("K/N");
+  app->add_flag("--resume", command.resume,
+                "continue from OUTDIR's checkpoint (left by a bake that was killed);\n"
+                "the outputs are byte-identical to an uninterrupted bake");
+  app->add_option("--checkpoint-seconds", command.checkpointSeconds,
+                  "at most this long between checkpoints of the VPL sums (default 5;\n0: after every VPL block)")
+      ->transform(cli::numberIn(0.0, 1e9))->type_name("S");
+  app->add_option("--vpl-block", o.vplBlock,
+                  "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default 512)")
+      ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
+  return app;
+}
 
-  if (scenes.size() != 1)
-    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(scenes.size()) +
+// The options that change the result, as CLI11 parsed them (so "--vpls=96" and "--vpls 96" agree):
+// partials and checkpoints carry their hash. Not the scene (hashed from its files) nor what only says
+// where and how fast to write.
+std::string resultOptionsHash(const CLI::App& app) {
+  std::istringstream config(app.config_to_str(true, false));
+  std::string line, kept;
+  const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "no-gltf",
+                                              "shard", "resume", "checkpoint-seconds"};
+  while (std::getline(config, line)) {
+    const std::string key = line.substr(0, line.find('='));
+    if (std::find(notResult.begin(), notResult.end(), key) == notResult.end()) kept += line + "\n";
+  }
+  return hashText(kept);
+}
+
+// The parsed arguments as options; throws Error(Usage) for combinations CLI11 cannot check.
+void applyArguments(BakeCommand& command, const BakeArguments& a) {
+  BakeOptions& o = command.options;
+  if (!a.shard.empty()) {
+    int k = 0, n = 0;
+    char tail = 0;
+    if (std::sscanf(a.shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || n > 1000000 || k < 1 || k > n)
+      throw Error(ErrorCode::Usage, "", "--shard needs K/N with 1 ≤ K ≤ N ≤ 1000000 (got '" + a.shard + "')");
+    command.shardIndex = k;
+    command.shardCount = n;
+  }
+
+  if (a.scenes.size() != 1)
+    throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
-  if (out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
-  if (quiet) log::setLevel(log::Level::Warn);
-  std::unique_ptr<tbb::global_control> threadLimit;
-  if (threads > 0)
-    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-
-  o.backend = parseBackend(backend);
-  o.walk.seed = static_cast<uint32_t>(seed);
-  o.atlas.texelsPerUnit = static_cast<float>(tpu);
-  o.texels.leakControl = !noLeakControl;
-  if (clampOption->count() > 0) {
-    o.eval.clampBound = static_cast<float>(clamp);
+  if (command.out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
+  command.scene = a.scenes[0];
+  o.backend = parseBackend(a.backend);
+  o.walk.seed = static_cast<uint32_t>(a.seed);
+  o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
+  o.texels.leakControl = !a.noLeakControl;
+  if (a.clampOption->count() > 0) {
+    o.eval.clampBound = static_cast<float>(a.clamp);
     o.autoClamp = false;
   }
-  o.eval.biasCompensation = !noBiasCompensation;  // on by default; --bias-compensation kept
-  o.postDilate = !noDilate;
-  o.postSeams = !noSeams;
+  o.eval.biasCompensation = !a.noBiasCompensation;  // on by default; --bias-compensation kept
+  o.postDilate = !a.noDilate;
+  o.postSeams = !a.noSeams;
+  if (command.shardIndex > 0 && namesGltfFile(command.out))
+    throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
+  if (command.shardIndex > 0 && o.backend == BackendKind::Reference)
+    throw Error(ErrorCode::Usage, "", "--shard splits the VPLs: the reference backend has none (use gl, embree or auto)");
+}
 
-  const OutputFolderLock lock(outputFolderOf(out));  // before any work: a second bake into OUTDIR fails at once
-  const std::filesystem::path scenePath = scenes[0];
-  Stopwatch loadTime;
+}  // namespace
+
+std::optional<BakeCommand> parseBakeCommand(const Args& args) {
+  BakeCommand command;
+  BakeArguments arguments;
+  const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
+  if (!cli::parse(*app, args)) return std::nullopt;
+  command.optionsHash = resultOptionsHash(*app);
+  applyArguments(command, arguments);
+  return command;
+}
+
+Scene loadBakeScene(const BakeCommand& command) {
+  const std::filesystem::path scenePath = command.scene;
   Scene scene = loadScene(scenePath);
-  if (!sun.empty()) {
-    const std::vector<double> d = cli::parseNumberList(sun);
+  if (!command.sun.empty()) {
+    const std::vector<double> d = cli::parseNumberList(command.sun);
     scene.lights.push_back(sunLight(glm::vec3(d[0], d[1], d[2]), static_cast<float>(d[3])));
   }
-  if (!sky.empty()) {
-    const std::vector<double> L = cli::parseNumberList(sky);
+  if (!command.sky.empty()) {
+    const std::vector<double> L = cli::parseNumberList(command.sky);
     for (double v : L)
       if (!(v >= 0.0)) throw Error(ErrorCode::Usage, "", "--sky needs three radiances ≥ 0 (R,G,B)");
     scene.environment = Environment::uniform(glm::vec3(L[0], L[1], L[2]));
   }
-  if (!env.empty()) {
-    if (!sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
-    scene.environment = loadEnvironment(env, static_cast<float>(envIntensity), static_cast<float>(envRotation));
+  if (!command.env.empty()) {
+    if (!command.sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
+    scene.environment = loadEnvironment(command.env, static_cast<float>(command.envIntensity),
+                                        static_cast<float>(command.envRotation));
   }
   requireLight(scene, scenePath);
-  double loadSeconds = loadTime.seconds();
+  return scene;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The checkpoint of a bake under way (removed when it finishes) and a shard's share, inside OUTDIR.
+constexpr const char* kCheckpointName = ".irbake.checkpoint";
+std::string partialName(int k, int n) {
+  return "partial_" + std::to_string(k) + "_of_" + std::to_string(n) + ".vplsum";
+}
+
+// Temp files a killed bake left mid-write in this folder: we hold its lock, so no writer is alive.
+void removeStaleTemps(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const size_t at = name.rfind(".tmp");
+    if (at == std::string::npos || at + 4 >= name.size() ||
+        name.find_first_not_of("0123456789_", at + 4) != std::string::npos)
+      continue;
+    std::error_code removeError;
+    fs::remove(entry.path(), removeError);
+  }
+}
+
+// The scene's identity: its files, and the environment map's when --env names one.
+std::string sceneIdentity(const BakeCommand& c) {
+  std::string hash = hashSceneFiles(c.scene);
+  if (!c.env.empty()) hash = hashText(hash + hashSceneFiles(c.env));
+  return hash;
+}
+
+}  // namespace
+
+std::string bakeSceneIdentity(const BakeCommand& c) { return sceneIdentity(c); }
+
+int runBake(const Args& args) {
+  std::optional<BakeCommand> parsed = parseBakeCommand(args);
+  if (!parsed) return 0;
+  BakeCommand& c = *parsed;
+  if (c.quiet) log::setLevel(log::Level::Warn);
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (c.threads > 0)
+    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);
+
+  const fs::path outDir = outputFolderOf(c.out);
+  const OutputFolderLock lock(outDir);  // before any work: a second bake into OUTDIR fails at once
+  removeStaleTemps(outDir);
+  Stopwatch loadTime;
+  Scene scene = loadBakeScene(c);
+  const double loadSeconds = loadTime.seconds();
 
   TerminalProgress progress;
-  o.progress = progress.callback();
-  BakeResult result = bake(std::move(scene), o);
-  result.report["timings"]["seconds"]["load"] = loadSeconds;
+  c.options.progress = progress.callback();
+  StagedBake staged(std::move(scene), c.options);
 
-  OutputOptions oo;
-  oo.outDir = out;
-  oo.reportPath = report;
-  oo.writeGltf = !noGltf;
-  Stopwatch writeTime;
-  o.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
-  auto files = writeBakeOutputs(result, oo);
-  o.progress("write", 1.0);
-  progress.finish();
-  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() + " in " +
-            std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " + std::to_string(writeTime.seconds()) +
-            " s writing)");
-  for (const auto& f : files) std::printf("%s\n", f.string().c_str());
+  // The blocks this process adds: all, or share K of N.
+  const size_t blocks = staged.blockCount();
+  const size_t begin = c.shardIndex ? blocks * (c.shardIndex - 1) / c.shardCount : 0;
+  const size_t end = c.shardIndex ? blocks * c.shardIndex / c.shardCount : blocks;
+  VplSumHeader header;
+  header.sceneHash = sceneIdentity(c);
+  header.optionsHash = c.optionsHash;
+  header.seed = c.options.walk.seed;
+  header.backend = toString(staged.backend());
+  header.blockCount = blocks;
+  header.firstBlock = begin;
+  header.shardIndex = c.shardIndex;
+  header.shardCount = c.shardCount;
+  header.command = {{"scene", fs::absolute(c.scene).string()},
+                    {"env", c.env.empty() ? std::string() : fs::absolute(c.env).string()},
+                    {"args", args}};
+
+  ExactVplSums sums = staged.emptySums();
+  size_t next = begin;
+  const fs::path checkpoint = outDir / kCheckpointName;
+  if (fs::exists(checkpoint)) {
+    if (c.resume) {
+      VplSumFile saved = readVplSumFile(checkpoint);
+      std::string differs = header.mismatch(saved.header);
+      if (differs.empty() && (saved.header.firstBlock != begin || saved.header.endBlock > end))
+        differs = "share of the VPL blocks";
+      if (differs.empty() && !saved.sums.sameLayout(sums)) differs = "page layout";
+      if (!differs.empty())
+        throw Error(ErrorCode::Usage, checkpoint.string(),
+                    "this checkpoint belongs to another bake (different " + differs +
+                        "): delete it, or bake without --resume");
+      sums = std::move(saved.sums);
+      next = saved.header.endBlock;
+      staged.addBackendCounts(saved.header.backendCounts);
+      log::info("resuming at VPL block " + std::to_string(next) + " of " + std::to_string(end) + " (" +
+                checkpoint.string() + ")");
+    } else {
+      log::warn("ignoring the checkpoint " + checkpoint.string() + " of an earlier bake (--resume would continue it)");
+    }
+  } else if (c.resume) {
+    log::info("no checkpoint in " + outDir.string() + ": baking from the start");
+  }
+
+  Stopwatch sinceCheckpoint;
+  staged.evaluateBlocks(next, end, sums, [&](size_t done) {
+    if (done >= end || sinceCheckpoint.seconds() < c.checkpointSeconds) return;
+    VplSumHeader h = header;
+    h.kind = "checkpoint";
+    h.endBlock = done;
+    h.backendCounts = staged.backendCounts();
+    writeVplSumFile(checkpoint, h, sums);
+    sinceCheckpoint.reset();
+  });
+
+  std::error_code ec;
+  if (c.shardIndex > 0) {
+    header.kind = "partial";
+    header.endBlock = end;
+    header.backendCounts = staged.backendCounts();
+    const fs::path partial = outDir / partialName(c.shardIndex, c.shardCount);
+    writeVplSumFile(partial, header, sums);
+    fs::remove(checkpoint, ec);
+    progress.finish();
+    log::info("shard " + std::to_string(c.shardIndex) + "/" + std::to_string(c.shardCount) + ": VPL blocks " +
+              std::to_string(begin) + ".." + std::to_string(end) + " of " + std::to_string(blocks));
+    std::printf("%s\n", partial.string().c_str());
+    return 0;
+  }
+
+  BakeResult result = staged.finish(std::move(sums));
+  result.report["timings"]["seconds"]["load"] = loadSeconds;
+  writeFinishedBake(c, result, progress);
+  fs::remove(checkpoint, ec);
   return 0;
 }
 
+void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress) {
+  OutputOptions oo;
+  oo.outDir = c.out;
+  oo.reportPath = c.report;
+  oo.writeGltf = !c.noGltf;
+  Stopwatch writeTime;
+  c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
+  auto files = writeBakeOutputs(result, oo);
+  c.options.progress("write", 1.0);
+  progress.finish();
+  log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() +
+            " in " + std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " +
+            std::to_string(writeTime.seconds()) + " s writing)");
+  for (const auto& f : files) std::printf("%s\n", f.string().c_str());
+}
 }  // namespace irbake::app

@@ -9,6 +9,7 @@ using Args = std::vector<std::string>;  // arguments after the subcommand name
 int runInfo(const Args& args);
 int runUnwrap(const Args& args);
 int runBake(const Args& args);
+int runMerge(const Args& args);
 int runDiff(const Args& args);
 int runSamples(const Args& args);
 }  // namespace irbake::app

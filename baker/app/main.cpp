@@ -16,6 +16,7 @@ const char* kUsage =
     "  info SCENE                       print a summary of a glTF scene\n"
     "  unwrap IN -o OUT [options]       add a lightmap UV set (TEXCOORD_1)\n"
     "  bake SCENE -o OUTDIR [options]   bake light maps (EXR) and export glTF with MOZ_lightmap\n"
+    "  merge DIR... -o OUTDIR           finish a bake from its shards (bake --shard K/N)\n"
     "  diff A B                         compare two bakes of the same atlas\n"
     "  samples OUTDIR                   write the built-in sample scenes\n"
     "  --version                        print the version and exit\n"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
     if (cmd == "info") return irbake::app::runInfo(args);
     if (cmd == "unwrap") return irbake::app::runUnwrap(args);
     if (cmd == "bake") return irbake::app::runBake(args);
+    if (cmd == "merge") return irbake::app::runMerge(args);
     if (cmd == "diff") return irbake::app::runDiff(args);
     if (cmd == "samples") return irbake::app::runSamples(args);
     std::fprintf(stderr, "irbake: error: unknown command '%s'\n%s", cmd.c_str(), kUsage);

@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "common/progress.h"
 #include "scene/scene.h"
 
@@ -50,6 +52,15 @@ struct AtlasStats {
 struct AtlasResult {
   std::vector<AtlasPage> pages;
   AtlasStats stats;
+  nlohmann::json toJson() const {  // report "atlas": page sizes and the figures a user checks
+    nlohmann::json sizes = nlohmann::json::array();
+    for (const auto& pg : pages) sizes.push_back({{"width", pg.width}, {"height", pg.height}});
+    return {{"pages", sizes},
+            {"charts", stats.charts},
+            {"texelsPerUnit", stats.texelsPerUnit},
+            {"centreUtilisation", stats.centreUtilisation},
+            {"warnings", stats.warnings}};
+  }
 };
 
 // UV winding: every non-degenerate triangle has a positive signed area (u1-u0)(v2-v0)-(v1-v0)(u2-u0)

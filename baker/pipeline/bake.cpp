@@ -17,6 +17,8 @@
 #include "common/error.h"
 #include "common/log.h"
 #include "common/progress.h"
+#include "backend/gl/shadow_views.h"
+#include "common/maths.h"
 #include "post/post.h"
 #include "raytrace/ray_tracer.h"
 
@@ -39,69 +41,6 @@ std::string seeThroughMaterials(const Scene& scene) {
     if (m.transmission > 0.0f) return "material '" + m.name + "' is transmissive";
   }
   return {};
-}
-
-// The backend stage. The GL engineer owns the GL line (options, stats); every backend returns one
-// Lightmap per texel page. glContext: the bake's context (current on this thread) for the GL backend.
-std::vector<Lightmap> runBackend(BackendKind backend, const BakeOptions& options, const BakeInputs& inputs,
-                                 nlohmann::json& report, GlContext* glContext) {
-  const int interleave =
-      options.interleave > 0 ? options.interleave : chooseInterleave(inputs.texels, inputs.eval.clampBound);
-  switch (backend) {
-    case BackendKind::Gl: {
-      // One context for every call (interleaved sampling makes n² + 1 of them).
-      GlBakeStats total;
-      VplBackend gl = [&](const BakeInputs& in) {
-        GlBakeStats st;
-        GlBackendOptions go = options.gl;
-        go.stats = &st;
-        go.context = glContext;
-        std::vector<Lightmap> maps = bakeGl(in, go);
-        total.add(st);
-        return maps;
-      };
-      InterleaveStats is;
-      std::vector<Lightmap> maps = bakeInterleaved(inputs, interleave, gl, &is);
-      report["renderer"] = total.renderer;
-      report["gl"] = {{"passes", total.passes},               {"facesRendered", total.facesRendered},
-                      {"trianglesDrawn", total.trianglesDrawn}, {"cubeFaceSize", total.cubeFaceSize},
-                      {"contactTexels", total.contactTexels},
-                      {"contactFraction", total.texelsEvaluated ? double(total.contactTexels) / total.texelsEvaluated : 0.0}};
-      report["timings"]["gl"] = {{"setupSeconds", total.setupSeconds},     {"shadowSeconds", total.shadowSeconds},
-                                 {"accumulateSeconds", total.accumulateSeconds}, {"foldSeconds", total.foldSeconds},
-                                 {"contactSeconds", total.contactSeconds}};
-      report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
-      return maps;
-    }
-    case BackendKind::Embree: {
-      InterleaveStats is;
-      std::vector<Lightmap> maps =
-          bakeInterleaved(inputs, interleave, [](const BakeInputs& in) { return bakeEmbree(in); }, &is);
-      report["interleave"] = {{"classes", is.classes}, {"backendCalls", is.backendCalls}};
-      return maps;
-    }
-    case BackendKind::Auto:
-      break;  // resolved by bake() before this stage
-    case BackendKind::Reference: {
-      ReferenceOptions ref;
-      ref.spp = options.referenceSpp;
-      ref.seed = options.walk.seed;
-      std::vector<Lightmap> standardError;
-      std::vector<Lightmap> maps = bakeReference(inputs, ref, &standardError);
-      // The mean standard error over valid texels says how converged the yardstick is.
-      double se = 0.0, value = 0.0;
-      for (size_t p = 0; p < maps.size() && p < standardError.size(); ++p)
-        for (size_t i = 0; i < maps[p].size() && i < standardError[p].size(); ++i) {
-          if (i < maps[p].valid.size() && !maps[p].valid[i]) continue;
-          const glm::vec3 &e = standardError[p].texels[i], &v = maps[p].texels[i];
-          se += (e.x + e.y + e.z) / 3.0;
-          value += (v.x + v.y + v.z) / 3.0;
-        }
-      report["reference"] = {{"spp", ref.spp}, {"relativeStandardError", value > 0.0 ? se / value : 0.0}};
-      return maps;
-    }
-  }
-  throw Error(ErrorCode::Usage, "", "unknown backend");
 }
 
 }  // namespace
@@ -144,211 +83,453 @@ double peakMemoryMiB() {
   return usage.ru_maxrss / 1024.0;  // Linux: kilobytes
 }
 
-BakeResult bake(Scene scene, const BakeOptions& options) {
-  BakeResult r;
-  r.scene = std::move(scene);
-  Scene& s = r.scene;
-  if (s.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.sourcePath, "no triangles to bake");
-  nlohmann::json& report = r.report;
-  nlohmann::json seconds;
-  Stopwatch total, stage;
-  auto withProgress = [&](ProgressCallback cb) { return cb ? cb : options.progress; };
+namespace {
 
-  AtlasOptions atlasOptions = options.atlas;
-  atlasOptions.progress = withProgress(atlasOptions.progress);
-  r.atlas = buildAtlas(s, atlasOptions);
-  seconds["atlas"] = stage.seconds();
+// The evaluation flags each backend call gets, decided here once: VPL blocks evaluate the clamped VPL sum
+// only, the direct call the punctual lights only, and no backend compensates the clamp (that is its own
+// stage, backend/compensation, after either backend).
+VplEvalOptions vplBlockEval(const VplEvalOptions& eval) {
+  VplEvalOptions e = eval;
+  e.includeDirect = false;
+  e.biasCompensation = false;
+  return e;
+}
+VplEvalOptions directEval(const VplEvalOptions& eval) {
+  VplEvalOptions e = eval;
+  e.includeVpls = false;
+  e.biasCompensation = false;
+  return e;
+}
 
-  stage.reset();
-  RayTracer rt(s);
-  seconds["raytrace"] = stage.seconds();
+// A contiguous range of one interleave class's VPLs.
+struct VplBlock {
+  int vplClass = 0;
+  size_t begin = 0, end = 0;
+};
 
-  stage.reset();
-  TexelSampleOptions texelOptions = options.texels;
-  texelOptions.progress = withProgress(texelOptions.progress);
-  std::vector<TexelSamples> texels = buildTexelSamples(s, rt, texelOptions);
-  seconds["texels"] = stage.seconds();
+}  // namespace
 
-  stage.reset();
-  WalkOptions walk = options.walk;
-  walk.progress = withProgress(walk.progress);
-  r.vpls = generateVpls(s, rt, walk);
-  seconds["vpls"] = stage.seconds();
-
-  VplEvalOptions eval = options.eval;
-  bool clampDerived = false;
+struct StagedBake::State {
+  BakeOptions options;
+  Scene scene;
+  AtlasResult atlas;
+  std::unique_ptr<RayTracer> rayTracer;
+  std::vector<TexelSamples> texels;
+  VplSet vpls;
+  VplEvalOptions eval;        // with the derived clamp
   double clampK = 0.0;
-  if (options.autoClamp && eval.clampBound == 0.0f) {
+  bool clampDerived = false;
+  BackendKind backend = BackendKind::Auto;
+  std::string backendReason = "asked for";
+  std::unique_ptr<GlContext> glContext;
+  GlBackendOptions gl;        // with the cube face size fixed for every block
+  int interleave = 1;
+  std::vector<VplSet> classVpls;                    // per interleave class
+  int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
+  std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
+  std::vector<VplBlock> blocks;
+  GlBakeStats glStats;
+  InterleaveStats interleaveStats;
+  std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
+  std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
+  bool compensate = false, overlap = false;
+  nlohmann::json seconds = nlohmann::json::object();
+  Stopwatch total;
+
+  ProgressCallback withProgress(ProgressCallback cb) const { return cb ? cb : options.progress; }
+  BakeInputs inputs(const std::vector<TexelSamples>& pages, const VplSet& set, const VplEvalOptions& e,
+                    ProgressCallback progress = {}) const {
+    return BakeInputs{scene, *rayTracer, pages, set, e, std::move(progress)};
+  }
+
+  // Each stage records its wall time under its name.
+  template <class Stage>
+  void timed(const char* name, Stage&& stage) {
+    Stopwatch watch;
+    stage();
+    seconds[name] = seconds.value(name, 0.0) + watch.seconds();
+  }
+
+  void prepare() {
+    timed("atlas", [&] {
+      AtlasOptions o = options.atlas;
+      o.progress = withProgress(o.progress);
+      atlas = buildAtlas(scene, o);
+    });
+    timed("raytrace", [&] { rayTracer = std::make_unique<RayTracer>(scene); });
+    timed("texels", [&] {
+      TexelSampleOptions o = options.texels;
+      o.progress = withProgress(o.progress);
+      texels = buildTexelSamples(scene, *rayTracer, o);
+    });
+    timed("vpls", [&] {
+      WalkOptions o = options.walk;
+      o.progress = withProgress(o.progress);
+      vpls = generateVpls(scene, *rayTracer, o);
+    });
+    deriveClamp();
+    // The gather keeps a reference to its inputs, so they live as long as the bake.
+    wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
+    timed("backend", [&] {  // the GL context is made here: its time counts to the backend, as it did
+      chooseBackend();
+      planBlocks();
+    });
+  }
+
+  void deriveClamp() {
+    eval = options.eval;
+    if (!options.autoClamp || eval.clampBound != 0.0f) return;
     clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
              : eval.biasCompensation     ? kCompensatedClampVplsPerMean
                                          : kClampVplsPerMean;
-    eval.clampBound = deriveClampBound(s, r.vpls, clampK);
+    eval.clampBound = deriveClampBound(scene, vpls, clampK);
     clampDerived = true;
   }
 
-  stage.reset();
   // --backend auto: GL where it is both right and fast, Embree otherwise (the choice and why in the report).
-  std::unique_ptr<GlContext> glContext;
-  BackendKind backend = options.backend;
-  std::string backendReason = "asked for";
-  if (backend == BackendKind::Auto) {
-    backend = BackendKind::Embree;
-    if (std::string why = seeThroughMaterials(s); !why.empty()) {
-      backendReason = why + ": the GL backend would trace most texels it shades anyway (red pane test: 64%)";
-    } else {
-      try {
-        glContext = std::make_unique<GlContext>();
-        if (!glContext->softwareRenderer()) {
-          backend = BackendKind::Gl;
-          backendReason = "hardware GL renderer";
-        } else if (s.triangleCount() <= kSoftwareGlTriangleHint) {
-          backend = BackendKind::Gl;
-          backendReason = "software GL renderer, " + std::to_string(s.triangleCount()) + " triangles (≤ " +
-                          std::to_string(kSoftwareGlTriangleHint) + ": GL as fast as Embree)";
-        } else {
-          backendReason = "software GL renderer with " + std::to_string(s.triangleCount()) +
-                          " triangles: its shadow pass draws them for every VPL cube (docs/performance.md)";
+  void chooseBackend() {
+    backend = options.backend;
+    if (backend == BackendKind::Auto) {
+      backend = BackendKind::Embree;
+      if (std::string why = seeThroughMaterials(scene); !why.empty()) {
+        backendReason = why + ": the GL backend would trace most texels it shades anyway (red pane test: 64%)";
+      } else {
+        try {
+          glContext = std::make_unique<GlContext>();
+          if (!glContext->softwareRenderer()) {
+            backend = BackendKind::Gl;
+            backendReason = "hardware GL renderer";
+          } else if (scene.triangleCount() <= kSoftwareGlTriangleHint) {
+            backend = BackendKind::Gl;
+            backendReason = "software GL renderer, " + std::to_string(scene.triangleCount()) + " triangles (≤ " +
+                            std::to_string(kSoftwareGlTriangleHint) + ": GL as fast as Embree)";
+          } else {
+            backendReason = "software GL renderer with " + std::to_string(scene.triangleCount()) +
+                            " triangles: its shadow pass draws them for every VPL cube (docs/performance.md)";
+          }
+        } catch (const Error& e) {
+          backendReason = std::string("no GL context: ") + e.what();
         }
-      } catch (const Error& e) {
-        backendReason = std::string("no GL context: ") + e.what();
+        if (backend != BackendKind::Gl) glContext.reset();
       }
-      if (backend != BackendKind::Gl) glContext.reset();
+      log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
     }
-    log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
-  }
-  report["backendChoice"] = {{"asked", toString(options.backend)}, {"used", toString(backend)}, {"reason", backendReason}};
-
-  // Bias compensation is its own stage after either VPL backend (backend/compensation), so the backends
-  // evaluate the clamped sum only.
-  const bool compensate = eval.biasCompensation && backend != BackendKind::Reference;
-  VplEvalOptions backendEval = eval;
-  if (compensate) backendEval.biasCompensation = false;
-  BakeInputs inputs{s, rt, texels, r.vpls, backendEval, options.progress};
-  ClampCompensationOptions co = options.compensation;
-  co.seed = options.walk.seed;
-  // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
-  // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and the
-  // rasteriser waits for its slowest thread (Cornell box: bake 1.95 → 2.43 s). Embree uses every core itself.
-  if (backend == BackendKind::Gl) {
+    compensate = eval.biasCompensation && backend != BackendKind::Reference;
+    if (backend != BackendKind::Gl) return;
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
     // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/performance.md).
-    if (glContext->softwareRenderer() && s.triangleCount() > kSoftwareGlTriangleHint && r.vpls.vpls.size() > 0)
-      log::warn("GL backend on a software renderer with " + std::to_string(s.triangleCount()) +
+    if (glContext->softwareRenderer() && scene.triangleCount() > kSoftwareGlTriangleHint && !vpls.vpls.empty())
+      log::warn("GL backend on a software renderer with " + std::to_string(scene.triangleCount()) +
                 " triangles: its shadow pass draws them for every VPL cube (on the 2-core bench machine the Embree "
                 "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");
+    // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
+    // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and
+    // the rasteriser waits for its slowest thread (Cornell box: bake 1.95 → 2.43 s).
+    overlap = compensate && (options.overlapCompensation > 0 ||
+                             (options.overlapCompensation < 0 && !glContext->softwareRenderer()));
   }
-  std::future<std::unique_ptr<ClampGather>> gather;
-  const bool overlap = compensate && glContext &&
-                       (options.overlapCompensation > 0 ||
-                        (options.overlapCompensation < 0 && !glContext->softwareRenderer()));
-  if (overlap)
-    gather = std::async(std::launch::async, [&inputs, co] { return std::make_unique<ClampGather>(inputs, co); });
-  report["compensationOverlapped"] = overlap;
-  r.maps = runBackend(backend, options, inputs, report, glContext.get());
-  if (r.maps.size() != texels.size())
-    throw Error(ErrorCode::InvalidData, s.sourcePath, "the backend returned " + std::to_string(r.maps.size()) +
-                                                          " pages for " + std::to_string(texels.size()));
-  for (size_t p = 0; p < r.maps.size(); ++p) {
-    r.maps[p].page = static_cast<int>(p);
-    if (r.maps[p].valid.size() != r.maps[p].size()) r.maps[p].valid = texels[p].valid;
+
+  // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
+  void planBlocks() {
+    if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
+    interleave = options.interleave > 0 ? options.interleave : chooseInterleave(texels, eval.clampBound);
+    classVpls = classVplSubsets(vpls, interleave);
+    const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
+    for (size_t c = 0; c < classVpls.size(); ++c)
+      for (size_t b0 = 0; b0 < classVpls[c].vpls.size(); b0 += blockSize)
+        blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[c].vpls.size(), b0 + blockSize)});
+    gl = options.gl;
+    if (backend == BackendKind::Gl && gl.cubeFaceSize <= 0)  // once for every block, from the first class
+      gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), eval.clampBound, gl.cubeFootprintPerTexel,
+                                           gl.minCubeFaceSize, gl.maxCubeFaceSize)
+                            .size;
+    interleaveStats.classes = static_cast<int>(classVpls.size());
   }
-  seconds["backend"] = stage.seconds();
+
+  // The texel samples of an interleave class as pages of their own (interleave 1: the pages themselves).
+  const std::vector<TexelSamples>& pagesOf(int vplClass) {
+    if (interleave <= 1) return texels;
+    if (pagesClass != vplClass) {
+      classPages = interleaveClass(texels, interleave, vplClass % interleave, vplClass / interleave);
+      pagesClass = vplClass;
+    }
+    return classPages;
+  }
+
+  // One call of the GL or Embree backend.
+  std::vector<Lightmap> runVplBackend(const BakeInputs& in) {
+    if (backend == BackendKind::Gl) {
+      GlBakeStats callStats;
+      GlBackendOptions o = gl;
+      o.stats = &callStats;
+      o.context = glContext.get();
+      std::vector<Lightmap> maps = bakeGl(in, o);
+      glStats.add(callStats);
+      ++interleaveStats.backendCalls;
+      return maps;
+    }
+    ++interleaveStats.backendCalls;
+    return bakeEmbree(in);
+  }
+
+  void evaluateBlock(size_t index, ExactVplSums& sums, ProgressCallback progress) {
+    const VplBlock& block = blocks[index];
+    const VplSet& classSet = classVpls[static_cast<size_t>(block.vplClass)];
+    VplSet set;
+    set.meanReflectivity = classSet.meanReflectivity;
+    set.bounces = classSet.bounces;
+    set.emittedPower = classSet.emittedPower;
+    set.vpls.assign(classSet.vpls.begin() + static_cast<std::ptrdiff_t>(block.begin),
+                    classSet.vpls.begin() + static_cast<std::ptrdiff_t>(block.end));
+    const std::vector<TexelSamples>& pages = pagesOf(block.vplClass);
+    const std::vector<Lightmap> maps = runVplBackend(inputs(pages, set, vplBlockEval(eval), std::move(progress)));
+    const int n = interleave, cx = block.vplClass % n, cy = block.vplClass / n;
+    for (size_t p = 0; p < maps.size() && p < texels.size(); ++p) {
+      const Lightmap& m = maps[p];
+      const int fullWidth = texels[p].width;
+      for (int y = 0; y < m.height; ++y)
+        for (int x = 0; x < m.width; ++x) {
+          const size_t ct = static_cast<size_t>(y) * m.width + x;
+          if (ct >= m.valid.size() || !m.valid[ct]) continue;
+          const size_t t = static_cast<size_t>(n * y + cy) * fullWidth + (n * x + cx);
+          if (!sums.add(p, t, m.texels[ct]))
+            throw Error(ErrorCode::NumericError, scene.sourcePath,
+                        "VPL block " + std::to_string(index) + " gave a non-finite or absurd value (≥ 2^40) at page " +
+                            std::to_string(p) + " texel " + std::to_string(t % fullWidth) + "," +
+                            std::to_string(t / fullWidth));
+        }
+    }
+  }
+
+  // Punctual lights on every texel, exact and unfiltered (blank valid pages when there are none).
+  std::vector<Lightmap> directStage() {
+    if (eval.includeDirect && !scene.lights.empty()) {
+      const VplSet none;
+      return runVplBackend(inputs(texels, none, directEval(eval)));
+    }
+    std::vector<Lightmap> maps;
+    for (const TexelSamples& ts : texels) {
+      maps.push_back(blankLightmap(ts));
+      maps.back().valid = ts.valid;
+    }
+    return maps;
+  }
+
+  std::vector<Lightmap> referenceStage(nlohmann::json& report) {
+    ReferenceOptions ref;
+    ref.spp = options.referenceSpp;
+    ref.seed = options.walk.seed;
+    std::vector<Lightmap> standardError;
+    std::vector<Lightmap> maps = bakeReference(inputs(texels, vpls, eval), ref, &standardError);
+    // The mean standard error over valid texels says how converged the yardstick is.
+    double se = 0.0, value = 0.0;
+    for (size_t p = 0; p < maps.size() && p < standardError.size(); ++p)
+      for (size_t i = 0; i < maps[p].size() && i < standardError[p].size(); ++i) {
+        if (i < maps[p].valid.size() && !maps[p].valid[i]) continue;
+        se += channelMean(standardError[p].texels[i]);
+        value += channelMean(maps[p].texels[i]);
+      }
+    report["reference"] = {{"spp", ref.spp}, {"relativeStandardError", value > 0.0 ? se / value : 0.0}};
+    return maps;
+  }
+
+  // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference).
+  std::vector<Lightmap> backendMaps(const ExactVplSums& sums, nlohmann::json& report) {
+    if (backend == BackendKind::Reference) return referenceStage(report);
+    std::vector<Lightmap> maps = directStage();
+    if (maps.size() != texels.size())
+      throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
+                                                                " pages for " + std::to_string(texels.size()));
+    for (size_t p = 0; p < maps.size(); ++p) {
+      maps[p].page = static_cast<int>(p);
+      if (maps[p].valid.size() != maps[p].size()) maps[p].valid = texels[p].valid;
+      if (blocks.empty()) continue;
+      std::vector<glm::vec3> vplPart(texels[p].layerSize(), glm::vec3(0.0f));
+      for (size_t t = 0; t < vplPart.size(); ++t) vplPart[t] = sums.value(p, t);
+      addMixedClasses(texels[p], interleave, vplPart, sums.pages[p].valid, maps[p]);
+    }
+    return maps;
+  }
 
   // The sky's direct light, traced (every VPL backend; the reference integrator finds the sky itself).
   // Before the compensation, whose gather reads the map as the light leaving each surface.
-  if (s.environment.present() && backend != BackendKind::Reference) {
-    stage.reset();
-    SkyLightOptions so = options.sky;
-    so.seed = options.walk.seed;
-    SkyLightStats ss;
-    addSkyLight(inputs, r.maps, so, &ss);
-    seconds["sky"] = stage.seconds();
-    report["sky"] = {{"rays", ss.rays}, {"raysPerSample", ss.raysPerSample},
-                     {"uniform", s.environment.isUniform()}, {"source", s.environment.source()},
-                     {"integral", rgb(s.environment.integral())}};
+  void skyStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
+    if (!scene.environment.present() || backend == BackendKind::Reference) return;
+    timed("sky", [&] {
+      SkyLightOptions o = options.sky;
+      o.seed = options.walk.seed;
+      SkyLightStats stats;
+      addSkyLight(*wholeInputs, maps, o, &stats);
+      report["sky"] = stats.toJson();
+      report["sky"]["uniform"] = scene.environment.isUniform();
+      report["sky"]["source"] = scene.environment.source();
+      report["sky"]["integral"] = rgb(scene.environment.integral());
+    });
   }
 
-  if (compensate) {
-    stage.reset();
-    ClampCompensationStats cs;
-    if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
-    std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(inputs, co);
-    g->apply(r.maps, &cs);
-    if (options.progress) options.progress("compensate", 1.0);
-    seconds["compensation"] = stage.seconds();  // with the GL backend: the sweeps (and any trace not yet done)
-    seconds["compensationTrace"] = g->traceSeconds();
-    report["compensation"] = {{"rays", cs.raysTraced},
-                              {"samplesRefined", cs.samplesRefined},
-                              {"hitsKept", cs.hitsKept},
-                              {"addedFraction", cs.addedFraction},
-                              {"raysPerSample", cs.raysPerSample},
-                              {"filterRadius", cs.filterRadius},
-                              {"sweeps", cs.sweeps}};
+  // Bias compensation: the clamp's lost near-field light gathered back from the baked map.
+  void compensationStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
+    if (!compensate) return;
+    timed("compensation", [&] {  // with an overlapped trace: the sweeps (and any trace not yet done)
+      ClampCompensationOptions o = options.compensation;
+      o.seed = options.walk.seed;
+      ClampCompensationStats stats;
+      if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
+      std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(*wholeInputs, o);
+      g->apply(maps, &stats);
+      if (options.progress) options.progress("compensate", 1.0);
+      seconds["compensationTrace"] = g->traceSeconds();
+      report["compensation"] = stats.toJson();
+    });
   }
 
-  stage.reset();
-  PostOptions post;
-  post.dilate = options.postDilate;
-  post.stitchSeams = options.postSeams;
-  if (options.progress) options.progress("post", 0.0);
-  PostStats postStats = postProcess(s, r.maps, post);
-  if (options.progress) options.progress("post", 1.0);
-  seconds["post"] = stage.seconds();
-  seconds["bake"] = total.seconds();
+  PostStats postStage(std::vector<Lightmap>& maps) {
+    PostStats stats;
+    timed("post", [&] {
+      PostOptions o;
+      o.dilate = options.postDilate;
+      o.stitchSeams = options.postSeams;
+      if (options.progress) options.progress("post", 0.0);
+      stats = postProcess(scene, maps, o);
+      if (options.progress) options.progress("post", 1.0);
+    });
+    return stats;
+  }
 
-  // The report: what was baked, how, how long, and where the energy went.
-  size_t texelCount = 0, covered = 0, valid = 0;
-  for (const auto& t : texels) {
-    texelCount += t.layerSize();
-    for (auto c : t.covered) covered += c != 0;
-    for (auto v : t.valid) valid += v != 0;
+  // What was baked and how: each stage's stats as its own object.
+  void describe(nlohmann::json& report, const PostStats& post) const {
+    size_t texelCount = 0, covered = 0, valid = 0;
+    for (const auto& t : texels) {
+      texelCount += t.layerSize();
+      for (auto c : t.covered) covered += c != 0;
+      for (auto v : t.valid) valid += v != 0;
+    }
+    report["backendChoice"] = {{"asked", toString(options.backend)}, {"used", toString(backend)}, {"reason", backendReason}};
+    report["compensationOverlapped"] = overlap;
+    report["backend"] = toString(backend);
+    if (backend == BackendKind::Gl) {
+      report["renderer"] = glStats.renderer;
+      report["gl"] = glStats.toJson();
+      report["timings"]["gl"] = glStats.timingsJson();
+    }
+    if (backend != BackendKind::Reference) {
+      report["interleave"] = interleaveStats.toJson();
+      report["interleave"]["vplBlocks"] = blocks.size();
+      report["interleave"]["vplsPerBlock"] = options.vplBlock;
+    }
+    report["scene"] = {{"source", scene.sourcePath},
+                       {"triangles", scene.triangleCount()},
+                       {"primitives", scene.primitives.size()},
+                       {"lights", scene.lights.size()},
+                       {"emitterPower", rgb(glm::dvec3(scene.emitterPower()))}};
+    report["atlas"] = atlas.toJson();
+    report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
+                        {"supersample", std::max(1, options.texels.supersample)},
+                        {"leakControl", options.texels.leakControl}};
+    report["vpls"] = vpls.toJson();
+    report["vpls"]["paths"] = options.walk.paths;
+    report["vpls"]["seed"] = options.walk.seed;
+    report["eval"] = {{"clampBound", eval.clampBound},
+                      {"clampVplsPerMean", clampK},
+                      {"clampDerived", clampDerived},
+                      {"biasCompensation", eval.biasCompensation}};
+    if (backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
+    report["post"] = post.toJson();
   }
-  nlohmann::json pages = nlohmann::json::array();
-  for (const auto& pg : r.atlas.pages) pages.push_back({{"width", pg.width}, {"height", pg.height}});
-  nlohmann::json perBounce = nlohmann::json::array();
-  glm::dvec3 vplPower(0.0);
-  for (size_t b = 0; b < r.vpls.countPerBounce.size(); ++b) {
-    glm::dvec3 pw = b < r.vpls.powerPerBounce.size() ? r.vpls.powerPerBounce[b] : glm::dvec3(0.0);
-    vplPower += pw;
-    perBounce.push_back({{"bounce", b}, {"count", r.vpls.countPerBounce[b]}, {"power", rgb(pw)}});
+};
+
+StagedBake::StagedBake(Scene scene, const BakeOptions& options) : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.options = options;
+  s.scene = std::move(scene);
+  if (s.scene.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.scene.sourcePath, "no triangles to bake");
+  s.prepare();
+}
+
+StagedBake::~StagedBake() = default;
+
+size_t StagedBake::blockCount() const { return state_->blocks.size(); }
+BackendKind StagedBake::backend() const { return state_->backend; }
+
+ExactVplSums StagedBake::emptySums() const {
+  // Receivers: the texels a backend can return valid (GL and Embree keep the samples' valid flags).
+  std::vector<std::vector<uint8_t>> receivers;
+  for (const TexelSamples& ts : state_->texels)
+    receivers.push_back(ts.valid.size() == ts.layerSize() ? ts.valid : std::vector<uint8_t>(ts.layerSize(), 1));
+  return ExactVplSums::zeros(receivers);
+}
+
+void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
+                                const std::function<void(size_t next)>& afterBlock) {
+  State& s = *state_;
+  end = std::min(end, s.blocks.size());
+  if (s.overlap && !s.gather.valid() && begin == 0 && end == s.blocks.size()) {
+    const ClampCompensationOptions o = [&] {
+      ClampCompensationOptions c = s.options.compensation;
+      c.seed = s.options.walk.seed;
+      return c;
+    }();
+    // The gather reads the pages' texel samples and the geometry only: it runs while the GL backend bakes.
+    s.gather = std::async(std::launch::async, [&s, o] { return std::make_unique<ClampGather>(*s.wholeInputs, o); });
   }
-  report["backend"] = toString(backend);
-  report["scene"] = {{"source", s.sourcePath},
-                     {"triangles", s.triangleCount()},
-                     {"primitives", s.primitives.size()},
-                     {"lights", s.lights.size()},
-                     {"emitterPower", rgb(glm::dvec3(s.emitterPower()))}};
-  report["atlas"] = {{"pages", pages},
-                     {"charts", r.atlas.stats.charts},
-                     {"texelsPerUnit", r.atlas.stats.texelsPerUnit},
-                     {"centreUtilisation", r.atlas.stats.centreUtilisation},
-                     {"warnings", r.atlas.stats.warnings}};
-  report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
-                      {"supersample", std::max(1, options.texels.supersample)},
-                      {"leakControl", options.texels.leakControl}};
-  report["vpls"] = {{"paths", options.walk.paths},
-                    {"count", r.vpls.vpls.size()},
-                    {"bounces", r.vpls.bounces},
-                    {"meanReflectivity", r.vpls.meanReflectivity},
-                    {"emittedPower", rgb(r.vpls.emittedPower)},
-                    {"totalPower", rgb(vplPower)},
-                    {"perBounce", perBounce},
-                    {"seed", options.walk.seed}};
-  report["eval"] = {{"clampBound", eval.clampBound},
-                    {"clampVplsPerMean", clampK},
-                    {"clampDerived", clampDerived},
-                    {"biasCompensation", eval.biasCompensation}};
-  if (backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
-  report["post"] = {{"texelsFilled", postStats.texelsFilled},
-                    {"seamEdges", postStats.seamEdges},
-                    {"seamMismatchBefore", postStats.seamMismatchBefore},
-                    {"seamMismatchAfter", postStats.seamMismatchAfter}};
+  s.timed("backend", [&] {
+    for (size_t b = begin; b < end; ++b) {
+      ProgressCallback progress;
+      if (s.options.progress) {
+        const double count = static_cast<double>(std::max<size_t>(1, end - begin));
+        progress = [&s, b, begin, count](const char* stage, double f) {
+          s.options.progress(stage, (static_cast<double>(b - begin) + std::clamp(f, 0.0, 1.0)) / count);
+        };
+      }
+      s.evaluateBlock(b, sums, progress);
+      if (afterBlock) afterBlock(b + 1);
+    }
+  });
+}
+
+nlohmann::json StagedBake::backendCounts() const {
+  nlohmann::json counts = state_->glStats.toJson();
+  counts["texelsEvaluated"] = state_->glStats.texelsEvaluated;
+  counts["backendCalls"] = state_->interleaveStats.backendCalls;
+  return counts;
+}
+
+void StagedBake::addBackendCounts(const nlohmann::json& counts) {
+  state_->glStats.addCounts(counts);
+  state_->interleaveStats.backendCalls += counts.value("backendCalls", 0);
+}
+
+BakeResult StagedBake::finish(ExactVplSums sums) {
+  State& s = *state_;
+  BakeResult r;
+  nlohmann::json& report = r.report;
+  s.classPages = {};
+  s.timed("backend", [&] { r.maps = s.backendMaps(sums, report); });
+  sums = {};  // rounded into the maps: its memory is not needed at the peak (compensation)
+  s.skyStage(r.maps, report);
+  s.compensationStage(r.maps, report);
+  const PostStats post = s.postStage(r.maps);
+  s.seconds["bake"] = s.total.seconds();
+  s.describe(report, post);
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,
   // the GL stage split, peak memory); the rest of the report is the same bytes every time.
-  report["timings"]["seconds"] = seconds;
+  report["timings"]["seconds"] = s.seconds;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
+  r.atlas = std::move(s.atlas);
+  r.vpls = std::move(s.vpls);
+  s.gather = {};
+  s.wholeInputs.reset();
+  s.rayTracer.reset();  // it refers to the scene, which moves into the result
+  r.scene = std::move(s.scene);
   return r;
+}
+
+BakeResult bake(Scene scene, const BakeOptions& options) {
+  StagedBake staged(std::move(scene), options);
+  ExactVplSums sums = staged.emptySums();
+  staged.evaluateBlocks(0, staged.blockCount(), sums);
+  return staged.finish(std::move(sums));
 }
 
 }  // namespace irbake

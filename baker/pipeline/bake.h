@@ -1,6 +1,8 @@
 // The bake: every stage in order, one way — scene → atlas → texels → VPLs → backend → post.
 #pragma once
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
+#include "pipeline/vpl_sums.h"
 #include "vpl/vpl.h"
 
 namespace irbake {
@@ -47,6 +50,8 @@ struct BakeOptions {
   int overlapCompensation = -1;           // trace the compensation's rays while the GL backend bakes: -1 auto
                                           // (hardware renderers only: on llvmpipe both fight over the cores,
                                           // bake 1.95 → 2.43 s), 0 never, 1 always
+  int vplBlock = 512;                     // VPLs per block of the exact VPL sum (within one interleave class):
+                                          // the unit of shards and checkpoints, fixed by the options alone
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams
@@ -61,8 +66,40 @@ struct BakeResult {
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 
-// Runs the whole bake on a loaded scene. Throws Error on failure.
+// Runs the whole bake on a loaded scene. Throws Error on failure. = StagedBake: every block, then finish.
 BakeResult bake(Scene scene, const BakeOptions& options);
+
+// The bake in three steps, so a shard can stop after its VPL blocks and a merge (or a resumed bake) can
+// pick up after them (docs/distributed.md):
+//   prepare (the constructor): atlas, ray tracer, texel samples, VPLs, clamp, backend choice, VPL blocks;
+//   evaluateBlocks: the VPL blocks [begin, end) through the backend, added exactly into an ExactVplSums;
+//   finish: punctual lights, the interleave classes mixed, sky, clamp compensation, post, report.
+// Block boundaries depend on the scene and options only, never on threads, shards or interruptions, and
+// the sums are exact, so any split of the blocks gives the same bytes.
+class StagedBake {
+ public:
+  StagedBake(Scene scene, const BakeOptions& options);
+  ~StagedBake();
+  StagedBake(const StagedBake&) = delete;
+  StagedBake& operator=(const StagedBake&) = delete;
+
+  size_t blockCount() const;       // VPL blocks of the whole bake (0 for the reference backend)
+  BackendKind backend() const;     // the backend used (auto resolved)
+  ExactVplSums emptySums() const;  // zero sums laid out like the pages
+  // Evaluates blocks [begin, end) in order into sums; afterBlock(next) runs after each (next = index + 1).
+  void evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
+                      const std::function<void(size_t next)>& afterBlock = {});
+  // Backend counts of the blocks evaluated so far (report "gl"), for a partial to carry to the merge;
+  // addBackendCounts adds a shard's.
+  nlohmann::json backendCounts() const;
+  void addBackendCounts(const nlohmann::json& counts);
+  // Everything after the VPL blocks; sums must hold every block (moved in: freed once rounded). Call once.
+  BakeResult finish(ExactVplSums sums);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // "auto" | "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
 BackendKind parseBackend(const std::string& name);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "backend/lightmap.h"
 #include "scene/scene.h"
@@ -71,6 +72,10 @@ struct PostStats {
   size_t seamEdges = 0;          // seam edges found
   double seamMismatchBefore = 0; // RMS seam mismatch before stitching
   double seamMismatchAfter = 0;  // and after
+  nlohmann::json toJson() const {  // report "post"
+    return {{"texelsFilled", texelsFilled}, {"seamEdges", seamEdges}, {"seamMismatchBefore", seamMismatchBefore},
+            {"seamMismatchAfter", seamMismatchAfter}};
+  }
 };
 
 // The whole post stage in order: finite check → dilation → seam stitching → finite check.

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "common/progress.h"
 #include "raytrace/ray_tracer.h"
@@ -39,6 +40,19 @@ struct VplSet {
   glm::dvec3 tailFactor{1.0};               // bounces ⌈J/2⌉…J carry this × their own power: with it, the
                                             // light of bounces > J, P_J r/(1−r) per channel, r the ratio of
                                             // successive bounce powers pooled over those bounces
+  // The report's "vpls" object without what the walk was asked for (paths, seed: the bake adds them).
+  nlohmann::json toJson() const {
+    auto rgb = [](const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+    nlohmann::json perBounce = nlohmann::json::array();
+    glm::dvec3 total(0.0);
+    for (size_t b = 0; b < countPerBounce.size(); ++b) {
+      const glm::dvec3 power = b < powerPerBounce.size() ? powerPerBounce[b] : glm::dvec3(0.0);
+      total += power;
+      perBounce.push_back({{"bounce", b}, {"count", countPerBounce[b]}, {"power", rgb(power)}});
+    }
+    return {{"count", vpls.size()},          {"bounces", bounces},     {"meanReflectivity", meanReflectivity},
+            {"emittedPower", rgb(emittedPower)}, {"totalPower", rgb(total)}, {"perBounce", perBounce}};
+  }
 };
 
 // The deepest bounce of the auto walk for N paths at mean reflectivity ρ̄: the largest J with

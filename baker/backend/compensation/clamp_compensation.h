@@ -19,6 +19,8 @@
 #include <memory>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
 
@@ -55,6 +57,11 @@ struct ClampCompensationStats {
   int sweeps = 0;             // Jacobi sweeps run
   double addedFraction = 0;   // residual / map before, summed over valid texels (channel mean)
   double seconds = 0;
+  nlohmann::json toJson() const {  // report "compensation" (seconds go to timings)
+    return {{"rays", raysTraced},       {"samplesRefined", samplesRefined}, {"hitsKept", hitsKept},
+            {"addedFraction", addedFraction}, {"raysPerSample", raysPerSample}, {"filterRadius", filterRadius},
+            {"sweeps", sweeps}};
+  }
 };
 
 // The two halves of compensateClamp. Construction traces the rays and keeps the hits inside the clamp

@@ -741,8 +741,7 @@ void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<ui
   stats.contactTexels += count;
   if (count == 0) return;
   Stopwatch watch;
-  BakeInputs rays{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};
-  rays.eval.biasCompensation = false;  // the GL backend evaluates the clamped sum only
+  const BakeInputs rays{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};
   EmbreeOptions eo;
   eo.texelSubset = &contact;
   const std::vector<Lightmap> traced = bakeEmbree(rays, eo);

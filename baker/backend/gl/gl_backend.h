@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
 
@@ -30,7 +32,30 @@ struct GlBakeStats {
   size_t contactTexels = 0;      // texels resolved with rays (GlBackendOptions::resolveContacts)
   size_t texelsEvaluated = 0;    // valid texels of the pages
   double contactSeconds = 0.0;   // the rays of the contact texels
-  // Adds another call's figures (interleaved sampling calls the backend once per texel class).
+  // The report's "gl" object (counts, the same every run) and its "timings.gl" object (wall clock).
+  nlohmann::json toJson() const {
+    return {{"passes", passes},
+            {"facesRendered", facesRendered},
+            {"trianglesDrawn", trianglesDrawn},
+            {"cubeFaceSize", cubeFaceSize},
+            {"contactTexels", contactTexels},
+            {"contactFraction", texelsEvaluated ? double(contactTexels) / texelsEvaluated : 0.0}};
+  }
+  nlohmann::json timingsJson() const {
+    return {{"setupSeconds", setupSeconds},           {"shadowSeconds", shadowSeconds},
+            {"accumulateSeconds", accumulateSeconds}, {"foldSeconds", foldSeconds},
+            {"contactSeconds", contactSeconds}};
+  }
+  // The counts toJson() reports back from a partial (a merge adds its shards' counts).
+  void addCounts(const nlohmann::json& j) {
+    passes += j.value("passes", size_t{0});
+    facesRendered += j.value("facesRendered", size_t{0});
+    trianglesDrawn += j.value("trianglesDrawn", size_t{0});
+    cubeFaceSize = std::max(cubeFaceSize, j.value("cubeFaceSize", 0));
+    contactTexels += j.value("contactTexels", size_t{0});
+    texelsEvaluated += j.value("texelsEvaluated", size_t{0});
+  }
+  // Adds another call's figures (the bake calls the backend once per VPL block).
   void add(const GlBakeStats& o) {
     renderer = o.renderer;
     setupSeconds += o.setupSeconds;

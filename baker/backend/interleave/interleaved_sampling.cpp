@@ -54,6 +54,57 @@ int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, i
   return static_cast<int>(std::clamp(std::floor(clampRadius / (16.0f * h)), 1.0f, static_cast<float>(std::max(1, maxN))));
 }
 
+std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n) {
+  if (n <= 1) return {vpls};
+  const int m = n * n;
+  // VPL indices per bounce, in path order.
+  std::vector<std::vector<size_t>> byBounce;
+  for (size_t k = 0; k < vpls.vpls.size(); ++k) {
+    const size_t b = static_cast<size_t>(std::max(0, vpls.vpls[k].bounce));
+    if (b >= byBounce.size()) byBounce.resize(b + 1);
+    byBounce[b].push_back(k);
+  }
+  std::vector<VplSet> subsets(m);
+  for (int c = 0; c < m; ++c) {
+    VplSet& subset = subsets[c];
+    subset.meanReflectivity = vpls.meanReflectivity;
+    subset.bounces = vpls.bounces;
+    subset.emittedPower = vpls.emittedPower;
+    for (const auto& list : byBounce) {
+      // Class c takes the c-th contiguous chunk of this bounce's VPLs (in path order): consecutive
+      // Halton points stay well stratified, every k-th ones do not (base 2: every 4th point of Φ2
+      // lies in one quarter of [0,1)). Scale = the bounce's count over the chunk's.
+      const size_t count = list.size(), b0 = count * c / m, b1 = count * (c + 1) / m;
+      if (b1 <= b0) continue;
+      const float scale = static_cast<float>(count) / static_cast<float>(b1 - b0);
+      for (size_t k = b0; k < b1; ++k) {
+        Vpl v = vpls.vpls[list[k]];
+        v.power *= scale;
+        subset.vpls.push_back(v);
+      }
+    }
+  }
+  return subsets;
+}
+
+void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec3>& vplPart,
+                     const std::vector<uint8_t>& vplValid, Lightmap& map) {
+  std::vector<glm::vec3> mixed;
+  if (n > 1) {
+    TexelFilterOptions fo;
+    fo.radius = n - 1;
+    fo.tent = true;
+    mixed = filterOnSurface(page, vplPart, vplValid, fo);
+  }
+  const std::vector<glm::vec3>& added = n > 1 ? mixed : vplPart;
+  if (map.valid.size() != map.size()) map.valid = page.valid;
+  for (size_t t = 0; t < map.size() && t < added.size(); ++t) {
+    if (!vplValid[t]) continue;
+    map.texels[t] += added[t];
+    map.valid[t] = 1;
+  }
+}
+
 std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBackend& backend, InterleaveStats* stats) {
   if (stats) *stats = {};
   if (n <= 1 || !in.eval.includeVpls || in.vpls.vpls.empty()) {
@@ -69,7 +120,6 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
     VplSet none;
     BakeInputs direct{in.scene, in.rayTracer, in.texels, none, in.eval, {}};
     direct.eval.includeVpls = false;
-    direct.eval.biasCompensation = false;
     maps = backend(direct);
     ++calls;
   } else {
@@ -79,13 +129,7 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
     }
   }
 
-  // VPL indices per bounce, in path order.
-  std::vector<std::vector<size_t>> byBounce;
-  for (size_t k = 0; k < in.vpls.vpls.size(); ++k) {
-    const size_t b = static_cast<size_t>(std::max(0, in.vpls.vpls[k].bounce));
-    if (b >= byBounce.size()) byBounce.resize(b + 1);
-    byBounce[b].push_back(k);
-  }
+  const std::vector<VplSet> subsets = classVplSubsets(in.vpls, n);
 
   // The VPL part, class by class, scattered back into full pages.
   std::vector<std::vector<glm::vec3>> vplPart(in.texels.size());
@@ -96,31 +140,14 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
   }
   for (int c = 0; c < m; ++c) {
     const int cx = c % n, cy = c / n;
-    const std::vector<TexelSamples> pages = interleaveClass(in.texels, n, cx, cy);
-    VplSet subset;
-    subset.meanReflectivity = in.vpls.meanReflectivity;
-    subset.bounces = in.vpls.bounces;
-    subset.emittedPower = in.vpls.emittedPower;
-    for (const auto& list : byBounce) {
-      // Class c takes the c-th contiguous chunk of this bounce's VPLs (in path order): consecutive
-      // Halton points stay well stratified, every k-th ones do not (base 2: every 4th point of Φ2
-      // lies in one quarter of [0,1)). Scale = the bounce's count over the chunk's.
-      const size_t count = list.size(), b0 = count * c / m, b1 = count * (c + 1) / m;
-      if (b1 <= b0) continue;
-      const float scale = static_cast<float>(count) / static_cast<float>(b1 - b0);
-      for (size_t k = b0; k < b1; ++k) {
-        Vpl v = in.vpls.vpls[list[k]];
-        v.power *= scale;
-        subset.vpls.push_back(v);
-      }
-    }
+    const VplSet& subset = subsets[c];
     if (subset.vpls.empty()) continue;
+    const std::vector<TexelSamples> pages = interleaveClass(in.texels, n, cx, cy);
     ProgressCallback progress;
     if (in.progress)
       progress = [&, c](const char* stage, double f) { in.progress(stage, (c + std::clamp(f, 0.0, 1.0)) / m); };
     BakeInputs part{in.scene, in.rayTracer, pages, subset, in.eval, progress};
     part.eval.includeDirect = false;
-    part.eval.biasCompensation = false;
     const std::vector<Lightmap> classMaps = backend(part);
     ++calls;
     for (size_t p = 0; p < classMaps.size() && p < in.texels.size(); ++p) {
@@ -136,20 +163,8 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
     }
   }
 
-  // Mix the classes: tent of half-width n on the same surface, then add to the direct part.
-  for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p) {
-    TexelFilterOptions fo;
-    fo.radius = n - 1;
-    fo.tent = true;
-    const std::vector<glm::vec3> mixed = filterOnSurface(in.texels[p], vplPart[p], vplValid[p], fo);
-    Lightmap& map = maps[p];
-    if (map.valid.size() != map.size()) map.valid = in.texels[p].valid;
-    for (size_t t = 0; t < map.size(); ++t) {
-      if (!vplValid[p][t]) continue;
-      map.texels[t] += mixed[t];
-      map.valid[t] = 1;
-    }
-  }
+  for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p)
+    addMixedClasses(in.texels[p], n, vplPart[p], vplValid[p], maps[p]);
   if (stats) {
     stats->classes = m;
     stats->backendCalls = calls;

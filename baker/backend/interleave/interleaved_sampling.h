@@ -14,6 +14,8 @@
 #include <functional>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
 
@@ -23,7 +25,8 @@ using VplBackend = std::function<std::vector<Lightmap>(const BakeInputs&)>;
 
 struct InterleaveStats {
   int classes = 1;        // n²
-  int backendCalls = 0;   // n² VPL calls + 1 when there are punctual lights
+  int backendCalls = 0;   // VPL calls (n² here; one per VPL block in the bake) + 1 when there are punctual lights
+  nlohmann::json toJson() const { return {{"classes", classes}, {"backendCalls", backendCalls}}; }
 };
 
 // The texels of class (cx, cy) as their own pages ((W − cx)/n × (H − cy)/n, rounded up), same page ids.
@@ -33,6 +36,15 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
 // clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (16 h)⌋, 1, maxN), h the median
 // texel spacing over the pages. Cornell box, 1024 paths: 9.7k texels (h = 14 mm) → 1; 251k (2.8 mm) → 4.
 int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 4);
+
+// The VPLs of each of the n² classes (class c = cx + n·cy): per bounce the c-th contiguous chunk in path
+// order, power × bounce count / chunk count. n ≤ 1: one class with every VPL, unscaled, in path order.
+std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n);
+
+// Mixes the classes' VPL sums of one page (vplPart, full page, each texel from its own class) with the
+// tent of half-width n on the same surface and adds them to map where vplValid (n ≤ 1: added unfiltered).
+void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec3>& vplPart,
+                     const std::vector<uint8_t>& vplValid, Lightmap& map);
 
 // n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
 std::vector<Lightmap> bakeInterleaved(const BakeInputs& inputs, int n, const VplBackend& backend,

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "backend/bake_inputs.h"
 
 namespace irbake {
@@ -25,6 +27,7 @@ struct SkyLightStats {
   size_t rays = 0;
   int raysPerSample = 0;
   double seconds = 0.0;
+  nlohmann::json toJson() const { return {{"rays", rays}, {"raysPerSample", raysPerSample}}; }  // report "sky"
 };
 
 // Adds the sky's direct light to every valid texel of `maps` (one per in.texels page). No sky: no-op.

@@ -1,0 +1,45 @@
+// `irbake bake`'s command line as a value: parsed once for a bake, and again at `irbake merge` from the
+// arguments a shard stored in its partial, so both rebuild the same bake.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "app/commands.h"
+#include "common/progress.h"
+#include "pipeline/bake.h"
+#include "scene/scene.h"
+
+namespace irbake::app {
+
+struct BakeCommand {
+  BakeOptions options;             // everything the pipeline reads
+  std::string scene;               // SCENE as given
+  std::string out;                 // -o OUTDIR | OUT.glb | OUT.gltf
+  std::string report;              // --report (empty: OUTDIR/report.json)
+  std::string sun, sky, env;       // scene additions: --sun, --sky, --env
+  double envIntensity = 1.0;       // --env-intensity
+  double envRotation = 0.0;        // --env-rotation (degrees)
+  int threads = 0;                 // --threads (0: every core)
+  bool quiet = false;              // --quiet
+  bool noGltf = false;             // --no-gltf
+  int shardIndex = 0;              // --shard K/N: K (1-based), 0 without --shard
+  int shardCount = 0;              // N
+  bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
+  double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
+  std::string optionsHash;         // hash of every option that changes the result (not -o, --threads, ...)
+};
+
+// Parses the arguments after "bake"; nullopt when --help was printed. Throws Error(Usage).
+std::optional<BakeCommand> parseBakeCommand(const Args& args);
+
+// Loads SCENE with the command's additions (--sun, --sky, --env) and checks it has light.
+Scene loadBakeScene(const BakeCommand& command);
+
+// The scene's identity for partials and checkpoints: hashes of its files (and of --env's map).
+std::string bakeSceneIdentity(const BakeCommand& command);
+
+// Writes a finished bake's outputs where the command says (the all-or-nothing set) and lists them.
+void writeFinishedBake(const BakeCommand& command, const BakeResult& result, TerminalProgress& progress);
+
+}  // namespace irbake::app
