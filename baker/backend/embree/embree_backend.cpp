@@ -7,6 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "transport/directional.h"
 #include "transport/geometry_term.h"
 #include "common/error.h"
 
@@ -35,13 +36,16 @@ bool unshadowedVplValue(const Vpl& v, float bound, const glm::vec3& x, const glm
   return value.x > 0.0f || value.y > 0.0f || value.z > 0.0f;
 }
 
-// Adds the VPLs [begin, end) seen from (x, n) into acc, tracing the shadow rays in packets of 8.
-void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
-                       size_t end, KahanSum& acc) {
+// Visits the VPLs [begin, end) visible from (x, n) with their (transmitted) map value, visit(value, vpl),
+// tracing the shadow rays in packets of 8.
+template <typename Visit>
+void visitVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
+                      size_t end, Visit&& visit) {
   const auto& vpls = in.vpls.vpls;
   constexpr size_t kBatch = 64;
   ShadowRay rays[kBatch];
   glm::vec3 values[kBatch];
+  size_t which[kBatch];
   uint8_t blocked[kBatch];
   size_t count = 0;
   auto flush = [&]() {
@@ -49,8 +53,9 @@ void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, co
     const bool seeThrough = in.rayTracer.hasTransmission();
     for (size_t i = 0; i < count; ++i)
       if (!blocked[i])
-        acc.add(seeThrough ? values[i] * in.rayTracer.transmittance(rays[i].origin, rays[i].dir, 0.0f, rays[i].tmax)
-                           : values[i]);
+        visit(seeThrough ? values[i] * in.rayTracer.transmittance(rays[i].origin, rays[i].dir, 0.0f, rays[i].tmax)
+                         : values[i],
+              vpls[which[i]]);
     count = 0;
   };
   for (size_t k = begin; k < end; ++k) {
@@ -58,13 +63,20 @@ void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, co
     glm::vec3 value;
     if (!unshadowedVplValue(v, bound, x, n, value)) continue;
     if (!in.rayTracer.visibilityRay(x, n, v.position, v.normal, rays[count])) {
-      acc.add(value);  // closer than ε: visible
+      visit(value, v);  // closer than ε: visible
       continue;
     }
+    which[count] = k;
     values[count++] = value;
     if (count == kBatch) flush();
   }
   if (count) flush();
+}
+
+// Adds the VPLs [begin, end) seen from (x, n) into acc, tracing the shadow rays in packets of 8.
+void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
+                       size_t end, KahanSum& acc) {
+  visitVplsPackets(in, bound, x, n, begin, end, [&](const glm::vec3& value, const Vpl&) { acc.add(value); });
 }
 
 // Adds the VPLs [begin, end) seen from (x, n) into acc.
@@ -84,8 +96,9 @@ void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm
   }
 }
 
-glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n) {
-  glm::vec3 sum(0.0f);
+// Visits the punctual lights visible from (x, n): visit(map value, unit direction towards the light).
+template <typename Visit>
+void visitDirect(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Visit&& visit) {
   const float eps = in.rayTracer.epsilon();
   for (const Light& l : in.scene.lights) {
     PunctualContribution c = punctualDirect(l, x, n);
@@ -93,8 +106,14 @@ glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n)
     glm::vec3 origin = x + n * eps;
     float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
     if (tmax > 0.0f && in.rayTracer.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-    sum += tmax > 0.0f ? c.mapValue * in.rayTracer.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
+    visit(tmax > 0.0f ? c.mapValue * in.rayTracer.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue,
+          c.toLight);
   }
+}
+
+glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n) {
+  glm::vec3 sum(0.0f);
+  visitDirect(in, x, n, [&](const glm::vec3& value, const glm::vec3&) { sum += value; });
   return sum;
 }
 
@@ -195,6 +214,53 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
   }
   if (in.progress) in.progress("embree", 1.0);
   return maps;
+}
+
+std::array<std::vector<Lightmap>, 3> bakeEmbreeDirectional(const BakeInputs& in, const EmbreeOptions& options) {
+  std::array<std::vector<Lightmap>, 3> axes;
+  const float bound = clampBoundFor(in);
+  const size_t tile = static_cast<size_t>(std::max(1, options.tileSlots));
+  const size_t numVpls = in.eval.includeVpls ? in.vpls.vpls.size() : 0;
+  for (size_t page = 0; page < in.texels.size(); ++page) {
+    const TexelSamples& ts = in.texels[page];
+    const size_t slots = ts.slotCount();
+    std::vector<L1Vectors> slotValue(slots, L1Vectors{});
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, tile), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t s = r.begin(); s != r.end(); ++s) {
+        if (!(ts.positionWeight[s].w > 0.0f)) continue;
+        const glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
+        // Double sums: thousands of small VPL terms, 9 numbers per sample.
+        std::array<glm::dvec3, 3> g{};
+        auto add = [&](const glm::vec3& value, const glm::vec3& toSource) {
+          const float c = glm::dot(n, toSource);
+          if (!(c > 0.0f)) return;
+          const glm::dvec3 e = glm::dvec3(value) / double(c);
+          for (int k = 0; k < 3; ++k) g[k] += e * double(toSource[k]);
+        };
+        if (numVpls)
+          visitVplsPackets(in, bound, x, n, 0, numVpls,
+                           [&](const glm::vec3& value, const Vpl& v) { add(value, glm::normalize(v.position - x)); });
+        if (in.eval.includeDirect) visitDirect(in, x, n, add);
+        slotValue[s] = tangentialPart(L1Vectors{glm::vec3(g[0]), glm::vec3(g[1]), glm::vec3(g[2])}, n);
+      }
+    });
+    for (int k = 0; k < 3; ++k) {
+      Lightmap map = blankLightmap(ts);
+      for (size_t t = 0; t < ts.layerSize(); ++t) {
+        glm::vec3 value;
+        if (!texelMean(ts, t, [&](size_t s) { return slotValue[s][k]; }, value)) continue;
+        if (!ts.valid.empty() && ts.valid[t] == 0) continue;
+        if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z))
+          throw Error(ErrorCode::NumericError, in.scene.sourcePath,
+                      "embree backend produced a non-finite directional value at page " + std::to_string(ts.page) +
+                          " texel " + std::to_string(t % ts.width) + "," + std::to_string(t / ts.width));
+        map.texels[t] = value;
+        map.valid[t] = 1;
+      }
+      axes[k].push_back(std::move(map));
+    }
+  }
+  return axes;
 }
 
 }  // namespace irbake

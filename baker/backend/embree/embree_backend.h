@@ -3,6 +3,7 @@
 // fallback. Formulas: transport/geometry_term.h. The energy the clamp removes is given back after any backend
 // by backend/compensation (ClampGather); eval.biasCompensation is not read here.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +26,11 @@ struct EmbreeOptions {
 
 // One Lightmap per TexelSamples page; valid = the texel's valid flag. Throws Error(NumericError) on NaN/Inf.
 std::vector<Lightmap> bakeEmbree(const BakeInputs& inputs, const EmbreeOptions& options = {});
+
+// Directional maps (transport/directional.h): per page the three L1 pages (x, y, z world components of the
+// tangential irradiance vector t, RGB each) from the punctual lights (eval.includeDirect) and the clamped
+// VPLs (eval.includeVpls); valid flags as bakeEmbree's. The sky and the clamp compensation add none.
+std::array<std::vector<Lightmap>, 3> bakeEmbreeDirectional(const BakeInputs& inputs, const EmbreeOptions& options = {});
 
 // What one texel sample at (x, n) receives, as irradiance / π. For tests and tools.
 struct PointShading {
