@@ -110,6 +110,9 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--env-rotation", envRotation, "turns --env about +Y (degrees, default 0)")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
+  app->add_flag("--directional", o.directional,
+                "also bake directional maps (L1: lightmap_<page>_l1x/y/z.exr and the glTF\n"
+                "extension IRBAKE_lightmap_directional; docs/export.md)");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
   app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
@@ -178,6 +181,8 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.postSeams = !a.noSeams;
   if (command.shardIndex > 0 && namesGltfFile(command.out))
     throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
+  if (o.directional && o.backend == BackendKind::Reference)
+    throw Error(ErrorCode::Usage, "", "--directional needs a VPL backend (gl, embree or auto), not reference");
   if (command.shardIndex > 0 && o.backend == BackendKind::Reference)
     throw Error(ErrorCode::Usage, "", "--shard splits the VPLs: the reference backend has none (use gl, embree or auto)");
 }

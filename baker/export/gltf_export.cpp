@@ -25,6 +25,7 @@
 #include "common/log.h"
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
+#include "export/directional_export.h"
 #include "export/lightmap_png.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_source.h"
@@ -452,6 +453,14 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   if (fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
   // The sky the bake used, for viewers (irview draws it behind the scene) and for a bake of this export.
   if (scene.environment.present()) doc.root["extras"]["irbakeSky"] = skyJson(scene.environment);
+  const bool directional = options.directional && !(*options.directional)[0].empty();
+  if (directional) {
+    for (const auto& axis : *options.directional) checkMaps(axis, file);
+    addDirectionalExtension(doc, *options.directional, options.writeExrPages ? options.exrPrefix : std::string());
+    if (options.writeExrPages)
+      for (const auto& m : maps)
+        for (int k = 0; k < 3; ++k) pageUris.push_back(directionalPageUri(options.exrPrefix, m.page, k));
+  }
 
   std::vector<PendingFile> files;
   const std::filesystem::path folder = options.output.parent_path();
@@ -482,6 +491,13 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
       const Lightmap* map = &maps[i];
       files.push_back({folder / pageUris[i], [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});
     }
+    if (directional)
+      for (int k = 0; k < 3; ++k)
+        for (const Lightmap& m : (*options.directional)[k]) {
+          const Lightmap* map = &m;
+          files.push_back({folder / directionalPageUri(options.exrPrefix, m.page, k),
+                           [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});
+        }
   }
   files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
   writeAllAtomically(files);

@@ -2,6 +2,7 @@
 // records and MOZ_lightmap materials added (sRGB PNG × intensity, float EXR pages beside it); see
 // docs/export.md for the convention a client follows.
 #pragma once
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -21,6 +22,8 @@ struct ExportOptions {
   std::string exrPrefix = "lightmap"; // EXR names: <prefix>_<page>.exr
   LightmapPngOptions png;             // the 8-bit MOZ_lightmap PNG's encoding (sRGB, range at a percentile)
   std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
+  // Directional maps' L1 pages (x, y, z; export/directional_export.h), or null: no extension, no files.
+  const std::array<std::vector<Lightmap>, 3>* directional = nullptr;
 };
 
 // True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.

@@ -384,6 +384,38 @@ struct StagedBake::State {
     });
   }
 
+  // Directional maps: the L1 pages from the Embree backend whatever backend baked L0, interleaved like the
+  // L0 VPL sum (one Embree pass fills all three axes; the interleave mixes each), then post-processed
+  // per axis. The sky and the clamp compensation add to L0 only: their light counts as arriving along
+  // the normal (docs/units.md).
+  std::array<std::vector<Lightmap>, 3> directionalStage(nlohmann::json& report) {
+    std::array<std::vector<Lightmap>, 3> axes;
+    if (!options.directional) return axes;
+    if (backend == BackendKind::Reference)
+      throw Error(ErrorCode::Usage, scene.sourcePath, "--directional needs a VPL backend (gl, embree or auto)");
+    timed("directional", [&] {
+      std::vector<std::array<std::vector<Lightmap>, 3>> calls;  // per backend call of the interleave
+      size_t call = 0;
+      int axis = 0;
+      VplBackend embree = [&](const BakeInputs& in) {
+        if (axis == 0) calls.push_back(bakeEmbreeDirectional(in));
+        return std::move(calls[call++][axis]);
+      };
+      for (axis = 0; axis < 3; ++axis) {
+        call = 0;
+        axes[axis] = bakeInterleaved(*wholeInputs, interleave, embree);
+        for (size_t p = 0; p < axes[axis].size(); ++p) axes[axis][p].page = static_cast<int>(p);
+      }
+      PostOptions o;
+      o.dilate = options.postDilate;
+      o.stitchSeams = options.postSeams;
+      PostStats stats;
+      for (auto& pages : axes) stats = postProcess(scene, pages, o);
+      report["directional"] = {{"pages", axes[0].size() * 3}, {"seamMismatchAfter", stats.seamMismatchAfter}};
+    });
+    return axes;
+  }
+
   PostStats postStage(std::vector<Lightmap>& maps) {
     PostStats stats;
     timed("post", [&] {
@@ -509,6 +541,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   sums = {};  // rounded into the maps: its memory is not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, report);
+  r.directional = s.directionalStage(report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();
   s.describe(report, post);

@@ -1,5 +1,6 @@
 // The bake: every stage in order, one way — scene → atlas → texels → VPLs → backend → post.
 #pragma once
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -55,6 +56,8 @@ struct BakeOptions {
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams
+  bool directional = false;               // also bake the L1 pages (BakeResult::directional, issue 15);
+                                          // off: no extra work, the same bytes as before
   ProgressCallback progress;
 };
 
@@ -63,6 +66,9 @@ struct BakeResult {
   AtlasResult atlas;
   VplSet vpls;
   std::vector<Lightmap> maps;        // one per page, post-processed
+  // With BakeOptions::directional: the L1x, L1y, L1z pages (transport/directional.h), one per page each,
+  // post-processed like maps; empty otherwise.
+  std::array<std::vector<Lightmap>, 3> directional;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/log.h"
 #include "common/version.h"
+#include "export/directional_export.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
@@ -23,10 +24,16 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     throw Error(ErrorCode::Io, outDir.string(), "cannot create the output folder");
   std::vector<fs::path> exrs;
   for (const Lightmap& m : result.maps) exrs.push_back(outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
+  // Directional bakes: the L1 pages beside them (lightmap_<page>_l1x.exr, …).
+  std::vector<std::pair<fs::path, const Lightmap*>> l1Exrs;
+  for (int k = 0; k < 3; ++k)
+    for (const Lightmap& m : result.directional[k])
+      l1Exrs.push_back({outDir / directionalPageUri("lightmap", m.page, k), &m});
   const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   std::vector<fs::path> written;
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
+  for (const auto& [path, map] : l1Exrs) written.push_back(path);
 
   // The report names what is written, and is written with it: glTF (+ .bin, PNG), EXR pages and report are
   // one all-or-nothing set, so a failed bake leaves the previous outputs, report included, untouched.
@@ -48,12 +55,17 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.writeExrPages = true;
     ex.exrPrefix = "lightmap";
     ex.alsoWrite = {reportFile};
+    if (!result.directional[0].empty()) ex.directional = &result.directional;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;
     for (size_t i = 0; i < result.maps.size(); ++i) {
       const Lightmap* map = &result.maps[i];
       files.push_back({exrs[i], [map](const fs::path& temp) { writeExr(*map, temp); }});
+    }
+    for (const auto& [path, m] : l1Exrs) {
+      const Lightmap* map = m;
+      files.push_back({path, [map](const fs::path& temp) { writeExr(*map, temp); }});
     }
     files.push_back(reportFile);
     writeAllAtomically(files);

@@ -1,0 +1,122 @@
+// Directional maps (issue 15) through the whole pipeline: L0 stays the plain bake's bytes, the L1 pages
+// reconstruct the point light's cosine for tilted normals after atlas, texel samples and post, and the
+// export carries them in IRBAKE_lightmap_directional.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "common/maths.h"
+#include "export/exr_io.h"
+#include "pipeline/bake.h"
+#include "raytrace/ray_tracer.h"
+#include "samples/sample_scenes.h"
+#include "texels/texel_samples.h"
+#include "transport/directional.h"
+
+namespace fs = std::filesystem;
+using namespace irbake;
+
+namespace {
+
+BakeOptions embreeBake(bool directional) {
+  BakeOptions o;
+  o.backend = BackendKind::Embree;
+  o.atlas.texelsPerUnit = 6.0f;
+  o.walk.paths = 256;
+  o.walk.seed = 3;
+  o.directional = directional;
+  return o;
+}
+
+bool sameTexels(const Lightmap& a, const Lightmap& b) {
+  return a.width == b.width && a.height == b.height && a.valid == b.valid &&
+         std::memcmp(a.texels.data(), b.texels.data(), a.texels.size() * sizeof(glm::vec3)) == 0;
+}
+
+}  // namespace
+
+// The point light (I = 10 W/sr, 1 m over a grey plane, normal +y): every valid texel within 2 m, for
+// normals tilted 30° and 60° four ways, reconstructs I max(0, n·ω) / (π r²) within 1% of I / (π r²)
+// (one source: the L1 form is exact, what is left is the texel's extent); L0 is the plain bake's bytes.
+TEST(DirectionalBake, PointOverPlaneTiltedNormalsAndL0Unchanged) {
+  const BakeResult plain = bake(samples::makePointOverPlane(), embreeBake(false));
+  const BakeResult r = bake(samples::makePointOverPlane(), embreeBake(true));
+  EXPECT_TRUE(plain.directional[0].empty());
+  ASSERT_EQ(r.maps.size(), plain.maps.size());
+  for (size_t p = 0; p < r.maps.size(); ++p) EXPECT_TRUE(sameTexels(r.maps[p], plain.maps[p])) << p;
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(r.directional[k].size(), r.maps.size());
+
+  RayTracer rt(r.scene);
+  const std::vector<TexelSamples> texels = buildTexelSamples(r.scene, rt, embreeBake(true).texels);
+  const glm::vec3 light(0, 1, 0), ng(0, 1, 0);
+  double worst = 0.0;
+  size_t checked = 0;
+  for (size_t p = 0; p < texels.size(); ++p)
+    for (size_t t = 0; t < texels[p].layerSize(); ++t) {
+      if (!r.maps[p].valid[t]) continue;
+      glm::vec4 xw;
+      if (!texelMean(texels[p], t, [&](size_t s) { return texels[p].positionWeight[s]; }, xw)) continue;
+      const glm::dvec3 d = glm::dvec3(light) - glm::dvec3(xw);
+      const double r2 = glm::dot(d, d);
+      if (r2 > 5.0) continue;  // within 2 m sideways
+      const glm::dvec3 w = d / std::sqrt(r2);
+      const L1Vectors l1{r.directional[0][p].texels[t], r.directional[1][p].texels[t], r.directional[2][p].texels[t]};
+      for (float tilt : {30.0f, 60.0f})
+        for (int quarter = 0; quarter < 4; ++quarter) {
+          const float a = glm::radians(tilt), b = glm::radians(90.0f * quarter);
+          const glm::vec3 n(std::sin(a) * std::cos(b), std::cos(a), std::sin(a) * std::sin(b));
+          const double exact = 10.0 * std::max(0.0, glm::dot(glm::dvec3(n), w)) / (kPi * r2);
+          const double rec = reconstructDirectional(r.maps[p].texels[t], l1, ng, n).x;
+          worst = std::max(worst, std::abs(rec - exact) / (10.0 / (kPi * r2)));
+        }
+      ++checked;
+    }
+  std::printf("[ figure ] point over plane through the pipeline: %zu texels, worst error %.3e of I/(πr²)\n", checked,
+              worst);
+  EXPECT_GT(checked, 200u);
+  EXPECT_LT(worst, 0.01);
+  EXPECT_EQ(r.report["directional"]["pages"], 3 * r.maps.size());
+}
+
+// Export: the L1 pages as EXR files (read back bit for bit) and as PNG textures named in the material's
+// IRBAKE_lightmap_directional, listed in extensionsUsed and not required; MOZ_lightmap untouched.
+TEST(DirectionalBake, ExportCarriesTheExtension) {
+  const BakeResult r = bake(samples::makePointOverPlane(), embreeBake(true));
+  const fs::path out = fs::current_path() / "test_scratch" / "directional_export";
+  fs::remove_all(out);
+  OutputOptions o;
+  o.outDir = out;
+  writeBakeOutputs(r, o);
+  std::ifstream in(out / "scene.gltf");
+  const nlohmann::json g = nlohmann::json::parse(in);
+  const auto used = g.value("extensionsUsed", nlohmann::json::array());
+  EXPECT_NE(std::find(used.begin(), used.end(), "IRBAKE_lightmap_directional"), used.end());
+  EXPECT_FALSE(g.contains("extensionsRequired") &&
+               std::find(g["extensionsRequired"].begin(), g["extensionsRequired"].end(),
+                         "IRBAKE_lightmap_directional") != g["extensionsRequired"].end());
+  size_t materials = 0;
+  for (const auto& m : g["materials"]) {
+    if (!m.contains("extensions") || !m["extensions"].contains("IRBAKE_lightmap_directional")) continue;
+    ++materials;
+    EXPECT_TRUE(m["extensions"].contains("MOZ_lightmap"));
+    const auto& ext = m["extensions"]["IRBAKE_lightmap_directional"];
+    ASSERT_EQ(ext["l1"].size(), 3u);
+    ASSERT_EQ(ext["exr"].size(), 3u);
+    for (int k = 0; k < 3; ++k) {
+      const int tex = ext["l1"][k]["index"];
+      EXPECT_EQ(ext["l1"][k]["texCoord"], 1);
+      EXPECT_GT(ext["l1"][k]["scale"].get<double>(), 0.0);
+      const std::string uri = g["images"][g["textures"][tex]["source"].get<int>()]["uri"];
+      EXPECT_TRUE(fs::exists(out / uri)) << uri;
+      const Lightmap back = readExr(out / ext["exr"][k].get<std::string>());
+      EXPECT_EQ(std::memcmp(back.texels.data(), r.directional[k][0].texels.data(),
+                            back.texels.size() * sizeof(glm::vec3)), 0) << k;
+    }
+  }
+  EXPECT_GE(materials, 1u);
+}
