@@ -15,6 +15,7 @@
 #include "pipeline/bake.h"
 #include "raytrace/ray_tracer.h"
 #include "samples/sample_scenes.h"
+#include "scene/environment.h"
 #include "texels/texel_samples.h"
 #include "transport/directional.h"
 
@@ -119,4 +120,29 @@ TEST(DirectionalBake, ExportCarriesTheExtension) {
     }
   }
   EXPECT_GE(materials, 1u);
+}
+
+// A uniform sky over an open plane (issue 15, item 4): constant L0 (= L, as without --directional) and zero L1
+// (the sky's tangential vector traced with bounded-term rays: |t| < 0.2% of L).
+TEST(DirectionalBake, UniformSkyConstantL0ZeroL1) {
+  Scene s = samples::makePointOverPlane();
+  s.lights.clear();
+  s.environment = Environment::uniform({0.5f, 0.7f, 1.0f});
+  BakeOptions o = embreeBake(true);
+  o.atlas.texelsPerUnit = 3.0f;
+  const BakeResult r = bake(std::move(s), o);
+  double worstL0 = 0.0, worstL1 = 0.0;
+  size_t n = 0;
+  for (size_t p = 0; p < r.maps.size(); ++p)
+    for (size_t t = 0; t < r.maps[p].size(); ++t) {
+      if (!r.maps[p].valid[t]) continue;
+      worstL0 = std::max(worstL0, std::abs(double(r.maps[p].texels[t].z) - 1.0));
+      for (int k = 0; k < 3; ++k) worstL1 = std::max(worstL1, double(std::abs(r.directional[k][p].texels[t].z)));
+      ++n;
+    }
+  std::printf("[ figure ] uniform sky, open plane, directional: %zu texels, worst |L0 − L| %.2e, worst |L1| %.2e (L = 1)\n",
+              n, worstL0, worstL1);
+  EXPECT_GT(n, 100u);
+  EXPECT_LT(worstL0, 1e-3);
+  EXPECT_LT(worstL1, 2e-3);
 }

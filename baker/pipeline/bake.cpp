@@ -386,8 +386,8 @@ struct StagedBake::State {
 
   // Directional maps: the L1 pages from the Embree backend whatever backend baked L0, interleaved like the
   // L0 VPL sum (one Embree pass fills all three axes; the interleave mixes each), then post-processed
-  // per axis. The sky and the clamp compensation add to L0 only: their light counts as arriving along
-  // the normal (docs/units.md).
+  // per axis; the sky's part traced again (addSkyLightDirectional). The clamp compensation adds to L0 only:
+  // its light counts as arriving along the normal (docs/units.md).
   std::array<std::vector<Lightmap>, 3> directionalStage(nlohmann::json& report) {
     std::array<std::vector<Lightmap>, 3> axes;
     if (!options.directional) return axes;
@@ -405,6 +405,11 @@ struct StagedBake::State {
         call = 0;
         axes[axis] = bakeInterleaved(*wholeInputs, interleave, embree);
         for (size_t p = 0; p < axes[axis].size(); ++p) axes[axis][p].page = static_cast<int>(p);
+      }
+      if (scene.environment.present()) {
+        SkyLightOptions so = options.sky;
+        so.seed = options.walk.seed;
+        addSkyLightDirectional(*wholeInputs, axes, so);
       }
       PostOptions o;
       o.dilate = options.postDilate;

@@ -6,6 +6,7 @@
 // the first). Rays per sample follow a rotated Fibonacci lattice; the result is smoothed on the surface
 // by the texel filter. The sky's bounces are VPLs from the walk (vpl/walk.cpp), not this stage.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/bake_inputs.h"
+#include "transport/directional.h"
 
 namespace irbake {
 
@@ -33,6 +35,15 @@ struct SkyLightStats {
 // Adds the sky's direct light to every valid texel of `maps` (one per in.texels page). No sky: no-op.
 void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLightOptions& options = {},
                  SkyLightStats* stats = nullptr);
+
+// Directional maps (transport/directional.h): adds the sky's tangential irradiance vector to the L1 pages
+// (axes: x, y, z, one Lightmap per in.texels page each) at every texel valid there; the same rays and
+// seeds as addSkyLight, filtered alike. Traced again: only --directional bakes pay for it. No sky: no-op.
+void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightmap>, 3>& axes,
+                            const SkyLightOptions& options = {});
+
+// What skyLightAt's rays give as the tangential irradiance vector t at (x, n).
+L1Vectors skyDirectionalAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2);
 
 // The value one texel sample at (x, n) receives from the sky with `rays` rays (for tests and tools).
 glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2);
