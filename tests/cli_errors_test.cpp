@@ -275,3 +275,13 @@ TEST(CliSamples, WritesEverySampleAsGltf) {
     EXPECT_TRUE(std::filesystem::exists(dir / (std::string(name) + ".bin"))) << name;
   }
 }
+
+// --directional needs VPLs: with the reference backend it is refused before any work, nothing written.
+TEST(CliErrors, DirectionalWithTheReferenceBackendIsAUsageError) {
+  const auto scene = validScene("directional_reference");
+  const auto out = scene.parent_path() / "out";
+  RunResult r = runIrbake("bake " + quoted(scene) + " -o " + quoted(out) + " --backend reference --directional --quiet");
+  EXPECT_EQ(r.exitCode, exitCodeFor(ErrorCode::Usage)) << r.output;
+  EXPECT_NE(r.output.find("--directional needs a VPL backend"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "lightmap_0.exr"));
+}
