@@ -98,3 +98,34 @@ TEST(GltfFuzz, JsonValueReplacementNeverCrashes) {
   EXPECT_GT(cases, 200);
   EXPECT_GT(errors, cases / 10);
 }
+
+// Regression cases found by the libFuzzer harness (tests/fuzz). Each is the smallest document that
+// shows the fault; the fuzzer's own reproducer came from our Cornell-box sample.
+
+// 1. A number too large for a double (0.140000000596E4645): nlohmann::json throws out_of_range (406),
+//    not parse_error, and it escaped loadScene as a bare std::exception with no file name.
+TEST(GltfFuzzRegression, NumberOverflowIsAParseErrorNamingTheFile) {
+  auto dir = irbake::testing::testFolder("fuzz_regression_number");
+  GltfDocument doc = richDocument();
+  doc.root["cameras"][0]["perspective"]["yfov"] = "OVERFLOW_HERE";
+  irbake::testing::writeDocument(doc, dir / "marked.gltf");
+  std::ifstream in(dir / "marked.gltf");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string marker = "\"OVERFLOW_HERE\"";
+  ASSERT_NE(text.find(marker), std::string::npos);
+  text.replace(text.find(marker), marker.size(), "0.140000000596E4645");
+  std::ofstream(dir / "overflow.gltf") << text;
+  for (int fromMemory = 0; fromMemory < 2; ++fromMemory) {
+    try {
+      if (fromMemory)
+        loadSceneFromBytes(std::vector<uint8_t>(text.begin(), text.end()), dir / "overflow.gltf");
+      else
+        loadScene(dir / "overflow.gltf");
+      ADD_FAILURE() << "a number out of double range loaded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Parse);
+      EXPECT_EQ(e.file(), (dir / "overflow.gltf").string());
+      EXPECT_NE(std::string(e.what()).find("malformed JSON: number overflow"), std::string::npos) << e.what();
+    }
+  }
+}

@@ -228,9 +228,6 @@ void checkJsonDepth(const GltfSource& s, const char* text, size_t size) {
 }
 
 GltfSource readGltfSource(const std::filesystem::path& path) {
-  GltfSource s;
-  s.path = path;
-  s.folder = path.parent_path();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: no such file");
   if (std::filesystem::is_directory(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: it is a directory");
@@ -240,9 +237,17 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
   std::streamoff size = in.tellg();
   if (size < 0) throw Error(ErrorCode::Io, path.string(), "cannot read file");
   in.seekg(0);
-  s.bytes.resize(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(s.bytes.data()), size))
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size))
     throw Error(ErrorCode::Io, path.string(), "cannot read file: read failed");
+  return gltfSourceFromBytes(std::move(bytes), path);
+}
+
+GltfSource gltfSourceFromBytes(std::vector<uint8_t> bytes, const std::filesystem::path& path) {
+  GltfSource s;
+  s.path = path;
+  s.folder = path.parent_path();
+  s.bytes = std::move(bytes);
 
   if (s.bytes.size() >= 4 && std::memcmp(s.bytes.data(), "glTF", 4) == 0) {
     s.binary = true;
@@ -262,10 +267,12 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
   checkJsonDepth(s, text, s.jsonSize);
   try {
     s.json = nlohmann::json::parse(text, text + s.jsonSize);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error for bad syntax, but also out_of_range (406) for a number too large for a double,
+    // e.g. 1E4645: any of them is a malformed document (found by tests/fuzz).
     std::string msg = e.what();
-    size_t at = msg.find("parse error");
-    fail(ErrorCode::Parse, s, "malformed JSON: " + firstLine(at == std::string::npos ? msg : msg.substr(at)));
+    size_t at = msg.find("] ");
+    fail(ErrorCode::Parse, s, "malformed JSON: " + firstLine(at == std::string::npos ? msg : msg.substr(at + 2)));
   }
   if (!s.json.is_object()) fail(ErrorCode::Parse, s, "not a glTF file: the JSON is not an object");
   if (!s.json.contains("asset") || !s.json["asset"].is_object())
