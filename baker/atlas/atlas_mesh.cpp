@@ -18,6 +18,23 @@ struct CellHash {
   }
 };
 
+// Welds the primitive's positions on a grid of `cell`: appends one position per occupied cell to
+// vertexPos and returns the welded vertex of every input vertex. The cell map (~60 bytes per vertex)
+// is gone before the half-edge structure is built, the atlas stage's peak (docs/performance.md, "Memory").
+std::vector<uint32_t> weldPositions(const Primitive& prim, double cell, std::vector<glm::dvec3>& vertexPos) {
+  std::vector<uint32_t> weldOf(prim.positions.size());
+  std::unordered_map<std::array<int64_t, 3>, uint32_t, CellHash> cells;
+  for (size_t i = 0; i < prim.positions.size(); ++i) {
+    const glm::dvec3 p(prim.positions[i]);
+    const std::array<int64_t, 3> key{int64_t(std::llround(p.x / cell)), int64_t(std::llround(p.y / cell)),
+                                     int64_t(std::llround(p.z / cell))};
+    auto [it, added] = cells.try_emplace(key, uint32_t(vertexPos.size()));
+    if (added) vertexPos.push_back(p);
+    weldOf[i] = it->second;
+  }
+  return weldOf;
+}
+
 }  // namespace
 
 AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
@@ -28,21 +45,7 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   mesh.diagonal = bounds.diagonal();
 
   // Weld by position on a grid relative to the mesh size, so the result does not depend on units.
-  const double cell = std::max(mesh.diagonal * options.weldTolerance, 1e-30);
-  std::vector<uint32_t> weldOf(prim.positions.size());
-  {
-    // Scoped: the map holds ~60 bytes per vertex, gone before the half-edge structure is built (the
-    // atlas stage's peak, docs/performance.md "Memory").
-    std::unordered_map<std::array<int64_t, 3>, uint32_t, CellHash> cells;
-    for (size_t i = 0; i < prim.positions.size(); ++i) {
-      const glm::dvec3 p(prim.positions[i]);
-      const std::array<int64_t, 3> key{int64_t(std::llround(p.x / cell)), int64_t(std::llround(p.y / cell)),
-                                       int64_t(std::llround(p.z / cell))};
-      auto [it, added] = cells.try_emplace(key, uint32_t(mesh.vertexPos.size()));
-      if (added) mesh.vertexPos.push_back(p);
-      weldOf[i] = it->second;
-    }
-  }
+  std::vector<uint32_t> weldOf = weldPositions(prim, std::max(mesh.diagonal * options.weldTolerance, 1e-30), mesh.vertexPos);
 
   mesh.faceVertex.resize(faces);
   mesh.faceNeighbour.assign(faces, {kNone, kNone, kNone});
