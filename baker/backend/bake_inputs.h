@@ -13,7 +13,7 @@ namespace irbake {
 
 struct VplEvalOptions {
   float clampBound = 0.0f;         // upper bound on the VPL geometry term cosθx cosθy / r² (1/m²); 0 = no clamp
-  bool biasCompensation = false;   // Kollig & Keller 2004: recover the clamped energy (Embree backend)
+  bool biasCompensation = false;   // recover the clamped energy (backend/compensation, after Kollig & Keller 2004)
   bool includeDirect = true;       // punctual lights evaluated exactly (shadow ray / shadow map)
   bool includeVpls = true;         // area emitters and bounces through the VPLs
 };
