@@ -129,3 +129,21 @@ TEST(GltfFuzzRegression, NumberOverflowIsAParseErrorNamingTheFile) {
     }
   }
 }
+
+// 2. A buffer view whose byteOffset is 1e39: the out-of-bounds message cast the double to an integer
+//    (undefined behaviour; UBSan: "outside the range of representable values"). The message now gives
+//    such a number as written.
+TEST(GltfFuzzRegression, HugeBufferViewOffsetIsReportedAsWritten) {
+  auto dir = irbake::testing::testFolder("fuzz_regression_offset");
+  GltfDocument doc = richDocument();
+  doc.root["bufferViews"][0]["byteOffset"] = 1e39;
+  irbake::testing::writeDocument(doc, dir / "offset.gltf");
+  try {
+    loadScene(dir / "offset.gltf");
+    ADD_FAILURE() << "a buffer view at byte 1e39 loaded";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("buffer view 0 is out of bounds: bytes 1e+39..1e+39 of buffer 0"), std::string::npos)
+        << e.what();
+  }
+}

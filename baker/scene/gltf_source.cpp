@@ -1,6 +1,8 @@
 #include "scene/gltf_source.h"
 
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <fstream>
 #include <system_error>
 
@@ -22,6 +24,16 @@ uint32_t readU32(const uint8_t* p) {
 
 [[noreturn]] void fail(ErrorCode code, const GltfSource& s, const std::string& message) {
   throw Error(code, s.path.string(), message);
+}
+
+// A byte count from the JSON for a message: an integer where it is one, else as written (1e+39): a
+// double beyond 2^64 cast to an integer is undefined behaviour (found by tests/fuzz).
+std::string byteCount(double bytes) {
+  if (bytes >= 0.0 && bytes < 18446744073709549568.0 && bytes == std::floor(bytes))
+    return std::to_string(static_cast<uint64_t>(bytes));
+  std::ostringstream out;
+  out << bytes;
+  return out.str();
 }
 
 std::string firstLine(std::string s) {
@@ -115,9 +127,8 @@ void checkBufferViews(const GltfSource& s) {
     if (offset < 0.0 || length < 0.0) fail(ErrorCode::InvalidData, s, what + " has a negative or missing byteOffset/byteLength");
     if (offset + length > bufferLength)
       fail(ErrorCode::InvalidData, s,
-           what + " is out of bounds: bytes " + std::to_string(static_cast<uint64_t>(offset)) + ".." +
-               std::to_string(static_cast<uint64_t>(offset + length)) + " of buffer " + std::to_string(b) + " (" +
-               std::to_string(static_cast<uint64_t>(bufferLength)) + " bytes)");
+           what + " is out of bounds: bytes " + byteCount(offset) + ".." + byteCount(offset + length) + " of buffer " +
+               std::to_string(b) + " (" + byteCount(bufferLength) + " bytes)");
   }
 }
 
