@@ -412,7 +412,7 @@ std::vector<Lightmap> GlBaker::run() {
   }
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels));
 
-  const int K = std::clamp(opt_.vplsPerPass, 1, 256);
+  const int vplsPerPass = std::clamp(opt_.vplsPerPass, 1, 256);
   depthProgram_ = &programs_.get(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   shadowViewLocation_ = depthProgram_->uniform("shadowView");
@@ -435,12 +435,12 @@ std::vector<Lightmap> GlBaker::run() {
                                                   opt_.maxCubeFaceSize)
                                    .size;
     stats_.cubeFaceSize = faceSize;
-    atlas_ = std::make_unique<DepthAtlas>(faceSize, K);
-    if (seeThroughGeometry_) seeThroughAtlas_ = std::make_unique<DepthAtlas>(faceSize, K);
+    atlas_ = std::make_unique<DepthAtlas>(faceSize, vplsPerPass);
+    if (seeThroughGeometry_) seeThroughAtlas_ = std::make_unique<DepthAtlas>(faceSize, vplsPerPass);
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
   }
   glCreateBuffers(1, vplBuffer_.out());
-  glNamedBufferStorage(vplBuffer_.get(), K * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glNamedBufferStorage(vplBuffer_.get(), vplsPerPass * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
   glCreateTextures(GL_TEXTURE_BUFFER, 1, vplTable_.out());
   glTextureBuffer(vplTable_.get(), GL_RGBA32F, vplBuffer_.get());
   glCreateVertexArrays(1, emptyVao_.out());
@@ -452,7 +452,7 @@ std::vector<Lightmap> GlBaker::run() {
   const auto& vpls = in_.vpls.vpls;
   const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
-  const size_t totalWork = vplCount + lightCount * K;
+  const size_t totalWork = vplCount + lightCount * vplsPerPass;
   if (vplCount > 0) {
     if (opt_.shadowPcf && opt_.shadowCompare && !contactFlags()) {
       // Sampled through sampler2DShadow: lit (1) where the stored depth ≤ the reference.
@@ -472,8 +472,8 @@ std::vector<Lightmap> GlBaker::run() {
   if (vplCount > 0) {
     const DepthAtlas& atlas = *atlas_;
     int passesSinceFold = 0;
-    for (size_t first = 0; first < vplCount; first += K) {
-      const size_t count = std::min<size_t>(K, vplCount - first);
+    for (size_t first = 0; first < vplCount; first += vplsPerPass) {
+      const size_t count = std::min<size_t>(vplsPerPass, vplCount - first);
       shadowPassState();
       renderVplBatch(first, count, atlas);
       finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
@@ -493,7 +493,7 @@ std::vector<Lightmap> GlBaker::run() {
   for (size_t i = 0; i < lightCount; ++i) {
     bakeDirect(in_.scene.lights[i]);
     ++stats_.passes;
-    if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * K) / std::max<size_t>(1, totalWork));
+    if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * vplsPerPass) / std::max<size_t>(1, totalWork));
   }
   sw.reset();
   for (auto& page : pages_) page->fold();
