@@ -178,7 +178,10 @@ struct StagedBake::State {
 
   void deriveClamp() {
     eval = options.eval;
-    if (!options.autoClamp || eval.clampBound != 0.0f) return;
+    if (options.clamp != ClampMode::Derived) {
+      eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
+      return;
+    }
     clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
              : eval.biasCompensation     ? kCompensatedClampVplsPerMean
                                          : kClampVplsPerMean;
@@ -226,21 +229,24 @@ struct StagedBake::State {
     // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
     // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and
     // the rasteriser waits for its slowest thread (Cornell box: bake 1.95 → 2.43 s).
-    overlap = compensate && (options.overlapCompensation > 0 ||
-                             (options.overlapCompensation < 0 && !glContext->softwareRenderer()));
+    overlap = compensate && (options.overlapCompensation == OverlapCompensation::Always ||
+                             (options.overlapCompensation == OverlapCompensation::Auto &&
+                              !glContext->softwareRenderer()));
   }
 
   // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
   void planBlocks() {
     if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
-    interleave = options.interleave > 0 ? options.interleave : chooseInterleave(texels, eval.clampBound);
+    if (options.interleave && *options.interleave < 1)
+      throw Error(ErrorCode::Usage, "", "interleave must be at least 1 (got " + std::to_string(*options.interleave) + ")");
+    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound);
     classVpls = classVplSubsets(vpls, interleave);
     const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
     for (size_t c = 0; c < classVpls.size(); ++c)
       for (size_t b0 = 0; b0 < classVpls[c].vpls.size(); b0 += blockSize)
         blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[c].vpls.size(), b0 + blockSize)});
     gl = options.gl;
-    if (backend == BackendKind::Gl && gl.cubeFaceSize <= 0)  // once for every block, from the first class
+    if (backend == BackendKind::Gl && !gl.cubeFaceSize)  // once for every block, from the first class
       gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), eval.clampBound, gl.cubeFootprintPerTexel,
                                            gl.minCubeFaceSize, gl.maxCubeFaceSize)
                             .size;
