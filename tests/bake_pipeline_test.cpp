@@ -18,6 +18,7 @@
 #include "scene/gltf_loader.h"
 #include "samples/sample_scenes.h"
 #include "texels/texel_samples.h"
+#include "transport/geometry_term.h"
 
 namespace fs = std::filesystem;
 using namespace irbake;
@@ -195,6 +196,40 @@ TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
   BakeResult seeThrough = bake(std::move(glass), o);
   EXPECT_EQ(seeThrough.report["backend"], "embree");
   EXPECT_NE(seeThrough.report["backendChoice"]["reason"].get<std::string>().find("BLEND"), std::string::npos);
+}
+
+// Each clamp mode reaches the backends as one bound: derived = deriveClampBound at k = 256 (with bias
+// compensation) on the bake's own VPLs, off = 0 (no clamp), fixed = the given bound; fixed and off leave k at 0.
+TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
+  for (ClampMode mode : {ClampMode::Derived, ClampMode::Off, ClampMode::Fixed}) {
+    BakeOptions o = smallEmbreeBake(4.0f, 64);
+    o.clamp = mode;
+    o.clampBound = 5.0f;  // read by Fixed only
+    const BakeResult r = bake(loadSample("furnace"), o);
+    const nlohmann::json& eval = r.report["eval"];
+    const float expected = mode == ClampMode::Derived ? deriveClampBound(r.scene, r.vpls, 256.0)
+                           : mode == ClampMode::Fixed ? 5.0f
+                                                      : 0.0f;
+    EXPECT_EQ(eval["clampBound"].get<float>(), expected) << static_cast<int>(mode);
+    EXPECT_EQ(eval["clampDerived"].get<bool>(), mode == ClampMode::Derived);
+    EXPECT_EQ(eval["clampVplsPerMean"].get<double>(), mode == ClampMode::Derived ? 256.0 : 0.0);
+    if (mode == ClampMode::Derived) {
+      EXPECT_GT(expected, 0.0f);
+    }
+  }
+}
+
+// An interleave of n < 1 classes per side is a usage error, not a silent "automatic".
+TEST(BakePipeline, InterleaveBelowOneIsAUsageError) {
+  BakeOptions o = smallEmbreeBake(4.0f, 64);
+  o.interleave = 0;
+  try {
+    bake(loadSample("furnace"), o);
+    FAIL() << "interleave 0 accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Usage);
+    EXPECT_NE(std::string(e.what()).find("interleave"), std::string::npos) << e.what();
+  }
 }
 
 // The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
