@@ -5,8 +5,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -219,16 +222,26 @@ TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
   }
 }
 
-// An interleave of n < 1 classes per side is a usage error, not a silent "automatic".
-TEST(BakePipeline, InterleaveBelowOneIsAUsageError) {
-  BakeOptions o = smallEmbreeBake(4.0f, 64);
-  o.interleave = 0;
-  try {
-    bake(loadSample("furnace"), o);
-    FAIL() << "interleave 0 accepted";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::Usage);
-    EXPECT_NE(std::string(e.what()).find("interleave"), std::string::npos) << e.what();
+// A set option out of its range is a usage error naming the option, never a silent "automatic" (as 0 and
+// −1 were when they stood for it).
+TEST(BakePipeline, OptionsOutOfRangeAreUsageErrors) {
+  const std::vector<std::pair<std::string, std::function<void(BakeOptions&)>>> cases = {
+      {"interleave", [](BakeOptions& o) { o.interleave = 0; }},
+      {"cube face", [](BakeOptions& o) { o.gl.cubeFaceSize = 0; }},
+      {"bounce count", [](BakeOptions& o) { o.walk.maxBounces = -1; }},
+      {"filter radius", [](BakeOptions& o) { o.compensation.filterRadius = -1; }},
+      {"fixed clamp", [](BakeOptions& o) { o.clamp = ClampMode::Fixed; }},  // clampBound left at 0
+  };
+  for (const auto& [name, spoil] : cases) {
+    BakeOptions o = smallEmbreeBake(4.0f, 64);
+    spoil(o);
+    try {
+      bake(loadSample("furnace"), o);
+      ADD_FAILURE() << name << " out of range accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Usage) << name;
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -36,7 +36,7 @@ enum class ClampMode {
 
 // Whether the clamp compensation's rays are traced while the GL backend bakes (on the CPU beside the GPU).
 enum class OverlapCompensation {
-  Auto,    // hardware renderers only: on llvmpipe both fight over the cores (Cornell box bake 1.95 → 2.43 s)
+  Auto,    // hardware renderers only: on llvmpipe both fight over the cores (docs/performance.md)
   Never,   // after the VPL blocks
   Always,  // beside the VPL blocks, whatever the renderer
 };
@@ -58,7 +58,7 @@ struct BakeOptions {
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
-  float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m²)
+  float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)
   std::optional<int> interleave;          // n ≥ 1: VPLs split over n×n texel classes (Keller & Heidrich 2001),
