@@ -266,8 +266,8 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
 
   // Surviving path counts M_j (fractional absorption) and the deepest bounce.
   const uint64_t N = static_cast<uint64_t>(options.paths);
-  const bool autoDepth = options.maxBounces < 0;
-  const int cap = autoDepth ? autoBounceDepth(N, rho, options) : options.maxBounces;
+  const bool autoDepth = !options.maxBounces.has_value();
+  const int cap = autoDepth ? autoBounceDepth(N, rho, options) : *options.maxBounces;
   std::vector<uint64_t> survivors{N};
   for (int j = 1; j <= cap; ++j) {
     const uint64_t m = survivorCount(N, rho, j);

@@ -155,10 +155,11 @@ void ClampGather::Impl::chooseFilters() {
   radii.assign(in.texels.size(), 0);
   filters.resize(in.texels.size());
   for (size_t p = 0; p < in.texels.size(); ++p) {
-    if (options.filterRadius == 0 || (options.filterRadius < 0 && baseRays >= 32)) continue;
+    const std::optional<int>& fixedRadius = options.filterRadius;
+    if (fixedRadius ? *fixedRadius <= 0 : baseRays >= 32) continue;
     auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
     const float h = filter->spacing();
-    radii[p] = options.filterRadius > 0 ? options.filterRadius
+    radii[p] = fixedRadius ? *fixedRadius
                : h > 0.0f ? static_cast<int>(std::min(2.0f, std::floor(0.05f * clampRadius / h)))
                           : 0;
     filterRadius = std::max(filterRadius, radii[p]);

@@ -428,8 +428,8 @@ std::vector<Lightmap> GlBaker::run() {
     glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   }
   if (in_.eval.includeVpls && !in_.vpls.vpls.empty()) {
-    const int faceSize = opt_.cubeFaceSize > 0
-                             ? opt_.cubeFaceSize
+    const int faceSize = opt_.cubeFaceSize
+                             ? *opt_.cubeFaceSize
                              : chooseCubeFaceSize(in_.vpls.vpls, in_.texels, in_.eval.clampBound, opt_.cubeFootprintPerTexel,
                                                   opt_.minCubeFaceSize,
                                                   opt_.maxCubeFaceSize)
