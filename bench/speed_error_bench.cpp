@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -196,7 +197,7 @@ int sceneBench(const std::vector<std::string>& args) {
   bool compensate = false;
   std::vector<std::string> backends{"gl", "embree"};
   std::string refCache;
-  int interleave = 1;
+  std::optional<int> interleave = 1;  // unset: automatic (chooseInterleave)
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto next = [&] {
@@ -216,7 +217,7 @@ int sceneBench(const std::vector<std::string>& args) {
     else if (a == "--ref-cache") refCache = next();
     else if (a == "--interleave") {
       const std::string v = next();
-      interleave = v == "auto" ? 0 : std::stoi(v);
+      interleave = v == "auto" ? std::nullopt : std::optional<int>(std::stoi(v));
     }
     else if (a == "--ns") {
       ns.clear();
@@ -291,35 +292,35 @@ int sceneBench(const std::vector<std::string>& args) {
     sw.reset();
     WalkOptions walk;
     walk.paths = n;
-    if (const char* e = std::getenv("WALK_BOUNCES")) walk.maxBounces = std::atoi(e);  // diagnostics
+    if (const char* e = std::getenv("WALK_BOUNCES"); e && std::atoi(e) >= 0) walk.maxBounces = std::atoi(e);  // diagnostics
     walk.seed = std::getenv("WALK_SEED") ? static_cast<uint32_t>(std::atoi(std::getenv("WALK_SEED"))) : 1u;
     const VplSet vpls = generateVpls(scene, rt, walk);
     const double walkSeconds = sw.seconds();
     VplEvalOptions eval;
     eval.clampBound = deriveClampBound(scene, vpls, clampK);
     BakeInputs in{scene, rt, texels, vpls, eval, {}};
-    const int classes = interleave > 0 ? interleave : chooseInterleave(texels, eval.clampBound);
+    const int classes = interleave ? *interleave : chooseInterleave(texels, eval.clampBound);
     std::vector<Lightmap> glMaps;  // kept to score GL against Embree on the same VPLs
     for (const std::string& backendName : backends) {
       const char* backend = backendName.c_str();
-      GlBakeStats st;
+      GlBakeStats glStats;
       sw.reset();
       std::vector<Lightmap> maps;
       if (std::string(backend) == "gl") {
         GlContext context;  // one per bake, as the pipeline does (its programs are reused by every call)
         maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) {
           GlBakeStats one;
-          GlBackendOptions go;
-          go.context = &context;
-          go.stats = &one;
-          go.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
-          if (const char* e = std::getenv("CUBE_FACE")) go.cubeFaceSize = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("VPLS_PER_PASS")) go.vplsPerPass = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("SHADOW_PCF")) go.shadowPcf = std::atoi(e) != 0;  // diagnostics
-          if (const char* e = std::getenv("SLOPE_BIAS")) go.slopeBias = std::atof(e);  // diagnostics
-          if (const char* e = std::getenv("NORMAL_OFFSET")) go.normalOffset = std::atof(e);  // diagnostics
-          auto m = bakeGl(i, go);
-          st.add(one);
+          GlBackendOptions glOptions;
+          glOptions.context = &context;
+          glOptions.stats = &one;
+          glOptions.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
+          if (const char* e = std::getenv("CUBE_FACE"); e && std::atoi(e) > 0) glOptions.cubeFaceSize = std::atoi(e);  // diagnostics
+          if (const char* e = std::getenv("VPLS_PER_PASS")) glOptions.vplsPerPass = std::atoi(e);  // diagnostics
+          if (const char* e = std::getenv("SHADOW_PCF")) glOptions.shadowPcf = std::atoi(e) != 0;  // diagnostics
+          if (const char* e = std::getenv("SLOPE_BIAS")) glOptions.slopeBias = std::atof(e);  // diagnostics
+          if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
+          auto m = bakeGl(i, glOptions);
+          glStats.add(one);
           return m;
         });
       } else {
@@ -328,19 +329,19 @@ int sceneBench(const std::vector<std::string>& args) {
       double compensationSeconds = 0.0;
       if (compensate) {
         Stopwatch cw;
-        ClampCompensationOptions co;
-        co.seed = 1;
-        if (const char* e = std::getenv("COMP_RAYS")) co.rays = std::atoi(e);
-        if (const char* e = std::getenv("COMP_REFINE")) co.refineRays = std::atoi(e);
-        if (const char* e = std::getenv("COMP_FILTER")) co.filterRadius = std::atoi(e);
-        if (const char* e = std::getenv("COMP_FRACTION")) co.refineFraction = std::atof(e);
-        if (const char* e = std::getenv("COMP_SWEEPS")) co.sweeps = std::atoi(e);
-        if (const char* e = std::getenv("COMP_TOL")) co.sweepTolerance = std::atof(e);
+        ClampCompensationOptions compensationOptions;
+        compensationOptions.seed = 1;
+        if (const char* e = std::getenv("COMP_RAYS")) compensationOptions.rays = std::atoi(e);
+        if (const char* e = std::getenv("COMP_REFINE")) compensationOptions.refineRays = std::atoi(e);
+        if (const char* e = std::getenv("COMP_FILTER"); e && std::atoi(e) >= 0) compensationOptions.filterRadius = std::atoi(e);
+        if (const char* e = std::getenv("COMP_FRACTION")) compensationOptions.refineFraction = std::atof(e);
+        if (const char* e = std::getenv("COMP_SWEEPS")) compensationOptions.sweeps = std::atoi(e);
+        if (const char* e = std::getenv("COMP_TOL")) compensationOptions.sweepTolerance = std::atof(e);
         ClampCompensationStats cst;
-        compensateClamp(in, maps, co, &cst);
-        if (std::getenv("GL_VERBOSE") && st.facesRendered > 0)
-          std::printf("  gl: %zu faces, %.0f triangles drawn per face (of %zu)\n", st.facesRendered,
-                      double(st.trianglesDrawn) / st.facesRendered, scene.triangleCount());
+        compensateClamp(in, maps, compensationOptions, &cst);
+        if (std::getenv("GL_VERBOSE") && glStats.facesRendered > 0)
+          std::printf("  gl: %zu faces, %.0f triangles drawn per face (of %zu)\n", glStats.facesRendered,
+                      double(glStats.trianglesDrawn) / glStats.facesRendered, scene.triangleCount());
         if (std::getenv("COMP_VERBOSE")) std::printf("  compensation: %d sweeps, %zu hits kept, added %.2f%%\n", cst.sweeps, cst.hitsKept, 100 * cst.addedFraction);
         compensationSeconds = cw.seconds();
       }
@@ -350,13 +351,13 @@ int sceneBench(const std::vector<std::string>& args) {
       else if (!glMaps.empty()) glVsEmbree = compareMaps(glMaps, maps, areas).relativeRmse;
       if (reference.empty()) {
         std::printf("  %-6s N=%5d (%6zu VPLs): backend %.2f s (shadow %.2f, accumulate %.2f), GL vs Embree %.4f\n", backend,
-                    n, vpls.vpls.size(), backendSeconds, st.shadowSeconds, st.accumulateSeconds, glVsEmbree);
+                    n, vpls.vpls.size(), backendSeconds, glStats.shadowSeconds, glStats.accumulateSeconds, glVsEmbree);
         std::fflush(stdout);
         out << name << "," << scene.triangleCount() << "," << validTexels << "," << backend << "," << n << ","
             << vpls.vpls.size() << ",,,," << walkSeconds << "," << backendSeconds << "," << glVsEmbree << ","
-            << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << "," << st.shadowCpuSeconds
-            << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << st.renderer
-            << "\"," << clampK << "," << compensationSeconds << "," << classes << "," << st.cubeFaceSize << "\n";
+            << glStats.setupSeconds << "," << glStats.shadowSeconds << "," << glStats.accumulateSeconds << "," << glStats.shadowCpuSeconds
+            << "," << glStats.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ",0,0,0,\"" << glStats.renderer
+            << "\"," << clampK << "," << compensationSeconds << "," << classes << "," << glStats.cubeFaceSize << "\n";
         continue;
       }
       const MapDifference d = compareMaps(maps, reference, areas);
@@ -407,14 +408,14 @@ int sceneBench(const std::vector<std::string>& args) {
       if (glVsEmbree > 0) std::printf("  GL vs Embree on these VPLs: relative RMSE %.4f\n", glVsEmbree);
       std::printf("  %-6s N=%5d (%6zu VPLs): rel RMSE %.4f (noise-corrected %.4f), bias %+.4f, walk %.2f s, backend %.2f s (setup %.2f, shadow %.2f, accumulate %.2f, compensation %.2f; faces %d²)\n",
                   backend, n, vpls.vpls.size(), d.relativeRmse, corrected, d.relativeBias, walkSeconds, backendSeconds,
-                  st.setupSeconds, st.shadowSeconds, st.accumulateSeconds, compensationSeconds, st.cubeFaceSize);
+                  glStats.setupSeconds, glStats.shadowSeconds, glStats.accumulateSeconds, compensationSeconds, glStats.cubeFaceSize);
       std::fflush(stdout);
       out << name << "," << scene.triangleCount() << "," << validTexels << "," << backend << "," << n << ","
           << vpls.vpls.size() << "," << d.relativeRmse << "," << corrected << "," << d.relativeBias << "," << walkSeconds << ","
-          << backendSeconds << "," << glVsEmbree << "," << st.setupSeconds << "," << st.shadowSeconds << "," << st.accumulateSeconds << ","
-          << st.shadowCpuSeconds << "," << st.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
-          << spp << "," << refSeconds << "," << refRelSe << ",\"" << st.renderer << "\"," << clampK << ","
-          << compensationSeconds << "," << classes << "," << st.cubeFaceSize << "\n";
+          << backendSeconds << "," << glVsEmbree << "," << glStats.setupSeconds << "," << glStats.shadowSeconds << "," << glStats.accumulateSeconds << ","
+          << glStats.shadowCpuSeconds << "," << glStats.accumulateCpuSeconds << "," << atlasSeconds << "," << texelSeconds << ","
+          << spp << "," << refSeconds << "," << refRelSe << ",\"" << glStats.renderer << "\"," << clampK << ","
+          << compensationSeconds << "," << classes << "," << glStats.cubeFaceSize << "\n";
       out.flush();
     }
   }
@@ -510,13 +511,14 @@ int stagesBench(const std::vector<std::string>& args) {
   for (int rep = 0; rep < repeat; ++rep)
     for (const std::string& variant : variants)
       for (int k : ks) {
-        GlBakeStats st;
+        GlBakeStats glStats;
         GlBackendOptions o;
-        o.stats = &st;
+        o.stats = &glStats;
         o.stageTimings = true;
         o.vplsPerPass = k;
         o.cubeFaceSize = 256;  // the issue's per-VPL targets are stated at 256² faces
-        if (const char* e = std::getenv("CUBE_FACE")) o.cubeFaceSize = std::atoi(e);  // diagnostics
+        if (const char* e = std::getenv("CUBE_FACE"))  // diagnostics; 0: automatic
+          o.cubeFaceSize = std::atoi(e) > 0 ? std::optional<int>(std::atoi(e)) : std::nullopt;
         if (variant == "fetch4") o.shadowCompare = false;
         else if (variant == "nomask") o.skipInvalidTexels = false;
         else if (variant == "cluster256") o.clusterTriangles = 256;
@@ -524,15 +526,15 @@ int stagesBench(const std::vector<std::string>& args) {
         else if (variant != "default") throw Error(ErrorCode::Usage, "", "unknown variant " + variant);
         BakeInputs in{s, rt, pages, vs, {}, {}};
         bakeGl(in, o);
-        const double sv = 1e3 * st.shadowSeconds / nv, av = 1e3 * st.accumulateSeconds / nv;
-        const double sc = 1e3 * st.shadowCpuSeconds / nv, ac = 1e3 * st.accumulateCpuSeconds / nv;
+        const double sv = 1e3 * glStats.shadowSeconds / nv, av = 1e3 * glStats.accumulateSeconds / nv;
+        const double sc = 1e3 * glStats.shadowCpuSeconds / nv, ac = 1e3 * glStats.accumulateCpuSeconds / nv;
         std::printf("%-10s %zu triangles, %zu/%d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate "
                     "%.2f ms/VPL (CPU %.2f), %zu triangles drawn per VPL\n",
-                    variant.c_str(), s.triangleCount(), validTexels, tex * tex, k, o.cubeFaceSize, sv, sc, av, ac,
-                    st.trianglesDrawn / nv);
+                    variant.c_str(), s.triangleCount(), validTexels, tex * tex, k, glStats.cubeFaceSize, sv, sc, av, ac,
+                    glStats.trianglesDrawn / nv);
         std::fflush(stdout);
-        out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << o.cubeFaceSize << "," << sv
-            << "," << av << "," << sc << "," << ac << "," << st.trianglesDrawn / nv << ",\"" << st.renderer << "\","
+        out << s.triangleCount() << "," << tex * tex << "," << nv << "," << k << "," << glStats.cubeFaceSize << "," << sv
+            << "," << av << "," << sc << "," << ac << "," << glStats.trianglesDrawn / nv << ",\"" << glStats.renderer << "\","
             << variant << "," << validTexels << "," << loadAverage() << "\n";
       }
   return 0;

@@ -1,17 +1,17 @@
 // Direct light from one punctual light (KHR_lights_punctual) with its shadow map, exact apart from
 // the shadow-map resolution: value = I(ω) cosθx / r² / π (point, spot) or E cosθx / π (directional).
-layout(binding = 0) uniform sampler2DArray gPositionWeight;
-layout(binding = 1) uniform sampler2DArray gNormal;
-layout(binding = 2) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
-layout(binding = 3) uniform sampler2D mapDepth;          // spot (perspective) / directional (ortho)
-layout(binding = 4) uniform sampler2DArray gGeomNormal;  // the sample's triangle's normal (bias, self-shadow)
-layout(binding = 5) uniform sampler2DArray glassCube;    // see-through primitives alone: cube faces
-layout(binding = 6) uniform sampler2D glassMap;          // see-through primitives alone: spot / directional map
+layout(binding = BAKE_UNIT_POSITION_WEIGHT) uniform sampler2DArray gPositionWeight;
+layout(binding = BAKE_UNIT_NORMAL) uniform sampler2DArray gNormal;
+layout(binding = BAKE_UNIT_LIGHT_CUBE) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
+layout(binding = BAKE_UNIT_LIGHT_MAP) uniform sampler2D mapDepth;          // spot (perspective) / directional (ortho)
+layout(binding = BAKE_UNIT_GEOMETRIC_NORMAL) uniform sampler2DArray gGeomNormal;  // the sample's triangle's normal (bias, self-shadow)
+layout(binding = BAKE_UNIT_GLASS_CUBE) uniform sampler2DArray glassCube;    // see-through primitives alone: cube faces
+layout(binding = BAKE_UNIT_GLASS_MAP) uniform sampler2D glassMap;          // see-through primitives alone: spot / directional map
 uniform int seeThroughMaps;    // 1: the glass maps hold the scene's MASK / BLEND / transmissive primitives
 
 uniform int layers;
-uniform int lightType;         // 0 point, 1 spot, 2 directional
-uniform int shadowKind;        // 0 cube, 1 perspective 2D, 2 orthographic 2D
+uniform int lightType;         // BAKE_LIGHT_POINT, _SPOT or _DIRECTIONAL (bake_interface.glsl)
+uniform int shadowKind;        // BAKE_SHADOW_CUBE, _PERSPECTIVE (2D) or _ORTHOGRAPHIC (2D)
 uniform vec3 lightPosition;
 uniform vec3 lightDirection;   // direction light travels (spot, directional)
 uniform vec3 lightIntensity;   // colour × intensity (W/sr or W/m²)
@@ -44,10 +44,10 @@ bool mixed(bvec4 litTexels) { return any(litTexels) && !all(litTexels); }
 // when that answer may be wrong: a contact the bias let through, or a shadow edge (contactFlags).
 float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) {
   ambiguous = false;
-  float footprint = shadowKind == 2 ? texelAngle : r * texelAngle;
+  float footprint = shadowKind == BAKE_SHADOW_ORTHOGRAPHIC ? texelAngle : r * texelAngle;
   vec3 q = p + n * (normalOffset * footprint);
   float bias = shadowBias(constantBias, slopeBias, footprint, cosTheta);
-  if (shadowKind == 0) {
+  if (shadowKind == BAKE_SHADOW_CUBE) {
     vec3 local = q - lightPosition;
     float axisDistance;
     float depth = cubeDepth(cubeMaps, 0, local, axisDistance);
@@ -79,32 +79,32 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
   vec4 c = shadowClip * vec4(q, 1.0);
   if (c.w <= 0.0) return 0.0;
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadowKind == 2 ? 1.0 : 0.0;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadowKind == BAKE_SHADOW_ORTHOGRAPHIC ? 1.0 : 0.0;
   // The texel picked here (not by the sampler's own rounding), so its centre below is the one read.
   ivec2 size = textureSize(mapDepth, 0);
   ivec2 texel = clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
   float depth = texelFetch(mapDepth, texel, 0).r;
-  bool isLit = shadowKind == 1 ? cubeLit(depth, c.w, nearPlane, bias)
+  bool isLit = shadowKind == BAKE_SHADOW_PERSPECTIVE ? cubeLit(depth, c.w, nearPlane, bias)
                                : !(c.z * orthoDepthRange > depth * orthoDepthRange + bias);
-  bool drawn = shadowKind == 1 ? depth > 0.0 : depth < 1.0;
+  bool drawn = shadowKind == BAKE_SHADOW_PERSPECTIVE ? depth > 0.0 : depth < 1.0;
   if (contactFlags != 0) {
     if (isLit && drawn) {
       // The stored surface at the centre of its texel, back in world space.
       vec2 centre = (vec2(texel) + 0.5) / vec2(size);
       vec4 w = shadowClipInverse * vec4(centre * 2.0 - 1.0, depth, 1.0);
       vec3 stored = w.xyz / w.w;
-      ambiguous = inFrontOfPlane(stored, p, ng, shadowKind == 2 ? orthoDepthRange : length(stored - lightPosition),
+      ambiguous = inFrontOfPlane(stored, p, ng, shadowKind == BAKE_SHADOW_ORTHOGRAPHIC ? orthoDepthRange : length(stored - lightPosition),
                                  footprint);
     }
     ivec2 t0 = clamp(ivec2(floor(uv * vec2(size) - 0.5)), ivec2(0), size - 2);
     vec4 d = vec4(texelFetch(mapDepth, t0, 0).r, texelFetch(mapDepth, t0 + ivec2(1, 0), 0).r,
                   texelFetch(mapDepth, t0 + ivec2(0, 1), 0).r, texelFetch(mapDepth, t0 + 1, 0).r);
-    bvec4 l = shadowKind == 1 ? lessThanEqual(c.w * d, vec4(nearPlane) + bias * d)
+    bvec4 l = shadowKind == BAKE_SHADOW_PERSPECTIVE ? lessThanEqual(c.w * d, vec4(nearPlane) + bias * d)
                               : lessThanEqual(vec4(c.z * orthoDepthRange), d * orthoDepthRange + bias);
     ambiguous = ambiguous || mixed(l);
     if (isLit && seeThroughMaps != 0) {  // a see-through surface in front: for the rays
       float glass = texelFetch(glassMap, texel, 0).r;
-      ambiguous = ambiguous || (shadowKind == 1 ? glass > 0.0 && !cubeLit(glass, c.w, nearPlane, bias)
+      ambiguous = ambiguous || (shadowKind == BAKE_SHADOW_PERSPECTIVE ? glass > 0.0 && !cubeLit(glass, c.w, nearPlane, bias)
                                                 : glass < 1.0 && c.z * orthoDepthRange > glass * orthoDepthRange + bias);
     }
   }
@@ -122,7 +122,7 @@ void main() {
     vec3 toLight;
     float r = 1.0;
     vec3 e;
-    if (lightType == 2) {
+    if (lightType == BAKE_LIGHT_DIRECTIONAL) {
       toLight = -lightDirection;
       e = lightIntensity;
     } else {
@@ -131,7 +131,7 @@ void main() {
       if (r <= 0.0 || (lightRange > 0.0 && r > lightRange)) continue;
       toLight = d / r;
       vec3 I = lightIntensity;
-      if (lightType == 1) {
+      if (lightType == BAKE_LIGHT_SPOT) {
         float t = clamp((dot(lightDirection, -toLight) - cosOuter) * spotScale, 0.0, 1.0);
         I *= t * t;
       }

@@ -1,6 +1,6 @@
 // Accumulation: every texel sample of a page against a batch of VPLs, each with its depth cube (a cube in
 // the VPL's normal-aligned frame, reversed-Z: depth = near / axis distance) stored as tiles 5k..5k+4 of
-// one 2D depth atlas (gl_backend.cpp, DepthAtlas: faces +X −X +Y −Y +Z; −Z is never drawn and reads as lit).
+// one 2D depth atlas (gl_resources.h, DepthAtlas: faces +X −X +Y −Y +Z; −Z is never drawn and reads as lit).
 // Output: the batch's contribution to irradiance/π, summed by additive blending.
 //
 // Cost on llvmpipe (8 fragments per SIMD vector, 2 threads) is everything inside the per-VPL loop, so
@@ -14,24 +14,24 @@
 // - The VPLs come from a buffer texture and the per-bake constants are compiled in (see below).
 // Measured and dropped: unrolling the batch (constant VPL indices from a uniform block: 2× slower), a
 // cube-map-array sampler doing the face selection (no faster).
-layout(binding = 0) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
-layout(binding = 1) uniform sampler2DArray gNormal;          // xyz unit shading normal
-layout(binding = 4) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle
+layout(binding = BAKE_UNIT_POSITION_WEIGHT) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
+layout(binding = BAKE_UNIT_NORMAL) uniform sampler2DArray gNormal;          // xyz unit shading normal
+layout(binding = BAKE_UNIT_GEOMETRIC_NORMAL) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle
 #if defined(CONTACT_FLAGS)
-layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, raw depths (2×2 filter by textureGather)
+layout(binding = BAKE_UNIT_VPL_DEPTH) uniform sampler2D vplDepth;        // depth atlas, raw depths (2×2 filter by textureGather)
 #ifdef SEE_THROUGH
-layout(binding = 5) uniform sampler2D seeThroughDepth;  // the same cubes, see-through primitives only
+layout(binding = BAKE_UNIT_VPL_SEE_THROUGH_DEPTH) uniform sampler2D seeThroughDepth;  // the same cubes, see-through primitives only
 #endif
 #elif defined(SHADOW_COMPARE)
-layout(binding = 2) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
+layout(binding = BAKE_UNIT_VPL_DEPTH) uniform sampler2DShadow vplDepth;  // depth atlas, 5 tiles per VPL cube, compare GL_GEQUAL
 #else
-layout(binding = 2) uniform sampler2D vplDepth;        // depth atlas, 5 tiles per VPL cube
+layout(binding = BAKE_UNIT_VPL_DEPTH) uniform sampler2D vplDepth;        // depth atlas, 5 tiles per VPL cube
 #endif
 
-// The batch's VPLs: 3 RGBA32F texels each (gl_backend.cpp, VplTexels). A buffer texture, not a uniform
+// The batch's VPLs: 3 RGBA32F texels each (gl_resources.h, VplTexels). A buffer texture, not a uniform
 // block: the loop index is not known to be uniform, so a block read is a per-lane gather of every
 // component (8 scalar loads each), while a texelFetch loads the 4 components of a lane at once.
-layout(binding = 3) uniform samplerBuffer vplTable;
+layout(binding = BAKE_UNIT_VPL_TABLE) uniform samplerBuffer vplTable;
 struct Vpl {
   vec3 position;   // geometry term
   vec3 normal;     // unit normal = local +Z of its cube

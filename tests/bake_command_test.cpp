@@ -289,6 +289,30 @@ TEST(BakeCommand, CubeFaceSizeIsAutomaticOrSet) {
   EXPECT_NE(log.find("--cube-face"), std::string::npos) << log;
 }
 
+// --clamp 0 is no clamp, --clamp B that bound, none derives it; --bounces N is exactly N, auto follows the energy.
+TEST(BakeCommand, ClampAndBouncesAreAutomaticOffOrSet) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path dir = scratch("clamp_modes");
+  fs::path scene = samplesDir() / "cornell_box.gltf";
+  std::string log;
+  const std::string common = " --backend embree --texels-per-unit 4 --vpls 64 --no-gltf";
+  auto report = [&](const std::string& name, const std::string& options) {
+    EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir / name) + common + options, &log), 0) << log;
+    return nlohmann::json::parse(std::ifstream(dir / name / "report.json"));
+  };
+  const nlohmann::json derived = report("derived", ""), off = report("off", " --clamp 0 --bounces 1"),
+                       fixed = report("fixed", " --clamp 2.5 --bounces auto");
+  EXPECT_TRUE(derived["eval"]["clampDerived"].get<bool>());
+  EXPECT_GT(derived["eval"]["clampBound"].get<double>(), 0.0);
+  EXPECT_FALSE(off["eval"]["clampDerived"].get<bool>());
+  EXPECT_EQ(off["eval"]["clampBound"].get<double>(), 0.0);
+  EXPECT_FALSE(fixed["eval"]["clampDerived"].get<bool>());
+  EXPECT_EQ(fixed["eval"]["clampBound"].get<double>(), 2.5);
+  EXPECT_EQ(off["vpls"]["bounces"].get<int>(), 1);
+  EXPECT_GT(derived["vpls"]["bounces"].get<int>(), 1);  // the box's ρ̄ ≈ 0.67 walks deeper than one bounce
+  EXPECT_EQ(fixed["vpls"]["bounces"], derived["vpls"]["bounces"]);
+}
+
 TEST(BakeCommand, ReferenceBackendReportsItsSamplesAndMatchesTheClosedForm) {
   ASSERT_FALSE(samplesDir().empty());
   fs::path dir = scratch("reference");

@@ -5,8 +5,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -18,6 +21,7 @@
 #include "scene/gltf_loader.h"
 #include "samples/sample_scenes.h"
 #include "texels/texel_samples.h"
+#include "transport/geometry_term.h"
 
 namespace fs = std::filesystem;
 using namespace irbake;
@@ -94,11 +98,11 @@ TEST(BakePipeline, FurnaceMatchesTheClosedFormWithBiasCompensation) {
 // The default bake (GL backend, k = 256 clamp, compensation gather, automatic interleaving) and the same
 // with 2×2 interleaving forced: the furnace's mean within 1% of Le/(1−ρ) = 2, and the report says what ran.
 TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
-  for (int interleave : {0, 2}) {
+  for (int interleave : {0, 2}) {  // 0: automatic
     BakeOptions o;
     o.atlas.texelsPerUnit = 12.0f;
     o.walk.paths = 1024;
-    o.interleave = interleave;
+    if (interleave > 0) o.interleave = interleave;
     BakeResult r = bake(loadSample("furnace"), o);
     double sum = 0.0;
     size_t n = 0;
@@ -197,6 +201,50 @@ TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
   EXPECT_NE(seeThrough.report["backendChoice"]["reason"].get<std::string>().find("BLEND"), std::string::npos);
 }
 
+// Each clamp mode reaches the backends as one bound: derived = deriveClampBound at k = 256 (with bias
+// compensation) on the bake's own VPLs, off = 0 (no clamp), fixed = the given bound; fixed and off leave k at 0.
+TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
+  for (ClampMode mode : {ClampMode::Derived, ClampMode::Off, ClampMode::Fixed}) {
+    BakeOptions o = smallEmbreeBake(4.0f, 64);
+    o.clamp = mode;
+    o.clampBound = 5.0f;  // read by Fixed only
+    const BakeResult r = bake(loadSample("furnace"), o);
+    const nlohmann::json& eval = r.report["eval"];
+    const float expected = mode == ClampMode::Derived ? deriveClampBound(r.scene, r.vpls, 256.0)
+                           : mode == ClampMode::Fixed ? 5.0f
+                                                      : 0.0f;
+    EXPECT_EQ(eval["clampBound"].get<float>(), expected) << static_cast<int>(mode);
+    EXPECT_EQ(eval["clampDerived"].get<bool>(), mode == ClampMode::Derived);
+    EXPECT_EQ(eval["clampVplsPerMean"].get<double>(), mode == ClampMode::Derived ? 256.0 : 0.0);
+    if (mode == ClampMode::Derived) {
+      EXPECT_GT(expected, 0.0f);
+    }
+  }
+}
+
+// A set option out of its range is a usage error naming the option, never a silent "automatic" (as 0 and
+// −1 were when they stood for it).
+TEST(BakePipeline, OptionsOutOfRangeAreUsageErrors) {
+  const std::vector<std::pair<std::string, std::function<void(BakeOptions&)>>> cases = {
+      {"interleave", [](BakeOptions& o) { o.interleave = 0; }},
+      {"cube face", [](BakeOptions& o) { o.gl.cubeFaceSize = 0; }},
+      {"bounce count", [](BakeOptions& o) { o.walk.maxBounces = -1; }},
+      {"filter radius", [](BakeOptions& o) { o.compensation.filterRadius = -1; }},
+      {"fixed clamp", [](BakeOptions& o) { o.clamp = ClampMode::Fixed; }},  // clampBound left at 0
+  };
+  for (const auto& [name, spoil] : cases) {
+    BakeOptions o = smallEmbreeBake(4.0f, 64);
+    spoil(o);
+    try {
+      bake(loadSample("furnace"), o);
+      ADD_FAILURE() << name << " out of range accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Usage) << name;
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
 // The compensation's rays traced while the GL backend bakes (what a hardware renderer gets by default)
 // give the same map, bit for bit, as tracing them after it: the trace reads no map.
 TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {
@@ -205,7 +253,7 @@ TEST(BakePipeline, CompensationTracedDuringTheGlBakeGivesTheSameMap) {
     BakeOptions o;
     o.atlas.texelsPerUnit = 12.0f;
     o.walk.paths = 256;
-    o.overlapCompensation = overlap;
+    o.overlapCompensation = overlap == 1 ? OverlapCompensation::Always : OverlapCompensation::Never;
     runs[overlap] = bake(loadSample("furnace"), o);
     EXPECT_EQ(runs[overlap].report["compensationOverlapped"].get<bool>(), overlap == 1);
     EXPECT_GT(runs[overlap].report["compensation"]["hitsKept"].get<size_t>(), 0u);

@@ -30,6 +30,7 @@ struct BakeArguments {
   std::string backend = "auto", shard;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0;
+  int bounces = -1, interleave = 0, cubeFace = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
@@ -63,7 +64,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
   app->add_option("--vpls", o.walk.paths, "light paths of the quasi-random walk (default 4096)")
       ->transform(cli::integerIn(1, 1 << 26))->type_name("N");
-  app->add_option("--bounces", o.walk.maxBounces, "diffuse bounces (default auto: follow the energy left)")
+  app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
@@ -88,12 +89,12 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
       ->transform(cli::integerIn(0, 65536))->type_name("N");
-  app->add_option("--interleave", o.interleave,
+  app->add_option("--interleave", a.interleave,
                   "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                   "of the VPLs, then a filter on the surface mixes them\n"
                   "(default auto: 1..4 from the texel size and the clamp radius;\n1 = every VPL everywhere)")
       ->transform(cli::integerOrAuto(1, 8, 0))->type_name("N|auto");
-  app->add_option("--cube-face", o.gl.cubeFaceSize,
+  app->add_option("--cube-face", a.cubeFace,
                   "GL backend: VPL depth-cube face size in texels\n"
                   "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, 128..256)")
       ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
@@ -172,9 +173,12 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.walk.seed = static_cast<uint32_t>(a.seed);
   o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
   o.texels.leakControl = !a.noLeakControl;
-  if (a.clampOption->count() > 0) {
-    o.eval.clampBound = static_cast<float>(a.clamp);
-    o.autoClamp = false;
+  if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
+  if (a.interleave > 0) o.interleave = a.interleave;
+  if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;
+  if (a.clampOption->count() > 0) {  // --clamp 0: no clamp; none given: derived
+    o.clamp = a.clamp > 0.0 ? ClampMode::Fixed : ClampMode::Off;
+    o.clampBound = static_cast<float>(a.clamp);
   }
   o.eval.biasCompensation = !a.noBiasCompensation;  // on by default; --bias-compensation kept
   o.postDilate = !a.noDilate;
@@ -353,13 +357,13 @@ int runBake(const Args& args) {
 }
 
 void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress) {
-  OutputOptions oo;
-  oo.outDir = c.out;
-  oo.reportPath = c.report;
-  oo.writeGltf = !c.noGltf;
+  OutputOptions outputOptions;
+  outputOptions.outDir = c.out;
+  outputOptions.reportPath = c.report;
+  outputOptions.writeGltf = !c.noGltf;
   Stopwatch writeTime;
   c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
-  auto files = writeBakeOutputs(result, oo);
+  auto files = writeBakeOutputs(result, outputOptions);
   c.options.progress("write", 1.0);
   progress.finish();
   log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() +

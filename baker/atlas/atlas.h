@@ -68,8 +68,8 @@ struct AtlasResult {
 // Unwraps every primitive of `scene` in place: vertices are split along chart seams (sourceVertex
 // records where each came from), uv1 is set in [0,1] over the primitive's page, and
 // primitive.lightmap names the page. A primitive whose charts land on several pages is split into
-// one primitive per page. Emissive-only or non-lightmapped primitives keep lightmap.page = -1 only
-// if the options say so (by default every triangle is lightmapped).
+// one primitive per page. Every primitive is lightmapped, emissive ones included (there is no option
+// to leave one out).
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options);
 
 }  // namespace irbake

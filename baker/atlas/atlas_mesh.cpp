@@ -18,6 +18,23 @@ struct CellHash {
   }
 };
 
+// Welds the primitive's positions on a grid of `cell`: appends one position per occupied cell to
+// vertexPos and returns the welded vertex of every input vertex. The cell map (~60 bytes per vertex)
+// is gone before the half-edge structure is built, the atlas stage's peak (docs/performance.md, "Memory").
+std::vector<uint32_t> weldPositions(const Primitive& prim, double cell, std::vector<glm::dvec3>& vertexPos) {
+  std::vector<uint32_t> weldOf(prim.positions.size());
+  std::unordered_map<std::array<int64_t, 3>, uint32_t, CellHash> cells;
+  for (size_t i = 0; i < prim.positions.size(); ++i) {
+    const glm::dvec3 p(prim.positions[i]);
+    const std::array<int64_t, 3> key{int64_t(std::llround(p.x / cell)), int64_t(std::llround(p.y / cell)),
+                                     int64_t(std::llround(p.z / cell))};
+    auto [it, added] = cells.try_emplace(key, uint32_t(vertexPos.size()));
+    if (added) vertexPos.push_back(p);
+    weldOf[i] = it->second;
+  }
+  return weldOf;
+}
+
 }  // namespace
 
 AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
@@ -28,17 +45,7 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   mesh.diagonal = bounds.diagonal();
 
   // Weld by position on a grid relative to the mesh size, so the result does not depend on units.
-  const double cell = std::max(mesh.diagonal * options.weldTolerance, 1e-30);
-  std::unordered_map<std::array<int64_t, 3>, uint32_t, CellHash> cells;
-  std::vector<uint32_t> weldOf(prim.positions.size());
-  for (size_t i = 0; i < prim.positions.size(); ++i) {
-    const glm::dvec3 p(prim.positions[i]);
-    const std::array<int64_t, 3> key{int64_t(std::llround(p.x / cell)), int64_t(std::llround(p.y / cell)),
-                                     int64_t(std::llround(p.z / cell))};
-    auto [it, added] = cells.try_emplace(key, uint32_t(mesh.vertexPos.size()));
-    if (added) mesh.vertexPos.push_back(p);
-    weldOf[i] = it->second;
-  }
+  std::vector<uint32_t> weldOf = weldPositions(prim, std::max(mesh.diagonal * options.weldTolerance, 1e-30), mesh.vertexPos);
 
   mesh.faceVertex.resize(faces);
   mesh.faceNeighbour.assign(faces, {kNone, kNone, kNone});
@@ -61,6 +68,7 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
     }
   }
   mesh.meanEdge = edgeCount ? edgeSum / double(edgeCount) : 0.0;
+  std::vector<uint32_t>().swap(weldOf);
   for (size_t f = 0; f < faces; ++f) {
     const auto& v = mesh.faceVertex[f];
     const bool repeated = v[0] == v[1] || v[1] == v[2] || v[0] == v[2];
@@ -78,7 +86,10 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   // The half-edge structure: OpenMesh refuses faces that would make an edge or vertex non-manifold;
   // such a face gets its own copies of its corners (it becomes an island) so no face is lost.
   OmMesh om;
-  om.reserve(mesh.vertexPos.size(), faces * 3 / 2, faces);
+  // Edges: V + F − χ by Euler's formula, so V + F is enough for any union of discs and spheres (an
+  // open grid has V + F − 1; faces·3/2, the closed-mesh count, was short there and the edge array
+  // doubled while full: 96 → 192 MB plus the old copy for a 2M-triangle grid). Never more than 3F.
+  om.reserve(mesh.vertexPos.size(), std::min(mesh.vertexPos.size() + faces, 3 * faces), faces);
   for (const glm::dvec3& p : mesh.vertexPos) om.add_vertex(OmMesh::Point(float(p.x), float(p.y), float(p.z)));
   std::vector<uint32_t> faceOfOm;
   faceOfOm.reserve(faces);

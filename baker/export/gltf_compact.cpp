@@ -294,24 +294,46 @@ void compactDocument(GltfDocument& doc) {
   auto imageRefs = [](json& r, auto&& f) { forEachImageRef(r, f); };
   keepUsed(root, "images", usedBy(root, "images", imageRefs), imageRefs);
 
-  // Buffer views: keep the used ones, copying their bytes into a fresh buffer 0.
+  // Buffer views: keep the used ones, their bytes packed in view order (4-byte aligned) into buffer 0.
   auto viewRefs = [](json& r, auto&& f) { forEachViewRef(r, f); };
   std::vector<bool> usedViews = usedBy(root, "bufferViews", viewRefs);
-  std::vector<uint8_t> bin;
+  struct Move {
+    size_t from, to, length;
+    bool inside;  // the source range lies inside buffer 0 (else the view reads as zeros)
+  };
+  std::vector<Move> moves;
+  size_t size = 0;
+  bool inPlace = true;  // every view moves towards the front: compact within buffer 0 itself
   if (root.contains("bufferViews"))
     for (size_t i = 0; i < usedViews.size(); ++i) {
       if (!usedViews[i]) continue;
       json& v = root["bufferViews"][i];
       const size_t offset = v.value("byteOffset", size_t(0)), length = v.value("byteLength", size_t(0));
-      while (bin.size() % 4) bin.push_back(0);
-      v["byteOffset"] = bin.size();
+      size = (size + 3) / 4 * 4;
+      const bool inside = offset + length <= doc.bin.size();
+      moves.push_back({offset, size, length, inside});
+      if ((inside && size > offset) || size + length > doc.bin.size()) inPlace = false;
+      v["byteOffset"] = size;
       v["buffer"] = 0;
-      if (offset + length <= doc.bin.size()) bin.insert(bin.end(), doc.bin.begin() + offset, doc.bin.begin() + offset + length);
-      else bin.resize(bin.size() + length, 0);
       if (v["byteOffset"] == 0) v.erase("byteOffset");
+      size += length;
     }
   keepUsed(root, "bufferViews", usedViews, viewRefs);
-  doc.bin = std::move(bin);
+  // Writes for views before k end at or before moves[k].to ≤ moves[k].from, so packing in view order
+  // never overwrites bytes a later view still has to read. In place, buffer 0 is not held twice (for a
+  // 2M-triangle bake: the source's buffers plus the new geometry, ~100 MB, at the export's peak).
+  std::vector<uint8_t> fresh;
+  if (!inPlace) fresh.resize(size);
+  uint8_t* out = inPlace ? doc.bin.data() : fresh.data();
+  size_t end = 0;
+  for (const Move& m : moves) {
+    std::fill(out + end, out + m.to, uint8_t(0));  // alignment padding
+    if (m.inside) std::memmove(out + m.to, doc.bin.data() + m.from, m.length);
+    else std::fill(out + m.to, out + m.to + m.length, uint8_t(0));
+    end = m.to + m.length;
+  }
+  if (inPlace) doc.bin.resize(size);
+  else doc.bin = std::move(fresh);
 }
 
 std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(GltfDocument& doc, std::vector<std::string> taken) {

@@ -89,27 +89,57 @@ std::string mimeFor(const std::vector<uint8_t>& bytes, const std::string& fallba
   }
 }
 
-// The source document with all buffers merged into buffer 0 and every image embedded.
-GltfDocument documentFromSource(const std::filesystem::path& sourcePath) {
+// Reads `length` bytes of a buffer file straight into bin[offset, offset + length): a big .bin is
+// never held twice (a whole-file vector read by stream iterators grew by doubling, 2× at its peak).
+// False when the file is missing or shorter.
+bool readFileInto(const std::filesystem::path& path, std::vector<uint8_t>& bin, size_t offset, size_t length) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  bin.resize(offset + length);
+  return length == 0 || static_cast<bool>(in.read(reinterpret_cast<char*>(bin.data() + offset), static_cast<std::streamsize>(length)));
+}
+
+// The source document with all buffers merged into buffer 0 and every image embedded. `extraBytes`:
+// what the caller will append (reserved up front, so buffer 0 is not copied while it grows; reserved
+// pages it does not use are never touched, so cost no memory).
+GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t extraBytes) {
   GltfSource src = readGltfSource(sourcePath);
-  json root = src.json;
+  json root = std::move(src.json);
   std::vector<uint8_t> bin;
   std::vector<size_t> offsets;
   if (root.contains("buffers")) {
+    size_t total = extraBytes;
+    for (const json& b : root["buffers"]) total += b.value("byteLength", size_t(0)) + 16;
+    bin.reserve(total);
     for (size_t i = 0; i < root["buffers"].size(); ++i) {
       const json& b = root["buffers"][i];
-      std::vector<uint8_t> data;
-      if (b.contains("uri")) data = uriBytes(src, b["uri"].get<std::string>());
-      else if (src.binary && i == 0) data.assign(src.bytes.begin() + src.binOffset, src.bytes.begin() + src.binOffset + src.binSize);
-      size_t length = b.value("byteLength", size_t(0));
-      if (data.size() < length)
-        throw Error(ErrorCode::Io, sourcePath.string(), "cannot re-read buffer " + std::to_string(i) + " of the source scene");
-      data.resize(length);
+      const size_t length = b.value("byteLength", size_t(0));
       while (bin.size() % 16) bin.push_back(0);  // keeps every accessor's alignment
-      offsets.push_back(bin.size());
-      bin.insert(bin.end(), data.begin(), data.end());
+      const size_t offset = bin.size();
+      offsets.push_back(offset);
+      bool complete = false;
+      if (b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) != 0) {
+        complete = readFileInto(src.folder / decodeUriEscapes(b["uri"].get<std::string>()), bin, offset, length);
+      } else {
+        const uint8_t* data = nullptr;
+        size_t size = 0;
+        std::vector<uint8_t> decoded;
+        if (b.contains("uri")) {
+          decoded = decodeDataUri(b["uri"].get<std::string>());
+          data = decoded.data();
+          size = decoded.size();
+        } else if (src.binary && i == 0) {
+          data = src.bytes.data() + src.binOffset;
+          size = src.binSize;
+        }
+        complete = size >= length;
+        if (complete) bin.insert(bin.end(), data, data + length);
+      }
+      if (!complete)
+        throw Error(ErrorCode::Io, sourcePath.string(), "cannot re-read buffer " + std::to_string(i) + " of the source scene");
     }
   }
+  std::vector<uint8_t>().swap(src.bytes);  // a GLB's whole file: its BIN chunk is in bin now
   if (root.contains("bufferViews"))
     for (auto& v : root["bufferViews"]) {
       size_t b = v.value("buffer", 0);
@@ -164,11 +194,21 @@ bool readsTexcoord1(const json& j) {
   return false;
 }
 
+// About what SourceExport appends to buffer 0: per vertex the gathered source attributes (96 bytes
+// covers position, normal, tangent, two UV sets and a colour) and TEXCOORD_1, per corner an index,
+// and the light-map PNGs. Only a reservation: more just grows the buffer.
+size_t appendedBytes(const Scene& scene, const std::vector<LightmapPng>& pngs) {
+  size_t bytes = 0;
+  for (const Primitive& p : scene.primitives) bytes += p.positions.size() * (96 + 8) + p.indices.size() * 4 + 64;
+  for (const LightmapPng& png : pngs) bytes += png.png.size() + 4;
+  return bytes;
+}
+
 // The source document with only the light-map data added (see the file comment).
 class SourceExport {
  public:
   SourceExport(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<LightmapPng>& pngs, const std::string& file)
-      : scene_(scene), pngs_(pngs), file_(file), doc_(documentFromSource(scene.sourcePath)) {
+      : scene_(scene), pngs_(pngs), file_(file), doc_(documentFromSource(scene.sourcePath, appendedBytes(scene, pngs))) {
     for (size_t i = 0; i < maps.size(); ++i) pngOfPage_[maps[i].page] = i;
     sourceMaterials_ = doc_.root.value("materials", json::array());
     sourceMeshes_ = doc_.root.value("meshes", json::array());

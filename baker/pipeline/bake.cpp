@@ -43,6 +43,22 @@ std::string seeThroughMaterials(const Scene& scene) {
   return {};
 }
 
+// The values an option holds when it is set must make sense: unset is "automatic", never a number.
+void checkOptionRanges(const BakeOptions& o) {
+  auto atLeast = [](const std::optional<int>& value, int lowest, const char* name) {
+    if (value && *value < lowest)
+      throw Error(ErrorCode::Usage, "", std::string(name) + " must be at least " + std::to_string(lowest) + " (got " +
+                                            std::to_string(*value) + ")");
+  };
+  atLeast(o.interleave, 1, "interleave");
+  atLeast(o.gl.cubeFaceSize, 1, "GL cube face size");
+  atLeast(o.walk.maxBounces, 0, "bounce count");
+  atLeast(o.compensation.filterRadius, 0, "compensation filter radius");
+  if (o.clamp == ClampMode::Fixed && !(o.clampBound > 0.0f))
+    throw Error(ErrorCode::Usage, "", "a fixed clamp bound must be positive (got " + std::to_string(o.clampBound) +
+                                          "; ClampMode::Off for no clamp)");
+}
+
 }  // namespace
 
 BackendKind parseBackend(const std::string& name) {
@@ -178,7 +194,10 @@ struct StagedBake::State {
 
   void deriveClamp() {
     eval = options.eval;
-    if (!options.autoClamp || eval.clampBound != 0.0f) return;
+    if (options.clamp != ClampMode::Derived) {
+      eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
+      return;
+    }
     clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
              : eval.biasCompensation     ? kCompensatedClampVplsPerMean
                                          : kClampVplsPerMean;
@@ -225,22 +244,23 @@ struct StagedBake::State {
                 "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");
     // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
     // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and
-    // the rasteriser waits for its slowest thread (Cornell box: bake 1.95 → 2.43 s).
-    overlap = compensate && (options.overlapCompensation > 0 ||
-                             (options.overlapCompensation < 0 && !glContext->softwareRenderer()));
+    // the rasteriser waits for its slowest thread (docs/performance.md).
+    overlap = compensate && (options.overlapCompensation == OverlapCompensation::Always ||
+                             (options.overlapCompensation == OverlapCompensation::Auto &&
+                              !glContext->softwareRenderer()));
   }
 
   // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
   void planBlocks() {
     if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
-    interleave = options.interleave > 0 ? options.interleave : chooseInterleave(texels, eval.clampBound);
+    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound);
     classVpls = classVplSubsets(vpls, interleave);
     const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
     for (size_t c = 0; c < classVpls.size(); ++c)
       for (size_t b0 = 0; b0 < classVpls[c].vpls.size(); b0 += blockSize)
         blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[c].vpls.size(), b0 + blockSize)});
     gl = options.gl;
-    if (backend == BackendKind::Gl && gl.cubeFaceSize <= 0)  // once for every block, from the first class
+    if (backend == BackendKind::Gl && !gl.cubeFaceSize)  // once for every block, from the first class
       gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), eval.clampBound, gl.cubeFootprintPerTexel,
                                            gl.minCubeFaceSize, gl.maxCubeFaceSize)
                             .size;
@@ -481,6 +501,7 @@ StagedBake::StagedBake(Scene scene, const BakeOptions& options) : state_(std::ma
   s.options = options;
   s.scene = std::move(scene);
   if (s.scene.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.scene.sourcePath, "no triangles to bake");
+  checkOptionRanges(options);
   s.prepare();
 }
 

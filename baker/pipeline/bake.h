@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,21 @@ namespace irbake {
 // transmission), whose texels the GL backend would mostly trace with rays anyway.
 enum class BackendKind { Auto, Gl, Embree, Reference };
 
-// The default evaluation: derived clamp, bias compensation on, direct and VPLs.
+// How the bake bounds the VPL geometry term (VplEvalOptions::clampBound of every backend call).
+enum class ClampMode {
+  Derived,  // deriveClampBound from the scene and VPLs (k = BakeOptions::clampVplsPerMean)
+  Off,      // no clamp
+  Fixed,    // BakeOptions::clampBound
+};
+
+// Whether the clamp compensation's rays are traced while the GL backend bakes (on the CPU beside the GPU).
+enum class OverlapCompensation {
+  Auto,    // hardware renderers only: on llvmpipe both fight over the cores (docs/performance.md)
+  Never,   // after the VPL blocks
+  Always,  // beside the VPL blocks, whatever the renderer
+};
+
+// The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
 inline VplEvalOptions compensatedEval() {
   VplEvalOptions e;
   e.biasCompensation = true;
@@ -39,18 +54,18 @@ struct BakeOptions {
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
-  VplEvalOptions eval = compensatedEval();  // clamp (0 = derived from the scene), bias compensation (on)
+  VplEvalOptions eval = compensatedEval();  // bias compensation (on), direct, VPLs; its clampBound is not read
+                                            // (the bake sets it from clamp)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
-  bool autoClamp = true;                  // derive eval.clampBound from the scene when it is 0
+  ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
+  float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)
-  int interleave = 0;                     // n: VPLs split over n×n texel classes (Keller & Heidrich 2001);
-                                          // 1 = off, 0 = automatic (chooseInterleave: 1…4)
-  GlBackendOptions gl;                    // GL backend: cube face size (0 = from the light map), VPLs per pass, biases
-  int overlapCompensation = -1;           // trace the compensation's rays while the GL backend bakes: -1 auto
-                                          // (hardware renderers only: on llvmpipe both fight over the cores,
-                                          // bake 1.95 → 2.43 s), 0 never, 1 always
+  std::optional<int> interleave;          // n ≥ 1: VPLs split over n×n texel classes (Keller & Heidrich 2001),
+                                          // 1 = off; unset: automatic (chooseInterleave: 1…4)
+  GlBackendOptions gl;                    // GL backend: cube face size (unset = from the light map), VPLs per pass, biases
+  OverlapCompensation overlapCompensation = OverlapCompensation::Auto;  // compensation rays beside the GL bake
   int vplBlock = 512;                     // VPLs per block of the exact VPL sum (within one interleave class):
                                           // the unit of shards and checkpoints, fixed by the options alone
   int referenceSpp = 256;                 // reference backend: paths per texel sample

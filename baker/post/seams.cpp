@@ -3,9 +3,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
+#include "common/error.h"
 #include "post/post.h"
 
 namespace irbake {
@@ -34,6 +36,40 @@ struct EdgeSide {
 std::array<int64_t, 3> quantise(const glm::vec3& p, double cell) {
   return {static_cast<int64_t>(std::llround(p.x / cell)), static_cast<int64_t>(std::llround(p.y / cell)),
           static_cast<int64_t>(std::llround(p.z / cell))};
+}
+
+// One triangle edge in 8 bytes: the 32-bit hash of its key and its corner's global number (the
+// corners of all primitives counted in order). Hashes collide about once per 2^32/edges pairs; the
+// keys themselves decide within a run of equal hashes.
+struct EdgeRef {
+  uint32_t hash;    // EdgeKeyHash of the edge's key, folded to 32 bits
+  uint32_t corner;  // global corner: cornerBase[primitive] + t + e (edge e of the triangle at t)
+};
+
+// The edge's endpoints (vertex indices) in key order, and its key; false for a degenerate edge.
+bool edgeKey(const Primitive& prim, uint32_t corner, double cell, EdgeKey& key, uint32_t* i0 = nullptr,
+             uint32_t* i1 = nullptr) {
+  const uint32_t first = corner - corner % 3;
+  uint32_t a = prim.indices[corner], b = prim.indices[first + (corner - first + 1) % 3];
+  auto q0 = quantise(prim.positions[a], cell), q1 = quantise(prim.positions[b], cell);
+  if (q0 == q1) return false;
+  if (q1 < q0) {
+    std::swap(q0, q1);
+    std::swap(a, b);
+  }
+  key = EdgeKey{{q0[0], q0[1], q0[2], q1[0], q1[1], q1[2]}};
+  if (i0) *i0 = a;
+  if (i1) *i1 = b;
+  return true;
+}
+
+EdgeSide edgeSide(const Primitive& prim, uint32_t corner, double cell) {
+  EdgeKey key;
+  uint32_t i0 = 0, i1 = 0;
+  edgeKey(prim, corner, cell, key, &i0, &i1);
+  const bool haveNormals = prim.normals.size() == prim.positions.size();
+  return {prim.lightmap.page, prim.uv1[i0], prim.uv1[i1], haveNormals ? prim.normals[i0] : glm::vec3(0.0f),
+          haveNormals ? prim.normals[i1] : glm::vec3(0.0f)};
 }
 
 // Bilinear taps of one lookup (same convention as sampleLightmap): up to 4 (texel index, weight).
@@ -110,44 +146,93 @@ double rowsMismatch(const std::vector<Lightmap>& maps, const std::vector<size_t>
 }  // namespace
 
 std::vector<SeamEdge> findSeams(const Scene& scene, const SeamOptions& options) {
-  double cell = std::max(1e-12, double(options.positionTolerance) * std::max(1e-6f, scene.bounds().diagonal()));
-  std::unordered_map<EdgeKey, std::vector<EdgeSide>, EdgeKeyHash> edges;
-  for (const Primitive& prim : scene.primitives) {
-    if (prim.lightmap.page < 0 || prim.uv1.size() != prim.positions.size()) continue;
-    bool haveNormals = prim.normals.size() == prim.positions.size();
-    for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
-      for (int e = 0; e < 3; ++e) {
-        uint32_t i0 = prim.indices[t + e], i1 = prim.indices[t + (e + 1) % 3];
-        auto q0 = quantise(prim.positions[i0], cell), q1 = quantise(prim.positions[i1], cell);
-        if (q0 == q1) continue;  // degenerate edge
-        if (q1 < q0) {
-          std::swap(q0, q1);
-          std::swap(i0, i1);
-        }
-        EdgeKey key{{q0[0], q0[1], q0[2], q1[0], q1[1], q1[2]}};
-        glm::vec3 n0 = haveNormals ? prim.normals[i0] : glm::vec3(0.0f);
-        glm::vec3 n1 = haveNormals ? prim.normals[i1] : glm::vec3(0.0f);
-        edges[key].push_back({prim.lightmap.page, prim.uv1[i0], prim.uv1[i1], n0, n1});
-      }
+  const double cell = std::max(1e-12, double(options.positionTolerance) * std::max(1e-6f, scene.bounds().diagonal()));
+  // Every triangle edge as 8 bytes (its key's hash and where it is), sorted so that the triangles
+  // sharing a 3D edge sit side by side. A hash map from key to a vector of sides held ~290 bytes per
+  // triangle (588 MB for a 2M-triangle grid, the bake's peak: docs/performance.md, "Memory").
+  std::vector<uint64_t> cornerBase(scene.primitives.size() + 1, 0);  // first global corner of each primitive
+  for (size_t p = 0; p < scene.primitives.size(); ++p) {
+    const Primitive& prim = scene.primitives[p];
+    const bool mapped = prim.lightmap.page >= 0 && prim.uv1.size() == prim.positions.size();
+    cornerBase[p + 1] = cornerBase[p] + (mapped ? prim.indices.size() / 3 * 3 : 0);
+  }
+  if (cornerBase.back() > UINT32_MAX)
+    throw Error(ErrorCode::InvalidData, scene.sourcePath, "more than 2^32 triangle corners: too large to stitch seams");
+  auto locate = [&](uint32_t global, uint32_t& corner) -> const Primitive& {
+    const size_t p = std::upper_bound(cornerBase.begin(), cornerBase.end(), uint64_t(global)) - cornerBase.begin() - 1;
+    corner = static_cast<uint32_t>(global - cornerBase[p]);
+    return scene.primitives[p];
+  };
+  std::vector<EdgeRef> refs;
+  refs.reserve(cornerBase.back());
+  for (size_t p = 0; p < scene.primitives.size(); ++p) {
+    const Primitive& prim = scene.primitives[p];
+    if (cornerBase[p + 1] == cornerBase[p]) continue;
+    for (uint32_t corner = 0; corner + cornerBase[p] < cornerBase[p + 1]; ++corner) {
+      EdgeKey key;
+      if (!edgeKey(prim, corner, cell, key)) continue;  // degenerate edge
+      const uint64_t h = EdgeKeyHash()(key);
+      refs.push_back({static_cast<uint32_t>(h ^ (h >> 32)), static_cast<uint32_t>(cornerBase[p] + corner)});
     }
   }
+  // (hash, corner): within one key the sides keep the order the triangles come in.
+  std::sort(refs.begin(), refs.end(), [](const EdgeRef& x, const EdgeRef& y) {
+    return x.hash != y.hash ? x.hash < y.hash : x.corner < y.corner;
+  });
+
   std::vector<SeamEdge> seams;
   const float uvTol = 1e-6f;
-  for (const auto& [key, sides] : edges) {
+  auto keyOf = [&](const EdgeRef& r) {
+    uint32_t corner = 0;
+    const Primitive& prim = locate(r.corner, corner);
+    EdgeKey key;
+    edgeKey(prim, corner, cell, key);
+    return key;
+  };
+  auto sideOf = [&](const EdgeRef& r) {
+    uint32_t corner = 0;
+    const Primitive& prim = locate(r.corner, corner);
+    return edgeSide(prim, corner, cell);
+  };
+  // One 3D edge's sides [first, last): a seam when exactly two charts meet there.
+  auto consider = [&](const EdgeRef* first, const EdgeRef* last) {
     // Manifold edges only: an edge shared by three or more triangles has no single "other side".
-    if (sides.size() != 2) continue;
-    const EdgeSide& a = sides[0];
-    const EdgeSide& b = sides[1];
+    if (last - first != 2) return;
+    const EdgeSide a = sideOf(first[0]);
+    const EdgeSide b = sideOf(first[1]);
     bool sameUv = a.page == b.page && glm::length(a.uv0 - b.uv0) < uvTol && glm::length(a.uv1 - b.uv1) < uvTol;
-    if (sameUv) continue;  // an edge inside one chart
+    if (sameUv) return;  // an edge inside one chart
     // A crease (flat-shaded box corner) is not a seam: light there may legitimately differ.
-    if (glm::dot(a.n0, b.n0) < options.normalCosTolerance || glm::dot(a.n1, b.n1) < options.normalCosTolerance) continue;
+    if (glm::dot(a.n0, b.n0) < options.normalCosTolerance || glm::dot(a.n1, b.n1) < options.normalCosTolerance) return;
     seams.push_back({a.page, b.page, a.uv0, a.uv1, b.uv0, b.uv1});
+  };
+  for (size_t begin = 0; begin < refs.size();) {
+    size_t end = begin + 1;
+    while (end < refs.size() && refs[end].hash == refs[begin].hash) ++end;
+    if (end - begin == 1) {
+      // an edge of one triangle only: a border, never a seam
+    } else if (end - begin == 2 && keyOf(refs[begin]) == keyOf(refs[begin + 1])) {
+      consider(&refs[begin], &refs[end]);  // the common case: one edge, two triangles
+    } else {
+      // Several keys under one hash, or one key with many sides: group by the key itself.
+      std::vector<std::pair<EdgeKey, EdgeRef>> run;
+      for (size_t i = begin; i < end; ++i) run.emplace_back(keyOf(refs[i]), refs[i]);
+      std::stable_sort(run.begin(), run.end(), [](const auto& x, const auto& y) { return x.first.q < y.first.q; });
+      std::vector<EdgeRef> group;
+      for (size_t i = 0; i < run.size();) {
+        group.clear();
+        size_t j = i;
+        for (; j < run.size() && run[j].first == run[i].first; ++j) group.push_back(run[j].second);
+        consider(group.data(), group.data() + group.size());
+        i = j;
+      }
+    }
+    begin = end;
   }
-  // Deterministic order (the hash map's is not).
+  // Deterministic order, a total one: a seam's sides and pages decide its place, not the hash.
   std::sort(seams.begin(), seams.end(), [](const SeamEdge& x, const SeamEdge& y) {
-    auto kx = std::make_tuple(x.pageA, x.uvA0.x, x.uvA0.y, x.uvA1.x, x.uvA1.y);
-    auto ky = std::make_tuple(y.pageA, y.uvA0.x, y.uvA0.y, y.uvA1.x, y.uvA1.y);
+    auto kx = std::make_tuple(x.pageA, x.uvA0.x, x.uvA0.y, x.uvA1.x, x.uvA1.y, x.pageB, x.uvB0.x, x.uvB0.y, x.uvB1.x, x.uvB1.y);
+    auto ky = std::make_tuple(y.pageA, y.uvA0.x, y.uvA0.y, y.uvA1.x, y.uvA1.y, y.pageB, y.uvB0.x, y.uvB0.y, y.uvB1.x, y.uvB1.y);
     return kx < ky;
   });
   return seams;

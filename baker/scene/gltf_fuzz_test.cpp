@@ -98,3 +98,52 @@ TEST(GltfFuzz, JsonValueReplacementNeverCrashes) {
   EXPECT_GT(cases, 200);
   EXPECT_GT(errors, cases / 10);
 }
+
+// Regression cases found by the libFuzzer harness (tests/fuzz). Each is the smallest document that
+// shows the fault; the fuzzer's own reproducer came from our Cornell-box sample.
+
+// 1. A number too large for a double (0.140000000596E4645): nlohmann::json throws out_of_range (406),
+//    not parse_error, and it escaped loadScene as a bare std::exception with no file name.
+TEST(GltfFuzzRegression, NumberOverflowIsAParseErrorNamingTheFile) {
+  auto dir = irbake::testing::testFolder("fuzz_regression_number");
+  GltfDocument doc = richDocument();
+  doc.root["cameras"][0]["perspective"]["yfov"] = "OVERFLOW_HERE";
+  irbake::testing::writeDocument(doc, dir / "marked.gltf");
+  std::ifstream in(dir / "marked.gltf");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string marker = "\"OVERFLOW_HERE\"";
+  ASSERT_NE(text.find(marker), std::string::npos);
+  text.replace(text.find(marker), marker.size(), "0.140000000596E4645");
+  std::ofstream(dir / "overflow.gltf") << text;
+  for (int fromMemory = 0; fromMemory < 2; ++fromMemory) {
+    try {
+      if (fromMemory)
+        loadSceneFromBytes(std::vector<uint8_t>(text.begin(), text.end()), dir / "overflow.gltf");
+      else
+        loadScene(dir / "overflow.gltf");
+      ADD_FAILURE() << "a number out of double range loaded";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Parse);
+      EXPECT_EQ(e.file(), (dir / "overflow.gltf").string());
+      EXPECT_NE(std::string(e.what()).find("malformed JSON: number overflow"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// 2. A buffer view whose byteOffset is 1e39: the out-of-bounds message cast the double to an integer
+//    (undefined behaviour; UBSan: "outside the range of representable values"). The message now gives
+//    such a number as written.
+TEST(GltfFuzzRegression, HugeBufferViewOffsetIsReportedAsWritten) {
+  auto dir = irbake::testing::testFolder("fuzz_regression_offset");
+  GltfDocument doc = richDocument();
+  doc.root["bufferViews"][0]["byteOffset"] = 1e39;
+  irbake::testing::writeDocument(doc, dir / "offset.gltf");
+  try {
+    loadScene(dir / "offset.gltf");
+    ADD_FAILURE() << "a buffer view at byte 1e39 loaded";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+    EXPECT_NE(std::string(e.what()).find("buffer view 0 is out of bounds: bytes 1e+39..1e+39 of buffer 0"), std::string::npos)
+        << e.what();
+  }
+}

@@ -892,6 +892,10 @@ Scene loadScene(const std::filesystem::path& path, const LoadOptions& options) {
   return Loader(readGltfSource(path), options).load();
 }
 
+Scene loadSceneFromBytes(std::vector<uint8_t> bytes, const std::filesystem::path& path, const LoadOptions& options) {
+  return Loader(gltfSourceFromBytes(std::move(bytes), path), options).load();
+}
+
 void requireLight(const Scene& scene, const std::filesystem::path& path) {
   if (!scene.hasLightOrEmitter())
     throw Error(ErrorCode::NoLight, path.string(),

@@ -1,6 +1,8 @@
 #include "scene/gltf_source.h"
 
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <fstream>
 #include <system_error>
 
@@ -22,6 +24,16 @@ uint32_t readU32(const uint8_t* p) {
 
 [[noreturn]] void fail(ErrorCode code, const GltfSource& s, const std::string& message) {
   throw Error(code, s.path.string(), message);
+}
+
+// A byte count from the JSON for a message: an integer where it is one, else as written (1e+39): a
+// double beyond 2^64 cast to an integer is undefined behaviour (found by tests/fuzz).
+std::string byteCount(double bytes) {
+  if (bytes >= 0.0 && bytes < 18446744073709549568.0 && bytes == std::floor(bytes))
+    return std::to_string(static_cast<uint64_t>(bytes));
+  std::ostringstream out;
+  out << bytes;
+  return out.str();
 }
 
 std::string firstLine(std::string s) {
@@ -115,9 +127,8 @@ void checkBufferViews(const GltfSource& s) {
     if (offset < 0.0 || length < 0.0) fail(ErrorCode::InvalidData, s, what + " has a negative or missing byteOffset/byteLength");
     if (offset + length > bufferLength)
       fail(ErrorCode::InvalidData, s,
-           what + " is out of bounds: bytes " + std::to_string(static_cast<uint64_t>(offset)) + ".." +
-               std::to_string(static_cast<uint64_t>(offset + length)) + " of buffer " + std::to_string(b) + " (" +
-               std::to_string(static_cast<uint64_t>(bufferLength)) + " bytes)");
+           what + " is out of bounds: bytes " + byteCount(offset) + ".." + byteCount(offset + length) + " of buffer " +
+               std::to_string(b) + " (" + byteCount(bufferLength) + " bytes)");
   }
 }
 
@@ -228,9 +239,6 @@ void checkJsonDepth(const GltfSource& s, const char* text, size_t size) {
 }
 
 GltfSource readGltfSource(const std::filesystem::path& path) {
-  GltfSource s;
-  s.path = path;
-  s.folder = path.parent_path();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: no such file");
   if (std::filesystem::is_directory(path, ec)) throw Error(ErrorCode::Io, path.string(), "cannot read file: it is a directory");
@@ -240,9 +248,17 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
   std::streamoff size = in.tellg();
   if (size < 0) throw Error(ErrorCode::Io, path.string(), "cannot read file");
   in.seekg(0);
-  s.bytes.resize(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(s.bytes.data()), size))
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size))
     throw Error(ErrorCode::Io, path.string(), "cannot read file: read failed");
+  return gltfSourceFromBytes(std::move(bytes), path);
+}
+
+GltfSource gltfSourceFromBytes(std::vector<uint8_t> bytes, const std::filesystem::path& path) {
+  GltfSource s;
+  s.path = path;
+  s.folder = path.parent_path();
+  s.bytes = std::move(bytes);
 
   if (s.bytes.size() >= 4 && std::memcmp(s.bytes.data(), "glTF", 4) == 0) {
     s.binary = true;
@@ -262,10 +278,12 @@ GltfSource readGltfSource(const std::filesystem::path& path) {
   checkJsonDepth(s, text, s.jsonSize);
   try {
     s.json = nlohmann::json::parse(text, text + s.jsonSize);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error for bad syntax, but also out_of_range (406) for a number too large for a double,
+    // e.g. 1E4645: any of them is a malformed document (found by tests/fuzz).
     std::string msg = e.what();
-    size_t at = msg.find("parse error");
-    fail(ErrorCode::Parse, s, "malformed JSON: " + firstLine(at == std::string::npos ? msg : msg.substr(at)));
+    size_t at = msg.find("] ");
+    fail(ErrorCode::Parse, s, "malformed JSON: " + firstLine(at == std::string::npos ? msg : msg.substr(at + 2)));
   }
   if (!s.json.is_object()) fail(ErrorCode::Parse, s, "not a glTF file: the JSON is not an object");
   if (!s.json.contains("asset") || !s.json["asset"].is_object())

@@ -24,6 +24,9 @@ struct GltfSource {
 
 // Reads and checks `path`. Throws Error(Io | Parse | InvalidData, path, ...).
 GltfSource readGltfSource(const std::filesystem::path& path);
+// The same checks on bytes already in memory (the fuzz harness): `path` names them in messages and
+// its folder resolves relative URIs, exactly as if the bytes had been read from `path`.
+GltfSource gltfSourceFromBytes(std::vector<uint8_t> bytes, const std::filesystem::path& path);
 
 // Decodes %XX escapes of a URI (glTF URIs are RFC 3986 references).
 std::string decodeUriEscapes(const std::string& uri);

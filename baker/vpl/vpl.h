@@ -1,6 +1,7 @@
 // Virtual point lights from Keller's quasi-random walk.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -22,7 +23,8 @@ struct Vpl {
 
 struct WalkOptions {
   int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights)
-  int maxBounces = -1;     // -1 = auto (autoBounceDepth); ≥ 0: exactly this deepest bounce, no tail added
+  std::optional<int> maxBounces;  // unset: auto (autoBounceDepth, tail added); set (≥ 0): exactly this deepest
+                                  // bounce, no tail added
   double tailEnergy = 1e-3;      // auto: stop once the light not yet placed, ρ̄^(J+1), is below this fraction
   double maxVplsPerPath = 8.0;   // auto: VPL budget Σ_j M_j ≤ this × N (a scene of ρ̄ = 0.9 reaches J = 14)
   bool geometricTail = true;     // auto: the bounces beyond J added to bounce J as a geometric series

@@ -87,130 +87,125 @@ glm::dvec3 geometricTailFactor(const glm::dvec3& lastPower, const glm::dvec3& pr
   return f;
 }
 
-VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options) {
-  VplSet out;
-  if (options.paths <= 0) throw Error(ErrorCode::Usage, "", "the walk needs at least one path (--vpls)");
-  LightSources sources = collectLightSources(scene);
-  out.emittedPower = sources.totalPower;
-  const double rho = meanReflectivity(scene);
-  out.meanReflectivity = rho;
-  if (sources.all.empty() || channelMean(sources.totalPower) <= 0.0) return out;
+namespace {
 
-  // Surviving path counts M_j (fractional absorption) and the deepest bounce.
-  const uint64_t N = static_cast<uint64_t>(options.paths);
-  const bool autoDepth = options.maxBounces < 0;
-  const int cap = autoDepth ? autoBounceDepth(N, rho, options) : options.maxBounces;
-  std::vector<uint64_t> survivors{N};
-  for (int j = 1; j <= cap; ++j) {
-    const uint64_t m = survivorCount(N, rho, j);
-    if (m == 0) break;
-    survivors.push_back(m);
-  }
-  const int maxBounce = static_cast<int>(survivors.size()) - 1;
-  const Halton halton(4 + 2 * std::max(maxBounce, 1), options.seed);
-  const float eps = rt.epsilon();
+// Where path i leaves its light: the point, direction and power (Φ_s / (p_s N), before the albedo
+// products). An emitter surface also leaves the path's bounce-0 VPL in `vpls`.
+struct PathStart {
+  glm::vec3 origin{0.0f}, dir{0.0f}, normal{0.0f};
+  glm::dvec3 power{0.0};
+  bool onSurface = false;  // starts on a surface (origin inset): rays leave along the normal
+};
+
+PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources& sources, const Halton& halton,
+                    uint64_t i, uint64_t N, std::vector<Vpl>& vpls) {
   const size_t numTriangles = sources.triangles.size();
-
-  std::vector<std::vector<Vpl>> perPath(N);
-  std::atomic<uint64_t> done{0};
-  if (options.progress) options.progress("walk", 0.0);
-  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, N, 64), [&](const tbb::blocked_range<uint64_t>& range) {
-    for (uint64_t i = range.begin(); i != range.end(); ++i) {
-      std::vector<Vpl>& vpls = perPath[i];
-      double residual = 0.0;
-      size_t s = sources.all.sample(halton.sample(0, i), &residual);
-      double u1 = halton.sample(1, i);
-      double p = sources.all.pdf(s);
-      glm::dvec3 pathPower(0.0);  // Φ_s / (p_s N), before the albedo products
-      glm::vec3 origin, dir, normal(0.0f);
-      bool surfaceStart = false;
-      if (s < numTriangles) {
-        const EmitterTriangle& e = sources.triangles[s];
-        const Primitive& prim = scene.primitives[e.primitive];
-        glm::vec2 bary = uniformTriangle(residual, u1);
-        const uint32_t* idx = &prim.indices[3 * e.triangle];
-        origin = rt.insetPoint(e.primitive, e.triangle,
-                               prim.positions[idx[0]] * (1.0f - bary.x - bary.y) + prim.positions[idx[1]] * bary.x +
-                                   prim.positions[idx[2]] * bary.y);
-        normal = e.normal;
-        // Emission at the sampled point (textures), so the estimate is unbiased for textured emitters.
-        glm::dvec3 Le(scene.emissionAt(prim, e.triangle, bary));
-        pathPower = Le * (kPi * e.area) / (p * static_cast<double>(N));
-        vpls.push_back(Vpl{origin, normal, glm::vec3(pathPower), 0});
-        dir = cosineHemisphere(normal, halton.sample(2, i), halton.sample(3, i));
-        surfaceStart = true;
-      } else if (sources.hasSky && s == numTriangles + scene.lights.size()) {
-        // The sky: a direction towards it by luminance, a point on a disc covering the bounding sphere
-        // upstream; the path carries L(ω)/p(ω) · π R² / N (its colour included).
-        double pdf = 0.0;
-        const glm::vec3 toSky = scene.environment.sample(halton.sample(2, i), halton.sample(3, i), pdf);
-        dir = -toSky;
+  double residual = 0.0;
+  size_t s = sources.all.sample(halton.sample(0, i), &residual);
+  double u1 = halton.sample(1, i);
+  double p = sources.all.pdf(s);
+  PathStart path;
+  glm::dvec3& pathPower = path.power;
+  glm::vec3 &origin = path.origin, &dir = path.dir, &normal = path.normal;
+  bool& surfaceStart = path.onSurface;
+  if (s < numTriangles) {
+    const EmitterTriangle& e = sources.triangles[s];
+    const Primitive& prim = scene.primitives[e.primitive];
+    glm::vec2 bary = uniformTriangle(residual, u1);
+    const uint32_t* idx = &prim.indices[3 * e.triangle];
+    origin = rt.insetPoint(e.primitive, e.triangle,
+                           prim.positions[idx[0]] * (1.0f - bary.x - bary.y) + prim.positions[idx[1]] * bary.x +
+                               prim.positions[idx[2]] * bary.y);
+    normal = e.normal;
+    // Emission at the sampled point (textures), so the estimate is unbiased for textured emitters.
+    glm::dvec3 Le(scene.emissionAt(prim, e.triangle, bary));
+    pathPower = Le * (kPi * e.area) / (p * static_cast<double>(N));
+    vpls.push_back(Vpl{origin, normal, glm::vec3(pathPower), 0});
+    dir = cosineHemisphere(normal, halton.sample(2, i), halton.sample(3, i));
+    surfaceStart = true;
+  } else if (sources.hasSky && s == numTriangles + scene.lights.size()) {
+    // The sky: a direction towards it by luminance, a point on a disc covering the bounding sphere
+    // upstream; the path carries L(ω)/p(ω) · π R² / N (its colour included).
+    double pdf = 0.0;
+    const glm::vec3 toSky = scene.environment.sample(halton.sample(2, i), halton.sample(3, i), pdf);
+    dir = -toSky;
+    glm::vec3 t, b;
+    orthonormalBasis(dir, t, b);
+    const double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
+    origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+             b * float(r * std::sin(phi));
+    const double R = sources.sceneRadius;
+    pathPower = pdf > 0.0 ? glm::dvec3(scene.environment.radiance(toSky)) * (kPi * R * R / (pdf * p * static_cast<double>(N)))
+                          : glm::dvec3(0.0);
+  } else {
+    const Light& l = scene.lights[s - numTriangles];
+    pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
+    switch (l.type) {
+      case LightType::Point:
+        origin = l.position;
+        dir = uniformSphere(halton.sample(2, i), halton.sample(3, i));
+        break;
+      case LightType::Spot:
+        origin = l.position;
+        dir = spotDirection(l, halton.sample(2, i), halton.sample(3, i));
+        break;
+      case LightType::Directional: {
+        // Uniform point on a disc covering the scene's bounding sphere, upstream of it.
+        dir = glm::normalize(l.direction);
         glm::vec3 t, b;
         orthonormalBasis(dir, t, b);
-        const double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
+        double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
         origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
                  b * float(r * std::sin(phi));
-        const double R = sources.sceneRadius;
-        pathPower = pdf > 0.0 ? glm::dvec3(scene.environment.radiance(toSky)) * (kPi * R * R / (pdf * p * static_cast<double>(N)))
-                              : glm::dvec3(0.0);
-      } else {
-        const Light& l = scene.lights[s - numTriangles];
-        pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
-        switch (l.type) {
-          case LightType::Point:
-            origin = l.position;
-            dir = uniformSphere(halton.sample(2, i), halton.sample(3, i));
-            break;
-          case LightType::Spot:
-            origin = l.position;
-            dir = spotDirection(l, halton.sample(2, i), halton.sample(3, i));
-            break;
-          case LightType::Directional: {
-            // Uniform point on a disc covering the scene's bounding sphere, upstream of it.
-            dir = glm::normalize(l.direction);
-            glm::vec3 t, b;
-            orthonormalBasis(dir, t, b);
-            double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
-            origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
-                     b * float(r * std::sin(phi));
-            break;
-          }
-        }
+        break;
       }
-      // Follow the path while it is among the survivors of the next bounce.
-      glm::dvec3 throughput(1.0);
-      for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
-        glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
-        RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
-        // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
-        // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
-        // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
-        for (int layer = 0; hit.hit && layer < 64; ++layer) {
-          const SurfaceTransmission st = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
-          if (st.fraction <= 0.0f) break;
-          Rng pass(hashSeed(options.seed, i, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
-          if (pass.uniform() >= st.fraction) break;
-          throughput *= glm::dvec3(st.tint);
-          hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
-        }
-        if (!hit.hit) break;  // escaped: its energy leaves the scene
-        throughput *= glm::dvec3(rt.albedoAt(hit));
-        glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
-        glm::dvec3 power = pathPower * throughput * (static_cast<double>(N) / static_cast<double>(survivors[j]));
-        glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
-        vpls.push_back(Vpl{at, n, glm::vec3(power), j});
-        if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
-        origin = at;
-        normal = n;
-        surfaceStart = true;
-        dir = cosineHemisphere(n, halton.sample(2 + 2 * j, i), halton.sample(3 + 2 * j, i));
-      }
-      uint64_t d = ++done;
-      if (options.progress && (d & 1023) == 0) options.progress("walk", static_cast<double>(d) / N);
     }
-  });
+  }
+  return path;
+}
 
-  // Order by bounce, then path: deterministic whatever the thread schedule.
+// Follows path i from its start while it is among the survivors of the next bounce, leaving one VPL
+// per bounce in `vpls` (power × albedo products × N / M_j).
+void followPath(const Scene& scene, const RayTracer& rt, const Halton& halton, const std::vector<uint64_t>& survivors,
+                uint64_t seed, uint64_t i, const PathStart& path, std::vector<Vpl>& vpls) {
+  const int maxBounce = static_cast<int>(survivors.size()) - 1;
+  const uint64_t N = survivors[0];
+  const float eps = rt.epsilon();
+  const glm::dvec3 pathPower = path.power;
+  glm::vec3 origin = path.origin, dir = path.dir, normal = path.normal;
+  bool surfaceStart = path.onSurface;
+  glm::dvec3 throughput(1.0);
+  for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
+    glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
+    RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+    // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
+    // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
+    // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
+    for (int layer = 0; hit.hit && layer < 64; ++layer) {
+      const SurfaceTransmission transmission = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+      if (transmission.fraction <= 0.0f) break;
+      Rng pass(hashSeed(seed, i, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
+      if (pass.uniform() >= transmission.fraction) break;
+      throughput *= glm::dvec3(transmission.tint);
+      hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
+    }
+    if (!hit.hit) break;  // escaped: its energy leaves the scene
+    throughput *= glm::dvec3(rt.albedoAt(hit));
+    glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
+    glm::dvec3 power = pathPower * throughput * (static_cast<double>(N) / static_cast<double>(survivors[j]));
+    glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
+    vpls.push_back(Vpl{at, n, glm::vec3(power), j});
+    if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
+    origin = at;
+    normal = n;
+    surfaceStart = true;
+    dir = cosineHemisphere(n, halton.sample(2 + 2 * j, i), halton.sample(3 + 2 * j, i));
+  }
+}
+
+// Collects every path's VPLs ordered by bounce, then path: deterministic whatever the thread
+// schedule. Sets the counts and powers per bounce and the deepest bounce reached.
+void orderByBounce(const std::vector<std::vector<Vpl>>& perPath, int maxBounce, VplSet& out) {
   out.countPerBounce.assign(maxBounce + 1, 0);
   out.powerPerBounce.assign(maxBounce + 1, glm::dvec3(0.0));
   for (const auto& path : perPath)
@@ -228,34 +223,73 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
     out.powerPerBounce.pop_back();
   }
   out.bounces = std::max(0, static_cast<int>(out.countPerBounce.size()) - 1);
+}
 
-  // The bounces beyond J (auto depth only): their power, P_J r/(1 − r), shared by the VPLs of the deeper
-  // half of the walk (bounces ⌈J/2⌉…J, in proportion to their power). Deep bounces have forgotten where
-  // the light entered, so they share one distribution; many VPLs carrying the tail instead of bounce J's
-  // few keeps its noise down (furnace ρ = 0.9, 1024 paths: 1.0% → see vpl_test).
-  if (autoDepth && options.geometricTail && out.bounces >= 1) {
-    const int J = out.bounces, from = std::max(1, (J + 1) / 2);
-    // The ratio r pooled over the same bounces (P_j for j = from−1…J, bounce 0 counted as the emitted
-    // power): deep bounces have few paths, and one bounce's ratio alone can be far off (an open corner,
-    // 16 paths left at J = 24, came out +18% against the reference).
-    auto bouncePower = [&](int j) { return j == 0 ? out.emittedPower : out.powerPerBounce[j]; };
-    glm::dvec3 later(0.0), earlier(0.0);
-    for (int j = from; j <= J; ++j) {
-      later += bouncePower(j);
-      earlier += bouncePower(j - 1);
-    }
-    const glm::dvec3 tail = out.powerPerBounce[J] * (geometricTailFactor(later, earlier) - 1.0);
-    glm::dvec3 carriers(0.0);
-    size_t first = out.vpls.size();
-    for (int j = from; j <= J; ++j) {
-      carriers += out.powerPerBounce[j];
-      first -= out.countPerBounce[j];
-    }
-    for (int c = 0; c < 3; ++c) out.tailFactor[c] = carriers[c] > 0.0 ? 1.0 + tail[c] / carriers[c] : 1.0;
-    for (size_t v = first; v < out.vpls.size(); ++v)
-      out.vpls[v].power = glm::vec3(glm::dvec3(out.vpls[v].power) * out.tailFactor);
-    for (int j = from; j <= J; ++j) out.powerPerBounce[j] *= out.tailFactor;
+// The bounces beyond J (auto depth only): their power, P_J r/(1 − r), shared by the VPLs of the deeper
+// half of the walk (bounces ⌈J/2⌉…J, in proportion to their power). Deep bounces have forgotten where
+// the light entered, so they share one distribution; many VPLs carrying the tail instead of bounce J's
+// few keeps its noise down (furnace ρ = 0.9, 1024 paths: 1.0% → see vpl_test).
+void addGeometricTail(VplSet& out) {
+  const int J = out.bounces, from = std::max(1, (J + 1) / 2);
+  // The ratio r pooled over the same bounces (P_j for j = from−1…J, bounce 0 counted as the emitted
+  // power): deep bounces have few paths, and one bounce's ratio alone can be far off (an open corner,
+  // 16 paths left at J = 24, came out +18% against the reference).
+  auto bouncePower = [&](int j) { return j == 0 ? out.emittedPower : out.powerPerBounce[j]; };
+  glm::dvec3 later(0.0), earlier(0.0);
+  for (int j = from; j <= J; ++j) {
+    later += bouncePower(j);
+    earlier += bouncePower(j - 1);
   }
+  const glm::dvec3 tail = out.powerPerBounce[J] * (geometricTailFactor(later, earlier) - 1.0);
+  glm::dvec3 carriers(0.0);
+  size_t first = out.vpls.size();
+  for (int j = from; j <= J; ++j) {
+    carriers += out.powerPerBounce[j];
+    first -= out.countPerBounce[j];
+  }
+  for (int c = 0; c < 3; ++c) out.tailFactor[c] = carriers[c] > 0.0 ? 1.0 + tail[c] / carriers[c] : 1.0;
+  for (size_t v = first; v < out.vpls.size(); ++v)
+    out.vpls[v].power = glm::vec3(glm::dvec3(out.vpls[v].power) * out.tailFactor);
+  for (int j = from; j <= J; ++j) out.powerPerBounce[j] *= out.tailFactor;
+}
+
+}  // namespace
+
+VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options) {
+  VplSet out;
+  if (options.paths <= 0) throw Error(ErrorCode::Usage, "", "the walk needs at least one path (--vpls)");
+  LightSources sources = collectLightSources(scene);
+  out.emittedPower = sources.totalPower;
+  const double rho = meanReflectivity(scene);
+  out.meanReflectivity = rho;
+  if (sources.all.empty() || channelMean(sources.totalPower) <= 0.0) return out;
+
+  // Surviving path counts M_j (fractional absorption) and the deepest bounce.
+  const uint64_t N = static_cast<uint64_t>(options.paths);
+  const bool autoDepth = !options.maxBounces.has_value();
+  const int cap = autoDepth ? autoBounceDepth(N, rho, options) : *options.maxBounces;
+  std::vector<uint64_t> survivors{N};
+  for (int j = 1; j <= cap; ++j) {
+    const uint64_t m = survivorCount(N, rho, j);
+    if (m == 0) break;
+    survivors.push_back(m);
+  }
+  const int maxBounce = static_cast<int>(survivors.size()) - 1;
+  const Halton halton(4 + 2 * std::max(maxBounce, 1), options.seed);
+
+  std::vector<std::vector<Vpl>> perPath(N);
+  std::atomic<uint64_t> done{0};
+  if (options.progress) options.progress("walk", 0.0);
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, N, 64), [&](const tbb::blocked_range<uint64_t>& range) {
+    for (uint64_t i = range.begin(); i != range.end(); ++i) {
+      const PathStart path = startPath(scene, rt, sources, halton, i, N, perPath[i]);
+      followPath(scene, rt, halton, survivors, options.seed, i, path, perPath[i]);
+      uint64_t d = ++done;
+      if (options.progress && (d & 1023) == 0) options.progress("walk", static_cast<double>(d) / N);
+    }
+  });
+  orderByBounce(perPath, maxBounce, out);
+  if (autoDepth && options.geometricTail && out.bounces >= 1) addGeometricTail(out);
   if (options.progress) options.progress("walk", 1.0);
   return out;
 }

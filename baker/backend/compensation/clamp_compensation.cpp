@@ -21,13 +21,20 @@ namespace {
 constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
 
 // A hit inside the clamp radius, kept for the sweeps: residual(slot) += Le + albedo ⊙ M(page, texel).
-// Le and albedo are already multiplied by w / (rays of the slot).
+// Le and albedo are already multiplied by w / (rays of the slot). 24 bytes: the kept hits are the
+// compensation's memory (≈ 3.5 per texel in the Cornell box), and few of them see an emitter, so Le
+// lives apart (EmittedHit) instead of 12 zero bytes in every hit (docs/performance.md, "Memory").
 struct KeptHit {
-  uint32_t slot = 0;
-  int32_t map = -1;          // index into maps; -1: the hit surface has no light map (Le only)
+  uint16_t slotInTile = 0;   // slot − Tile::begin (< kTileSlots)
+  int16_t map = -1;          // index into maps (< kMaxPages); -1: the hit surface has no light map (Le only)
   glm::vec2 texel{0.0f};     // continuous texel coordinates (u·W − ½, v·H − ½)
-  glm::vec3 emitted{0.0f};
   glm::vec3 albedo{0.0f};
+};
+
+// Le of a kept hit whose emission is not zero.
+struct EmittedHit {
+  uint32_t hit = 0;          // index into its tile's hits
+  glm::vec3 emitted{0.0f};
 };
 
 // Bilinear read of irradiance/π over the valid texels of a map; the nearest valid texel of the 3×3
@@ -62,10 +69,14 @@ glm::vec3 lookup(const Lightmap& m, const std::vector<glm::vec3>& value, glm::ve
   return nearest;
 }
 
+constexpr size_t kTileSlots = 256;  // slots per tile (KeptHit::slotInTile is 16 bits)
+constexpr size_t kMaxPages = 32767;  // KeptHit::map is 16 bits
+
 // Kept hits of one tile of slots (a tile owns its slots, so tiles are traced and swept in parallel).
 struct Tile {
   size_t page = 0, begin = 0, end = 0;
   std::vector<KeptHit> hits;
+  std::vector<EmittedHit> emitted;  // in hit order; hits not listed have Le = 0
 };
 
 // Ray counts of the two rounds, after the budget.
@@ -122,7 +133,7 @@ struct ClampGather::Impl {
 
   void makeTiles();
   void chooseFilters();
-  int traceSlot(size_t page, size_t slot, int count, uint64_t round, std::vector<KeptHit>& out) const;
+  int traceSlot(size_t page, size_t slot, int count, uint64_t round, Tile& out) const;
   std::vector<std::vector<uint16_t>> traceFirstRound();
   void traceRefinement(const std::vector<std::vector<uint16_t>>& firstHits, const RayPlan& plan);
   void divideByRaysOfSlot();
@@ -130,10 +141,10 @@ struct ClampGather::Impl {
 
 // Per page, per tile of slots, one list of kept hits (tiles own their slots, so they trace in parallel).
 void ClampGather::Impl::makeTiles() {
-  constexpr size_t kTile = 256;
+  constexpr size_t kTile = kTileSlots;
   for (size_t p = 0; p < in.texels.size(); ++p)
     for (size_t b = 0; b < in.texels[p].slotCount(); b += kTile)
-      tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}});
+      tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}, {}});
 }
 
 // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
@@ -144,10 +155,11 @@ void ClampGather::Impl::chooseFilters() {
   radii.assign(in.texels.size(), 0);
   filters.resize(in.texels.size());
   for (size_t p = 0; p < in.texels.size(); ++p) {
-    if (options.filterRadius == 0 || (options.filterRadius < 0 && baseRays >= 32)) continue;
+    const std::optional<int>& fixedRadius = options.filterRadius;
+    if (fixedRadius ? *fixedRadius <= 0 : baseRays >= 32) continue;
     auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
     const float h = filter->spacing();
-    radii[p] = options.filterRadius > 0 ? options.filterRadius
+    radii[p] = fixedRadius ? *fixedRadius
                : h > 0.0f ? static_cast<int>(std::min(2.0f, std::floor(0.05f * clampRadius / h)))
                           : 0;
     filterRadius = std::max(filterRadius, radii[p]);
@@ -158,7 +170,7 @@ void ClampGather::Impl::chooseFilters() {
 // Traces `count` cosine rays from slot s of page p (a rotated Fibonacci lattice: well stratified over
 // the hemisphere for any count) and appends the hits inside the clamp radius, not yet divided by the
 // slot's ray count. Returns how many it kept.
-int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, std::vector<KeptHit>& out) const {
+int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, Tile& out) const {
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
   const TexelSamples& ts = in.texels[p];
@@ -179,10 +191,11 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
     const float g = vplGeometryTerm(x, n, hit.position, hit.geometricNormal);
     if (g <= bound) continue;
     KeptHit kept;
-    kept.slot = static_cast<uint32_t>(s);
+    kept.slotInTile = static_cast<uint16_t>(s - out.begin);
     float w = 1.0f - bound / g;
     const Primitive& prim = scene.primitives[hit.primitive];
-    kept.emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
+    const glm::vec3 emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
+    if (emitted != glm::vec3(0.0f)) out.emitted.push_back({static_cast<uint32_t>(out.hits.size()), emitted});
     kept.albedo = w * rt.albedoAt(hit);
     int page = prim.lightmap.page;
     if (page >= 0 && static_cast<size_t>(page) < mapOfPage.size() && mapOfPage[page] >= 0 &&
@@ -191,10 +204,10 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
       float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
       glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
       const TexelSamples& m = in.texels[mapOfPage[page]];
-      kept.map = mapOfPage[page];
+      kept.map = static_cast<int16_t>(mapOfPage[page]);
       kept.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
     }
-    out.push_back(kept);
+    out.hits.push_back(kept);
     ++keptCount;
   }
   return keptCount;
@@ -216,7 +229,7 @@ std::vector<std::vector<uint16_t>> ClampGather::Impl::traceFirstRound() {
     size_t tracedHere = 0;
     for (size_t s = tile.begin; s < tile.end; ++s) {
       if (!(ts.positionWeight[s].w > 0.0f)) continue;
-      int keptCount = traceSlot(tile.page, s, baseRays, 0, tile.hits);
+      int keptCount = traceSlot(tile.page, s, baseRays, 0, tile);
       tracedHere += baseRays;
       raysOf[tile.page][s] = static_cast<uint16_t>(baseRays);
       firstHits[tile.page][s] = static_cast<uint16_t>(std::min(keptCount, 65535));
@@ -244,7 +257,7 @@ void ClampGather::Impl::traceRefinement(const std::vector<std::vector<uint16_t>>
     for (size_t s = tile.begin; s < tile.end; ++s) {
       const uint16_t h = firstHits[tile.page][s];
       if (h == 0 || h < plan.refineHits) continue;
-      traceSlot(tile.page, s, extra, 1, tile.hits);
+      traceSlot(tile.page, s, extra, 1, tile);
       tracedHere += extra;
       raysOf[tile.page][s] = static_cast<uint16_t>(raysOf[tile.page][s] + extra);
       ++refinedHere;
@@ -260,11 +273,14 @@ void ClampGather::Impl::traceRefinement(const std::vector<std::vector<uint16_t>>
 void ClampGather::Impl::divideByRaysOfSlot() {
   tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
     Tile& tile = tiles[ti];
-    for (KeptHit& kept : tile.hits) {
-      const float inv = 1.0f / static_cast<float>(std::max<uint16_t>(1, raysOf[tile.page][kept.slot]));
-      kept.emitted *= inv;
-      kept.albedo *= inv;
-    }
+    auto invRays = [&](const KeptHit& kept) {
+      return 1.0f / static_cast<float>(std::max<uint16_t>(1, raysOf[tile.page][tile.begin + kept.slotInTile]));
+    };
+    for (EmittedHit& e : tile.emitted) e.emitted *= invRays(tile.hits[e.hit]);
+    for (KeptHit& kept : tile.hits) kept.albedo *= invRays(kept);
+    // Exact size from here on: the doubling slack of the traced lists would stay for the sweeps.
+    tile.hits.shrink_to_fit();
+    tile.emitted.shrink_to_fit();
   });
 }
 
@@ -278,6 +294,8 @@ ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& o
   gather.bound = in.eval.clampBound;
   gather.enabled = in.eval.includeVpls && gather.bound > 0.0f;
   if (!gather.enabled) return;
+  if (in.texels.size() > kMaxPages)
+    throw Error(ErrorCode::InvalidData, "", "clamp compensation: more than " + std::to_string(kMaxPages) + " light-map pages");
   gather.mapOfPage = mapIndexOfPages(in.texels);
   gather.makeTiles();
   const RayPlan plan = planRays(in.texels, options);
@@ -304,8 +322,10 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   const auto& filters = g.filters;
 
   // Sweeps: residual per slot from the current maps, folded into texels; the next sweep reads base + residual.
-  std::vector<std::vector<glm::vec3>> base(maps.size()), current(maps.size());
-  for (size_t p = 0; p < maps.size(); ++p) base[p] = current[p] = maps[p].texels;
+  // The base is maps[p].texels itself (unchanged until the end): no third copy of every page.
+  std::vector<std::vector<glm::vec3>> current(maps.size());
+  for (size_t p = 0; p < maps.size(); ++p) current[p] = maps[p].texels;
+  auto base = [&](size_t p) -> const std::vector<glm::vec3>& { return maps[p].texels; };
   std::vector<std::vector<glm::vec3>> slotResidual(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) slotResidual[p].assign(in.texels[p].slotCount(), glm::vec3(0.0f));
   size_t kept = 0;
@@ -315,7 +335,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   double mapTotal = 0.0;
   for (size_t p = 0; p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t)
-      if (maps[p].valid[t]) mapTotal += channelMean(base[p][t]);
+      if (maps[p].valid[t]) mapTotal += channelMean(base(p)[t]);
   double lastAdded = 0.0;
   int sweepsDone = 0;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
@@ -323,34 +343,46 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
       for (size_t s = tile.begin; s < tile.end; ++s) res[s] = glm::vec3(0.0f);
-      for (const KeptHit& kept : tile.hits) {
-        glm::vec3 L = kept.emitted;
+      size_t e = 0;  // next EmittedHit
+      for (size_t h = 0; h < tile.hits.size(); ++h) {
+        const KeptHit& kept = tile.hits[h];
+        glm::vec3 L(0.0f);
+        if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
         if (kept.map >= 0) L += kept.albedo * lookup(maps[kept.map], current[kept.map], kept.texel);
-        res[kept.slot] += L;
+        res[tile.begin + kept.slotInTile] += L;
       }
     });
-    std::vector<std::vector<glm::vec3>> next = base;
     double added = 0.0;  // Σ residual (channel mean) = what this sweep's map adds to the base
     for (size_t p = 0; p < maps.size(); ++p) {
       const TexelSamples& ts = in.texels[p];
       const Lightmap& m = maps[p];
       const size_t layer = ts.layerSize();
-      std::vector<glm::vec3> residual(layer, glm::vec3(0.0f));
+      // The lookups of this sweep are done, so the page's current map is free until rebuilt below:
+      // the residual is gathered into it, and current = base + residual is written over it texel by
+      // texel (separate residual and "next" maps held two more copies of the page at the peak).
+      std::vector<glm::vec3>& residual = current[p];
+      residual.assign(layer, glm::vec3(0.0f));
       tbb::parallel_for(size_t(0), layer, [&](size_t t) {
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
+      std::vector<glm::vec3> filtered;
       if (filters[p]) {
         TexelFilterOptions filterOptions;
         filterOptions.radius = radii[p];
-        residual = filters[p]->apply(residual, m.valid, filterOptions);
+        filtered = filters[p]->apply(residual, m.valid, filterOptions);
       }
-      for (size_t t = 0; t < layer && t < m.valid.size(); ++t)
-        if (m.valid[t]) {
-          next[p][t] += residual[t];
-          added += channelMean(residual[t]);
+      const std::vector<glm::vec3>& residualUsed = filters[p] ? filtered : residual;
+      const std::vector<glm::vec3>& baseMap = base(p);
+      for (size_t t = 0; t < layer; ++t) {
+        if (t < m.valid.size() && m.valid[t]) {
+          const glm::vec3 r = residualUsed[t];
+          current[p][t] = baseMap[t] + r;
+          added += channelMean(r);
+        } else {
+          current[p][t] = baseMap[t];
         }
+      }
     }
-    current.swap(next);
     ++sweepsDone;
     // Each sweep adds one more bounce inside the clamp radius: stop once that changes the map by less
     // than the tolerance (a narrow gap needs more bounces than an open corner).
@@ -365,8 +397,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       if (!maps[p].valid[t]) continue;
       glm::vec3 c = current[p][t];
       if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;  // post's finite check reports
-      before += channelMean(base[p][t]);
-      added += channelMean(c - base[p][t]);
+      before += channelMean(base(p)[t]);
+      added += channelMean(c - base(p)[t]);
       maps[p].texels[t] = c;
     }
   }

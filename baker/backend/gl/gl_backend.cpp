@@ -12,6 +12,8 @@
 
 #include <time.h>
 
+#include "backend/gl/gl_resources.h"
+#include "bake_interface.glsl"  // texture units and light codes, shared with the shaders
 #include "backend/gl/shadow_views.h"
 #include "common/error.h"
 #include "common/log.h"
@@ -24,6 +26,23 @@ namespace irbake {
 namespace {
 
 constexpr int kFaces = 6;
+
+// The direct-light shader's light and shadow-map codes (shaders/bake_interface.glsl).
+enum class ShaderLightType : int { Point = BAKE_LIGHT_POINT, Spot = BAKE_LIGHT_SPOT, Directional = BAKE_LIGHT_DIRECTIONAL };
+enum class ShadowKind : int {
+  Cube = BAKE_SHADOW_CUBE,                  // six faces (points, wide spots)
+  Perspective = BAKE_SHADOW_PERSPECTIVE,    // one perspective map (spots), reversed-Z
+  Orthographic = BAKE_SHADOW_ORTHOGRAPHIC,  // one orthographic box (directional)
+};
+
+ShaderLightType shaderLightType(LightType type) {
+  switch (type) {
+    case LightType::Point: return ShaderLightType::Point;
+    case LightType::Spot: return ShaderLightType::Spot;
+    case LightType::Directional: return ShaderLightType::Directional;
+  }
+  return ShaderLightType::Directional;
+}
 
 // Process CPU time (every thread, so llvmpipe's rasteriser threads count): comparable across machine load.
 double processCpuSeconds() {
@@ -39,250 +58,6 @@ struct StageClock {
   void reset() {
     wall.reset();
     cpuStart = processCpuSeconds();
-  }
-};
-
-// One VPL as 3 RGBA32F texels of the buffer texture vplTable (shaders/vpl_accumulate.frag, loadVpl);
-// the shader rebuilds the bitangent as normal × tangent, as vplFrame does.
-struct VplTexels {
-  glm::vec4 position;   // xyz VPL position, w Φ.r
-  glm::vec4 normal;     // xyz unit normal (local +Z), w Φ.g
-  glm::vec4 tangent;    // xyz local +X, w Φ.b
-};
-
-// Scene triangles on the GPU (world positions, one index buffer) with culling clusters.
-struct GpuGeometry {
-  GLuint vao = 0, vbo = 0, ibo = 0;
-  std::vector<TriangleCluster> clusters;
-  size_t triangles = 0;
-  ~GpuGeometry() {
-    glDeleteVertexArrays(1, &vao);
-    glDeleteBuffers(1, &vbo);
-    glDeleteBuffers(1, &ibo);
-  }
-};
-
-// 30-bit Morton code of a point in the unit cube: spatially close triangles get close codes.
-uint32_t morton3(glm::vec3 u) {
-  auto spread = [](uint32_t v) {
-    v = (v | (v << 16)) & 0x030000FFu;
-    v = (v | (v << 8)) & 0x0300F00Fu;
-    v = (v | (v << 4)) & 0x030C30C3u;
-    v = (v | (v << 2)) & 0x09249249u;
-    return v;
-  };
-  const glm::uvec3 q = glm::uvec3(glm::clamp(u, glm::vec3(0.0f), glm::vec3(1.0f)) * 1023.0f);
-  return (spread(q.x) << 2) | (spread(q.y) << 1) | spread(q.z);
-}
-
-// See-through primitives (MASK holes, BLEND, transmission) are drawn into shadow maps of their own: a
-// lookup that finds one in front of the receiver cannot be answered by depth alone, and its texel is
-// resolved with rays (contact texels), which model them.
-bool seeThrough(const Scene& scene, const Primitive& prim) {
-  const Material& m = scene.materials[prim.material];
-  return m.alphaMode == AlphaMode::Mask || m.isTransmissive();
-}
-
-// The scene's opaque primitives (or, with seeThroughOnly, the see-through ones) as one vertex/index buffer.
-void uploadGeometry(const Scene& scene, int clusterTriangles, GpuGeometry& g, bool seeThroughOnly = false) {
-  std::vector<glm::vec3> positions;
-  std::vector<uint32_t> indices;
-  for (const Primitive& prim : scene.primitives) {
-    if (seeThrough(scene, prim) != seeThroughOnly) continue;
-    const uint32_t base = static_cast<uint32_t>(positions.size());
-    positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
-    for (uint32_t i : prim.indices) indices.push_back(base + i);
-  }
-  // Triangles in Morton order of their centroids, so each culling cluster is spatially compact
-  // (consecutive triangles of a long strip would give clusters spanning a whole wall).
-  const size_t triangleCount = indices.size() / 3;
-  const Bounds3 b = scene.bounds();
-  const glm::vec3 inv = 1.0f / glm::max(b.extent(), glm::vec3(1e-12f));
-  std::vector<std::pair<uint32_t, uint32_t>> order(triangleCount);
-  for (size_t t = 0; t < triangleCount; ++t) {
-    const glm::vec3 c = (positions[indices[3 * t]] + positions[indices[3 * t + 1]] + positions[indices[3 * t + 2]]) / 3.0f;
-    order[t] = {morton3((c - b.min) * inv), static_cast<uint32_t>(t)};
-  }
-  std::sort(order.begin(), order.end());
-  std::vector<uint32_t> sorted(indices.size());
-  for (size_t t = 0; t < triangleCount; ++t)
-    for (int k = 0; k < 3; ++k) sorted[3 * t + k] = indices[3 * order[t].second + k];
-  indices.swap(sorted);
-  appendClusters(positions, indices, 0, triangleCount, clusterTriangles, g.clusters);
-  g.triangles = indices.size() / 3;
-  glCreateVertexArrays(1, &g.vao);
-  glCreateBuffers(1, &g.vbo);
-  glCreateBuffers(1, &g.ibo);
-  glNamedBufferStorage(g.vbo, std::max<size_t>(1, positions.size()) * sizeof(glm::vec3),
-                       positions.empty() ? nullptr : positions.data(), 0);
-  glNamedBufferStorage(g.ibo, std::max<size_t>(1, indices.size()) * sizeof(uint32_t),
-                       indices.empty() ? nullptr : indices.data(), 0);
-  glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
-  glVertexArrayElementBuffer(g.vao, g.ibo);
-  glEnableVertexArrayAttrib(g.vao, 0);
-  glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(g.vao, 0, 0);
-}
-
-// Punctual lights' depth targets: `layers` layers of size×size (a 2D array: 6 per cube) or one 2D map; one FBO
-// per layer. (VPL cubes use the DepthAtlas below.)
-struct DepthTargets {
-  GLuint texture = 0;
-  GLenum target = 0;
-  int size = 0;
-  std::vector<GLuint> fbos;
-  DepthTargets(GLenum tgt, int sz, int layers) : target(tgt), size(sz) {
-    glCreateTextures(target, 1, &texture);
-    if (target == GL_TEXTURE_2D)
-      glTextureStorage2D(texture, 1, GL_DEPTH_COMPONENT32F, size, size);
-    else
-      glTextureStorage3D(texture, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
-    glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureParameteri(texture, GL_TEXTURE_COMPARE_MODE, GL_NONE);
-    glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    fbos.resize(layers);
-    glCreateFramebuffers(layers, fbos.data());
-    for (int l = 0; l < layers; ++l) {
-      if (target == GL_TEXTURE_2D)
-        glNamedFramebufferTexture(fbos[l], GL_DEPTH_ATTACHMENT, texture, 0);
-      else
-        glNamedFramebufferTextureLayer(fbos[l], GL_DEPTH_ATTACHMENT, texture, 0, l);
-      glNamedFramebufferDrawBuffer(fbos[l], GL_NONE);
-      glNamedFramebufferReadBuffer(fbos[l], GL_NONE);
-      if (glCheckNamedFramebufferStatus(fbos[l], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        throw Error(ErrorCode::Gl, "", "depth framebuffer incomplete");
-    }
-  }
-  ~DepthTargets() {
-    glDeleteFramebuffers(static_cast<GLsizei>(fbos.size()), fbos.data());
-    glDeleteTextures(1, &texture);
-  }
-};
-
-// The VPL depth cubes of one batch as tiles of ONE 2D depth texture behind ONE framebuffer: tile
-// 5k + f holds face f (GL order +X −X +Y −Y +Z; the −Z face is never drawn for a hemisphere) of the
-// batch's k-th VPL, at column (5k + f) % cols, row (5k + f) / cols. Cleared once per batch, each face
-// drawn with its own viewport and scissor, so llvmpipe bins a whole batch as one scene instead of
-// paying a framebuffer switch and a scissored clear per face (docs/performance.md).
-struct DepthAtlas {
-  static constexpr int kTilesPerCube = 5;
-  GLuint texture = 0, fbo = 0;
-  int faceSize = 0, cols = 1, rows = 1;
-  DepthAtlas(int size, int cubes) : faceSize(size) {
-    const int tiles = std::max(1, cubes * kTilesPerCube);
-    GLint maxSize = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
-    const int maxTiles = std::max(1, maxSize / size);
-    // One cube per row (5 columns) when the rows fit: tile (face, cube), no division in the shader;
-    // otherwise a near-square grid.
-    cols = cubes <= maxTiles && kTilesPerCube <= maxTiles
-               ? kTilesPerCube
-               : std::min(maxTiles, std::max(1, int(std::ceil(std::sqrt(double(tiles))))));
-    rows = (tiles + cols - 1) / cols;
-    if (rows > maxTiles)
-      throw Error(ErrorCode::Gl, "", "VPL depth atlas of " + std::to_string(tiles) + " tiles of " +
-                                         std::to_string(size) + "² exceeds GL_MAX_TEXTURE_SIZE " +
-                                         std::to_string(maxSize) + " (lower the VPLs per pass or the face size)");
-    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
-    glTextureStorage2D(texture, 1, GL_DEPTH_COMPONENT32F, width(), height());
-    glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTextureParameteri(texture, GL_TEXTURE_COMPARE_MODE, GL_NONE);
-    glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glCreateFramebuffers(1, &fbo);
-    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, texture, 0);
-    glNamedFramebufferDrawBuffer(fbo, GL_NONE);
-    glNamedFramebufferReadBuffer(fbo, GL_NONE);
-    if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw Error(ErrorCode::Gl, "", "depth atlas framebuffer incomplete");
-  }
-  ~DepthAtlas() {
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteTextures(1, &texture);
-  }
-  int width() const { return cols * faceSize; }
-  int height() const { return rows * faceSize; }
-  glm::ivec2 tileOrigin(int cube, int face) const {
-    const int t = kTilesPerCube * cube + face;
-    return glm::ivec2(t % cols, t / cols) * faceSize;
-  }
-};
-
-// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a
-// validity mask as depth (1 valid, 0 not): the light-map passes draw at depth 0 with GL_LESS, so
-// llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
-struct GpuPage {
-  const TexelSamples* samples = nullptr;
-  GLuint positionWeight = 0, normal = 0, geomNormal = 0, accum = 0, validDepth = 0, fbo = 0;
-  std::vector<glm::dvec3> sum;
-  std::vector<double> leak;  // alpha: light of lookups that could not tell a contact from the receiver
-  std::vector<glm::vec4> readback;
-  GpuPage(const TexelSamples& s, const Scene& scene, bool validityMask)
-      : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)), leak(s.layerSize(), 0.0) {
-    const int layers = s.supersample * s.supersample;
-    if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
-      throw Error(ErrorCode::InvalidData, "", "texel samples of page " + std::to_string(s.page) + " are incomplete");
-    for (GLuint* t : {&positionWeight, &normal, &geomNormal}) {
-      glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, t);
-      glTextureStorage3D(*t, 1, GL_RGBA32F, s.width, s.height, layers);
-      glTextureParameteri(*t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(*t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
-    glTextureSubImage3D(positionWeight, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT,
-                        s.positionWeight.data());
-    glTextureSubImage3D(normal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, s.normal.data());
-    // The sample's triangle's own normal: the depth bias follows the surface the shadow map sampled, not
-    // the interpolated shading normal (smooth normals on a hard-edged box lean up to 55° off its faces).
-    std::vector<glm::vec4> faceNormal(s.slotCount());
-    for (size_t i = 0; i < faceNormal.size(); ++i) {
-      faceNormal[i] = s.normal[i];
-      if (i >= s.primitive.size() || i >= s.triangle.size() || s.primitive[i] >= scene.primitives.size()) continue;
-      const Primitive& p = scene.primitives[s.primitive[i]];
-      if (3 * size_t(s.triangle[i]) + 2 >= p.indices.size()) continue;
-      const uint32_t* idx = &p.indices[3 * size_t(s.triangle[i])];
-      const glm::vec3 n = glm::cross(p.positions[idx[1]] - p.positions[idx[0]], p.positions[idx[2]] - p.positions[idx[0]]);
-      const float len = glm::length(n);
-      if (len > 0.0f && std::isfinite(len)) faceNormal[i] = glm::vec4(n / len, 0.0f);
-    }
-    glTextureSubImage3D(geomNormal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, faceNormal.data());
-    glCreateTextures(GL_TEXTURE_2D, 1, &accum);
-    glTextureStorage2D(accum, 1, GL_RGBA32F, s.width, s.height);
-    glCreateFramebuffers(1, &fbo);
-    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, accum, 0);
-    if (validityMask) {
-      std::vector<float> depth(s.layerSize(), 1.0f);
-      for (size_t i = 0; i < depth.size(); ++i) depth[i] = i < s.valid.size() && s.valid[i] ? 1.0f : 0.0f;
-      glCreateTextures(GL_TEXTURE_2D, 1, &validDepth);
-      glTextureStorage2D(validDepth, 1, GL_DEPTH_COMPONENT32F, s.width, s.height);
-      glTextureSubImage2D(validDepth, 0, 0, 0, s.width, s.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-      glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, validDepth, 0);
-    }
-    if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw Error(ErrorCode::Gl, "", "accumulation framebuffer incomplete");
-    clear();
-  }
-  ~GpuPage() {
-    glDeleteFramebuffers(1, &fbo);
-    GLuint t[5] = {positionWeight, normal, geomNormal, accum, validDepth};
-    glDeleteTextures(5, t);
-  }
-  void clear() {
-    const float zero[4] = {0, 0, 0, 0};
-    glClearTexImage(accum, 0, GL_RGBA, GL_FLOAT, zero);
-  }
-  // Adds the float partial sums into the double accumulator and restarts them from zero.
-  void fold() {
-    readback.resize(samples->layerSize());
-    glGetTextureImage(accum, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(readback.size() * sizeof(glm::vec4)),
-                      readback.data());
-    for (size_t i = 0; i < sum.size(); ++i) {
-      sum[i] += glm::dvec3(readback[i]);
-      leak[i] += readback[i].w;
-    }
-    clear();
   }
 };
 
@@ -323,7 +98,9 @@ class GlBaker {
   const GlProgram* depthProgram_ = nullptr;
   GLint shadowViewLocation_ = -1;  // depthProgram_'s shadowView[5]
   const GlProgram* directProgram_ = nullptr;
-  GLuint vplBuffer_ = 0, vplTable_ = 0, emptyVao_ = 0;  // VPL batch: buffer and its RGBA32F buffer texture
+  GlBuffer vplBuffer_;       // the VPL batch (VplTexels)
+  GlTexture vplTable_;       // vplBuffer_ seen as an RGBA32F buffer texture
+  GlVertexArray emptyVao_;   // full-screen passes draw without attributes
   std::vector<GLsizei> drawCounts_;
   std::vector<const void*> drawOffsets_;
   std::vector<std::vector<uint8_t>> contactTexels_;
@@ -392,12 +169,11 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
 // The batch's cubes into the atlas: one clear (reversed-Z: 0 = nothing drawn), then each face with the
 // viewport of its tile, kept inside the tile by clip distances against the view's rectangle
 // (shaders/shadow_depth.vert), so nothing can spill into a neighbour. Clip distances instead of a scissor
-// per face: the scissor change cost llvmpipe about 6 µs per face (Cornell box, 251k texels: GL backend
-// median 1.80 → 1.67 s over 7 pairs; 99k triangles: unchanged). A glFlush every
+// per face: a scissor change is llvmpipe's largest fixed cost per face. A glFlush every
 // GlBackendOptions::shadowFlushTriangles submitted triangles hands the scene binned so far to llvmpipe's
 // rasteriser threads while the next faces are binned: one scene per batch is best for small scenes, but
-// at ~100k triangles per cube it serialises binning and rasterising (measured 13 ms/VPL wall, CPU 20,
-// against ≈ 10.5 / 17 with the flush).
+// at ~100k triangles per cube it serialises binning and rasterising. Both measured in
+// docs/performance.md ("GL against Embree", item 2; "What limits the per-VPL cost").
 void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   drawing_ = geometry_.get();
   renderVplCubes(first, count, atlas, *geometry_);
@@ -442,9 +218,9 @@ void GlBaker::renderVplCubes(size_t first, size_t count, const DepthAtlas& atlas
 }
 
 void GlBaker::bindGBuffer(const GpuPage& page) const {
-  glBindTextureUnit(0, page.positionWeight);
-  glBindTextureUnit(1, page.normal);
-  glBindTextureUnit(4, page.geomNormal);
+  glBindTextureUnit(BAKE_UNIT_POSITION_WEIGHT, page.positionWeight);
+  glBindTextureUnit(BAKE_UNIT_NORMAL, page.normal);
+  glBindTextureUnit(BAKE_UNIT_GEOMETRIC_NORMAL, page.geomNormal);
 }
 
 void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
@@ -454,11 +230,11 @@ void GlBaker::accumulateVplBatch(size_t first, size_t count, const DepthAtlas& a
     const VplFrame f = vplFrame(v.normal);
     batch[k] = {glm::vec4(v.position, v.power.r), glm::vec4(f.normal, v.power.g), glm::vec4(f.tangent, v.power.b)};
   }
-  if (count > 0) glNamedBufferSubData(vplBuffer_, 0, batch.size() * sizeof(VplTexels), batch.data());
-  glBindTextureUnit(3, vplTable_);
-  glBindTextureUnit(2, atlas.texture);
-  if (seeThroughAtlas_) glBindTextureUnit(5, seeThroughAtlas_->texture);
-  glBindVertexArray(emptyVao_);
+  if (count > 0) glNamedBufferSubData(vplBuffer_.get(), 0, batch.size() * sizeof(VplTexels), batch.data());
+  glBindTextureUnit(BAKE_UNIT_VPL_TABLE, vplTable_.get());
+  glBindTextureUnit(BAKE_UNIT_VPL_DEPTH, atlas.texture);
+  if (seeThroughAtlas_) glBindTextureUnit(BAKE_UNIT_VPL_SEE_THROUGH_DEPTH, seeThroughAtlas_->texture);
+  glBindVertexArray(emptyVao_.get());
   for (auto& page : pages_) {
     const GlProgram& program = vplProgram(page->samples->supersample * page->samples->supersample);
     program.use();
@@ -496,7 +272,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   }
   if (opt_.normalOffset != 0.0f) defines.push_back("#define HAS_NORMAL_OFFSET 1");
   return programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                                                {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "vpl_accumulate.frag"}}},
+                                                {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "vpl_accumulate.frag"}}},
                       defines);
 }
 
@@ -509,7 +285,7 @@ void GlBaker::bakeDirect(const Light& light) {
   std::unique_ptr<DepthTargets> maps;
   std::optional<ShadowView> view2d;
   float texelAngle = 0.0f, orthoRange = 0.0f;
-  int shadowKind = 0;
+  ShadowKind shadowKind = ShadowKind::Cube;
   depthProgram_->use();
   glBindVertexArray(geometry_->vao);
   shadowPassState();
@@ -527,14 +303,14 @@ void GlBaker::bakeDirect(const Light& light) {
                       tanHalf);
     drawView(*view2d, maps->fbos[0], maps->size, true);
     texelAngle = 2.0f * tanHalf / maps->size;
-    shadowKind = 1;
+    shadowKind = ShadowKind::Perspective;
   } else {
     maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D, opt_.lightMapSize, 1);
     float texelSize = 0.0f;
     view2d = directionalView(light.direction, bounds, opt_.lightMapSize, texelSize, orthoRange);
     drawView(*view2d, maps->fbos[0], maps->size, false);
     texelAngle = texelSize;
-    shadowKind = 2;
+    shadowKind = ShadowKind::Orthographic;
   }
   // The see-through primitives into maps of their own, with the same views (contact texels).
   std::unique_ptr<DepthTargets> glassMaps;
@@ -548,7 +324,7 @@ void GlBaker::bakeDirect(const Light& light) {
         drawView(*cubeFaceView(light.position, identity, face, glassMaps->size, scale_.nearPlane, false),
                  glassMaps->fbos[face], glassMaps->size, true);
     } else {
-      drawView(*view2d, glassMaps->fbos[0], glassMaps->size, shadowKind == 1);
+      drawView(*view2d, glassMaps->fbos[0], glassMaps->size, shadowKind == ShadowKind::Perspective);
     }
     drawing_ = geometry_.get();
   }
@@ -557,8 +333,8 @@ void GlBaker::bakeDirect(const Light& light) {
   lightMapPassState();  // blended: added to the VPL partial sums not yet folded
   directProgram_->use();
   const GlProgram& p = *directProgram_;
-  glUniform1i(p.uniform("lightType"), light.type == LightType::Point ? 0 : light.type == LightType::Spot ? 1 : 2);
-  glUniform1i(p.uniform("shadowKind"), shadowKind);
+  glUniform1i(p.uniform("lightType"), static_cast<int>(shaderLightType(light.type)));
+  glUniform1i(p.uniform("shadowKind"), static_cast<int>(shadowKind));
   glUniform3fv(p.uniform("lightPosition"), 1, &light.position[0]);
   glUniform3fv(p.uniform("lightDirection"), 1, &light.direction[0]);
   const glm::vec3 intensity = light.color * light.intensity;
@@ -574,10 +350,10 @@ void GlBaker::bakeDirect(const Light& light) {
   glUniform1i(p.uniform("contactFlags"), opt_.resolveContacts ? 1 : 0);
   glUniform1f(p.uniform("orthoDepthRange"), orthoRange);
   glUniform1f(p.uniform("texelAngle"), texelAngle);
-  glBindTextureUnit(cube ? 2 : 3, maps->texture);
+  glBindTextureUnit(cube ? BAKE_UNIT_LIGHT_CUBE : BAKE_UNIT_LIGHT_MAP, maps->texture);
   glUniform1i(p.uniform("seeThroughMaps"), glassMaps ? 1 : 0);
-  if (glassMaps) glBindTextureUnit(cube ? 5 : 6, glassMaps->texture);
-  glBindVertexArray(emptyVao_);
+  if (glassMaps) glBindTextureUnit(cube ? BAKE_UNIT_GLASS_CUBE : BAKE_UNIT_GLASS_MAP, glassMaps->texture);
+  glBindVertexArray(emptyVao_.get());
   for (auto& page : pages_) {
     glBindFramebuffer(GL_FRAMEBUFFER, page->fbo);
     glViewport(0, 0, page->samples->width, page->samples->height);
@@ -636,12 +412,12 @@ std::vector<Lightmap> GlBaker::run() {
   }
   for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels));
 
-  const int K = std::clamp(opt_.vplsPerPass, 1, 256);
+  const int vplsPerPass = std::clamp(opt_.vplsPerPass, 1, 256);
   depthProgram_ = &programs_.get(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   shadowViewLocation_ = depthProgram_->uniform("shadowView");
   directProgram_ = &programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                                                           {GL_FRAGMENT_SHADER, {"ir_transport.glsl", "direct_light.frag"}}});
+                                                           {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "direct_light.frag"}}});
   {
     const GlProgram* p = directProgram_;
     p->use();
@@ -652,22 +428,22 @@ std::vector<Lightmap> GlBaker::run() {
     glUniform1f(p->uniform("normalOffset"), opt_.normalOffset);
   }
   if (in_.eval.includeVpls && !in_.vpls.vpls.empty()) {
-    const int faceSize = opt_.cubeFaceSize > 0
-                             ? opt_.cubeFaceSize
+    const int faceSize = opt_.cubeFaceSize
+                             ? *opt_.cubeFaceSize
                              : chooseCubeFaceSize(in_.vpls.vpls, in_.texels, in_.eval.clampBound, opt_.cubeFootprintPerTexel,
                                                   opt_.minCubeFaceSize,
                                                   opt_.maxCubeFaceSize)
                                    .size;
     stats_.cubeFaceSize = faceSize;
-    atlas_ = std::make_unique<DepthAtlas>(faceSize, K);
-    if (seeThroughGeometry_) seeThroughAtlas_ = std::make_unique<DepthAtlas>(faceSize, K);
+    atlas_ = std::make_unique<DepthAtlas>(faceSize, vplsPerPass);
+    if (seeThroughGeometry_) seeThroughAtlas_ = std::make_unique<DepthAtlas>(faceSize, vplsPerPass);
     for (const auto& page : pages_) vplProgram(page->samples->supersample * page->samples->supersample);
   }
-  glCreateBuffers(1, &vplBuffer_);
-  glNamedBufferStorage(vplBuffer_, K * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  glCreateTextures(GL_TEXTURE_BUFFER, 1, &vplTable_);
-  glTextureBuffer(vplTable_, GL_RGBA32F, vplBuffer_);
-  glCreateVertexArrays(1, &emptyVao_);
+  glCreateBuffers(1, vplBuffer_.out());
+  glNamedBufferStorage(vplBuffer_.get(), vplsPerPass * sizeof(VplTexels), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateTextures(GL_TEXTURE_BUFFER, 1, vplTable_.out());
+  glTextureBuffer(vplTable_.get(), GL_RGBA32F, vplBuffer_.get());
+  glCreateVertexArrays(1, emptyVao_.out());
   // Reversed-Z with [0,1] clip depth: depth = near / distance keeps float precision at every range.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glBlendFunc(GL_ONE, GL_ONE);
@@ -676,7 +452,7 @@ std::vector<Lightmap> GlBaker::run() {
   const auto& vpls = in_.vpls.vpls;
   const size_t vplCount = in_.eval.includeVpls ? vpls.size() : 0;
   const size_t lightCount = in_.eval.includeDirect ? in_.scene.lights.size() : 0;
-  const size_t totalWork = vplCount + lightCount * K;
+  const size_t totalWork = vplCount + lightCount * vplsPerPass;
   if (vplCount > 0) {
     if (opt_.shadowPcf && opt_.shadowCompare && !contactFlags()) {
       // Sampled through sampler2DShadow: lit (1) where the stored depth ≤ the reference.
@@ -696,8 +472,8 @@ std::vector<Lightmap> GlBaker::run() {
   if (vplCount > 0) {
     const DepthAtlas& atlas = *atlas_;
     int passesSinceFold = 0;
-    for (size_t first = 0; first < vplCount; first += K) {
-      const size_t count = std::min<size_t>(K, vplCount - first);
+    for (size_t first = 0; first < vplCount; first += vplsPerPass) {
+      const size_t count = std::min<size_t>(vplsPerPass, vplCount - first);
       shadowPassState();
       renderVplBatch(first, count, atlas);
       finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
@@ -717,7 +493,7 @@ std::vector<Lightmap> GlBaker::run() {
   for (size_t i = 0; i < lightCount; ++i) {
     bakeDirect(in_.scene.lights[i]);
     ++stats_.passes;
-    if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * K) / std::max<size_t>(1, totalWork));
+    if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * vplsPerPass) / std::max<size_t>(1, totalWork));
   }
   sw.reset();
   for (auto& page : pages_) page->fold();
@@ -725,9 +501,6 @@ std::vector<Lightmap> GlBaker::run() {
   finishStage(stats_.foldSeconds, sw);
 
   std::vector<Lightmap> maps = readMaps();
-  glDeleteTextures(1, &vplTable_);
-  glDeleteBuffers(1, &vplBuffer_);
-  glDeleteVertexArrays(1, &emptyVao_);
   if (in_.progress) in_.progress("gl", 1.0);
   return maps;
 }

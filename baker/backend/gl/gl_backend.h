@@ -2,6 +2,7 @@
 // headless) and accumulated in float, folded into double. Same transport as the Embree backend.
 #pragma once
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -78,7 +79,7 @@ struct GlBakeStats {
 
 struct GlBackendOptions {
   int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
-  int cubeFaceSize = 0;          // VPL depth-cube face size (texels); 0: from the light map (chooseCubeFaceSize)
+  std::optional<int> cubeFaceSize;  // VPL depth-cube face size (texels, > 0); unset: from the light map (chooseCubeFaceSize)
   float cubeFootprintPerTexel = 1.0f;  // automatic face size: face texel footprint at the median VPL distance, in texel spacings
   int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see: furnished room, 64: GL vs Embree 1.2%, 128: 0.3%)
   int maxCubeFaceSize = 256;     // automatic face size: upper bound

@@ -77,7 +77,9 @@ void writeFile(const std::string& file, const char* format, const Pixels& px, in
   if (!out) throw Error(ErrorCode::Io, name, std::string("OpenImageIO has no ") + format + " writer: " + OIIO::geterror());
   const bool isFloat = px.u8.empty();
   OIIO::ImageSpec spec(px.width, px.height, px.channels, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  if (std::string(format) == "openexr") spec.attribute("compression", "zip");
+  // No compression: a light map's float noise does not compress (zip saved 4% of a Cornell page, 7.7 vs 8.0 MB)
+  // and cost 0.6 s of a 8 s bake.
+  if (std::string(format) == "openexr") spec.attribute("compression", "none");
   // Byte-identical outputs for identical bakes: OpenEXR's writer stamps the current time (capDate) unless a
   // DateTime is given, so give the reproducible-builds one: SOURCE_DATE_EPOCH when set, else the epoch.
   spec.attribute("DateTime", reproducibleDateTime());
