@@ -15,6 +15,33 @@ namespace irbake {
 
 namespace {
 constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
+
+// An environment map's two strategies, half the rays each, balance heuristic: calls
+// visit(term, dir, cosθ) for every sample that reaches the sky, with term = L T cosθ / (n (p_cosine + p_sky)),
+// whose sum over the rays estimates the irradiance E (the map value is E / π).
+template <class Visit>
+void visitEnvironmentSamples(const Environment& sky, const RayTracer& rt, const glm::vec3& origin, const glm::vec3& n,
+                             int rays, double r1, double r2, Visit&& visit) {
+  const int half = std::max(1, rays / 2);
+  for (int i = 0; i < 2 * half; ++i) {
+    const int k = i % half;
+    const double u = std::fmod((k + 0.5) / half + r1, 1.0), v = std::fmod(k * kGolden + r2, 1.0);
+    glm::vec3 dir;
+    if (i < half) {
+      dir = cosineHemisphere(n, u, v);
+    } else {
+      double pdf;
+      dir = sky.sample(u, v, pdf);
+    }
+    const double cosTheta = glm::dot(n, dir);
+    if (!(cosTheta > 0.0)) continue;
+    const double pdfCosine = cosTheta / kPi, pdfSky = sky.pdf(dir);
+    const glm::vec3 L = sky.radiance(dir);
+    if (L == glm::vec3(0.0f) || rt.occluded(origin, dir, 0.0f, 1e30f)) continue;
+    visit(glm::dvec3(L * rt.transmittance(origin, dir, 0.0f, 1e30f)) * (cosTheta / (half * (pdfCosine + pdfSky))), dir,
+          cosTheta);
+  }
+}
 }  // namespace
 
 glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2) {
@@ -32,25 +59,8 @@ glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& 
     }
     return sky.uniformRadiance() * visible / static_cast<float>(std::max(1, rays));
   }
-  // Two strategies, half the rays each, balance heuristic: f / (n_c p_c + n_e p_e) summed over all rays.
-  const int half = std::max(1, rays / 2);
-  for (int i = 0; i < 2 * half; ++i) {
-    const int k = i % half;
-    const double u = std::fmod((k + 0.5) / half + r1, 1.0), v = std::fmod(k * kGolden + r2, 1.0);
-    glm::vec3 dir;
-    if (i < half) {
-      dir = cosineHemisphere(n, u, v);
-    } else {
-      double pdf;
-      dir = sky.sample(u, v, pdf);
-    }
-    const double cosTheta = glm::dot(n, dir);
-    if (!(cosTheta > 0.0)) continue;
-    const double pdfCosine = cosTheta / kPi, pdfSky = sky.pdf(dir);
-    const glm::vec3 L = sky.radiance(dir);
-    if (L == glm::vec3(0.0f) || rt.occluded(origin, dir, 0.0f, 1e30f)) continue;
-    sum += glm::dvec3(L * rt.transmittance(origin, dir, 0.0f, 1e30f)) * (cosTheta / (half * (pdfCosine + pdfSky)));
-  }
+  visitEnvironmentSamples(sky, rt, origin, n, rays, r1, r2,
+                          [&](const glm::dvec3& term, const glm::vec3&, double) { sum += term; });
   return glm::vec3(sum / kPi);
 }
 
@@ -139,25 +149,9 @@ L1Vectors skyDirectionalAt(const BakeInputs& in, const glm::vec3& x, const glm::
       for (int k = 0; k < 3; ++k) g[k] -= missed * double(dir[k]);
     }
   } else {
-    const int half = std::max(1, rays / 2);
-    for (int i = 0; i < 2 * half; ++i) {
-      const int k = i % half;
-      const double u = std::fmod((k + 0.5) / half + r1, 1.0), v = std::fmod(k * kGolden + r2, 1.0);
-      glm::vec3 dir;
-      if (i < half) {
-        dir = cosineHemisphere(n, u, v);
-      } else {
-        double pdf;
-        dir = sky.sample(u, v, pdf);
-      }
-      const double cosTheta = glm::dot(n, dir);
-      if (!(cosTheta > 0.0)) continue;
-      const double pdfCosine = cosTheta / kPi, pdfSky = sky.pdf(dir);
-      const glm::vec3 L = sky.radiance(dir);
-      if (L == glm::vec3(0.0f) || rt.occluded(origin, dir, 0.0f, 1e30f)) continue;
-      add(glm::dvec3(L * rt.transmittance(origin, dir, 0.0f, 1e30f)) * (cosTheta / (half * (pdfCosine + pdfSky))) / kPi,
-          dir, cosTheta);
-    }
+    visitEnvironmentSamples(sky, rt, origin, n, rays, r1, r2, [&](const glm::dvec3& term, const glm::vec3& dir, double cosTheta) {
+      add(term / kPi, dir, cosTheta);
+    });
   }
   return tangentialPart(L1Vectors{glm::vec3(g[0]), glm::vec3(g[1]), glm::vec3(g[2])}, n);
 }
