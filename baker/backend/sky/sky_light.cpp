@@ -42,6 +42,27 @@ void visitEnvironmentSamples(const Environment& sky, const RayTracer& rt, const 
           cosTheta);
   }
 }
+// Adds per-slot values to a page: averaged over each valid texel's samples, filtered on the surface
+// (filterRadius > 0), added where the page is valid.
+template <class SlotValue>
+void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotValue&& slotValue) {
+  std::vector<glm::vec3> texelValue(ts.layerSize(), glm::vec3(0.0f));
+  std::vector<uint8_t> valid(ts.layerSize(), 0);
+  for (size_t t = 0; t < ts.layerSize(); ++t) {
+    glm::vec3 v;
+    if (t < page.valid.size() && page.valid[t] && texelMean(ts, t, slotValue, v)) {
+      texelValue[t] = v;
+      valid[t] = 1;
+    }
+  }
+  if (filterRadius > 0) {
+    TexelFilterOptions fo;
+    fo.radius = filterRadius;
+    texelValue = filterOnSurface(ts, texelValue, valid, fo);
+  }
+  for (size_t t = 0; t < ts.layerSize(); ++t)
+    if (valid[t]) page.texels[t] += texelValue[t];
+}
 }  // namespace
 
 glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2) {
@@ -92,22 +113,7 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
       }
       traced += count;
     });
-    std::vector<glm::vec3> texelValue(ts.layerSize(), glm::vec3(0.0f));
-    std::vector<uint8_t> valid(ts.layerSize(), 0);
-    for (size_t t = 0; t < ts.layerSize(); ++t) {
-      glm::vec3 v;
-      if (t < maps[p].valid.size() && maps[p].valid[t] && texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, v)) {
-        texelValue[t] = v;
-        valid[t] = 1;
-      }
-    }
-    if (options.filterRadius > 0) {
-      TexelFilterOptions fo;
-      fo.radius = options.filterRadius;
-      texelValue = filterOnSurface(ts, texelValue, valid, fo);
-    }
-    for (size_t t = 0; t < ts.layerSize(); ++t)
-      if (valid[t]) maps[p].texels[t] += texelValue[t];
+    addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
     stats->rays = traced;
@@ -179,25 +185,8 @@ void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightma
         slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
       }
     });
-    for (int k = 0; k < 3; ++k) {
-      Lightmap& page = axes[k][p];
-      std::vector<glm::vec3> texelValue(ts.layerSize(), glm::vec3(0.0f));
-      std::vector<uint8_t> valid(ts.layerSize(), 0);
-      for (size_t t = 0; t < ts.layerSize(); ++t) {
-        glm::vec3 v;
-        if (t < page.valid.size() && page.valid[t] && texelMean(ts, t, [&](size_t s) { return slotValue[s][k]; }, v)) {
-          texelValue[t] = v;
-          valid[t] = 1;
-        }
-      }
-      if (options.filterRadius > 0) {
-        TexelFilterOptions fo;
-        fo.radius = options.filterRadius;
-        texelValue = filterOnSurface(ts, texelValue, valid, fo);
-      }
-      for (size_t t = 0; t < ts.layerSize(); ++t)
-        if (valid[t]) page.texels[t] += texelValue[t];
-    }
+    for (int k = 0; k < 3; ++k)
+      addToPage(ts, axes[k][p], options.filterRadius, [&](size_t s) { return slotValue[s][k]; });
   }
 }
 
