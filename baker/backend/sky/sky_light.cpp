@@ -63,6 +63,32 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
   for (size_t t = 0; t < ts.layerSize(); ++t)
     if (valid[t]) page.texels[t] += texelValue[t];
 }
+// Rays per texel sample: options.raysPerSample, fewer where the scene's samples would exceed maxRays (≥ 8).
+int skyRaysPerSample(const BakeInputs& in, const SkyLightOptions& options) {
+  size_t slotsWithWeight = 0;
+  for (const TexelSamples& ts : in.texels)
+    for (const glm::vec4& pw : ts.positionWeight) slotsWithWeight += pw.w > 0.0f;
+  return std::max(8, std::min(options.raysPerSample,
+                              static_cast<int>(options.maxRays / std::max<size_t>(1, slotsWithWeight))));
+}
+
+// Calls at(s, x, n, r1, r2) for every weighted sample s of a page, in parallel: x its position inset into its
+// triangle, n its normal, r1 r2 its lattice rotation (the same for the map and the directional pages).
+template <class At>
+void forEachSkySample(const BakeInputs& in, const TexelSamples& ts, uint64_t seed, At&& at) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t s = r.begin(); s != r.end(); ++s) {
+      if (!(ts.positionWeight[s].w > 0.0f)) continue;
+      glm::vec3 x(ts.positionWeight[s]);
+      const glm::vec3 n(ts.normal[s]);
+      if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
+        x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+      Rng rng(hashSeed(seed, 0x5c7ull << 8 | static_cast<uint64_t>(ts.page), s));
+      const double r1 = rng.uniform(), r2 = rng.uniform();
+      at(s, x, n, r1, r2);
+    }
+  });
+}
 }  // namespace
 
 glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2) {
@@ -89,29 +115,14 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
                  SkyLightStats* stats) {
   if (!in.scene.environment.present()) return;
   Stopwatch watch;
-  size_t slotsWithWeight = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (const glm::vec4& pw : ts.positionWeight) slotsWithWeight += pw.w > 0.0f;
-  const int rays = std::max(8, std::min(options.raysPerSample,
-                                        static_cast<int>(options.maxRays / std::max<size_t>(1, slotsWithWeight))));
+  const int rays = skyRaysPerSample(in, options);
   std::atomic<size_t> traced{0};
   for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-      size_t count = 0;
-      for (size_t s = r.begin(); s != r.end(); ++s) {
-        if (!(ts.positionWeight[s].w > 0.0f)) continue;
-        glm::vec3 x(ts.positionWeight[s]);
-        const glm::vec3 n(ts.normal[s]);
-        if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
-          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
-        Rng rng(hashSeed(options.seed, 0x5c7ull << 8 | static_cast<uint64_t>(ts.page), s));
-        const double r1 = rng.uniform(), r2 = rng.uniform();
-        slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
-        count += static_cast<size_t>(rays);
-      }
-      traced += count;
+    forEachSkySample(in, ts, options.seed, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+      slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
+      traced += static_cast<size_t>(rays);
     });
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
@@ -165,25 +176,12 @@ L1Vectors skyDirectionalAt(const BakeInputs& in, const glm::vec3& x, const glm::
 void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightmap>, 3>& axes,
                             const SkyLightOptions& options) {
   if (!in.scene.environment.present()) return;
-  size_t slotsWithWeight = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (const glm::vec4& pw : ts.positionWeight) slotsWithWeight += pw.w > 0.0f;
-  const int rays = std::max(8, std::min(options.raysPerSample,
-                                        static_cast<int>(options.maxRays / std::max<size_t>(1, slotsWithWeight))));
+  const int rays = skyRaysPerSample(in, options);
   for (size_t p = 0; p < in.texels.size() && p < axes[0].size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<L1Vectors> slotValue(ts.slotCount(), L1Vectors{});
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t s = r.begin(); s != r.end(); ++s) {
-        if (!(ts.positionWeight[s].w > 0.0f)) continue;
-        glm::vec3 x(ts.positionWeight[s]);
-        const glm::vec3 n(ts.normal[s]);
-        if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
-          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
-        Rng rng(hashSeed(options.seed, 0x5c7ull << 8 | static_cast<uint64_t>(ts.page), s));  // addSkyLight's
-        const double r1 = rng.uniform(), r2 = rng.uniform();
-        slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
-      }
+    forEachSkySample(in, ts, options.seed, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+      slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
     });
     for (int k = 0; k < 3; ++k)
       addToPage(ts, axes[k][p], options.filterRadius, [&](size_t s) { return slotValue[s][k]; });
