@@ -66,7 +66,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(1, 1 << 26))->type_name("N");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
-  app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page)")
+  app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page, or\n64 texels per triangle where that is more, at most 4M)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
                   "texel budget of all pages together (default 16777216 = 16M);\n"

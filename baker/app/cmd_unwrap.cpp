@@ -54,7 +54,7 @@ int runUnwrap(const Args& args) {
                               "primitive.");
   app->add_option("IN", inputs, "the glTF/GLB scene to unwrap");
   app->add_option("-o,--output", output, "the unwrapped scene")->type_name("OUT.gltf|OUT.glb");
-  app->add_option("--texels-per-unit", tpu, "texel density per metre (default: fit the charts into about one target page)")
+  app->add_option("--texels-per-unit", tpu, "texel density per metre (default: fit the charts into about\none target page, or 64 texels per triangle where that is more, at most 4M)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", options.maxTexels, "texel budget of all pages together (default 16M; 0 = no limit)")
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
