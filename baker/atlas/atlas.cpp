@@ -228,8 +228,11 @@ double chooseDensity(const std::vector<ChartUv>& charts, const AtlasOptions& opt
   double density = options.texelsPerUnit;
   if (!(density > 0.0)) {
     const double page = double(options.targetPageSize) * options.targetPageSize;
-    const double byTriangles = std::min(double(options.texelsPerTriangle) * double(scene.triangleCount()),
-                                        double(options.maxAutoTexels));
+    double byTriangles = std::min(double(options.texelsPerTriangle) * double(scene.triangleCount()),
+                                  double(options.maxAutoTexels));
+    // Never past the texel budget by itself: the pages hold about the texels aimed at (charts fill ~60%), so
+    // half the budget leaves room for the packing's slack.
+    if (options.maxTexels > 0) byTriangles = std::min(byTriangles, 0.5 * double(options.maxTexels));
     density = totalArea > 0.0 ? std::sqrt(0.6 * std::max(page, byTriangles) / totalArea) : 1.0;
   }
   if (!std::isfinite(density) || density <= 0.0) throw Error(ErrorCode::InvalidData, scene.sourcePath, "atlas: no surface area to unwrap");

@@ -405,18 +405,21 @@ TEST(Atlas, AutoDensityFitsTheTargetPage) {
 TEST(Atlas, AutoDensityFollowsTheTriangleCountAboveOnePage) {
   // The torus (1024 triangles) at 64 texels per triangle asks for 65,536 chart texels, 16× one 64² page:
   // 4× the page fit's density. Capped at 16,384 texels (4 pages) it is twice the page fit's.
-  auto densityWith = [](float perTriangle, size_t cap) {
+  // A --max-texels budget of 32,768 holds it at half the budget, 16,384: twice the page fit's again.
+  auto densityWith = [](float perTriangle, size_t cap, size_t budget = size_t(1) << 24) {
     Scene s = sceneOf({torus(1.0f, 0.35f, 32, 16)});
     AtlasOptions o;
     o.targetPageSize = 64;
     o.texelsPerTriangle = perTriangle;
     o.maxAutoTexels = cap;
+    o.maxTexels = budget;
     return buildAtlas(s, o).stats.texelsPerUnit;
   };
   const double pageFit = densityWith(0.0f, size_t(1) << 22);
   EXPECT_NEAR(densityWith(1.0f, size_t(1) << 22), pageFit, 1e-9 * pageFit);  // 1,024 texels < one page
   EXPECT_NEAR(densityWith(64.0f, size_t(1) << 22), 4.0 * pageFit, 1e-6 * pageFit);
   EXPECT_NEAR(densityWith(64.0f, 16384), 2.0 * pageFit, 1e-6 * pageFit);
+  EXPECT_NEAR(densityWith(64.0f, size_t(1) << 22, 32768), 2.0 * pageFit, 1e-6 * pageFit);
 }
 
 TEST(Atlas, SmallPagesSplitPrimitivesAcrossPages) {
