@@ -372,15 +372,25 @@ struct StagedBake::State {
     return maps;
   }
 
+  SkyLightOptions skyOptions() const {
+    SkyLightOptions o = options.sky;
+    o.seed = options.walk.seed;
+    return o;
+  }
+  PostOptions postOptions() const {
+    PostOptions o;
+    o.dilate = options.postDilate;
+    o.stitchSeams = options.postSeams;
+    return o;
+  }
+
   // The sky's direct light, traced (every VPL backend; the reference integrator finds the sky itself).
   // Before the compensation, whose gather reads the map as the light leaving each surface.
   void skyStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
     if (!scene.environment.present() || backend == BackendKind::Reference) return;
     timed("sky", [&] {
-      SkyLightOptions o = options.sky;
-      o.seed = options.walk.seed;
       SkyLightStats stats;
-      addSkyLight(*wholeInputs, maps, o, &stats);
+      addSkyLight(*wholeInputs, maps, skyOptions(), &stats);
       report["sky"] = stats.toJson();
       report["sky"]["uniform"] = scene.environment.isUniform();
       report["sky"]["source"] = scene.environment.source();
@@ -426,16 +436,9 @@ struct StagedBake::State {
         axes[axis] = bakeInterleaved(*wholeInputs, interleave, embree);
         for (size_t p = 0; p < axes[axis].size(); ++p) axes[axis][p].page = static_cast<int>(p);
       }
-      if (scene.environment.present()) {
-        SkyLightOptions so = options.sky;
-        so.seed = options.walk.seed;
-        addSkyLightDirectional(*wholeInputs, axes, so);
-      }
-      PostOptions o;
-      o.dilate = options.postDilate;
-      o.stitchSeams = options.postSeams;
+      if (scene.environment.present()) addSkyLightDirectional(*wholeInputs, axes, skyOptions());
       PostStats stats;
-      for (auto& pages : axes) stats = postProcess(scene, pages, o);
+      for (auto& pages : axes) stats = postProcess(scene, pages, postOptions());
       report["directional"] = {{"pages", axes[0].size() * 3}, {"seamMismatchAfter", stats.seamMismatchAfter}};
     });
     return axes;
@@ -444,11 +447,8 @@ struct StagedBake::State {
   PostStats postStage(std::vector<Lightmap>& maps) {
     PostStats stats;
     timed("post", [&] {
-      PostOptions o;
-      o.dilate = options.postDilate;
-      o.stitchSeams = options.postSeams;
       if (options.progress) options.progress("post", 0.0);
-      stats = postProcess(scene, maps, o);
+      stats = postProcess(scene, maps, postOptions());
       if (options.progress) options.progress("post", 1.0);
     });
     return stats;

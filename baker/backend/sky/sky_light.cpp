@@ -1,7 +1,6 @@
 #include "backend/sky/sky_light.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -63,13 +62,19 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
   for (size_t t = 0; t < ts.layerSize(); ++t)
     if (valid[t]) page.texels[t] += texelValue[t];
 }
+
+// Texel samples that carry weight (the ones the sky is traced from), over every page.
+size_t weightedSamples(const BakeInputs& in) {
+  size_t count = 0;
+  for (const TexelSamples& ts : in.texels)
+    for (const glm::vec4& pw : ts.positionWeight) count += pw.w > 0.0f;
+  return count;
+}
+
 // Rays per texel sample: options.raysPerSample, fewer where the scene's samples would exceed maxRays (≥ 8).
 int skyRaysPerSample(const BakeInputs& in, const SkyLightOptions& options) {
-  size_t slotsWithWeight = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (const glm::vec4& pw : ts.positionWeight) slotsWithWeight += pw.w > 0.0f;
   return std::max(8, std::min(options.raysPerSample,
-                              static_cast<int>(options.maxRays / std::max<size_t>(1, slotsWithWeight))));
+                              static_cast<int>(options.maxRays / std::max<size_t>(1, weightedSamples(in)))));
 }
 
 // Calls at(s, x, n, r1, r2) for every weighted sample s of a page, in parallel: x its position inset into its
@@ -116,18 +121,16 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
   if (!in.scene.environment.present()) return;
   Stopwatch watch;
   const int rays = skyRaysPerSample(in, options);
-  std::atomic<size_t> traced{0};
   for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
     forEachSkySample(in, ts, options.seed, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
       slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
-      traced += static_cast<size_t>(rays);
     });
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
-    stats->rays = traced;
+    stats->rays = weightedSamples(in) * static_cast<size_t>(rays);  // every weighted sample traces `rays`
     stats->raysPerSample = rays;
     stats->seconds = watch.seconds();
   }

@@ -78,7 +78,7 @@ void writeFile(const std::string& file, const char* format, const Pixels& px, in
   const bool isFloat = px.u8.empty();
   OIIO::ImageSpec spec(px.width, px.height, px.channels, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   // No compression: a light map's float noise does not compress (zip saved 4% of a Cornell page, 7.7 vs 8.0 MB)
-  // and cost 0.6 s of a 8 s bake.
+  // and cost about 0.5 s of an 8 s bake.
   if (std::string(format) == "openexr") spec.attribute("compression", "none");
   // Byte-identical outputs for identical bakes: OpenEXR's writer stamps the current time (capDate) unless a
   // DateTime is given, so give the reproducible-builds one: SOURCE_DATE_EPOCH when set, else the epoch.
