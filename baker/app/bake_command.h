@@ -22,6 +22,7 @@ struct BakeCommand {
   double envRotation = 0.0;        // --env-rotation (degrees)
   int threads = 0;                 // --threads (0: every core)
   bool quiet = false;              // --quiet
+  bool verbose = false;            // --verbose
   bool noGltf = false;             // --no-gltf
   int shardIndex = 0;              // --shard K/N: K (1-based), 0 without --shard
   int shardCount = 0;              // N

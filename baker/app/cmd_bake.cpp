@@ -50,6 +50,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   long long& seed = a.seed;
   double &tpu = a.tpu, &clamp = a.clamp;
   int& threads = command.threads;
+  bool &verbose = command.verbose;
   bool &quiet = command.quiet, &noGltf = command.noGltf;
   bool &noLeakControl = a.noLeakControl, &noDilate = a.noDilate, &noSeams = a.noSeams;
   bool &noBiasCompensation = a.noBiasCompensation, &biasCompensation = a.biasCompensation;
@@ -121,6 +122,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
+  app->add_flag("--verbose", verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
   app->add_option("--shard", shard,
                   "evaluate share K of N of the VPL blocks and write the exact partial\n"
                   "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
@@ -143,7 +145,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
 std::string resultOptionsHash(const CLI::App& app) {
   std::istringstream config(app.config_to_str(true, false));
   std::string line, kept;
-  const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "no-gltf",
+  const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
                                               "shard", "resume", "checkpoint-seconds"};
   while (std::getline(config, line)) {
     const std::string key = line.substr(0, line.find('='));
@@ -265,6 +267,7 @@ int runBake(const Args& args) {
   if (!parsed) return 0;
   BakeCommand& c = *parsed;
   if (c.quiet) log::setLevel(log::Level::Warn);
+  else if (c.verbose) log::setLevel(log::Level::Debug);
   std::unique_ptr<tbb::global_control> threadLimit;
   if (c.threads > 0)
     threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "common/log.h"
 #include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
@@ -336,9 +337,12 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   for (size_t p = 0; p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t)
       if (maps[p].valid[t]) mapTotal += channelMean(base(p)[t]);
-  double lastAdded = 0.0;
+  double lastAdded = 0.0, lastStep = 0.0, stepBefore = 0.0;
   int sweepsDone = 0;
+  bool tailAdded = false;
+  std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
+    if (options.extrapolateTail && sweep >= 1) previous = current;
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
@@ -384,9 +388,34 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       }
     }
     ++sweepsDone;
+    const double step = added - lastAdded;  // what this sweep's bounce added (sweep 0: the first bounce)
+    log::debug("compensation sweep " + std::to_string(sweep) + ": added " + std::to_string(added / mapTotal) +
+               " of the map");
     // Each sweep adds one more bounce inside the clamp radius: stop once that changes the map by less
     // than the tolerance (a narrow gap needs more bounces than an open corner).
-    const bool converged = sweep > 0 && std::abs(added - lastAdded) <= options.sweepTolerance * std::abs(mapTotal);
+    const double tolerance = options.sweepTolerance * std::abs(mapTotal);
+    const bool converged = sweep > 0 && std::abs(step) <= tolerance;
+    // Or add the rest at once: the steps are a Neumann series, step_{k+1} = T step_k, so once their
+    // ratio q has settled the remaining sweeps add step_k · q/(1 − q), texel by texel. Settled: the
+    // tails predicted by this ratio and the last one differ by at most the tolerance (Sponza: steps
+    // 4.1, 1.6, 0.67, 0.30% of the map, ratios 0.39, 0.41, 0.45: 4 sweeps and a tail within 0.03% of 8). At
+    // least 4 sweeps: the ratio still creeps up over the first few (longer paths reach narrower gaps).
+    if (!converged && options.extrapolateTail && sweep >= 3 && lastStep > 0.0 && step > 0.0) {
+      const double q = step / lastStep, qBefore = lastStep / stepBefore;
+      auto tailOf = [&](double r) { return step * r / (1.0 - r); };
+      if (q < 0.9 && qBefore > 0.0 && qBefore < 0.9 && std::abs(tailOf(q) - tailOf(qBefore)) <= tolerance) {
+        const float factor = static_cast<float>(q / (1.0 - q));
+        for (size_t p = 0; p < maps.size(); ++p)
+          tbb::parallel_for(size_t(0), current[p].size(), [&](size_t t) {
+            if (t < maps[p].valid.size() && maps[p].valid[t])
+              current[p][t] += factor * (current[p][t] - previous[p][t]);
+          });
+        tailAdded = true;
+        break;
+      }
+    }
+    stepBefore = lastStep;
+    lastStep = step;
     lastAdded = added;
     if (converged) break;
   }
@@ -409,6 +438,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     stats->raysPerSample = g.baseRays;
     stats->filterRadius = g.filterRadius;
     stats->sweeps = sweepsDone;
+    stats->tailExtrapolated = tailAdded;
     stats->addedFraction = before > 0.0 ? added / before : 0.0;
     stats->seconds = g.traceSeconds + clock.seconds();
   }

@@ -45,7 +45,9 @@ struct ClampCompensationOptions {
                                     // auto (below 32 rays: r ≤ 2 with r texels ≤ r_c / 20, r_c = 1/√B)
   int sweeps = 8;              // at most this many Jacobi sweeps; each reads the map with the previous sweep's
                                // residual added (furnished room, N = 1024: 3 sweeps 2.75%, 8: 2.54%)
-  double sweepTolerance = 2e-4;  // stop when a sweep changes the summed map by less than this fraction (< 0: never)
+  double sweepTolerance = 5e-4;  // stop when a sweep changes the summed map by less than this fraction (< 0: never),
+                                 // or when the extrapolated tail is known to within it
+  bool extrapolateTail = true;   // once the sweeps' ratio settles, add the remaining sweeps as a geometric tail
   uint32_t seed = 0;           // rotates the per-sample ray lattices (deterministic per seed)
 };
 
@@ -56,12 +58,13 @@ struct ClampCompensationStats {
   int raysPerSample = 0;      // first round, after the budget
   int filterRadius = 0;       // as applied (largest over pages)
   int sweeps = 0;             // Jacobi sweeps run
+  bool tailExtrapolated = false;  // the sweeps after the last were added as a geometric tail
   double addedFraction = 0;   // residual / map before, summed over valid texels (channel mean)
   double seconds = 0;
   nlohmann::json toJson() const {  // report "compensation" (seconds go to timings)
     return {{"rays", raysTraced},       {"samplesRefined", samplesRefined}, {"hitsKept", hitsKept},
             {"addedFraction", addedFraction}, {"raysPerSample", raysPerSample}, {"filterRadius", filterRadius},
-            {"sweeps", sweeps}};
+            {"sweeps", sweeps}, {"tailExtrapolated", tailExtrapolated}};
   }
 };
 
