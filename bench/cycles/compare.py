@@ -19,7 +19,8 @@ For each option set (--opts, repeatable; "" = defaults) it runs `irbake bake SCE
         each spp (seed 3) and scores it against the reference the same way: Cycles' time for an error.
   VIEW  (--views): cycles_render.py renders the input SCENE from glTF camera i at W x H (two renders of spp/2,
         seeds 1 and 2); irview renders our export at 4W x 4H, averaged 4x4 down. Pixels left out: emitters
-        (either image above --emitter-cut in any channel, dilated by one pixel), background (both zero), and
+        (either image above --emitter-cut in any channel, dilated by one pixel), background (both zero; with
+        --sky R,G,B, Cycles renders through bench/cycles/cycles_render_sky.py and its sky pixels are background), and
         1-pixel edges: pixels whose `irview --view charts` colour at W x H differs from any 4-neighbour's
         (chart borders = silhouettes, creases, and seams inside flat regions; both pixels of a border).
         4x4 (8x8) pixel bins with at least half their pixels kept. Columns *_with_edges: the same with the
@@ -308,8 +309,13 @@ def view_mode(args, out, row, rows):
     for v in [int(x) for x in args.views.split(",")]:
         base = ["--camera-index", str(v), "--width", str(w), "--height", str(h), "--max-bounces", str(args.max_bounces)]
         half = max(1, args.view_spp // 2)
-        refs = [cycles_cached(args, args.render_script, args.scene, base + ["--spp", str(half), "--seed", str(s)],
-                              "view.exr") for s in (1, 2)]
+        script = args.render_script
+        if args.sky:  # our wrapper: the shared script with the world set to the sky's radiance
+            script = os.path.join(REPO, "bench", "cycles", "cycles_render_sky.py")
+            base += ["--sky", args.sky, "--cycles-dir", args.cycles_dir]
+        refs = [cycles_cached(args, script, args.scene, base + ["--spp", str(half), "--seed", str(s)],
+                              "view.exr", key_files=gltf_files(args.scene) + [args.render_script] if args.sky else None)
+                for s in (1, 2)]
         a, b = read_exr(refs[0][0])[..., :3], read_exr(refs[1][0])[..., :3]
         big = os.path.join(out, "view%d_x4.exr" % v)
         charts = os.path.join(out, "view%d_charts.exr" % v)
@@ -333,6 +339,9 @@ def view_mode(args, out, row, rows):
         e2[:, 1:] |= emit[:, :-1]
         e2[:, :-1] |= emit[:, 1:]
         empty = (ours.max(axis=2) <= 0) & (a.max(axis=2) <= 0) & (b.max(axis=2) <= 0)
+        if args.sky:  # background: Cycles' camera rays that miss return exactly the sky's radiance
+            sky = np.array([float(x) for x in args.sky.split(",")])
+            empty |= np.all(np.abs(a - sky) < 1e-5, axis=2) & np.all(np.abs(b - sky) < 1e-5, axis=2)
         mask = ~(edge | e2 | empty)
         s = score(ours, a, b, mask)
         s_all = score(ours, a, b, ~(e2 | empty))  # edges kept: how much the edge rule matters
@@ -369,6 +378,8 @@ def main():
     ap.add_argument("--emitter-cut", type=float, default=3.0, help="radiance above which a pixel is an emitter")
     ap.add_argument("--hidden-cut", type=float, default=0.02,
                     help="maps: covered texels darker than this fraction of the mean in Cycles are hidden (left out)")
+    ap.add_argument("--sky", default="", help="views: Cycles' world = this uniform radiance R,G,B (as irbake "
+                    "--sky; put --sky in --opts too); sky pixels are left out as background")
     ap.add_argument("--save-diff", action="store_true", help="write view<i>_ratio.exr (ours/Cycles) beside our bake")
     ap.add_argument("--csv", help="append rows here (default bench/results/cycles_NAME.csv)")
     args = ap.parse_args()
