@@ -2,11 +2,15 @@
 // primitive into a 1280×720 RGBA8 framebuffer with the display shading (exposure + sRGB), then
 // glFinish, as the window does before a swap (the shader encodes sRGB, as in the window). Scenes:
 // the baked Cornell box (Embree backend) and a generated ~100k-triangle height field with a 1024²
-// light-map page, untextured and with a 512² base colour texture repeated 8 × 8.
+// light-map page, untextured and with a 512² base colour texture repeated 8 × 8; the DamagedHelmet from
+// ../shared/scenes (skipped when absent) baked with directional maps, shaded with them (SH, normal map) and
+// with L0 only.
 // Run: viewer_bench --benchmark_repetitions=9 --benchmark_report_aggregates_only=true (quote medians).
 #include <sys/resource.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include <benchmark/benchmark.h>
@@ -15,6 +19,7 @@
 #include "glcontext/gl_context.h"
 #include "pipeline/bake.h"
 #include "samples/sample_scenes.h"
+#include "scene/gltf_loader.h"
 #include "view_renderer.h"
 
 using namespace irbake;
@@ -183,13 +188,38 @@ ViewerScene bakedCornell() {
   return makeViewerScene(std::move(r.scene), std::move(r.maps));
 }
 
-void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam) {
+// The shared DamagedHelmet (source folder's ../shared/scenes, found from the working directory upwards), baked
+// as bench/directional_bench.sh does (Embree, the sun 0.3,−1,−0.4 at 3 W/m², --directional); null when absent.
+const ViewerScene* bakedHelmet() {
+  static std::unique_ptr<ViewerScene> v = []() -> std::unique_ptr<ViewerScene> {
+    for (std::filesystem::path dir = std::filesystem::current_path(); !dir.empty(); dir = dir.parent_path()) {
+      const std::filesystem::path gltf = dir / "shared/scenes/damaged_helmet/DamagedHelmet.gltf";
+      if (std::filesystem::exists(gltf)) {
+        LoadOptions load;
+        load.shadingMaps = true;
+        Scene s = loadScene(gltf, load);
+        s.lights.push_back(sunLight(glm::vec3(0.3f, -1.0f, -0.4f), 3.0f));
+        BakeOptions o;
+        o.backend = BackendKind::Embree;
+        o.directional = true;
+        BakeResult r = bake(std::move(s), o);
+        return std::make_unique<ViewerScene>(makeViewerScene(std::move(r.scene), std::move(r.maps), std::move(r.directional)));
+      }
+      if (dir == dir.parent_path()) break;
+    }
+    return nullptr;
+  }();
+  return v.get();
+}
+
+void frameLoop(benchmark::State& state, const ViewerScene& v, const ViewCamera& cam, LightmapMode mode = LightmapMode::Sh) {
   context();
   ViewRenderer renderer(v);
   RenderTarget target(kWidth, kHeight, GL_RGBA8);
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
   DrawSettings settings;
   settings.encodeSrgb = true;
+  settings.lightmapMode = mode;
   renderer.draw(cam, kWidth, kHeight, settings);  // warm-up: shader compile, texture residency
   glFinish();
   const double cpu0 = processCpuSeconds();
@@ -233,10 +263,23 @@ void BM_Frame100kFurnishedRoom(benchmark::State& state) {
   frameLoop(state, v, lookAt({5.8f, 2.6f, 4.8f}, {1.5f, 0.4f, 0.8f}, 60.0f, v.scene.bounds()));
 }
 
+void helmetFrame(benchmark::State& state, LightmapMode mode) {
+  const ViewerScene* v = bakedHelmet();
+  if (!v) {
+    state.SkipWithError("../shared/scenes/damaged_helmet absent");
+    return;
+  }
+  frameLoop(state, *v, lookAt({0.9f, 0.35f, 2.6f}, {0, 0, 0}, 40.0f, v->scene.bounds()), mode);
+}
+void BM_FrameHelmetDirectionalSh(benchmark::State& state) { helmetFrame(state, LightmapMode::Sh); }
+void BM_FrameHelmetDirectionalL0(benchmark::State& state) { helmetFrame(state, LightmapMode::L0); }
+
 }  // namespace
 
 BENCHMARK(BM_FrameCornellBox)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(BM_Frame100kTriangles)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(BM_Frame100kTrianglesTextured)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK(BM_Frame100kFurnishedRoom)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(BM_FrameHelmetDirectionalSh)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+BENCHMARK(BM_FrameHelmetDirectionalL0)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 BENCHMARK_MAIN();

@@ -15,6 +15,7 @@ std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const Viewe
   ViewRenderer renderer(v);
   DrawSettings settings;
   settings.mode = o.mode;
+  settings.lightmapMode = o.lightmapMode;
   settings.exposure = o.exposure;
   settings.background = skyBackground(v.scene);
   std::vector<std::filesystem::path> written;
@@ -31,7 +32,9 @@ std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const Viewe
   RgbaImage img = renderer.render(startCamera(o, v.scene), o.width, o.height, settings);
   writeScreenshot(img, o.screenshot, o.exposure);
   log::info("wrote " + o.screenshot.string() + " (" + std::to_string(o.width) + "x" +
-            std::to_string(o.height) + ", " + toString(o.mode) + ", " + gl.renderer() + ")");
+            std::to_string(o.height) + ", " + toString(o.mode) +
+            (renderer.directionalPrimitiveCount() ? std::string(", light map ") + toString(o.lightmapMode) : "") + ", " +
+            gl.renderer() + ")");
   written.push_back(o.screenshot);
   return written;
 }

@@ -142,7 +142,8 @@ TEST(IrviewCli, WindowUnderXvfbRendersTenFramesAndWritesAScreenshot) {
 // Options are checked by range as typed; --help lists them with the exit codes; --version prints one line.
 TEST(IrviewCli, OptionRangesHelpAndVersion) {
   const std::string scene = sampleFile("furnace").string();
-  for (const char* bad : {"--width 4294967297", "--camera -1", "--fov 180", "--eye 1,2 --target 0,0,0", "--view shiny"}) {
+  for (const char* bad : {"--width 4294967297", "--camera -1", "--fov 180", "--eye 1,2 --target 0,0,0", "--view shiny",
+                          "--lightmap-mode l2"}) {
     RunResult r = run(scene + " " + bad + " --screenshot never.png");
     EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     EXPECT_EQ(r.output.rfind("irview: error: ", 0), 0u) << bad << ": " << r.output;

@@ -1,6 +1,7 @@
 #include "view_renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -85,6 +86,14 @@ const char* toString(ViewMode mode) {
   return "?";
 }
 
+const char* toString(LightmapMode mode) { return mode == LightmapMode::L0 ? "l0" : "sh"; }
+
+LightmapMode parseLightmapMode(const std::string& name) {
+  for (LightmapMode m : {LightmapMode::Sh, LightmapMode::L0})
+    if (name == toString(m)) return m;
+  throw Error(ErrorCode::Usage, "", "unknown light-map mode '" + name + "' (sh, l0)");
+}
+
 ViewMode parseViewMode(const std::string& name) {
   for (ViewMode m : {ViewMode::Lit, ViewMode::Lightmap, ViewMode::Albedo, ViewMode::Charts,
                      ViewMode::TexelDensity, ViewMode::Wireframe})
@@ -103,15 +112,16 @@ struct Variant {
   int emissiveTex = 0;  // 0 none, 1 TEXCOORD_0, 2 TEXCOORD_1
   int lightmap = 0;     // 1: the primitive has a light map
   int alphaMask = 0;    // 1: alphaMode MASK
+  int directional = 0;  // L1 SH with the normal map: 0 off, 1 normal map on TEXCOORD_0, 2 on TEXCOORD_1
 
   int key() const {
-    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9;
+    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9 | directional << 10;
   }
   static Variant fromKey(int k) {
-    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1};
+    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1, (k >> 10) & 3};
   }
-  // `all`: every feature of the primitive; keeps those `mode` reads.
-  static Variant forMode(int mode, int output, const Variant& all) {
+  // `all`: every feature of the primitive; keeps those `mode` reads (and the SH only when `sh`).
+  static Variant forMode(int mode, int output, const Variant& all, bool sh = true) {
     Variant v;
     v.mode = mode;
     v.output = output;
@@ -121,17 +131,21 @@ struct Variant {
     v.baseTex = baseShown || all.alphaMask ? all.baseTex : 0;  // other views read base alpha for holes only
     v.emissiveTex = mode == 0 ? all.emissiveTex : 0;
     v.lightmap = mode == 0 || mode == 1 ? all.lightmap : 0;
+    v.directional = v.lightmap && sh ? all.directional : 0;
     return v;
   }
-  int needUv0() const { return baseTex == 1 || emissiveTex == 1; }
-  int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4; }
-  int needNormal() const { return mode == 3; }
+  int needUv0() const { return baseTex == 1 || emissiveTex == 1 || directional == 1; }
+  int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4 || directional == 2; }
+  int needNormal() const { return mode == 3 || directional != 0; }
+  int needTangent() const { return directional != 0; }
   int needChart() const { return mode == 3 || mode == 4; }
 };
 
 struct ViewRenderer::Impl {
   struct GpuPrimitive {
     GLuint vao = 0, vbo = 0, ebo = 0;
+    GLuint tangentVbo = 0;        // only for a directional primitive (its normal map needs the frame)
+    GLuint l1[3] = {0, 0, 0};     // L1x, L1y, L1z (values, decoded), for a directional primitive
     GLsizei indexCount = 0;
     int material = 0;
     GLuint lightmap = 0;          // 0: none (albedo only)
@@ -149,6 +163,8 @@ struct ViewRenderer::Impl {
   std::map<int, GLuint> colorTextures;     // Scene::textures index → GL texture
   std::map<int, GLuint> textureLightmaps;  // Scene::textures index → float light map texture
   std::vector<GLuint> pageTextures;        // ViewerScene::pages index → GL texture
+  std::array<std::vector<GLuint>, 3> directionalPageTextures;  // ViewerScene::directionalPages → GL texture
+  std::map<std::pair<int, float>, GLuint> directionalPngs;    // (Scene::textures index, scale) → decoded L1
   std::vector<GpuPrimitive> prims;
   std::unique_ptr<RenderTarget> offscreen;  // float target of render(), resized on demand
 
@@ -175,7 +191,8 @@ struct ViewRenderer::Impl {
           define("BASE_TEX", f.baseTex),        define("EMISSIVE_TEX", f.emissiveTex),
           define("HAS_LIGHTMAP", f.lightmap),   define("ALPHA_MASK", f.alphaMask),
           define("NEED_UV0", f.needUv0()),      define("NEED_UV1", f.needUv1()),
-          define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart())};
+          define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart()),
+          define("DIRECTIONAL", f.directional), define("NEED_TANGENT", f.needTangent())};
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
@@ -196,6 +213,18 @@ struct ViewRenderer::Impl {
     auto it = colorTextures.find(index);
     if (it != colorTextures.end()) return it->second;
     return colorTextures[index] = uploadColorTexture(t);
+  }
+
+  // An IRBAKE_lightmap_directional PNG as values, (2·texel − 1)·scale (docs/export.md), decoded once per
+  // (texture, scale): the shader then reads float pages and PNGs alike, and bilinear filtering commutes with
+  // the affine decode.
+  GLuint directionalPng(int index, float scale) {
+    auto it = directionalPngs.find({index, scale});
+    if (it != directionalPngs.end()) return it->second;
+    const Texture& t = scene.textures.at(index);
+    std::vector<glm::vec4> values(t.texels.size());
+    for (size_t i = 0; i < values.size(); ++i) values[i] = glm::vec4((2.0f * glm::vec3(t.texels[i]) - 1.0f) * scale, 1.0f);
+    return directionalPngs[{index, scale}] = uploadLightmap(t.width, t.height, GL_RGBA, values.data());
   }
 
   void ensureFramebuffer(int w, int h) {
@@ -238,6 +267,11 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     I.pageTextures.push_back(page.size() > 0 && page.texels.size() == page.size()
                                  ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
                                  : 0);
+  for (int k = 0; k < 3; ++k)
+    for (const Lightmap& page : v.directionalPages[k])
+      I.directionalPageTextures[k].push_back(page.size() > 0 && page.texels.size() == page.size()
+                                                 ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
+                                                 : 0);
 
   uint32_t chartBase = 0, nextChartBase = 0;
   for (const Primitive& p : v.scene.primitives) {
@@ -320,6 +354,29 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     g.features.emissiveTex = I.colorTexture(m.emissiveTexture) ? (m.emissiveTexCoord == 1 ? 2 : 1) : 0;
     g.features.lightmap = g.lightmap ? 1 : 0;
     g.features.alphaMask = m.alphaMode == AlphaMode::Mask ? 1 : 0;
+    // Directional maps only change what a normal map bends: at n = n_g the reconstruction is L0 itself
+    // (the L1 pages hold t ⟂ n_g), so a primitive without a normal map keeps the plain shading and skips the
+    // three fetches.
+    const DirectionalSource l1Source = directionalSourceOf(v, p);
+    const std::vector<glm::vec2>& normalUv = m.normalTexCoord == 1 ? p.uv1 : p.uv0;
+    if (g.lightmap && l1Source != DirectionalSource::None && I.colorTexture(m.normalTexture) &&
+        normalUv.size() == p.positions.size() && p.normals.size() == p.positions.size()) {
+      for (int k = 0; k < 3; ++k)
+        g.l1[k] = l1Source == DirectionalSource::Pages
+                      ? I.directionalPageTextures[k][p.lightmap.page]
+                      : I.directionalPng(m.directionalTextures[k], m.directionalScales[k]);
+      const std::vector<glm::vec4> tangents =
+          p.tangents.size() == p.positions.size() ? p.tangents : generateTangents(p, normalUv);
+      glGenBuffers(1, &g.tangentVbo);
+      glBindBuffer(GL_ARRAY_BUFFER, g.tangentVbo);
+      glBufferData(GL_ARRAY_BUFFER, tangents.size() * sizeof(glm::vec4), tangents.data(), GL_STATIC_DRAW);
+      glBindVertexArray(g.vao);
+      glEnableVertexAttribArray(5);
+      glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, sizeof(glm::vec4), nullptr);
+      glBindVertexArray(0);
+      g.features.directional = m.normalTexCoord == 1 ? 2 : 1;
+      ++directionalPrimitives_;
+    }
     g.cullBackFaces = !g.features.alphaMask && isClosedOutward(p);  // a masked hole would show the back
     // Compile the lit variant now: shader errors surface here, and the first frame compiles nothing.
     I.useProgram(Variant::forMode(0, 0, g.features).key());
@@ -334,11 +391,16 @@ ViewRenderer::~ViewRenderer() {
     glDeleteVertexArrays(1, &g.vao);
     glDeleteBuffers(1, &g.vbo);
     glDeleteBuffers(1, &g.ebo);
+    if (g.tangentVbo) glDeleteBuffers(1, &g.tangentVbo);
   }
   for (auto& [i, t] : I.colorTextures) glDeleteTextures(1, &t);
   for (auto& [i, t] : I.textureLightmaps) glDeleteTextures(1, &t);
   for (GLuint t : I.pageTextures)
     if (t) glDeleteTextures(1, &t);
+  for (const auto& axis : I.directionalPageTextures)
+    for (GLuint t : axis)
+      if (t) glDeleteTextures(1, &t);
+  for (auto& [key, t] : I.directionalPngs) glDeleteTextures(1, &t);
   I.offscreen.reset();
   I.programs.clear();
 }
@@ -364,6 +426,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
   const int output = settings.encodeSrgb ? 1 : 0;
+  const bool sh = settings.lightmapMode == LightmapMode::Sh;
   // Front to back, by the distance to each primitive's farthest bounding-box corner (a room's walls,
   // whose far corner is the farthest thing in view, go last): llvmpipe tests depth before shading,
   // so what is drawn behind something already drawn costs no shading (furnished-room bench: 1.72 M
@@ -380,12 +443,17 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
     I.program = 0;
     for (const auto& [distance, index] : order) {
       const auto& g = I.prims[index];
-      if (I.useProgram(Variant::forMode(mode, output, g.features).key())) {
+      const Variant variant = Variant::forMode(mode, output, g.features, sh);
+      if (I.useProgram(variant.key())) {
         glUniformMatrix4fv(I.u("uViewProjection"), 1, GL_FALSE, &vp[0][0]);
         glUniform1f(I.u("uExposureScale"), std::exp2(settings.exposure));
         glUniform1i(I.u("uBaseColorTex"), 0);
         glUniform1i(I.u("uEmissiveTex"), 1);
         glUniform1i(I.u("uLightmap"), 2);
+        glUniform1i(I.u("uNormalTex"), 3);
+        glUniform1i(I.u("uL1x"), 4);
+        glUniform1i(I.u("uL1y"), 5);
+        glUniform1i(I.u("uL1z"), 6);
         glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
       }
       const Material& m = I.scene.materials.at(g.material);
@@ -401,6 +469,15 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
       glActiveTexture(GL_TEXTURE2);
       glBindTexture(GL_TEXTURE_2D, g.lightmap);
       glUniform1f(I.u("uAlphaCutoff"), m.alphaCutoff);
+      if (variant.directional) {
+        glUniform1f(I.u("uNormalScale"), m.normalScale);
+        glActiveTexture(GL_TEXTURE3);
+        glBindTexture(GL_TEXTURE_2D, I.colorTexture(m.normalTexture));
+        for (int k = 0; k < 3; ++k) {
+          glActiveTexture(GL_TEXTURE4 + k);
+          glBindTexture(GL_TEXTURE_2D, g.l1[k]);
+        }
+      }
       if (g.cullBackFaces)
         glEnable(GL_CULL_FACE);
       else

@@ -18,8 +18,16 @@ const char* toString(ViewMode mode);
 // "lit", "lightmap", "albedo", "charts", "density", "wireframe"; throws Error(Usage) otherwise.
 ViewMode parseViewMode(const std::string& name);
 
+// How a directional light map (IRBAKE_lightmap_directional) is shaded: the L1 reconstruction for the normal
+// map's normal, or L0 alone (the plain map, for comparison). Without directional maps both are the plain map.
+enum class LightmapMode { Sh, L0 };
+const char* toString(LightmapMode mode);
+// "sh", "l0"; throws Error(Usage) otherwise.
+LightmapMode parseLightmapMode(const std::string& name);
+
 struct DrawSettings {
   ViewMode mode = ViewMode::Lit;   // what to show
+  LightmapMode lightmapMode = LightmapMode::Sh;  // lit and lightmap views: L1 SH with the normal map, or L0 only
   float exposure = 0.0f;           // EV stops, display only (×2^EV before the sRGB encode)
   bool encodeSrgb = false;         // true: exposure + sRGB in the shader (window); false: linear out
   glm::vec3 background{0.0f};      // clear colour (linear radiance; exposed and encoded like the scene)
@@ -64,11 +72,14 @@ class ViewRenderer {
   // (always linear), so the pixels are radiance in the scene's units.
   RgbaImage render(const ViewCamera& camera, int width, int height, DrawSettings settings);
   size_t triangleCount() const { return triangles_; }
+  // Primitives shaded with directional maps and a normal map in LightmapMode::Sh (0: the mode changes nothing).
+  size_t directionalPrimitiveCount() const { return directionalPrimitives_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   size_t triangles_ = 0;
+  size_t directionalPrimitives_ = 0;
 };
 
 // The background for a scene: its sky's radiance (a map's mean radiance), black without a sky.

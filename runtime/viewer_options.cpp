@@ -10,12 +10,12 @@ namespace {
 
 const char* kWindowKeys =
     "window keys: mouse drag look, WASD/QE fly (shift: faster), 1-9 glTF cameras, V view mode,\n"
-    "  +/- exposure, F12 screenshot, Esc quit\n";
+    "  L light map SH/L0, +/- exposure, F12 screenshot, Esc quit\n";
 
 // The option values as typed on the command line, before the checks that need several of them.
 struct RawOptions {
   std::vector<std::string> scenes;
-  std::string eye, target, view, screenshot;
+  std::string eye, target, view, screenshot, lightmapMode;
 };
 
 std::unique_ptr<CLI::App> viewerApp(ViewerOptions& o, RawOptions& raw) {
@@ -38,6 +38,10 @@ std::unique_ptr<CLI::App> viewerApp(ViewerOptions& o, RawOptions& raw) {
       ->transform(cli::integerIn(0, 100000))->type_name("N");
   app->add_option("--view", raw.view, "view mode")
       ->check(CLI::IsMember({"lit", "lightmap", "albedo", "charts", "density", "wireframe"}));
+  app->add_option("--lightmap-mode", raw.lightmapMode,
+                  "directional maps (IRBAKE_lightmap_directional): sh = L1 with the normal map (default), l0 = the "
+                  "plain map only")
+      ->check(CLI::IsMember({"sh", "l0"}));
   app->add_option("--exposure", o.exposure, "display exposure in stops (PNG and window)")
       ->transform(cli::numberIn(-64.0, 64.0))->type_name("EV");
   app->add_flag("--window", o.window, "open the window even with --screenshot");
@@ -71,6 +75,7 @@ std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& 
   if (o.walkthrough > 0 && o.screenshot.empty())
     throw Error(ErrorCode::Usage, "", "--walkthrough needs --screenshot OUT.png|OUT.exr (frames are OUT_0000...)");
   if (!raw.view.empty()) o.mode = parseViewMode(raw.view);
+  if (!raw.lightmapMode.empty()) o.lightmapMode = parseLightmapMode(raw.lightmapMode);
   return o;
 }
 

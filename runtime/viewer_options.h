@@ -21,6 +21,7 @@ struct ViewerOptions {
   int width = 1280, height = 720;           // image / window size in pixels
   int walkthrough = 0;                      // N > 0: N frames along the glTF cameras or an orbit
   ViewMode mode = ViewMode::Lit;            // --view
+  LightmapMode lightmapMode = LightmapMode::Sh;  // --lightmap-mode: directional maps shaded (sh) or L0 only (l0)
   float exposure = 0.0f;                    // EV stops for PNG and the window
   bool window = false;                      // --window: open a window even when a screenshot is asked for
   int frames = 0;                           // window: close after this many frames (0: until closed)

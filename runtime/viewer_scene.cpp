@@ -24,10 +24,26 @@ LightmapSource lightmapSourceOf(const ViewerScene& v, const Primitive& p) {
   return LightmapSource::None;
 }
 
-ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages) {
+DirectionalSource directionalSourceOf(const ViewerScene& v, const Primitive& p) {
+  const LightmapSource l0 = lightmapSourceOf(v, p);
+  if (l0 == LightmapSource::None) return DirectionalSource::None;
+  bool pages = p.lightmap.page >= 0;
+  for (const auto& axis : v.directionalPages)
+    pages = pages && p.lightmap.page < static_cast<int>(axis.size()) && axis[p.lightmap.page].size() > 0 &&
+            axis[p.lightmap.page].texels.size() == axis[p.lightmap.page].size();
+  if (pages) return DirectionalSource::Pages;
+  const Material& m = v.scene.materials.at(p.material);
+  if (!m.hasDirectionalTextures()) return DirectionalSource::None;
+  for (int t : m.directionalTextures)
+    if (t >= static_cast<int>(v.scene.textures.size()) || v.scene.textures[t].texels.empty()) return DirectionalSource::None;
+  return DirectionalSource::MaterialTextures;
+}
+
+ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages, std::array<std::vector<Lightmap>, 3> directionalPages) {
   ViewerScene v;
   v.scene = std::move(scene);
   v.pages = std::move(pages);
+  v.directionalPages = std::move(directionalPages);
   size_t unlit = 0;
   for (const auto& p : v.scene.primitives)
     if (lightmapSourceOf(v, p) == LightmapSource::None) ++unlit;
@@ -40,7 +56,9 @@ ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages) {
 }
 
 ViewerScene loadViewerScene(const std::filesystem::path& path) {
-  Scene scene = loadScene(path);
+  LoadOptions options;
+  options.shadingMaps = true;  // the normal maps, tangents and directional maps a bake does not read
+  Scene scene = loadScene(path, options);
   std::vector<Lightmap> pages;
   std::vector<std::string> warnings;
   // The float pages carry the full range; if one cannot be read the PNG × intensity still shows.
@@ -55,10 +73,63 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
       break;
     }
   }
-  ViewerScene v = makeViewerScene(std::move(scene), std::move(pages));
+  // The L1 pages named by each page's materials (the same three files for every material of a page).
+  std::array<std::vector<Lightmap>, 3> directional;
+  std::map<int, const Material*> materialOfPage;
+  for (const Primitive& p : scene.primitives) {
+    const Material& m = scene.materials.at(p.material);
+    if (p.lightmap.page >= 0 && !m.directionalExrPaths[0].empty()) materialOfPage.emplace(p.lightmap.page, &m);
+  }
+  try {
+    for (const auto& [page, m] : materialOfPage)
+      for (int k = 0; k < 3; ++k) {
+        if (directional[k].size() <= static_cast<size_t>(page)) directional[k].resize(page + 1);
+        directional[k][page] = readExr(m->directionalExrPaths[k]);
+        directional[k][page].page = page;
+      }
+  } catch (const Error& e) {
+    warnings.push_back(std::string(e.what()) + ": using the IRBAKE_lightmap_directional PNGs instead");
+    directional = {};
+  }
+  ViewerScene v = makeViewerScene(std::move(scene), std::move(pages), std::move(directional));
   v.warnings.insert(v.warnings.begin(), warnings.begin(), warnings.end());
   for (const auto& w : v.scene.stats.warnings) v.warnings.push_back(w);
   return v;
+}
+
+std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv) {
+  const size_t n = p.positions.size();
+  std::vector<glm::dvec3> dPdu(n, glm::dvec3(0.0)), dPdv(n, glm::dvec3(0.0));
+  if (uv.size() == n) {
+    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+      const uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
+      if (a >= n || b >= n || c >= n) continue;
+      const glm::dvec3 e1 = glm::dvec3(p.positions[b]) - glm::dvec3(p.positions[a]);
+      const glm::dvec3 e2 = glm::dvec3(p.positions[c]) - glm::dvec3(p.positions[a]);
+      const glm::dvec2 d1 = glm::dvec2(uv[b]) - glm::dvec2(uv[a]), d2 = glm::dvec2(uv[c]) - glm::dvec2(uv[a]);
+      const double det = d1.x * d2.y - d2.x * d1.y;  // e1 = dPdu d1.x + dPdv d1.y, e2 likewise: solve
+      if (!(std::abs(det) > 1e-20)) continue;
+      const glm::dvec3 su = (e1 * d2.y - e2 * d1.y) / det, sv = (e2 * d1.x - e1 * d2.x) / det;
+      for (uint32_t v : {a, b, c}) {
+        dPdu[v] += su;
+        dPdv[v] += sv;
+      }
+    }
+  }
+  std::vector<glm::vec4> out(n);
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec3 nrm = i < p.normals.size() ? glm::dvec3(p.normals[i]) : glm::dvec3(0, 1, 0);
+    glm::dvec3 t = dPdu[i] - nrm * glm::dot(nrm, dPdu[i]);
+    if (!(glm::length(t) > 1e-12)) {  // no UV gradient here: any unit vector orthogonal to the normal
+      t = std::abs(nrm.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+      t -= nrm * glm::dot(nrm, t);
+    }
+    t = glm::normalize(t);
+    // cross(n, t)·w must point where v decreases.
+    const double w = glm::dot(glm::cross(nrm, t), dPdv[i]) > 0.0 ? -1.0 : 1.0;
+    out[i] = glm::vec4(glm::vec3(t), static_cast<float>(w));
+  }
+  return out;
 }
 
 std::vector<uint32_t> chartIds(const Primitive& p) {

@@ -1,7 +1,11 @@
 // What the viewer shows: a Scene plus its baked light maps, resolved per primitive.
 // Light maps come from the float EXR pages of an irbake export when present (full range), else from
 // the MOZ_lightmap texture × intensity of each material; a primitive with neither shows albedo only.
+//
+// Directional maps (IRBAKE_lightmap_directional, docs/export.md): the L1x/L1y/L1z pages likewise come from the
+// material's float EXR pages when they can be read, else from its 8-bit PNGs (value = (2·texel − 1)·scale).
 #pragma once
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -14,6 +18,9 @@ namespace irbake::view {
 struct ViewerScene {
   Scene scene;
   std::vector<Lightmap> pages;        // float pages, index = LightmapRef::page (empty: none)
+  // L1x, L1y, L1z float pages (transport/directional.h), index = LightmapRef::page; a missing or empty one:
+  // that page has none.
+  std::array<std::vector<Lightmap>, 3> directionalPages;
   std::vector<std::string> warnings;  // e.g. "no light map: showing albedo only"
 };
 
@@ -22,12 +29,27 @@ enum class LightmapSource { Page, MaterialTexture, None };
 // Where primitive `p` reads its light map from.
 LightmapSource lightmapSourceOf(const ViewerScene& v, const Primitive& p);
 
+enum class DirectionalSource { Pages, MaterialTextures, None };
+
+// Where primitive `p` reads its L1 pages from: float pages (directionalPages) when all three exist for its
+// page, else its material's IRBAKE_lightmap_directional PNGs; None without a light map or without either.
+DirectionalSource directionalSourceOf(const ViewerScene& v, const Primitive& p);
+
 // A scene with maps handed over in memory (a bake result, or maps built in code). Warns when no
 // primitive has a light map.
-ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages);
+ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages,
+                            std::array<std::vector<Lightmap>, 3> directionalPages = {});
 
 // Loads a glTF/GLB (an irbake export or any glTF) and its EXR pages. Throws Error naming the file.
 ViewerScene loadViewerScene(const std::filesystem::path& path);
+
+// Per-vertex tangents (xyz unit and orthogonal to the vertex normal, w = ±1) for a primitive without TANGENT,
+// from the UV set `uv` a normal map reads. An approximation of the MikkTSpace frame that glTF asks for: per
+// triangle dP/du and dP/dv (Lengyel's UV-gradient solve), summed at each vertex, Gram–Schmidt against the
+// vertex normal. The bitangent cross(n, t)·w points towards decreasing v (up in the image: glTF's normal maps
+// have +Y up and UV (0,0) at the top left). Identical to MikkTSpace on planar charts with affine UVs; on curved
+// ones the two differ by how corners are weighted. A vertex whose triangles have no UV area gets any frame.
+std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv);
 
 // Per-vertex chart id: connected components of triangles sharing a vertex index. After the atlas,
 // vertices are split along chart seams, so these are the atlas charts.

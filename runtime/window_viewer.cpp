@@ -53,6 +53,8 @@ void onKey(GLFWwindow* w, int key, int, int action, int) {
   } else if (key == GLFW_KEY_V) {
     auto it = std::find(std::begin(kModes), std::end(kModes), s.settings.mode);
     s.settings.mode = kModes[(it - std::begin(kModes) + 1) % std::size(kModes)];
+  } else if (key == GLFW_KEY_L) {
+    s.settings.lightmapMode = s.settings.lightmapMode == LightmapMode::Sh ? LightmapMode::L0 : LightmapMode::Sh;
   } else if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) {
     s.settings.exposure += 0.5f;
   } else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) {
@@ -111,6 +113,7 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   s.scene = &v;
   s.options = &o;
   s.settings.mode = o.mode;
+  s.settings.lightmapMode = o.lightmapMode;
   s.settings.exposure = o.exposure;
   s.settings.background = skyBackground(v.scene);
   s.settings.encodeSrgb = true;
@@ -157,9 +160,11 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
       ++titleFrames;
       if (now - titleTime > 0.5) {
         char title[256];
-        std::snprintf(title, sizeof title, "irview - %s - %.2f ms/frame - %s - EV %+.1f",
+        std::snprintf(title, sizeof title, "irview - %s - %.2f ms/frame - %s%s%s - EV %+.1f",
                       o.scene.filename().string().c_str(), 1000.0 * frameSum / titleFrames,
-                      toString(s.settings.mode), s.settings.exposure);
+                      toString(s.settings.mode), renderer.directionalPrimitiveCount() ? " - light map " : "",
+                      renderer.directionalPrimitiveCount() ? toString(s.settings.lightmapMode) : "",
+                      s.settings.exposure);
         glfwSetWindowTitle(window, title);
         titleTime = now;
         titleFrames = 0;

@@ -1,5 +1,6 @@
 // irview shading: baseColor × lightmap + emissive, in linear radiance. The light map stores
-// irradiance/π, so a Lambertian surface of albedo ρ shows ρ·map (docs/units.md).
+// irradiance/π, so a Lambertian surface of albedo ρ shows ρ·map (docs/units.md). With directional maps
+// (DIRECTIONAL) the map is reconstructed for the normal map's normal from L0 and the L1 pages.
 // Compiled once per view, output encoding and material features, all defined by the renderer:
 // llvmpipe executes both sides of a branch, even on a uniform, so a texture fetch behind
 // `if (uHasTexture)` is paid by every fragment; each variant keeps only what it shows.
@@ -33,6 +34,12 @@
 #ifndef NEED_CHART
 #define NEED_CHART 1
 #endif
+#ifndef DIRECTIONAL
+#define DIRECTIONAL 0  // L1 SH with the normal map: 0 off, 1 normal map on TEXCOORD_0, 2 on TEXCOORD_1
+#endif
+#ifndef NEED_TANGENT
+#define NEED_TANGENT 0
+#endif
 
 #if NEED_NORMAL
 in vec3 vNormal;
@@ -46,6 +53,9 @@ in vec2 vUv1;
 #if NEED_CHART
 flat in float vChart;
 #endif
+#if NEED_TANGENT
+in vec4 vTangent;
+#endif
 
 uniform vec4 uBaseColorFactor;
 uniform sampler2D uBaseColorTex;   // linear (decoded from sRGB by the sampler or at load)
@@ -57,6 +67,9 @@ uniform vec2 uLightmapSize;        // page size in texels (density checker)
 uniform float uAlphaCutoff;
 uniform float uExposureScale;      // 2^EV (OUTPUT 1)
 uniform vec3 uLineColor;
+uniform sampler2D uNormalTex;      // glTF normalTexture, linear: tangent-space normal × 0.5 + 0.5
+uniform float uNormalScale;        // normalTexture.scale
+uniform sampler2D uL1x, uL1y, uL1z;  // L1 pages (values: world x, y, z component of t per colour channel)
 
 out vec4 fragColor;
 
@@ -64,6 +77,11 @@ out vec4 fragColor;
 #define BASE_UV vUv0
 #elif BASE_TEX == 2
 #define BASE_UV vUv1
+#endif
+#if DIRECTIONAL == 1
+#define NORMAL_UV vUv0
+#elif DIRECTIONAL == 2
+#define NORMAL_UV vUv1
 #endif
 #if EMISSIVE_TEX == 1
 #define EMISSIVE_UV vUv0
@@ -100,8 +118,30 @@ vec4 baseColor() {
   return base;
 }
 
+#if DIRECTIONAL
+// The world normal after the normal map (glTF 2.0: n = normalize(T·x + B·y + N·z), xy × scale, B =
+// cross(N, T)·w), with N the interpolated vertex normal and T made orthogonal to it.
+vec3 mappedNormal(vec3 ng) {
+  vec3 t = vTangent.xyz - ng * dot(ng, vTangent.xyz);
+  t *= inversesqrt(max(dot(t, t), 1e-20));
+  vec3 b = cross(ng, t) * (vTangent.w < 0.0 ? -1.0 : 1.0);
+  vec3 m = texture(uNormalTex, NORMAL_UV).xyz * 2.0 - 1.0;
+  m.xy *= uNormalScale;
+  return normalize(t * m.x + b * m.y + ng * m.z);
+}
+#endif
+
 vec3 lightmap() {
-#if HAS_LIGHTMAP
+#if HAS_LIGHTMAP && DIRECTIONAL
+  // transport/directional.h: value(n) = max(0, L0 (n_g·n) + t·n); the max is the deringing (one linear term
+  // is exact wherever no light arrives from below n's horizon, and would go negative where it does).
+  vec3 ng = normalize(vNormal);
+  vec3 n = mappedNormal(ng);
+  vec3 l0 = texture(uLightmap, vUv1).rgb * uLightmapScale;
+  vec3 v = l0 * dot(ng, n) + texture(uL1x, vUv1).rgb * n.x + texture(uL1y, vUv1).rgb * n.y +
+           texture(uL1z, vUv1).rgb * n.z;
+  return max(v, vec3(0.0));
+#elif HAS_LIGHTMAP
   return texture(uLightmap, vUv1).rgb * uLightmapScale;
 #else
   return vec3(1.0);

@@ -290,6 +290,7 @@ Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& char
     dst.positions.push_back(src.positions[inputVertex]);
     if (src.normals.size() == src.positions.size()) dst.normals.push_back(src.normals[inputVertex]);
     if (src.uv0.size() == src.positions.size()) dst.uv0.push_back(src.uv0[inputVertex]);
+    if (src.tangents.size() == src.positions.size()) dst.tangents.push_back(src.tangents[inputVertex]);
     dst.uv1.push_back(glm::vec2(texelUv * toUnit));
     dst.sourceVertex.push_back(src.sourceVertex.empty() ? inputVertex : src.sourceVertex[inputVertex]);
     return uint32_t(dst.positions.size() - 1);

@@ -235,6 +235,11 @@ json materialJson(const Scene& scene, const Material& m, GltfDocument& doc, std:
     mat["emissiveTexture"] = {{"index", texture(m.emissiveTexture, true)}};
     if (m.emissiveTexCoord) mat["emissiveTexture"]["texCoord"] = m.emissiveTexCoord;
   }
+  if (m.normalTexture >= 0 && !scene.textures.at(m.normalTexture).texels.empty()) {
+    mat["normalTexture"] = {{"index", texture(m.normalTexture, false)}};
+    if (m.normalTexCoord) mat["normalTexture"]["texCoord"] = m.normalTexCoord;
+    if (m.normalScale != 1.0f) mat["normalTexture"]["scale"] = m.normalScale;
+  }
   if (m.lightmapTexture >= 0 && !scene.textures.at(m.lightmapTexture).texels.empty()) {
     mat["extensions"]["MOZ_lightmap"] = {{"index", texture(m.lightmapTexture, false)}, {"texCoord", 1}, {"intensity", m.lightmapIntensity}};
     doc.useExtension("MOZ_lightmap");

@@ -152,6 +152,7 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 struct LocalPrimitive {
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> uv0, uv1;
+  std::vector<glm::vec4> tangents;  // TANGENT (LoadOptions::shadingMaps only)
   std::vector<uint32_t> indices;  // triangle list (strips and fans expanded)
   int material = -1;
   LightmapRef lightmap;
@@ -547,6 +548,7 @@ class Loader {
     readVec("NORMAL", 3, lp.normals);
     readVec("TEXCOORD_0", 2, lp.uv0);
     readVec("TEXCOORD_1", 2, lp.uv1);
+    if (options_.shadingMaps) readVec("TANGENT", 4, lp.tangents);
 
     std::vector<uint32_t> raw;
     if (prim.indices >= 0) {
@@ -640,8 +642,28 @@ class Loader {
       }
       if (out.indices.empty()) continue;
       scene_.stats.trianglesKept += out.indices.size() / 3;
+      worldTangents(lp, linear, mirrored, out);
       finishNormals(lp, normalMatrix, out);
       scene_.primitives.push_back(std::move(out));
+    }
+  }
+
+  // TANGENT to world space: xyz through the node's linear part (tangents follow the surface, unlike normals),
+  // w = ±1, flipped by a mirroring node (the bitangent cross(n, t)·w must stay the mirrored one). A zero or
+  // non-finite tangent drops the attribute: the viewer then generates the frame from the UVs.
+  void worldTangents(const LocalPrimitive& lp, const glm::mat3& linear, bool mirrored, Primitive& out) {
+    if (lp.tangents.size() != lp.positions.size()) return;
+    out.tangents.resize(lp.tangents.size());
+    for (size_t i = 0; i < lp.tangents.size(); ++i) {
+      const glm::vec3 t = linear * glm::vec3(lp.tangents[i]);
+      const float len = glm::length(t);
+      if (!(len > 0.0f) || !std::isfinite(len)) {
+        out.tangents.clear();
+        warn("mesh " + std::to_string(out.gltfMesh) + " has a zero or non-finite TANGENT: tangents are generated instead");
+        return;
+      }
+      const float w = (lp.tangents[i].w < 0.0f) != mirrored ? -1.0f : 1.0f;
+      out.tangents[i] = glm::vec4(t / len, w);
     }
   }
 
@@ -651,7 +673,7 @@ class Loader {
   // the accessor vertex). Smooth normals here bent a box's shading normals by up to 55° at its corners.
   void flatNormals(Primitive& out) {
     const size_t n = out.positions.size();
-    const bool hasUv0 = out.uv0.size() == n, hasUv1 = out.uv1.size() == n;
+    const bool hasUv0 = out.uv0.size() == n, hasUv1 = out.uv1.size() == n, hasTangents = out.tangents.size() == n;
     Primitive split;
     std::map<std::tuple<uint32_t, int, int, int>, uint32_t> copies;  // (vertex, quantised normal) → new vertex
     split.indices.reserve(out.indices.size());
@@ -666,6 +688,7 @@ class Loader {
           split.normals.push_back(f);
           if (hasUv0) split.uv0.push_back(out.uv0[v]);
           if (hasUv1) split.uv1.push_back(out.uv1[v]);
+          if (hasTangents) split.tangents.push_back(out.tangents[v]);
           split.sourceVertex.push_back(v);
         }
         split.indices.push_back(it->second);
@@ -675,6 +698,7 @@ class Loader {
     out.normals.swap(split.normals);
     if (hasUv0) out.uv0.swap(split.uv0);
     if (hasUv1) out.uv1.swap(split.uv1);
+    if (hasTangents) out.tangents.swap(split.tangents);
     out.indices.swap(split.indices);
     out.sourceVertex.swap(split.sourceVertex);
   }
@@ -768,6 +792,7 @@ class Loader {
         if (ti && ti->is_number_integer()) m.lightmapTexture = textureIndex(ti->get<int>(), srgb, m.name);
         m.lightmapIntensity = static_cast<float>(numberOr(child(*moz, "intensity"), 1.0));
       }
+      if (options_.shadingMaps) readShadingMaps(g, *mj, m);
     }
     if (g.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
     else if (g.alphaMode == "BLEND") m.alphaMode = AlphaMode::Blend;
@@ -778,6 +803,39 @@ class Loader {
     if (!finite(m.emissiveFactor) || !std::isfinite(m.emissiveStrength) || !std::isfinite(m.lightmapIntensity))
       invalid("material " + std::to_string(index) + " has a NaN/Inf emissive factor, strength or lightmap intensity");
     return m;
+  }
+
+  // The viewer's maps (LoadOptions::shadingMaps): the normal texture and IRBAKE_lightmap_directional
+  // (docs/export.md), all linear. An incomplete directional extension is ignored with a warning.
+  void readShadingMaps(const tinygltf::Material& g, const json& mj, Material& m) {
+    if (g.normalTexture.index >= 0) {
+      m.normalTexture = textureIndex(g.normalTexture.index, false, m.name);
+      m.normalTexCoord = g.normalTexture.texCoord;
+      m.normalScale = std::isfinite(g.normalTexture.scale) ? static_cast<float>(g.normalTexture.scale) : 1.0f;
+    }
+    const json* ext = path(mj, {"extensions", "IRBAKE_lightmap_directional"});
+    if (!ext || !ext->is_object()) return;
+    const json* l1 = child(*ext, "l1");
+    bool complete = l1 && l1->is_array() && l1->size() == 3;
+    for (int k = 0; complete && k < 3; ++k) {
+      const json* index = child((*l1)[k], "index");
+      const double scale = numberOr(child((*l1)[k], "scale"), 1.0);
+      if (!index || !index->is_number_integer() || !std::isfinite(scale) || !(scale >= 0.0)) {
+        complete = false;
+        break;
+      }
+      m.directionalTextures[k] = textureIndex(index->get<int>(), false, m.name);
+      m.directionalScales[k] = static_cast<float>(scale);
+    }
+    if (!complete) {
+      m.directionalTextures = {-1, -1, -1};
+      warn("material '" + m.name + "': IRBAKE_lightmap_directional needs three l1 textures with a finite scale: ignored");
+      return;
+    }
+    const json* exr = child(*ext, "exr");
+    if (exr && exr->is_array() && exr->size() == 3 && (*exr)[0].is_string() && (*exr)[1].is_string() && (*exr)[2].is_string())
+      for (int k = 0; k < 3; ++k)
+        m.directionalExrPaths[k] = (src_.folder / decodeUriEscapes((*exr)[k].get<std::string>())).string();
   }
 
   // (glTF texture, colour space) → Scene texture; texels are filled by decodeTextures().

@@ -11,6 +11,7 @@ namespace irbake {
 struct LoadOptions {
   bool decodeImages = true;      // decode base colour / emissive / lightmap images (false: textures stay empty)
   bool computeMissingNormals = true;  // flat normals when NORMAL is absent (the glTF rule; vertices split per face orientation)
+  bool shadingMaps = false;      // also TANGENT, normalTexture and IRBAKE_lightmap_directional (the viewer's; a bake skips them)
 };
 
 // Loads a glTF or GLB file. Throws Error(Io | Parse | InvalidData | EmptyScene, path, one-line message).

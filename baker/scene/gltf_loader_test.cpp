@@ -288,6 +288,58 @@ TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   EXPECT_EQ(std::filesystem::path(s.lightmapExrPaths[0]), dir / "pages/lightmap_0.exr");
 }
 
+// The viewer's maps (LoadOptions::shadingMaps): TANGENT to world space (w flipped by a mirroring node),
+// normalTexture (linear, texCoord, scale) and IRBAKE_lightmap_directional (three linear PNGs, scales, EXR paths
+// beside the glTF). A bake's load (the default options) reads none of them.
+TEST(GltfLoader, ShadingMapsTangentsNormalTextureAndDirectionalExtension) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}});
+  auto& prim = doc.root["meshes"][0]["primitives"][0];
+  prim["attributes"]["TEXCOORD_0"] = doc.addVec2({{0, 0}, {1, 0}, {0, 1}});
+  const std::vector<glm::vec4> tangents(3, glm::vec4(2, 0, 0, 1));  // unnormalised on purpose
+  doc.append("accessors", {{"bufferView", doc.addBufferView(tangents.data(), tangents.size() * sizeof(glm::vec4), 34962)},
+                           {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+  prim["attributes"]["TANGENT"] = doc.root["accessors"].size() - 1;
+  prim["material"] = 0;
+  Texture t;
+  t.width = t.height = 1;
+  t.texels = {glm::vec4(128 / 255.0f, 64 / 255.0f, 1.0f, 1.0f)};
+  auto texture = [&](const char* name) { return doc.addTexture(doc.addPngImage(encodePng(t, false), name), -1); };
+  const int normal = texture("normal");
+  json l1 = json::array();
+  for (int k = 0; k < 3; ++k) l1.push_back({{"index", texture("l1")}, {"texCoord", 1}, {"scale", 0.25 * (k + 1)}});
+  doc.append("materials", {{"normalTexture", {{"index", normal}, {"texCoord", 0}, {"scale", 0.5}}},
+                           {"extensions", {{"IRBAKE_lightmap_directional",
+                                            {{"l1", l1}, {"exr", {"a_l1x.exr", "a_l1y.exr", "a%20l1z.exr"}}}}}}});
+  doc.root["nodes"][0]["scale"] = {-1, 1, 1};  // mirrored: w flips, xyz follows the node
+  auto dir = testFolder("loader_shading_maps");
+  writeDocument(doc, dir / "s.gltf");
+  LoadOptions viewer;
+  viewer.shadingMaps = true;
+  const Scene s = loadScene(dir / "s.gltf", viewer);
+  const Primitive& p = s.primitives[0];
+  ASSERT_EQ(p.tangents.size(), 3u);
+  expectNear(glm::vec3(p.tangents[0]), {-1, 0, 0});
+  EXPECT_EQ(p.tangents[0].w, -1.0f);
+  const Material& m = s.materials[0];
+  ASSERT_GE(m.normalTexture, 0);
+  EXPECT_EQ(m.normalTexCoord, 0);
+  EXPECT_FLOAT_EQ(m.normalScale, 0.5f);
+  EXPECT_NEAR(s.textures[m.normalTexture].texels[0].g, 64.0f / 255.0f, 1e-6f);  // linear, not sRGB-decoded
+  ASSERT_TRUE(m.hasDirectionalTextures());
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_FLOAT_EQ(m.directionalScales[k], 0.25f * (k + 1));
+    EXPECT_NEAR(s.textures[m.directionalTextures[k]].texels[0].r, 128.0f / 255.0f, 1e-6f);
+  }
+  EXPECT_EQ(std::filesystem::path(m.directionalExrPaths[0]), dir / "a_l1x.exr");
+  EXPECT_EQ(std::filesystem::path(m.directionalExrPaths[2]), dir / "a l1z.exr");
+
+  const Scene bake = loadScene(dir / "s.gltf");
+  EXPECT_TRUE(bake.primitives[0].tangents.empty());
+  EXPECT_EQ(bake.materials[0].normalTexture, -1);
+  EXPECT_FALSE(bake.materials[0].hasDirectionalTextures());
+  EXPECT_TRUE(bake.textures.empty());
+}
+
 TEST(GltfLoader, ExrAndMissingImagesLoadWithWarnings) {
   GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
   doc.root["meshes"][0]["primitives"][0]["material"] = 0;

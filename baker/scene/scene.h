@@ -1,6 +1,7 @@
 // The scene model every stage reads: world-space triangles, materials, textures, lights, cameras.
 // Units: metres; radiometric quantities in watts (see docs/units.md).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -49,6 +50,18 @@ struct Material {
   int gltfMaterial = -1;            // source index, -1 for the default material
   int lightmapTexture = -1;         // MOZ_lightmap texture (index into Scene::textures), -1 none
   float lightmapIntensity = 1.0f;   // MOZ_lightmap intensity: map value = PNG value × intensity
+  // Read only with LoadOptions::shadingMaps (the viewer shades with them; a bake never reads them):
+  int normalTexture = -1;           // normalTexture (index into Scene::textures, linear), -1 none
+  int normalTexCoord = 0;           // which TEXCOORD set it reads
+  float normalScale = 1.0f;         // normalTexture.scale: tangent-space x and y are multiplied by it
+  // IRBAKE_lightmap_directional (docs/export.md): the L1x/L1y/L1z PNGs (indices into Scene::textures, linear,
+  // value = (2·texel − 1)·scale), -1 none; and the float EXR pages, resolved beside the glTF ("" none).
+  std::array<int, 3> directionalTextures{-1, -1, -1};
+  std::array<float, 3> directionalScales{1.0f, 1.0f, 1.0f};
+  std::array<std::string, 3> directionalExrPaths;
+  bool hasDirectionalTextures() const {
+    return directionalTextures[0] >= 0 && directionalTextures[1] >= 0 && directionalTextures[2] >= 0;
+  }
   // Emitted radiance scale (W/(m² sr)) before the emissive texture: factor × strength.
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   // Light passes through (docs/units.md, "See-through surfaces"): BLEND (fraction 1 − α) or transmission.
@@ -72,6 +85,9 @@ struct Primitive {
   bool normalsComputed = false;      // the loader made them (NORMAL absent): their breaks are not authored seams
   std::vector<glm::vec2> uv0;        // TEXCOORD_0 (empty when absent)
   std::vector<glm::vec2> uv1;        // TEXCOORD_1: lightmap UV in [0,1] over the page (empty when absent)
+  // TANGENT, world space: xyz unit, w = ±1 the bitangent's sign (glTF: bitangent = cross(normal, xyz) · w);
+  // read only with LoadOptions::shadingMaps, empty when absent.
+  std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices;     // triangle list, counter-clockwise front faces in world space
   int material = 0;                  // index into Scene::materials (always valid: a default is added)
   int node = -1, gltfMesh = -1, gltfPrimitive = -1;  // provenance for export
