@@ -63,7 +63,7 @@ struct BakeOptions {
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: 256 with
                                           // bias compensation, 16 without (docs/accuracy.md)
   std::optional<int> interleave;          // n ≥ 1: VPLs split over n×n texel classes (Keller & Heidrich 2001),
-                                          // 1 = off; unset: automatic (chooseInterleave: 1…4)
+                                          // 1 = off; unset: automatic (chooseInterleave: 1…6)
   GlBackendOptions gl;                    // GL backend: cube face size (unset = from the light map), VPLs per pass, biases
   OverlapCompensation overlapCompensation = OverlapCompensation::Auto;  // compensation rays beside the GL bake
   int vplBlock = 512;                     // VPLs per block of the exact VPL sum (within one interleave class):

@@ -51,7 +51,7 @@ int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, i
   const float h = spacings[spacings.size() / 2];
   if (!(clampBound > 0.0f)) return std::max(1, maxN);
   const float clampRadius = 1.0f / std::sqrt(clampBound);
-  return static_cast<int>(std::clamp(std::floor(clampRadius / (16.0f * h)), 1.0f, static_cast<float>(std::max(1, maxN))));
+  return static_cast<int>(std::clamp(std::floor(clampRadius / (10.0f * h)), 1.0f, static_cast<float>(std::max(1, maxN))));
 }
 
 std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n) {

@@ -33,9 +33,12 @@ struct InterleaveStats {
 std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages, int n, int cx, int cy);
 
 // The automatic n: the class filter (half-width n texels) must stay well inside the scale on which the
-// clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (16 h)⌋, 1, maxN), h the median
-// texel spacing over the pages. Cornell box, 1024 paths: 9.7k texels (h = 14 mm) → 1; 251k (2.8 mm) → 4.
-int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 4);
+// clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (10 h)⌋, 1, maxN), h the median
+// texel spacing over the pages. Cornell box, 1024 paths: 9.7k texels (h = 14 mm) → 1; 609k (1.75 mm),
+// 6144 paths (r_c = 10.6 cm) → 6. Session 6, against Cycles in our atlas: 6×6 classes with 6144 paths
+// cost less than 4×4 with 4096 and are more accurate (sample box 1.99 → 1.63%, McGuire 1.79 → 1.65%),
+// while 8×8 blurs (4096 paths: 2.24%; docs/accuracy.md).
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 6);
 
 // The VPLs of each of the n² classes (class c = cx + n·cy): per bounce the c-th contiguous chunk in path
 // order, power × bounce count / chunk count. n ≤ 1: one class with every VPL, unscaled, in path order.
