@@ -3,9 +3,12 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 #include <future>
 #include <memory>
+
+#include <algorithm>
 
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
@@ -198,9 +201,13 @@ struct StagedBake::State {
       eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
       return;
     }
+    const bool emitters = std::any_of(scene.primitives.begin(), scene.primitives.end(), [&](const Primitive& p) {
+      return p.material < scene.materials.size() && scene.materials[p.material].isEmissive();
+    });
     clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
-             : eval.biasCompensation     ? kCompensatedClampVplsPerMean
-                                         : kClampVplsPerMean;
+             : !eval.biasCompensation     ? kClampVplsPerMean
+             : emitters                   ? kCompensatedClampVplsPerMean
+                                          : kCompensatedClampVplsPerMeanNoEmitters;
     eval.clampBound = deriveClampBound(scene, vpls, clampK);
     clampDerived = true;
   }

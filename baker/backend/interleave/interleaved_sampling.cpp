@@ -73,10 +73,15 @@ std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n) {
     for (const auto& list : byBounce) {
       // Class c takes the c-th contiguous chunk of this bounce's VPLs (in path order): consecutive
       // Halton points stay well stratified, every k-th ones do not (base 2: every 4th point of Φ2
-      // lies in one quarter of [0,1)). Scale = the bounce's count over the chunk's.
+      // lies in one quarter of [0,1)). Scale = the bounce's count over the chunk's, so that each class
+      // alone estimates the bounce's whole sum. A bounce with fewer VPLs than classes leaves some chunks
+      // empty: there every VPL is in a class of its own and counts m times (the mix averages the m
+      // classes, so each VPL is counted exactly once); count/1 would drop (m − count)/m of its light
+      // (Sponza's deep bounces, 1–13 VPLs each with 16–36 classes).
       const size_t count = list.size(), b0 = count * c / m, b1 = count * (c + 1) / m;
       if (b1 <= b0) continue;
-      const float scale = static_cast<float>(count) / static_cast<float>(b1 - b0);
+      const float scale = count >= static_cast<size_t>(m) ? static_cast<float>(count) / static_cast<float>(b1 - b0)
+                                                          : static_cast<float>(m);
       for (size_t k = b0; k < b1; ++k) {
         Vpl v = vpls.vpls[list[k]];
         v.power *= scale;

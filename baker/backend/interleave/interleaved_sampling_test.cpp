@@ -42,6 +42,29 @@ TEST(InterleavedSampling, ClassesPartitionTheTexels) {
   }
 }
 
+// The mix averages the m = n² classes, so every bounce's light survives the split exactly when the
+// classes' powers of that bounce sum to m times its power: also for a bounce with fewer VPLs than
+// classes (Sponza's deep bounces), whose VPLs then sit one per class.
+TEST(InterleavedSampling, ClassSubsetsKeepEveryBouncesPower) {
+  VplSet vpls;
+  const int counts[] = {32, 3, 1};  // bounce 0: a multiple of m; bounces 1, 2: fewer than m
+  for (int b = 0; b < 3; ++b)
+    for (int k = 0; k < counts[b]; ++k)
+      vpls.vpls.push_back(Vpl{glm::vec3(0.0f), glm::vec3(0, 1, 0), glm::vec3(1.0f + 0.25f * k), b});
+  for (int n : {2, 4}) {
+    const int m = n * n;
+    const std::vector<VplSet> subsets = classVplSubsets(vpls, n);
+    ASSERT_EQ(subsets.size(), static_cast<size_t>(m));
+    for (int b = 0; b < 3; ++b) {
+      double whole = 0.0, classes = 0.0;
+      for (const Vpl& v : vpls.vpls) whole += v.bounce == b ? v.power.x : 0.0;
+      for (const VplSet& s : subsets)
+        for (const Vpl& v : s.vpls) classes += v.bounce == b ? v.power.x : 0.0;
+      EXPECT_NEAR(classes / (m * whole), 1.0, 1e-6) << "n = " << n << ", bounce " << b;
+    }
+  }
+}
+
 // Point light over a black floor: no VPL at all, so the interleaved bake is the exact direct light.
 TEST(InterleavedSampling, PunctualLightsStayExact) {
   Scene s;
