@@ -82,7 +82,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
           ->type_name("B");
   app->add_option("--clamp-k", o.clampVplsPerMean,
                   "derived clamp: no VPL adds more than 1/K of the mean\n"
-                  "(default with bias compensation: 256, or 2048 in a scene\nwithout emissive surfaces; 16 without; 0 = automatic)")
+                  "(default with bias compensation: 256, or 1024 in a scene\nwithout emissive surfaces; 16 without; 0 = automatic)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
   app->add_flag("--no-bias-compensation", noBiasCompensation,
                "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");

@@ -61,7 +61,7 @@ struct BakeOptions {
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
   float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: with bias
-                                          // compensation 256 (emissive surfaces) or 2048 (none), 16 without
+                                          // compensation 256 (emissive surfaces) or 1024 (none), 16 without
   std::optional<int> interleave;          // n ≥ 1: VPLs split over n×n texel classes (Keller & Heidrich 2001),
                                           // 1 = off; unset: automatic (chooseInterleave: 1…6)
   GlBackendOptions gl;                    // GL backend: cube face size (unset = from the light map), VPLs per pass, biases

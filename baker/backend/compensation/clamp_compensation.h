@@ -32,14 +32,15 @@ namespace irbake {
 // texels, 1024 paths: relative RMSE 7.97% (k = 16, no compensation) → 3.25% (k = 256, compensated);
 // 4096 paths: 3.42% → 1.55%. k = 512 / 1024 were worse (3.97% / 6.2%: the gather's own noise).
 constexpr double kCompensatedClampVplsPerMean = 256.0;
-// The same without emissive surfaces (punctual lights, sun, sky): the gather then reads only ρ·M, which
-// is as smooth as the map (the direct light in it is exact), while what limited k above was its rays
-// finding a small bright emitter. A tighter clamp hands more of the transport to the gather instead of to
-// the few VPLs that reach a region: Sponza's upper gallery, lit by a sunlit patch of its own floor and
-// the courtyard, is one of them (4 texels/m against our path tracer, 4 walk seeds: 0.85 / 0.79 / 1.66 /
-// 1.14 of it at k = 256, 0.99 / 0.96 / 1.11 / 1.02 at k = 4096; against Cycles at full density, view 3:
-// 12.4% → 7.5%, mean 0.92 → 0.97; docs/accuracy.md, session 6).
-constexpr double kCompensatedClampVplsPerMeanNoEmitters = 2048.0;
+// The same without emissive surfaces (punctual lights, sun, sky): the gather then reads only ρ·M (the
+// direct light in M exact), while what limited k above was its rays finding a small bright emitter. A
+// tighter clamp hands more of the transport to the gather instead of to the few VPLs that reach a region:
+// Sponza's upper gallery, lit by a sunlit patch of its own floor and the courtyard, is one (4 texels/m
+// against our path tracer, 4 walk seeds: 0.85 / 0.79 / 1.66 / 1.14 of it at k = 256, 0.99 / 0.96 / 1.11 /
+// 1.02 at k = 4096). Against Cycles at full density (views 2 / 3, 4×4 bins): sun alone 2.5 / 7.4% at
+// k = 256, 2.4 / 6.0% at 512, 3.2 / 5.7% at 1024, 3.8 / 6.2% at 2048; sun + sky 2.5 / 12.4%, 2.8 / 9.7%,
+// 3.1 / 7.8%, 3.2 / 7.5%: a sharp sunlit map makes the gather noisy in close-ups (view 2) as k grows.
+constexpr double kCompensatedClampVplsPerMeanNoEmitters = 1024.0;
 
 struct ClampCompensationOptions {
   int rays = 16;               // cosine rays per texel sample in the first round (fewer if over the budget)
