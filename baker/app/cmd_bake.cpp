@@ -91,6 +91,10 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
       ->transform(cli::integerIn(0, 65536))->type_name("N");
+  app->add_option("--comp-ray-budget", o.compensation.rayBudget,
+                  "bias compensation: first-round rays over all samples (default 2097152;\n"
+                  "a large page gets fewer per sample, never below 4; 0 = no cap)")
+      ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
   app->add_option("--interleave", a.interleave,
                   "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                   "of the VPLs, then a filter on the surface mixes them\n"
