@@ -30,7 +30,7 @@ struct BakeArguments {
   std::string backend = "auto", shard;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0;
-  int bounces = -1, interleave = 0, cubeFace = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
+  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
@@ -95,6 +95,11 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "bias compensation: first-round rays over all samples (default 2097152;\n"
                   "a large page gets fewer per sample, never below 4; 0 = no cap)")
       ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
+  app->add_option("--comp-filter", a.compFilter,
+                  "bias compensation: the residual averaged over (2R+1)² texels on\n"
+                  "the same surface (default auto: up to 4 where the rays per sample are\n"
+                  "few and R texels stay within 1/20 of the clamp radius; 0 = none)")
+      ->transform(cli::integerOrAuto(0, 8, -1))->type_name("R|auto");
   app->add_option("--interleave", a.interleave,
                   "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                   "of the VPLs, then a filter on the surface mixes them\n"
@@ -182,6 +187,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.texels.leakControl = !a.noLeakControl;
   if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
   if (a.interleave > 0) o.interleave = a.interleave;
+  if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;
   if (a.clampOption->count() > 0) {  // --clamp 0: no clamp; none given: derived
     o.clamp = a.clamp > 0.0 ? ClampMode::Fixed : ClampMode::Off;

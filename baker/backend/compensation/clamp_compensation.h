@@ -51,7 +51,7 @@ struct ClampCompensationOptions {
   float refineFraction = 0.0f; // least this fraction of the first rays hit clamped transport (0: any hit;
                                // Cornell 9.7k texels, 1024 paths: 3.25% with 0, 4.42% with 0.25)
   std::optional<int> filterRadius;  // residual smoothed over (2r+1)² texels on the same surface (0: none); unset:
-                                    // auto (below 32 rays: r ≤ 2 with r texels ≤ r_c / 20, r_c = 1/√B)
+                                    // auto (below 32 rays: r ≤ 4 with r texels ≤ r_c / 20, r_c = 1/√B)
   int sweeps = 8;              // at most this many Jacobi sweeps; each reads the map with the previous sweep's
                                // residual added (furnished room, N = 1024: 3 sweeps 2.75%, 8: 2.54%)
   double sweepTolerance = 5e-4;  // stop when a sweep changes the summed map by less than this fraction (< 0: never),
