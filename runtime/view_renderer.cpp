@@ -66,6 +66,21 @@ GLuint uploadLightmap(int width, int height, GLenum format, const void* data) {
   return tex;
 }
 
+// An environment map (Environment::texels, rows top to bottom) as RGB32F: the sky shader reads it with
+// texelFetch, so screenshots hold the map's radiance exactly.
+GLuint uploadEnvironment(const Environment& env) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, env.width(), env.height(), 0, GL_RGB, GL_FLOAT, env.texels().data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
 struct Vertex {
   glm::vec3 position, normal;
   glm::vec2 uv0, uv1;
@@ -167,6 +182,39 @@ struct ViewRenderer::Impl {
   std::map<std::pair<int, float>, GLuint> directionalPngs;    // (Scene::textures index, scale) → decoded L1
   std::vector<GpuPrimitive> prims;
   std::unique_ptr<RenderTarget> offscreen;  // float target of render(), resized on demand
+  GLuint environmentTexture = 0;           // the scene's environment map (0: none, or a uniform sky)
+  float environmentRotation = 0.0f;
+  std::unique_ptr<GlProgram> skyPrograms[2];  // view_sky per OUTPUT (0 linear, 1 exposure + sRGB)
+  GLuint skyVao = 0;                        // empty: the sky triangle comes from gl_VertexID
+
+  // Draws the environment map over the whole viewport, without depth, before the scene.
+  void drawSky(const glm::mat4& viewProjection, int width, int height, bool encode, float exposure) {
+    std::unique_ptr<GlProgram>& sky = skyPrograms[encode ? 1 : 0];
+    if (!sky)
+      sky = std::make_unique<GlProgram>(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_sky.vert"}},
+                                                                 {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_sky.frag"}}},
+                                        std::vector<std::string>{encode ? "#define OUTPUT 1" : "#define OUTPUT 0"},
+                                        "330 core");
+    if (!skyVao) glGenVertexArrays(1, &skyVao);
+    sky->use();
+    const glm::mat4 inverse = glm::inverse(viewProjection);
+    glUniformMatrix4fv(sky->uniform("uInverseViewProjection"), 1, GL_FALSE, &inverse[0][0]);
+    glUniform2f(sky->uniform("uViewportSize"), static_cast<float>(width), static_cast<float>(height));
+    glUniform1i(sky->uniform("uEnvironment"), 0);
+    glUniform1f(sky->uniform("uRotation"), environmentRotation);
+    glUniform1f(sky->uniform("uExposureScale"), std::exp2(exposure));
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, environmentTexture);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glBindVertexArray(skyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glDepthMask(GL_TRUE);
+    glUseProgram(0);
+    program = 0;
+  }
 
   explicit Impl(const Scene& s) : scene(s) {}
 
@@ -196,7 +244,7 @@ struct ViewRenderer::Impl {
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
-                                                          {GL_FRAGMENT_SHADER, {"view_mesh.frag"}}},
+                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_mesh.frag"}}},
                                  defines, "330 core"))
                .first;
     }
@@ -272,6 +320,11 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
       I.directionalPageTextures[k].push_back(page.size() > 0 && page.texels.size() == page.size()
                                                  ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
                                                  : 0);
+
+  if (v.scene.environment.present() && !v.scene.environment.isUniform()) {
+    I.environmentTexture = uploadEnvironment(v.scene.environment);
+    I.environmentRotation = v.scene.environment.rotation();
+  }
 
   uint32_t chartBase = 0, nextChartBase = 0;
   for (const Primitive& p : v.scene.primitives) {
@@ -401,6 +454,9 @@ ViewRenderer::~ViewRenderer() {
     for (GLuint t : axis)
       if (t) glDeleteTextures(1, &t);
   for (auto& [key, t] : I.directionalPngs) glDeleteTextures(1, &t);
+  if (I.environmentTexture) glDeleteTextures(1, &I.environmentTexture);
+  if (I.skyVao) glDeleteVertexArrays(1, &I.skyVao);
+  for (auto& sky : I.skyPrograms) sky.reset();
   I.offscreen.reset();
   I.programs.clear();
 }
@@ -415,6 +471,11 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   glClearColor(background.r, background.g, background.b, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  const float aspect = static_cast<float>(width) / std::max(height, 1);
+  const glm::mat4 vp = camera.projection(aspect) * camera.view();
+  // An environment map is drawn itself (the clear colour, its mean, stays underneath for nothing).
+  if (I.environmentTexture && settings.drawEnvironment)
+    I.drawSky(vp, width, height, settings.encodeSrgb, settings.exposure);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   // Culling only for closed outward solids (isClosedOutward): a wall seen from behind is still drawn,
@@ -422,8 +483,6 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
-  const float aspect = static_cast<float>(width) / std::max(height, 1);
-  const glm::mat4 vp = camera.projection(aspect) * camera.view();
 
   const int output = settings.encodeSrgb ? 1 : 0;
   const bool sh = settings.lightmapMode == LightmapMode::Sh;

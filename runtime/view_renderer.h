@@ -31,6 +31,7 @@ struct DrawSettings {
   float exposure = 0.0f;           // EV stops, display only (×2^EV before the sRGB encode)
   bool encodeSrgb = false;         // true: exposure + sRGB in the shader (window); false: linear out
   glm::vec3 background{0.0f};      // clear colour (linear radiance; exposed and encoded like the scene)
+  bool drawEnvironment = true;     // a scene with an environment map shows the map behind it (else background)
 };
 
 // Linear RGBA float image, row 0 at the top.
@@ -82,7 +83,8 @@ class ViewRenderer {
   size_t directionalPrimitives_ = 0;
 };
 
-// The background for a scene: its sky's radiance (a map's mean radiance), black without a sky.
+// The background colour for a scene: its sky's radiance (a map's mean radiance: the renderer draws the map itself
+// over it, DrawSettings::drawEnvironment), black without a sky.
 inline glm::vec3 skyBackground(const Scene& scene) {
   if (!scene.environment.present()) return glm::vec3(0.0f);
   if (scene.environment.isUniform()) return scene.environment.uniformRadiance();

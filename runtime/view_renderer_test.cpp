@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -358,6 +359,112 @@ TEST(ViewRenderer, SkyIsTheBackground) {
   EXPECT_NEAR(img.at(0, 0).g, 0.5f, 1e-3f);
   EXPECT_NEAR(img.at(0, 0).b, 1.0f, 1e-3f);
   EXPECT_EQ(skyBackground(Scene{}), glm::vec3(0.0f));  // no sky: black
+}
+
+// Issue 12: an environment map is drawn itself behind the scene. A 16 × 8 map with a distinct radiance per texel,
+// turned 40° about +Y: every background pixel whose view direction lies inside a texel (not within 2% of a texel
+// edge, where float and double directions may pick different neighbours) shows exactly the texel the baker's
+// Environment::radiance reads for that direction; pixels on the floor quad show the quad. On screen the same
+// pixels are exposed and sRGB-encoded like the scene's.
+TEST(ViewRenderer, EnvironmentMapIsDrawnBehindTheScene) {
+  GlContext gl;
+  const int mapW = 16, mapH = 8;
+  std::vector<glm::vec3> texels;
+  for (int y = 0; y < mapH; ++y)
+    for (int x = 0; x < mapW; ++x)
+      texels.emplace_back(0.05f + x / 16.0f, 0.05f + y / 8.0f, 0.3f + 0.02f * static_cast<float>((x * 7 + y * 3) % 11));
+  const float rotation = glm::radians(40.0f);
+  Scene s;
+  Material m;
+  m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+  s.materials.push_back(m);
+  addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0, -1, 0);
+  s.environment = Environment::fromEquirect(mapW, mapH, texels, 1.0f, rotation);
+  const Environment env = s.environment;
+  ViewerScene v = makeViewerScene(std::move(s), {});
+  ViewRenderer r(v);
+  const int w = 96, h = 64;
+  // From above the quad's corner, looking out and up: the quad, the horizon and most of a hemisphere of sky.
+  const ViewCamera cam = lookAt({0.8f, 0.6f, 0.8f}, {2.0f, 1.0f, -0.6f}, 120.0f, v.scene.bounds());
+  DrawSettings settings;
+  settings.background = skyBackground(v.scene);
+  const RgbaImage img = r.render(cam, w, h, settings);
+  const glm::mat4 inv = glm::inverse(cam.projection(static_cast<float>(w) / h) * cam.view());
+  auto directionOf = [&](int x, int y) {
+    const glm::vec2 ndc((x + 0.5f) / w * 2 - 1, 1 - (y + 0.5f) / h * 2);
+    const glm::vec4 a = inv * glm::vec4(ndc, -1, 1), b = inv * glm::vec4(ndc, 0, 1);
+    return std::pair{glm::vec3(a) / a.w, glm::normalize(glm::vec3(b) / b.w - glm::vec3(a) / a.w)};
+  };
+  auto insideATexel = [&](const glm::vec3& d) {  // the continuous map coordinates, away from texel edges
+    const double c = std::cos(rotation), sn = std::sin(rotation);
+    const glm::dvec3 mdir(c * d.x - sn * d.z, d.y, sn * d.x + c * d.z);
+    const double u = (std::atan2(mdir.x, -mdir.z) + kPi) / (2 * kPi) * mapW;
+    const double vv = std::acos(std::clamp(mdir.y, -1.0, 1.0)) / kPi * mapH;
+    auto away = [](double t) { return std::abs(t - std::round(t)) > 0.02; };
+    return away(u) && away(vv);
+  };
+  size_t sky = 0, floor = 0;
+  std::vector<int> seen(mapW * mapH, 0);
+  float worstSky = 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto [origin, d] = directionOf(x, y);
+      const glm::vec3 hit = origin + d * (-origin.y / d.y);
+      const bool onQuad = d.y < 0 && std::abs(hit.x) < 1 && std::abs(hit.z) < 1;
+      const bool nearEdge = d.y < 0 && std::abs(std::max(std::abs(hit.x), std::abs(hit.z)) - 1.0f) < 0.05f;
+      if (nearEdge) continue;
+      if (onQuad) {
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.at(x, y)[c], 0.5f, 1e-6f) << x << "," << y;
+        ++floor;
+        continue;
+      }
+      if (!insideATexel(d)) continue;
+      const glm::vec3 expected = env.radiance(d);
+      for (int c = 0; c < 3; ++c) worstSky = std::max(worstSky, std::abs(img.at(x, y)[c] - expected[c]));
+      for (int i = 0; i < mapW * mapH; ++i)
+        if (texels[i] == expected) seen[i] = 1;
+      ++sky;
+    }
+  int texelsSeen = 0;
+  for (int k : seen) texelsSeen += k;
+  std::printf("[ figure ] environment background: %zu sky pixels, %d texels, worst |pixel − texel| %.2g; %zu floor pixels\n",
+              sky, texelsSeen, worstSky, floor);
+  EXPECT_EQ(worstSky, 0.0f);  // RGB32F texel, fetched: the same float
+  EXPECT_GT(sky, 3000u);
+  EXPECT_GT(floor, 300u);
+  EXPECT_GE(texelsSeen, 30);
+
+  // The window's path: exposure +1 EV and the sRGB encode, like the scene's pixels.
+  RenderTarget target(w, h, GL_RGBA32F);
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer());
+  settings.encodeSrgb = true;
+  settings.exposure = 1.0f;
+  r.draw(cam, w, h, settings);
+  std::vector<glm::vec4> shown(static_cast<size_t>(w) * h);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, shown.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  float worstShown = 0.0f;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto [origin, d] = directionOf(x, y);
+      if (d.y < 0.05f || !insideATexel(d)) continue;  // sky only
+      const glm::vec3 L = env.radiance(d);
+      const glm::vec4& p = shown[static_cast<size_t>(h - 1 - y) * w + x];  // GL rows bottom up
+      for (int c = 0; c < 3; ++c) {
+        const double e = std::min(1.0, 2.0 * L[c]);
+        const double srgb = e <= 0.0031308 ? 12.92 * e : 1.055 * std::pow(e, 1.0 / 2.4) - 0.055;
+        worstShown = std::max(worstShown, static_cast<float>(std::abs(p[c] - srgb)));
+      }
+    }
+  std::printf("[ figure ] environment background on the display path: worst |pixel − sRGB(2L)| %.2g\n", worstShown);
+  EXPECT_LT(worstShown, 5e-4f);  // the shader's fitted encode: 3.6e-4 (view_encode.glsl)
+
+  // drawEnvironment = false: the flat background (the map's mean) as before.
+  settings = DrawSettings{};
+  settings.background = skyBackground(v.scene);
+  settings.drawEnvironment = false;
+  const RgbaImage flat = r.render(cam, w, h, settings);
+  EXPECT_NEAR(flat.at(w / 2, 2).r, settings.background.r, 1e-6f);
 }
 
 TEST(ViewRenderer, DebugViewsDifferFromLitAndStayFinite) {

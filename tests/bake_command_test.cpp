@@ -504,6 +504,38 @@ TEST(BakeCommand, SkyTravelsWithTheExport) {
       << log;
 }
 
+// Issue 12: an environment map travels as its file, mean radiance and rotation; the loader reads the file back
+// with the bake's --env-intensity (recovered from the recorded mean) and rotation, so irview draws the sky the bake
+// saw: every texel centre's direction returns intensity × the file's texel.
+TEST(BakeCommand, EnvironmentMapTravelsWithTheExport) {
+  const fs::path dir = scratch("env_export");
+  Lightmap map;
+  map.width = 8;
+  map.height = 4;
+  for (int i = 0; i < 32; ++i) map.texels.push_back(glm::vec3(0.1f + 0.05f * i, 0.2f + 0.02f * (i % 8), 0.3f));
+  map.valid.assign(32, 1);
+  writeExr(map, dir / "sky.exr");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(dir / "out") +
+                          " --vpls 64 --texels-per-unit 2 --quiet --env " + q(dir / "sky.exr") +
+                          " --env-intensity 2.5 --env-rotation 30",
+                      &log),
+            0)
+      << log;
+  const Scene back = loadScene(dir / "out" / "scene.gltf");
+  ASSERT_TRUE(back.environment.present());
+  ASSERT_FALSE(back.environment.isUniform());
+  EXPECT_NEAR(back.environment.rotation(), 30.0 * M_PI / 180.0, 1e-6);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const double theta = M_PI * (y + 0.5) / 4, phi = 2 * M_PI * (x + 0.5) / 8 - M_PI, r = 30.0 * M_PI / 180.0;
+      const glm::dvec3 m(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const glm::vec3 d(std::cos(r) * m.x + std::sin(r) * m.z, m.y, -std::sin(r) * m.x + std::cos(r) * m.z);
+      const glm::vec3 expected = 2.5f * map.texels[size_t(y) * 8 + x], got = back.environment.radiance(d);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expected[c], 1e-5f * expected[c]) << x << "," << y;
+    }
+}
+
 // Issue 14: the report is part of the all-or-nothing set: when it cannot be written, neither are the glTF,
 // its .bin and PNG, nor the EXR pages.
 TEST(BakeCommand, ReportIsWrittenWithTheOutputsOrNotAtAll) {

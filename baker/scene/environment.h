@@ -31,6 +31,8 @@ class Environment {
   int width() const { return width_; }
   int height() const { return height_; }
   float rotation() const { return rotation_; }
+  // The map's texels (width × height, rows top to bottom, intensity applied); empty for a uniform sky.
+  const std::vector<glm::vec3>& texels() const { return texels_; }
 
   // Radiance arriving from direction `towardSky` (unit, pointing away from the receiver).
   glm::vec3 radiance(const glm::vec3& towardSky) const;

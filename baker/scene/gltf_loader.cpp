@@ -917,12 +917,18 @@ class Loader {
       return;
     }
     const json* file = child(*sky, "environment");
+    const bool hasMean = rgb(child(*sky, "meanRadiance"), L);
     if (file && file->is_string() && std::filesystem::exists(file->get<std::string>())) {
-      scene_.environment = loadEnvironment(file->get<std::string>(), 1.0f,
-                                           static_cast<float>(numberOr(child(*sky, "rotation"), 0.0) * 180.0 / kPi));
+      const float degrees = static_cast<float>(numberOr(child(*sky, "rotation"), 0.0) * 180.0 / kPi);
+      scene_.environment = loadEnvironment(file->get<std::string>(), 1.0f, degrees);
+      // The export records no --env-intensity, but its mean radiance is the file's × intensity: recover it.
+      const glm::dvec3 fileMean = scene_.environment.integral() / (4.0 * kPi);
+      const double fileSum = fileMean.x + fileMean.y + fileMean.z, intensity = (double(L.x) + L.y + L.z) / fileSum;
+      if (hasMean && fileSum > 0.0 && std::isfinite(intensity) && std::abs(intensity - 1.0) > 1e-6)
+        scene_.environment = loadEnvironment(file->get<std::string>(), static_cast<float>(intensity), degrees);
       return;
     }
-    if (rgb(child(*sky, "meanRadiance"), L)) scene_.environment = Environment::uniform(L);
+    if (hasMean) scene_.environment = Environment::uniform(L);
   }
 
   void readLightmapPages() {

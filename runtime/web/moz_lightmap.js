@@ -5,17 +5,43 @@
 // three.js treats lightMap as irradiance and shades it with BRDF_Lambert = albedo/π, so the
 // lightMapIntensity it needs is intensity × π. Materials with a light map become MeshLambertMaterial
 // (a physical material would add a specular term the bake does not have).
-import { MeshLambertMaterial, SRGBColorSpace, NoColorSpace } from 'three';
+//
+// Directional maps (IRBAKE_lightmap_directional, docs/export.md): a material with it and a normalTexture is
+// shaded, per channel, with lightmap(n) = max(0, L0 · (n_g·n) + t·n) (baker/transport/directional.h, as irview's
+// view_mesh.frag): L0 the MOZ_lightmap value, t the world-space L1 vector decoded from the three linear PNGs as
+// (2 · texel − 1) · scale, n_g the interpolated vertex normal, n the normal after three.js's normal map, both
+// taken to world space. The tangent frame: the TANGENT attribute, else per-vertex tangents generated here as
+// irview generates them (generateTangents below), not three.js's per-pixel derivative frame.
+// Option lightmapMode 'l0' leaves the directional extension unused (the plain map), as irview --lightmap-mode l0.
+import { MeshLambertMaterial, SRGBColorSpace, NoColorSpace, BufferAttribute, ShaderChunk, Vector3 } from 'three';
+
+const DIRECTIONAL = 'IRBAKE_lightmap_directional';
+// three's lightmap term in lights_fragment_maps; the directional shader replaces this line (and fails loudly
+// when a three.js version no longer has it).
+const LIGHTMAP_LINE = 'vec3 lightMapIrradiance = lightMapTexel.rgb * lightMapIntensity;';
 
 export class MozLightmapExtension {
-  constructor(parser) {
+  constructor(parser, { lightmapMode = 'sh' } = {}) {
     this.parser = parser;
     this.name = 'MOZ_lightmap';
+    if (lightmapMode !== 'sh' && lightmapMode !== 'l0') throw new Error(`lightmap mode '${lightmapMode}': sh or l0`);
+    this.lightmapMode = lightmapMode;
+    this.directionalMaterials = 0;  // materials shaded with L1 (for the page and the tests)
+    this.generatedTangents = 0;     // meshes that had no TANGENT and got generated tangents
   }
 
   lightmapOf(materialIndex) {
     const def = this.parser.json.materials?.[materialIndex];
     return def?.extensions?.[this.name];
+  }
+
+  // The directional extension of a material when it will be used: sh mode, a light map and a normal map.
+  directionalOf(materialIndex) {
+    const def = this.parser.json.materials?.[materialIndex];
+    const ext = def?.extensions?.[DIRECTIONAL];
+    if (this.lightmapMode !== 'sh' || !this.lightmapOf(materialIndex) || !ext || def.normalTexture === undefined) return null;
+    if (!Array.isArray(ext.l1) || ext.l1.length !== 3) throw new Error(`material ${materialIndex}: ${DIRECTIONAL}.l1 needs 3 entries`);
+    return ext;
   }
 
   getMaterialType(materialIndex) {
@@ -32,4 +58,110 @@ export class MozLightmapExtension {
     return this.parser.assignTexture(params, 'lightMap', { index: moz.index, texCoord: moz.texCoord ?? 1 },
                                      srgb ? SRGBColorSpace : NoColorSpace);
   }
+
+  // After the scene is built: every mesh whose material carries a used directional extension gets tangents
+  // (when it has none) and the directional shader.
+  async afterRoot(result) {
+    const meshes = [];
+    result.scene.traverse(o => { if (o.isMesh) meshes.push(o); });
+    const shaded = new Set();
+    for (const mesh of meshes) {
+      const association = this.parser.associations.get(mesh.material);
+      const index = association?.materials;
+      if (index === undefined) continue;
+      const ext = this.directionalOf(index);
+      if (!ext) continue;
+      const def = this.parser.json.materials[index];
+      const uvName = uvAttributeName(def.normalTexture.texCoord ?? 0);
+      if (!mesh.geometry.attributes.tangent) {
+        if (!mesh.geometry.attributes[uvName] || !mesh.geometry.attributes.normal)
+          throw new Error(`mesh ${mesh.name}: a directional light map needs NORMAL and the normal map's ${uvName}`);
+        mesh.geometry.setAttribute('tangent', generateTangents(mesh.geometry, uvName));
+        ++this.generatedTangents;
+      }
+      // GLTFLoader flipped normalScale.y for the derivative frame it chose when TANGENT was missing; with
+      // tangents the glTF scale applies as written (B = cross(N, T)·w points where v decreases).
+      const scale = def.normalTexture.scale ?? 1;
+      mesh.material.normalScale.set(scale, scale);
+      if (shaded.has(mesh.material)) continue;
+      shaded.add(mesh.material);
+      const l1 = await Promise.all(ext.l1.map(async e => {
+        const texture = await this.parser.getDependency('texture', e.index);
+        texture.colorSpace = NoColorSpace;  // linear values, no sRGB curve
+        return texture;
+      }));
+      if (ext.l1.some(e => (e.texCoord ?? 1) !== ((this.lightmapOf(index).texCoord) ?? 1)))
+        throw new Error(`material ${index}: ${DIRECTIONAL} pages must use the light map's texCoord`);
+      makeDirectional(mesh.material, l1, ext.l1.map(e => e.scale ?? 1));
+      ++this.directionalMaterials;
+    }
+  }
+}
+
+function uvAttributeName(texCoord) { return texCoord === 0 ? 'uv' : `uv${texCoord}`; }
+
+// The light-map term of a Lambert material becomes max(0, L0 (n_g·n) + t·n) (times π: three's irradiance).
+function makeDirectional(material, l1, scales) {
+  if (!ShaderChunk.lights_fragment_maps.includes(LIGHTMAP_LINE))
+    throw new Error('three.js lights_fragment_maps changed: the directional light-map shader needs updating');
+  material.onBeforeCompile = shader => {
+    shader.uniforms.irbakeL1x = { value: l1[0] };
+    shader.uniforms.irbakeL1y = { value: l1[1] };
+    shader.uniforms.irbakeL1z = { value: l1[2] };
+    shader.uniforms.irbakeL1Scale = { value: new Vector3(...scales) };
+    shader.fragmentShader = shader.fragmentShader
+      .replace('#include <lightmap_pars_fragment>',
+               '#include <lightmap_pars_fragment>\nuniform sampler2D irbakeL1x, irbakeL1y, irbakeL1z;\nuniform vec3 irbakeL1Scale;')
+      .replace('#include <lights_fragment_maps>', ShaderChunk.lights_fragment_maps.replace(LIGHTMAP_LINE, `
+        // irbake directional light map: normal (after the normal map) and nonPerturbedNormal are view space.
+        vec3 irbakeN = inverseTransformDirection( normal, viewMatrix );
+        vec3 irbakeT = ( 2.0 * texture2D( irbakeL1x, vLightMapUv ).rgb - 1.0 ) * irbakeL1Scale.x * irbakeN.x
+                     + ( 2.0 * texture2D( irbakeL1y, vLightMapUv ).rgb - 1.0 ) * irbakeL1Scale.y * irbakeN.y
+                     + ( 2.0 * texture2D( irbakeL1z, vLightMapUv ).rgb - 1.0 ) * irbakeL1Scale.z * irbakeN.z;
+        vec3 lightMapIrradiance = max( lightMapTexel.rgb * lightMapIntensity * dot( nonPerturbedNormal, normal )
+                                       + PI * irbakeT, vec3( 0.0 ) );`));
+  };
+  material.customProgramCacheKey = () => 'irbake-directional';
+  material.needsUpdate = true;
+}
+
+// Per-vertex tangents as irview makes them (runtime/viewer_scene.cpp generateTangents): per triangle dP/du
+// and dP/dv from the UV gradients, summed at each vertex, Gram–Schmidt against the vertex normal, w such that
+// cross(n, t)·w points where v decreases (glTF normal maps: +Y up, UV (0, 0) at the image's top left).
+// In the geometry's own space (three transforms it with the normal matrix). An approximation of MikkTSpace.
+export function generateTangents(geometry, uvName) {
+  const pos = geometry.attributes.position, nrm = geometry.attributes.normal, uv = geometry.attributes[uvName];
+  const count = pos.count;
+  const index = geometry.index ? geometry.index.array : Array.from({ length: count }, (_, i) => i);
+  const dPdu = new Float64Array(3 * count), dPdv = new Float64Array(3 * count);
+  const p = i => [pos.getX(i), pos.getY(i), pos.getZ(i)];
+  for (let t = 0; t + 2 < index.length; t += 3) {
+    const a = index[t], b = index[t + 1], c = index[t + 2];
+    const pa = p(a), pb = p(b), pc = p(c);
+    const e1 = [0, 1, 2].map(k => pb[k] - pa[k]), e2 = [0, 1, 2].map(k => pc[k] - pa[k]);
+    const d1 = [uv.getX(b) - uv.getX(a), uv.getY(b) - uv.getY(a)], d2 = [uv.getX(c) - uv.getX(a), uv.getY(c) - uv.getY(a)];
+    const det = d1[0] * d2[1] - d2[0] * d1[1];
+    if (!(Math.abs(det) > 1e-20)) continue;
+    for (let k = 0; k < 3; ++k) {
+      const su = (e1[k] * d2[1] - e2[k] * d1[1]) / det, sv = (e2[k] * d1[0] - e1[k] * d2[0]) / det;
+      for (const v of [a, b, c]) { dPdu[3 * v + k] += su; dPdv[3 * v + k] += sv; }
+    }
+  }
+  const out = new Float32Array(4 * count);
+  for (let i = 0; i < count; ++i) {
+    const n = [nrm.getX(i), nrm.getY(i), nrm.getZ(i)];
+    const dot = (x, y) => x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    const du = [dPdu[3 * i], dPdu[3 * i + 1], dPdu[3 * i + 2]], dv = [dPdv[3 * i], dPdv[3 * i + 1], dPdv[3 * i + 2]];
+    let t = du.map((x, k) => x - n[k] * dot(n, du));
+    if (!(Math.hypot(...t) > 1e-12)) {  // no UV gradient here: any unit vector orthogonal to the normal
+      t = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+      const d = dot(n, t);
+      t = t.map((x, k) => x - n[k] * d);
+    }
+    const len = Math.hypot(...t);
+    t = t.map(x => x / len);
+    const b = [n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]];
+    out.set([...t, dot(b, dv) > 0 ? -1 : 1], 4 * i);
+  }
+  return new BufferAttribute(out, 4);
 }

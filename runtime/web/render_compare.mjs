@@ -3,6 +3,7 @@
 // absolute difference over RGB in 8-bit units and exits 1 when it exceeds --max-mean-abs.
 // Usage: node render_compare.mjs --modules DIR --scene FILE.gltf --camera N --width W --height H
 //          --reference REF.png --out WEB.png [--max-mean-abs 2] [--chromium /usr/bin/chromium]
+//          [--lightmap sh|l0] [--min-directional N: fail unless N materials were shaded with directional maps]
 import fs from 'node:fs';
 import path from 'node:path';
 import { createRequire } from 'node:module';
@@ -41,11 +42,13 @@ try {
   page.on('console', m => log.push(`${m.type()}: ${m.text()}`));
   page.on('pageerror', e => log.push(`pageerror: ${e.message}`));
   await page.setViewport({ width, height, deviceScaleFactor: 1 });
-  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height });
+  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height,
+                                  lightmap: args.lightmap ?? 'sh' });
   await page.goto(`http://127.0.0.1:${port}/web/index.html?${q}`);
   await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
   const error = await page.evaluate('window.viewerError');
   if (error) throw new Error(`viewer: ${error}\n${log.join('\n')}`);
+  const ready = await page.evaluate('window.viewerReady');
   const result = await page.evaluate(async (refUrl) => {
     const { canvasPixels } = await import('/web/viewer.js');
     const web = canvasPixels();
@@ -74,9 +77,16 @@ try {
   if (result.error) throw new Error(result.error);
   fs.writeFileSync(args.out, Buffer.from(result.png.split(',')[1], 'base64'));
   delete result.png;
+  result.lightmapMode = ready.lightmapMode;
+  result.directionalMaterials = ready.directionalMaterials;
+  result.generatedTangents = ready.generatedTangents;
   console.log(JSON.stringify(result));
   if (!(result.meanAbs <= maxMeanAbs)) {
     console.error(`render_compare: mean absolute difference ${result.meanAbs.toFixed(3)} > ${maxMeanAbs} (web ${args.out}, irview ${args.reference})`);
+    code = 1;
+  }
+  if (args['min-directional'] !== undefined && !(result.directionalMaterials >= Number(args['min-directional']))) {
+    console.error(`render_compare: ${result.directionalMaterials} materials with directional maps, expected at least ${args['min-directional']}`);
     code = 1;
   }
 } catch (e) {

@@ -3,7 +3,8 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 
-export async function showBakedScene({ scene, camera = 0, width, height }) {
+// lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
+export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh' }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
@@ -12,7 +13,8 @@ export async function showBakedScene({ scene, camera = 0, width, height }) {
   document.body.appendChild(renderer.domElement);
 
   const loader = new GLTFLoader();
-  loader.register(parser => new MozLightmapExtension(parser));
+  let lightmapExtension = null;
+  loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
   const gltf = await loader.loadAsync(scene);
   // The light maps hold the punctual lights' light already: drop the lights GLTFLoader made.
   const lights = [];
@@ -26,7 +28,8 @@ export async function showBakedScene({ scene, camera = 0, width, height }) {
   cam.updateProjectionMatrix();
   renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);
-  return { width, height, lights: lights.length };
+  return { width, height, lights: lights.length, lightmapMode, directionalMaterials: lightmapExtension.directionalMaterials,
+           generatedTangents: lightmapExtension.generatedTangents };
 }
 
 // RGBA bytes of the canvas, top row first (as a PNG), for comparisons.
