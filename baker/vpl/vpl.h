@@ -67,6 +67,11 @@ int autoBounceDepth(uint64_t paths, double rho, const WalkOptions& options);
 // operator's dominant mode, e.g. a closed furnace, where r = ρ).
 glm::dvec3 geometricTailFactor(const glm::dvec3& lastPower, const glm::dvec3& previousPower);
 
+// The bounces beyond J of an auto walk (J = set.bounces), P_J r/(1 − r), added to the VPLs of bounces ⌈J/2⌉…J
+// in proportion to their power (sets tailFactor). r is pooled over those bounces that hold at least 16 VPLs
+// (and whose previous bounce does); when none of them does, over the deepest such bounces.
+void addGeometricTail(VplSet& set);
+
 VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options);
 
 }  // namespace irbake

@@ -164,6 +164,43 @@ TEST(Walk, GeometricTailFactorIsOneOverOneMinusRatio) {
   EXPECT_NEAR(geometricTailFactor(glm::dvec3(2.0), glm::dvec3(1.0)).x, 1000.0, 1e-6);  // r clamped to 0.999
 }
 
+// A trap: the few paths alive at depth stay among bright surfaces, so their bounces do not decay (here
+// one VPL per bounce from bounce 6 on, each as bright as all of bounce 5), while every bounce many paths
+// reach halves. The tail must follow the populated bounces (r = 1/2: P_J r/(1 − r) = P_J), not the
+// deep path, whose r = 1 would have multiplied its VPLs by about 1000 (r is clamped at 0.999).
+TEST(Walk, TailRatioComesFromBouncesManyPathsReach) {
+  VplSet set;
+  const size_t counts[] = {0, 1024, 512, 256, 128, 64, 1, 1, 1, 1, 1, 1, 1};
+  const double powers[] = {0, 64, 32, 16, 8, 4, 4, 4, 4, 4, 4, 4, 4};
+  set.emittedPower = glm::dvec3(128.0);
+  for (int j = 0; j <= 12; ++j) {
+    set.countPerBounce.push_back(counts[j]);
+    set.powerPerBounce.push_back(glm::dvec3(powers[j]));
+    for (size_t k = 0; k < counts[j]; ++k)
+      set.vpls.push_back(Vpl{glm::vec3(0.0f), glm::vec3(0, 1, 0), glm::vec3(float(powers[j] / counts[j])), j});
+  }
+  set.bounces = 12;
+  addGeometricTail(set);
+  // Carriers: bounces 6…12 (⌈12/2⌉ = 6), power 7 · 4 = 28; tail P_12 · 1 = 4.
+  EXPECT_NEAR(set.tailFactor.x, 1.0 + 4.0 / 28.0, 1e-9);
+  EXPECT_NEAR(sumPower(set), 64 + 32 + 16 + 8 + 4 + 28 + 4, 1e-4);
+  // With the deep bounces populated (the furnace case) the pool is the deeper half itself.
+  VplSet furnace;
+  furnace.emittedPower = glm::dvec3(1.0);
+  for (int j = 0; j <= 8; ++j) {
+    furnace.countPerBounce.push_back(j == 0 ? 0 : 1024);
+    furnace.powerPerBounce.push_back(glm::dvec3(j == 0 ? 1.0 : std::pow(0.8, j)));
+    if (j > 0)
+      for (int k = 0; k < 1024; ++k)
+        furnace.vpls.push_back(Vpl{glm::vec3(0.0f), glm::vec3(0, 1, 0), glm::vec3(float(std::pow(0.8, j) / 1024)), j});
+  }
+  furnace.bounces = 8;
+  addGeometricTail(furnace);
+  double carriers = 0.0;
+  for (int j = 4; j <= 8; ++j) carriers += std::pow(0.8, j);
+  EXPECT_NEAR(furnace.tailFactor.x, 1.0 + std::pow(0.8, 8) * 4.0 / carriers, 1e-6);  // r = 0.8: r/(1 − r) = 4
+}
+
 // High-albedo furnaces: the auto walk stops at the VPL budget and adds the rest as a geometric tail;
 // in a closed grey box every bounce is the previous one times ρ, so the total is Φ/(1−ρ) exactly.
 TEST(Walk, TailMakesHighAlbedoFurnaceEnergyExact) {

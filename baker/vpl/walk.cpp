@@ -225,6 +225,8 @@ void orderByBounce(const std::vector<std::vector<Vpl>>& perPath, int maxBounce, 
   out.bounces = std::max(0, static_cast<int>(out.countPerBounce.size()) - 1);
 }
 
+}  // namespace
+
 // The bounces beyond J (auto depth only): their power, P_J r/(1 − r), shared by the VPLs of the deeper
 // half of the walk (bounces ⌈J/2⌉…J, in proportion to their power). Deep bounces have forgotten where
 // the light entered, so they share one distribution; many VPLs carrying the tail instead of bounce J's
@@ -235,8 +237,29 @@ void addGeometricTail(VplSet& out) {
   // power): deep bounces have few paths, and one bounce's ratio alone can be far off (an open corner,
   // 16 paths left at J = 24, came out +18% against the reference).
   auto bouncePower = [&](int j) { return j == 0 ? out.emittedPower : out.powerPerBounce[j]; };
+  // Only bounces that many paths reach tell the ratio: the few paths alive at depth are those that stayed
+  // among bright, enclosed surfaces, so their bounces decay slower than the scene's light does (Sponza,
+  // walk seed 2: one path trapped in the upper gallery made r = 0.91 over bounces 8–16, against 0.55–0.7
+  // over bounces 2–6, and the tail doubled that path's VPLs: its gallery came out +35%). So the pool skips
+  // bounces with fewer than kTailMinVpls VPLs, and when the deeper half has none, it takes the deepest
+  // bounces that have them.
+  constexpr size_t kTailMinVpls = 16;
+  auto populated = [&](int j) {
+    return out.countPerBounce[j] >= kTailMinVpls && (j == 1 || out.countPerBounce[j - 1] >= kTailMinVpls);
+  };
+  int poolFrom = from, poolTo = J;
+  bool deepPopulated = false;
+  for (int j = from; j <= J; ++j) deepPopulated = deepPopulated || populated(j);
+  if (!deepPopulated) {
+    int deepest = 0;
+    for (int j = from - 1; j >= 1 && deepest == 0; --j)
+      if (populated(j)) deepest = j;
+    if (deepest > 0) poolFrom = std::max(1, deepest - (J - from)), poolTo = deepest;
+  }
+  const bool sparseOnly = !deepPopulated && poolTo == J;  // no bounce is populated: pool them all, as before
   glm::dvec3 later(0.0), earlier(0.0);
-  for (int j = from; j <= J; ++j) {
+  for (int j = poolFrom; j <= poolTo; ++j) {
+    if (!sparseOnly && !populated(j)) continue;
     later += bouncePower(j);
     earlier += bouncePower(j - 1);
   }
@@ -252,8 +275,6 @@ void addGeometricTail(VplSet& out) {
     out.vpls[v].power = glm::vec3(glm::dvec3(out.vpls[v].power) * out.tailFactor);
   for (int j = from; j <= J; ++j) out.powerPerBounce[j] *= out.tailFactor;
 }
-
-}  // namespace
 
 VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& options) {
   VplSet out;
