@@ -7,10 +7,14 @@ reference's own noise, removed from the error as in bench/cycles/compare.py). Te
 non-zero in both references (the dilation ring included: there both bakes copy their neighbours).
 Prints the mean ratio, the relative RMSE over bins, the reference's noise and the error with it removed.
 """
+import os
 import sys
 
 import numpy as np
 import OpenImageIO as oiio
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "cycles"))
+from compare import bin_means as bins  # noqa: E402  (the same 4×4 / 8×8 binning as the Cycles comparison)
 
 
 def page(d):
@@ -18,15 +22,6 @@ def page(d):
     if buf.has_error:
         sys.exit("against_reference.py: %s: %s" % (d, buf.geterror()))
     return buf.get_pixels(oiio.FLOAT)[..., :3].astype(np.float64)
-
-
-def bins(img, mask, b):
-    h, w = (img.shape[0] // b) * b, (img.shape[1] // b) * b
-    m = mask[:h, :w].astype(np.float64)
-    s = (img[:h, :w] * m[..., None]).reshape(h // b, b, w // b, b, 3).sum(axis=(1, 3))
-    n = m.reshape(h // b, b, w // b, b).sum(axis=(1, 3))
-    keep = n >= b * b / 2
-    return s[keep] / n[keep][:, None]
 
 
 def main():

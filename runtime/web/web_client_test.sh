@@ -6,9 +6,7 @@ set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
 here="$(cd "$(dirname "$0")" && pwd)"
 source "$here/web_tests_common.sh"
-need_node_modules "$modules" three puppeteer-core
-[[ -x /usr/bin/chromium ]] || skip "/usr/bin/chromium not found (scripts/install-deps.sh installs Debian chromium)"
-rm -rf "$work" && mkdir -p "$work"
+need_browser_client "$modules" "$work"
 "$irbake" samples "$work/samples" > "$work/samples.log"
 "$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 512 --texels-per-unit 120 --quiet > "$work/bake.log" 2>&1
 w=320 h=320

@@ -14,9 +14,7 @@ set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
 here="$(cd "$(dirname "$0")" && pwd)"
 source "$here/web_tests_common.sh"
-need_node_modules "$modules" three puppeteer-core
-[[ -x /usr/bin/chromium ]] || skip "/usr/bin/chromium not found (scripts/install-deps.sh installs Debian chromium)"
-rm -rf "$work" && mkdir -p "$work"
+need_browser_client "$modules" "$work"
 w=256 h=256
 bake() {  # input folder, output folder, [--tangent]
   node "$here/make_directional_scene.mjs" "$work/$1" ${3:-} > /dev/null

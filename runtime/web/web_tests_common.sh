@@ -8,3 +8,11 @@ need_node_modules() {
     [[ -d "$modules/node_modules/$m" ]] || skip "$modules/node_modules/$m missing (run scripts/install-web-deps.sh BUILD_DIR)"
   done
 }
+# The start of a real-client test: three.js and puppeteer-core in MODULES, Debian's Chromium, and an empty
+# WORK folder.
+need_browser_client() {
+  local modules="$1" work="$2"
+  need_node_modules "$modules" three puppeteer-core
+  [[ -x /usr/bin/chromium ]] || skip "/usr/bin/chromium not found (scripts/install-deps.sh installs Debian chromium)"
+  rm -rf "$work" && mkdir -p "$work"
+}
