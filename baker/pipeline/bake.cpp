@@ -3,12 +3,9 @@
 
 #include <sys/resource.h>
 
-#include <algorithm>
 #include <cmath>
 #include <future>
 #include <memory>
-
-#include <algorithm>
 
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
@@ -201,12 +198,9 @@ struct StagedBake::State {
       eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
       return;
     }
-    const bool emitters = std::any_of(scene.primitives.begin(), scene.primitives.end(), [&](const Primitive& p) {
-      return p.material < scene.materials.size() && scene.materials[p.material].isEmissive();
-    });
     clampK = options.clampVplsPerMean > 0.0 ? options.clampVplsPerMean
              : !eval.biasCompensation     ? kClampVplsPerMean
-             : emitters                   ? kCompensatedClampVplsPerMean
+             : scene.hasEmissiveSurface() ? kCompensatedClampVplsPerMean
                                           : kCompensatedClampVplsPerMeanNoEmitters;
     eval.clampBound = deriveClampBound(scene, vpls, clampK);
     clampDerived = true;

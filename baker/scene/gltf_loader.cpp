@@ -924,8 +924,11 @@ class Loader {
       // The export records no --env-intensity, but its mean radiance is the file's × intensity: recover it.
       const glm::dvec3 fileMean = scene_.environment.integral() / (4.0 * kPi);
       const double fileSum = fileMean.x + fileMean.y + fileMean.z, intensity = (double(L.x) + L.y + L.z) / fileSum;
-      if (hasMean && fileSum > 0.0 && std::isfinite(intensity) && std::abs(intensity - 1.0) > 1e-6)
-        scene_.environment = loadEnvironment(file->get<std::string>(), static_cast<float>(intensity), degrees);
+      if (hasMean && fileSum > 0.0 && std::isfinite(intensity) && std::abs(intensity - 1.0) > 1e-6) {
+        const Environment& e = scene_.environment;  // scaled from the texels already read, not read again
+        scene_.environment = Environment::fromEquirect(e.width(), e.height(), e.texels(), static_cast<float>(intensity),
+                                                       e.rotation(), e.source());
+      }
       return;
     }
     if (hasMean) scene_.environment = Environment::uniform(L);

@@ -110,12 +110,13 @@ glm::vec3 Scene::emitterPower() const {
   return glm::vec3(total);
 }
 
-bool Scene::hasLightOrEmitter() const {
-  if (!lights.empty() || environment.present()) return true;
+bool Scene::hasEmissiveSurface() const {
   for (const auto& p : primitives)
     if (materials[p.material].isEmissive()) return true;
   return false;
 }
+
+bool Scene::hasLightOrEmitter() const { return !lights.empty() || environment.present() || hasEmissiveSurface(); }
 
 glm::vec4 Scene::baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 b) const {
   const Material& m = materials[prim.material];

@@ -165,6 +165,7 @@ struct Scene {
   size_t triangleCount() const;
   // Total emitted power of emissive surfaces (W, RGB): π · Le · area, emissive texture averaged per triangle.
   glm::vec3 emitterPower() const;
+  bool hasEmissiveSurface() const;  // any primitive whose material emits
   bool hasLightOrEmitter() const;
   // Base colour (linear RGBA) at a point of a triangle: factor × texture(bilinear, wrap) at its UV.
   glm::vec4 baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 barycentric) const;

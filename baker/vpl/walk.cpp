@@ -247,19 +247,14 @@ void addGeometricTail(VplSet& out) {
   auto populated = [&](int j) {
     return out.countPerBounce[j] >= kTailMinVpls && (j == 1 || out.countPerBounce[j - 1] >= kTailMinVpls);
   };
-  int poolFrom = from, poolTo = J;
-  bool deepPopulated = false;
-  for (int j = from; j <= J; ++j) deepPopulated = deepPopulated || populated(j);
-  if (!deepPopulated) {
-    int deepest = 0;
-    for (int j = from - 1; j >= 1 && deepest == 0; --j)
-      if (populated(j)) deepest = j;
-    if (deepest > 0) poolFrom = std::max(1, deepest - (J - from)), poolTo = deepest;
-  }
-  const bool sparseOnly = !deepPopulated && poolTo == J;  // no bounce is populated: pool them all, as before
+  int deepest = 0;
+  for (int j = J; j >= 1 && deepest == 0; --j)
+    if (populated(j)) deepest = j;
+  int poolFrom = from, poolTo = J;  // no populated bounce at all (tiny walks): the deeper half, all of it
+  if (deepest > 0 && deepest < from) poolFrom = std::max(1, deepest - (J - from)), poolTo = deepest;
   glm::dvec3 later(0.0), earlier(0.0);
   for (int j = poolFrom; j <= poolTo; ++j) {
-    if (!sparseOnly && !populated(j)) continue;
+    if (deepest > 0 && !populated(j)) continue;
     later += bouncePower(j);
     earlier += bouncePower(j - 1);
   }

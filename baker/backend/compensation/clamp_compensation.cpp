@@ -152,7 +152,8 @@ void ClampGather::Impl::makeTiles() {
 // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
 // per-sample ray count is low. At most 4 texels (9×9; until session 6 at most 2): on Sponza's 2.6M texels
 // the budget leaves 4 rays per sample, and the gather's noise showed in close-ups (view 2 against Cycles
-// 3.09 → 2.77%; Cornell boxes 1.78/1.83 → 1.77/1.81%, where r_c/20 allows 3). Radius and texel geometry per page, once for all sweeps.
+// 3.09 → 2.77%; Cornell boxes 1.78/1.83 → 1.77/1.81%, where r_c/20 allows 3). Radius and texel geometry
+// per page, once for all sweeps.
 void ClampGather::Impl::chooseFilters() {
   const float clampRadius = 1.0f / std::sqrt(bound);
   radii.assign(in.texels.size(), 0);
@@ -342,9 +343,10 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   double lastAdded = 0.0, lastStep = 0.0, stepBefore = 0.0;
   int sweepsDone = 0;
   bool tailAdded = false;
+  constexpr int kFirstTailSweep = 3;  // at least 4 sweeps before the tail: the ratio creeps up over the first few
   std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
-    if (options.extrapolateTail && sweep >= 1) previous = current;
+    if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
@@ -400,9 +402,9 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     // Or add the rest at once: the steps are a Neumann series, step_{k+1} = T step_k, so once their
     // ratio q has settled the remaining sweeps add step_k · q/(1 − q), texel by texel. Settled: the
     // tails predicted by this ratio and the last one differ by at most the tolerance (Sponza: steps
-    // 4.1, 1.6, 0.67, 0.30% of the map, ratios 0.39, 0.41, 0.45: 4 sweeps and a tail within 0.03% of 8). At
-    // least 4 sweeps: the ratio still creeps up over the first few (longer paths reach narrower gaps).
-    if (!converged && options.extrapolateTail && sweep >= 3 && lastStep > 0.0 && step > 0.0) {
+    // 4.1, 1.6, 0.67, 0.30% of the map, ratios 0.39, 0.41, 0.45: 4 sweeps and a tail within 0.03% of 8;
+    // the ratio creeps up over the first few sweeps as longer paths reach narrower gaps).
+    if (!converged && options.extrapolateTail && sweep >= kFirstTailSweep && lastStep > 0.0 && step > 0.0) {
       const double q = step / lastStep, qBefore = lastStep / stepBefore;
       auto tailOf = [&](double r) { return step * r / (1.0 - r); };
       if (q < 0.9 && qBefore > 0.0 && qBefore < 0.9 && std::abs(tailOf(q) - tailOf(qBefore)) <= tolerance) {
