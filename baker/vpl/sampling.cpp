@@ -50,49 +50,38 @@ double radicalInverse(uint32_t base, uint64_t index) {
 
 Halton::Halton(int dimensions, uint32_t seed) : primes_(firstPrimes(std::max(dimensions, 2))) {
   permutations_.resize(primes_.size());
-  for (size_t d = 2; d < primes_.size(); ++d) {
-    uint32_t b = primes_[d];
-    std::vector<uint16_t> perm(b);
-    std::iota(perm.begin(), perm.end(), uint16_t(0));
-    Rng rng(hashSeed(seed, d, 0x4A17));
-    for (uint32_t k = b - 1; k >= 2; --k) {  // Fisher–Yates on digits 1..b-1; 0 stays (no infinite tail)
-      uint32_t j = 1 + static_cast<uint32_t>(rng.nextU64() % k);
-      std::swap(perm[k], perm[j]);
+  digits_.resize(primes_.size());
+  for (size_t d = 0; d < primes_.size(); ++d) {
+    const uint32_t b = primes_[d];
+    // Enough digits for any 64-bit index and for double precision: b^-digits < 2^-53.
+    const int digits = static_cast<int>(std::ceil(64.0 * std::log(2.0) / std::log(static_cast<double>(b)))) + 1;
+    digits_[d] = digits;
+    std::vector<uint16_t>& perms = permutations_[d];
+    perms.resize(static_cast<size_t>(digits) * b);
+    for (int k = 0; k < digits; ++k) {
+      uint16_t* perm = &perms[static_cast<size_t>(k) * b];
+      std::iota(perm, perm + b, uint16_t(0));
+      Rng rng(hashSeed(seed, d, 0x4A170000ull + static_cast<uint64_t>(k)));
+      for (uint32_t i = b - 1; i >= 1; --i) {  // Fisher–Yates over all b digits
+        const uint32_t j = static_cast<uint32_t>(rng.nextU64() % (i + 1));
+        std::swap(perm[i], perm[j]);
+      }
     }
-    permutations_[d] = std::move(perm);
   }
-  if (seed != 0) {
-    Rng rng(hashSeed(seed, 0x5EED));
-    shift_[0] = rng.uniform();
-    shift_[1] = rng.uniform();
-  }
-  // Dimensions ≥ 2 are also rotated (for every seed): with digit 0 fixed by the permutations, point 0
-  // would otherwise be 0 in every direction dimension for every seed — a path leaving along the normal
-  // at each bounce. Keller's fractional absorption keeps the *first* paths longest, so that one path
-  // carried the deepest bounces: in the Cornell box it ping-ponged between the floor and the light
-  // (albedo 0.78 > ρ̄) and biased the bake by +1.8% at 1024 paths (+3.5% at 512).
-  highShift_.assign(primes_.size(), 0.0);
-  Rng rng(hashSeed(seed, 0xD1CE));
-  for (size_t d = 2; d < primes_.size(); ++d) highShift_[d] = rng.uniform();
 }
 
 double Halton::sample(int dim, uint64_t index) const {
-  uint32_t base = primes_[dim];
-  if (dim < 2) {
-    double r = radicalInverse(base, index) + shift_[dim];
-    r -= std::floor(r);
-    return std::min(r, 0.99999999999999989);
-  }
-  const auto& perm = permutations_[dim];
+  const uint32_t base = primes_[dim];
+  const uint16_t* perm = permutations_[dim].data();
   const double inv = 1.0 / base;
   double f = inv, r = 0.0;
-  while (index > 0) {
+  // Every digit position, the index's leading zeros included (they are permuted too), so the point is a
+  // uniform number whatever the index's length.
+  for (int k = 0; k < digits_[dim]; ++k, perm += base) {
     r += perm[index % base] * f;
     index /= base;
     f *= inv;
   }
-  r += highShift_[dim];
-  r -= std::floor(r);
   return std::min(r, 0.99999999999999989);
 }
 
