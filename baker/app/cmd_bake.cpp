@@ -30,7 +30,7 @@ struct BakeArguments {
   std::string backend = "auto", shard;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0;
-  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
+  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
@@ -68,6 +68,11 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(1, 1 << 26))->type_name("N");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
+  app->add_option("--walk-split", a.walkSplit,
+                  "paths fork into N where they leave bounce 1, each child carrying 1/N\n"
+                  "(default auto: 1/(share of that light meeting the scene again), at most 8;\n"
+                  "1 in closed scenes; 1 = Keller's plain walk)")
+      ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page, or\n64 texels per triangle where that is more, at most 4M)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
@@ -186,6 +191,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
   o.texels.leakControl = !a.noLeakControl;
   if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
+  if (a.walkSplit > 0) o.walk.split = a.walkSplit;
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;

@@ -28,6 +28,9 @@ struct WalkOptions {
   double tailEnergy = 1e-3;      // auto: stop once the light not yet placed, ρ̄^(J+1), is below this fraction
   double maxVplsPerPath = 8.0;   // auto: VPL budget Σ_j M_j ≤ this × N (a scene of ρ̄ = 0.9 reaches J = 14)
   bool geometricTail = true;     // auto: the bounces beyond J added to bounce J as a geometric series
+  std::optional<int> split;      // paths fork into this many where they leave bounce 1 (unset: auto, from the
+                                 // share of bounce-1 light that meets the scene again; 1 = Keller's walk)
+  int maxAutoSplit = 8;          // auto: at most this many children per path
   uint32_t seed = 0;       // Halton scramble / start offset
   ProgressCallback progress;
 };
@@ -38,6 +41,9 @@ struct VplSet {
   std::vector<glm::dvec3> powerPerBounce;   // watts, index = bounce
   glm::dvec3 emittedPower{0.0};             // area emitters + punctual lights (W)
   double meanReflectivity = 0.0;            // ρ̄ used for the path-count reduction
+  int split = 1;                            // children per path past bounce 1
+  double rehitFraction = 1.0;               // auto split: V_2 M_1 / (V_1 M_2), the share of paths leaving
+                                            // bounce 1 that hit the scene again
   int bounces = 0;                          // deepest bounce generated
   glm::dvec3 tailFactor{1.0};               // bounces ⌈J/2⌉…J carry this × their own power: with it, the
                                             // light of bounces > J, P_J r/(1−r) per channel, r the ratio of
@@ -53,7 +59,8 @@ struct VplSet {
       perBounce.push_back({{"bounce", b}, {"count", countPerBounce[b]}, {"power", rgb(power)}});
     }
     return {{"count", vpls.size()},          {"bounces", bounces},     {"meanReflectivity", meanReflectivity},
-            {"emittedPower", rgb(emittedPower)}, {"totalPower", rgb(total)}, {"perBounce", perBounce}};
+            {"emittedPower", rgb(emittedPower)}, {"totalPower", rgb(total)}, {"perBounce", perBounce},
+            {"split", split},                {"rehitFraction", rehitFraction}};
   }
 };
 

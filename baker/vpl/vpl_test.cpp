@@ -342,3 +342,93 @@ TEST(Walk, SpotPathsFollowTheFalloffAndDirectionalCoversTheScene) {
   double expected = 0.5 * 2.0 * (1.0 / std::sqrt(1.09)) * 4.0;
   EXPECT_NEAR(sumPower(ds, 1), expected, 0.01 * expected);
 }
+
+namespace {
+// An open-topped grey box (floor and four walls, 4 × 4 × 1.5, inward) under a tilted sun: light leaving
+// the floor mostly escapes through the top, so few paths reach bounce 2 and beyond.
+Scene courtyard(float rho) {
+  Scene s;
+  const int grey = addMaterial(s, glm::vec3(rho));
+  const glm::vec3 lo(0.0f), hi(4.0f, 4.0f, 1.5f);
+  addBox(s, grey, lo, hi, true, 2);
+  s.primitives.erase(s.primitives.begin() + 1);  // addBox adds bottom, top, then the walls: drop the top
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
+  sun.intensity = 2.0f;
+  s.lights.push_back(sun);
+  return s;
+}
+}  // namespace
+
+// Splitting where paths leave bounce 1 keeps the bookkeeping exact: in a closed room each surviving path
+// leaves s VPLs per deeper bounce of 1/s of the power, so bounce j still carries exactly Φ ρ̄^j.
+TEST(Walk, SplitPathsKeepEveryBouncesEnergyExact) {
+  Scene s;
+  addBox(s, addMaterial(s, glm::vec3(0.6f), glm::vec3(1.0f)), glm::vec3(0), glm::vec3(1), true, 2);
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 1000;
+  o.geometricTail = false;
+  o.split = 4;
+  const VplSet set = generateVpls(s, rt, o);
+  EXPECT_EQ(set.split, 4);
+  const double Phi = set.emittedPower.x;
+  ASSERT_GE(set.bounces, 5);
+  for (int j = 0; j <= set.bounces; ++j) {
+    const size_t m = static_cast<size_t>(std::floor(1000 * std::pow(0.6, j) + 1e-9));
+    EXPECT_EQ(set.countPerBounce[j], j >= 2 ? 4 * m : m) << "bounce " << j;
+    EXPECT_NEAR(set.powerPerBounce[j].x, Phi * std::pow(0.6, j), 1e-5 * Phi) << "bounce " << j;
+  }
+  // Auto in a closed room: every path leaving bounce 1 meets the room again, so no split.
+  o.split.reset();
+  const VplSet autoSet = generateVpls(s, rt, o);
+  EXPECT_EQ(autoSet.split, 1);
+  EXPECT_NEAR(autoSet.rehitFraction, 1.0, 0.02);
+}
+
+// In an open court the auto split is 1 / (share of bounce-1 light meeting the scene again), and the split
+// walk estimates the same deep bounces as a plain walk with many more paths (unbiased: the mean over 8
+// seeds), with s times as many VPLs carrying them and less spread from seed to seed.
+TEST(Walk, AutoSplitInAnOpenCourtMatchesAPlainWalkOfManyPaths) {
+  const Scene s = courtyard(0.7f);
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 4096;
+  o.maxBounces = 6;  // the same bounces walked in all, no tail
+  const VplSet first = generateVpls(s, rt, o);
+  EXPECT_LT(first.rehitFraction, 0.5);
+  EXPECT_EQ(first.split, std::clamp(static_cast<int>(std::floor(1.0 / first.rehitFraction)), 1, 8));
+  ASSERT_GE(first.split, 2);
+  constexpr int kSeeds = 8;
+  std::array<double, 4> splitMean{}, spread{};
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    o.seed = static_cast<uint32_t>(seed);
+    o.split.reset();
+    const VplSet split = generateVpls(s, rt, o);
+    o.split = 1;
+    const VplSet unsplit = generateVpls(s, rt, o);
+    EXPECT_EQ(split.countPerBounce[1], unsplit.countPerBounce[1]);
+    EXPECT_GE(split.countPerBounce[2], static_cast<size_t>(split.split - 1) * unsplit.countPerBounce[2]);
+    for (int j = 1; j <= 3; ++j) {
+      splitMean[j] += split.powerPerBounce[j].x / kSeeds;
+      spread[j] += split.powerPerBounce[j].x * split.powerPerBounce[j].x / kSeeds;
+    }
+  }
+  WalkOptions plainOptions = o;
+  plainOptions.paths = 4096 * 64;
+  plainOptions.split = 1;
+  plainOptions.seed = 99;
+  const VplSet plain = generateVpls(s, rt, plainOptions);
+  for (int j = 1; j <= 3; ++j) {
+    const double a = splitMean[j], b = plain.powerPerBounce[j].x;
+    std::printf("[ figure ] open court, split %d: bounce %d %.5g W over %d seeds, plain walk of 64x the paths %.5g W "
+                "(ratio %.4f)\n", first.split, j, a, kSeeds, b, a / b);
+    EXPECT_NEAR(a / b, 1.0, j == 1 ? 0.01 : 0.04) << "bounce " << j;
+  }
+  // Seed-to-seed spread of bounce 3 (RMS about the plain walk's value): the split walk's is smaller.
+  const double b3 = plain.powerPerBounce[3].x;
+  const double splitRms = std::sqrt(std::max(0.0, spread[3] - 2 * b3 * splitMean[3] + b3 * b3)) / b3;
+  std::printf("[ figure ] bounce 3 seed-to-seed spread: split %.2f%%\n", 100 * splitRms);
+  EXPECT_LT(splitRms, 0.06);
+}

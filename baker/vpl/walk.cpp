@@ -2,7 +2,7 @@
 //
 // N paths start on the lights (chosen by power with one alias table over emissive triangles and punctual
 // lights). Path i uses the i-th Halton point: dimension 0 picks the light and, through the alias
-// residual, gives with dimension 1 the point on the emitter (Φ2, Φ3); dimensions 2+2j, 3+2j give the
+// residual, gives with dimension 1 the point on the emitter; dimensions 2+2j, 3+2j give the
 // direction leaving bounce j (cosine for surfaces; by intensity for punctual lights).
 //
 // Fractional absorption: at bounce j only the first M_j = floor(N ρ̄^j) paths continue. A path that
@@ -165,41 +165,50 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
 }
 
 // Follows path i from its start while it is among the survivors of the next bounce, leaving one VPL
-// per bounce in `vpls` (power × albedo products × N / M_j).
+// per bounce in `vpls` (power × albedo products × N / M_j). With split s > 1 the path forks where it
+// leaves bounce 1: child k (index c = i s + k, its own Halton point from there on) carries 1/s of the
+// power, so each surviving path leaves s VPLs per deeper bounce and the bookkeeping stays exact.
 void followPath(const Scene& scene, const RayTracer& rt, const Halton& halton, const std::vector<uint64_t>& survivors,
-                uint64_t seed, uint64_t i, const PathStart& path, std::vector<Vpl>& vpls) {
+                uint64_t seed, uint64_t i, int split, const PathStart& path, std::vector<Vpl>& vpls) {
   const int maxBounce = static_cast<int>(survivors.size()) - 1;
   const uint64_t N = survivors[0];
   const float eps = rt.epsilon();
-  const glm::dvec3 pathPower = path.power;
-  glm::vec3 origin = path.origin, dir = path.dir, normal = path.normal;
-  bool surfaceStart = path.onSurface;
-  glm::dvec3 throughput(1.0);
-  for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
-    glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
-    RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
-    // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
-    // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
-    // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
-    for (int layer = 0; hit.hit && layer < 64; ++layer) {
-      const SurfaceTransmission transmission = scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
-      if (transmission.fraction <= 0.0f) break;
-      Rng pass(hashSeed(seed, i, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
-      if (pass.uniform() >= transmission.fraction) break;
-      throughput *= glm::dvec3(transmission.tint);
-      hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
+  const int children = maxBounce >= 2 && i < survivors[2] ? split : 1;
+  for (int k = 0; k < children; ++k) {
+    const uint64_t c = i * static_cast<uint64_t>(split) + static_cast<uint64_t>(k);  // Halton index past bounce 1
+    glm::vec3 origin = path.origin, dir = path.dir, normal = path.normal;
+    bool surfaceStart = path.onSurface;
+    glm::dvec3 throughput(1.0);
+    for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
+      glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
+      RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+      // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
+      // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
+      // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
+      const uint64_t pathId = j >= 2 ? c : i;
+      for (int layer = 0; hit.hit && layer < 64; ++layer) {
+        const SurfaceTransmission transmission =
+            scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+        if (transmission.fraction <= 0.0f) break;
+        Rng pass(hashSeed(seed, pathId, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
+        if (pass.uniform() >= transmission.fraction) break;
+        throughput *= glm::dvec3(transmission.tint);
+        hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
+      }
+      if (!hit.hit) break;  // escaped: its energy leaves the scene
+      throughput *= glm::dvec3(rt.albedoAt(hit));
+      glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
+      const double share = j >= 2 ? 1.0 / children : 1.0;
+      glm::dvec3 power = path.power * throughput * (share * static_cast<double>(N) / static_cast<double>(survivors[j]));
+      glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
+      if (j >= 2 || k == 0) vpls.push_back(Vpl{at, n, glm::vec3(power), j});  // bounce 1 is shared: left once
+      if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
+      origin = at;
+      normal = n;
+      surfaceStart = true;
+      const uint64_t next = j + 1 >= 2 ? c : i;
+      dir = cosineHemisphere(n, halton.sample(2 + 2 * j, next), halton.sample(3 + 2 * j, next));
     }
-    if (!hit.hit) break;  // escaped: its energy leaves the scene
-    throughput *= glm::dvec3(rt.albedoAt(hit));
-    glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
-    glm::dvec3 power = pathPower * throughput * (static_cast<double>(N) / static_cast<double>(survivors[j]));
-    glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
-    vpls.push_back(Vpl{at, n, glm::vec3(power), j});
-    if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
-    origin = at;
-    normal = n;
-    surfaceStart = true;
-    dir = cosineHemisphere(n, halton.sample(2 + 2 * j, i), halton.sample(3 + 2 * j, i));
   }
 }
 
@@ -294,16 +303,35 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   const Halton halton(4 + 2 * std::max(maxBounce, 1), options.seed);
 
   std::vector<std::vector<Vpl>> perPath(N);
-  std::atomic<uint64_t> done{0};
+  auto walk = [&](int split, bool report) {
+    std::atomic<uint64_t> done{0};
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, N, 64), [&](const tbb::blocked_range<uint64_t>& range) {
+      for (uint64_t i = range.begin(); i != range.end(); ++i) {
+        perPath[i].clear();
+        const PathStart path = startPath(scene, rt, sources, halton, i, N, perPath[i]);
+        followPath(scene, rt, halton, survivors, options.seed, i, split, path, perPath[i]);
+        uint64_t d = ++done;
+        if (report && options.progress && (d & 1023) == 0) options.progress("walk", static_cast<double>(d) / N);
+      }
+    });
+  };
   if (options.progress) options.progress("walk", 0.0);
-  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, N, 64), [&](const tbb::blocked_range<uint64_t>& range) {
-    for (uint64_t i = range.begin(); i != range.end(); ++i) {
-      const PathStart path = startPath(scene, rt, sources, halton, i, N, perPath[i]);
-      followPath(scene, rt, halton, survivors, options.seed, i, path, perPath[i]);
-      uint64_t d = ++done;
-      if (options.progress && (d & 1023) == 0) options.progress("walk", static_cast<double>(d) / N);
-    }
-  });
+  int split = std::max(1, options.split.value_or(1));
+  walk(split, options.split.has_value());
+  if (!options.split.has_value() && maxBounce >= 2) {
+    // Auto: how much of the light leaving bounce 1 meets the scene again, from the unsplit walk's counts
+    // (V_2 / V_1 against M_2 / M_1). In a closed scene that is 1 and nothing changes; in an open one
+    // (Sponza's courtyard: 7%) the deeper bounces would rest on a few dozen VPLs, so paths split.
+    size_t v1 = 0, v2 = 0;
+    for (const auto& path : perPath)
+      for (const Vpl& v : path) v1 += v.bounce == 1, v2 += v.bounce == 2;
+    out.rehitFraction = v1 > 0 ? (static_cast<double>(v2) * static_cast<double>(survivors[1])) /
+                                     (static_cast<double>(v1) * static_cast<double>(survivors[2]))
+                               : 1.0;
+    split = std::clamp(static_cast<int>(std::floor(1.0 / std::max(out.rehitFraction, 1e-6))), 1, options.maxAutoSplit);
+    if (split > 1) walk(split, true);
+  }
+  out.split = split;
   orderByBounce(perPath, maxBounce, out);
   if (autoDepth && options.geometricTail && out.bounces >= 1) addGeometricTail(out);
   if (options.progress) options.progress("walk", 1.0);
