@@ -63,6 +63,15 @@ inline Light pointLight(glm::vec3 position, float intensity) {
   return l;
 }
 
+// A directional light shining along `direction` (normalized here) with irradiance `intensity` (W/m²).
+inline Light directionalLight(glm::vec3 direction, float intensity) {
+  Light l;
+  l.type = LightType::Directional;
+  l.direction = glm::normalize(direction);
+  l.intensity = intensity;
+  return l;
+}
+
 // A W×H grid of texel samples (supersample 1) over the rectangle p0 + [0,1]e1 + [0,1]e2, texel centres,
 // all valid, normal = normalize(e1 × e2). Texel (x, y) sits at p0 + (x+0.5)/W e1 + (y+0.5)/H e2.
 // The samples name no triangle (primitive UINT32_MAX), so backends use the positions as given.

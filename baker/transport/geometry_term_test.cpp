@@ -45,10 +45,7 @@ TEST(GeometryTerm, ClosedFormsAndClamp) {
   glm::vec3 mid(std::sqrt(1 - midCos * midCos) / midCos, 0, 0);
   double r2 = 1.0 / (midCos * midCos);
   EXPECT_NEAR(punctualDirect(spot, mid, glm::vec3(0, 0, 1)).mapValue.x, 3.0 * 0.25 * midCos / r2 / kPi, 1e-5);
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(1, 0, -1));
-  sun.intensity = 2.0f;
+  const Light sun = directionalLight(glm::vec3(1, 0, -1), 2.0f);
   EXPECT_NEAR(punctualDirect(sun, glm::vec3(5), glm::vec3(0, 0, 1)).mapValue.x, 2.0 / std::sqrt(2.0) / kPi, 1e-6);
 }
 

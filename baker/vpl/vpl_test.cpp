@@ -330,11 +330,7 @@ TEST(Walk, SpotPathsFollowTheFalloffAndDirectionalCoversTheScene) {
   Scene d;
   int f = addMaterial(d, glm::vec3(0.5f));
   addQuad(d, f, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
-  sun.intensity = 2.0f;
-  d.lights.push_back(sun);
+  d.lights.push_back(directionalLight(glm::vec3(0.3f, 0.0f, -1.0f), 2.0f));
   RayTracer rt2(d);
   o.paths = 8192;
   VplSet ds = generateVpls(d, rt2, o);
@@ -352,11 +348,7 @@ Scene courtyard(float rho) {
   const glm::vec3 lo(0.0f), hi(4.0f, 4.0f, 1.5f);
   addBox(s, grey, lo, hi, true, 2);
   s.primitives.erase(s.primitives.begin() + 1);  // addBox adds bottom, top, then the walls: drop the top
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
-  sun.intensity = 2.0f;
-  s.lights.push_back(sun);
+  s.lights.push_back(directionalLight(glm::vec3(0.3f, 0.2f, -1.0f), 2.0f));
   return s;
 }
 }  // namespace

@@ -296,11 +296,7 @@ TEST(EmbreeBackend, DirectionalAndSpotShadowsAreExact) {
   int black = addMaterial(s, glm::vec3(0.0f));
   addQuad(s, black, glm::vec3(-2, -2, 0), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0));
   addQuad(s, black, glm::vec3(-0.25f, -0.25f, 1), glm::vec3(0.5f, 0, 0), glm::vec3(0, 0.5f, 0));  // occluder at z = 1
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = glm::normalize(glm::vec3(0.5f, 0.0f, -1.0f));
-  sun.intensity = 3.0f;
-  s.lights.push_back(sun);
+  s.lights.push_back(directionalLight(glm::vec3(0.5f, 0.0f, -1.0f), 3.0f));
   Light spot;
   spot.type = LightType::Spot;
   spot.position = glm::vec3(0, 0, 3);
