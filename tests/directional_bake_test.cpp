@@ -84,6 +84,51 @@ TEST(DirectionalBake, PointOverPlaneTiltedNormalsAndL0Unchanged) {
   EXPECT_EQ(r.report["directional"]["pages"], 3 * r.maps.size());
 }
 
+// The backends accumulate the L1 pages in their own passes, and the exact sums carry them beside the map:
+// on both backends, with the VPLs split over 2×2 interleave classes and a sun (the punctual pass), the
+// map of a directional bake is the plain bake's bytes, and the two backends' L1 pages agree.
+TEST(DirectionalBake, CornellL0IsThePlainBakesBytesOnBothBackends) {
+  auto options = [](BackendKind backend, bool directional) {
+    BakeOptions o;
+    o.backend = backend;
+    o.atlas.texelsPerUnit = 60.0f;
+    o.walk.paths = 256;
+    o.walk.seed = 5;
+    o.interleave = 2;
+    o.directional = directional;
+    return o;
+  };
+  auto scene = [] {
+    Scene s = samples::makeCornellBox();
+    s.lights.push_back(sunLight(glm::vec3(0.3f, -1.0f, -0.4f), 2.0f));
+    return s;
+  };
+  std::array<L1Pages, 2> l1;
+  for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree}) {
+    const BakeResult plain = bake(scene(), options(backend, false));
+    const BakeResult r = bake(scene(), options(backend, true));
+    ASSERT_EQ(r.maps.size(), plain.maps.size());
+    for (size_t p = 0; p < r.maps.size(); ++p) EXPECT_TRUE(sameTexels(r.maps[p], plain.maps[p])) << toString(backend) << p;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(r.directional[k].size(), r.maps.size());
+      for (size_t p = 0; p < r.maps.size(); ++p) EXPECT_EQ(r.directional[k][p].valid, r.maps[p].valid);
+    }
+    l1[backend == BackendKind::Gl ? 0 : 1] = r.directional;
+  }
+  double num = 0.0, den = 0.0;
+  for (int k = 0; k < 3; ++k)
+    for (size_t p = 0; p < l1[1][k].size(); ++p)
+      for (size_t t = 0; t < l1[1][k][p].size(); ++t) {
+        if (!l1[1][k][p].valid[t]) continue;
+        const glm::dvec3 d = glm::dvec3(l1[0][k][p].texels[t]) - glm::dvec3(l1[1][k][p].texels[t]);
+        num += glm::dot(d, d);
+        den += glm::dot(glm::dvec3(l1[1][k][p].texels[t]), glm::dvec3(l1[1][k][p].texels[t]));
+      }
+  const double rmse = std::sqrt(num / den);
+  std::printf("[ figure ] Cornell box + sun, directional: GL vs Embree L1 pages relative RMSE %.3f%%\n", 100.0 * rmse);
+  EXPECT_LT(rmse, 0.025);
+}
+
 // Export: the L1 pages as EXR files (read back bit for bit) and as PNG textures named in the material's
 // IRBAKE_lightmap_directional, listed in extensionsUsed and not required; MOZ_lightmap untouched.
 TEST(DirectionalBake, ExportCarriesTheExtension) {
