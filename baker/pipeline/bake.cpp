@@ -372,8 +372,9 @@ struct StagedBake::State {
   }
 
   // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference). With
-  // l1 (--directional) the L1 pages alike, each coefficient mixed on its own.
-  std::vector<Lightmap> backendMaps(const ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
+  // l1 (--directional) the L1 pages alike, each coefficient mixed on its own. Each page's sums are freed
+  // once rounded: with four coefficients they are the largest thing alive here.
+  std::vector<Lightmap> backendMaps(ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
     if (backend == BackendKind::Reference) return referenceStage(report);
     std::vector<Lightmap> maps = directStage(l1);
     if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
@@ -395,7 +396,9 @@ struct StagedBake::State {
         for (size_t t = 0; t < vplParts[c].size(); ++t) vplParts[c][t] = sums.value(p, t, c);
         parts.push_back(&vplParts[c]);
       }
-      addMixedClasses(texels[p], interleave, parts, sums.pages[p].valid, pages);
+      std::vector<uint8_t> vplValid = std::move(sums.pages[p].valid);
+      sums.pages[p] = {};
+      addMixedClasses(texels[p], interleave, parts, vplValid, pages);
     }
     return maps;
   }
@@ -576,7 +579,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   nlohmann::json& report = r.report;
   s.classPages = {};
   s.timed("backend", [&] { r.maps = s.backendMaps(sums, report, s.options.directional ? &r.directional : nullptr); });
-  sums = {};  // rounded into the maps: its memory is not needed at the peak (compensation)
+  sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, report);
   s.directionalStage(r.directional, report);
