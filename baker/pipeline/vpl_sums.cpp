@@ -36,14 +36,13 @@ ExactVplSums ExactVplSums::zeros(const std::vector<std::vector<uint8_t>>& receiv
 
 bool ExactVplSums::add(size_t page, size_t texel, const glm::vec3* values) {
   const size_t n = channels();
-  const float* v = &values[0].x;  // glm::vec3 is three packed floats
-  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  auto channel = [&](size_t c) { return values[c / 3][static_cast<int>(c % 3)]; };  // coefficient-major, RGB
   for (size_t c = 0; c < n; ++c)
-    if (!std::isfinite(v[c]) || std::fabs(v[c]) >= kMaxBlockValue) return false;
+    if (!std::isfinite(channel(c)) || std::fabs(channel(c)) >= kMaxBlockValue) return false;
   Page& p = pages[page];
   if (p.slot[texel] == kNoSum) return false;
   ExactInt* sum = &p.values[n * p.slot[texel]];
-  for (size_t c = 0; c < n; ++c) sum[c] += toFixed(v[c]);
+  for (size_t c = 0; c < n; ++c) sum[c] += toFixed(channel(c));
   p.valid[texel] = 1;
   return true;
 }
