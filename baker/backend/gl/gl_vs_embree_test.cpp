@@ -128,18 +128,19 @@ TEST(GlVsEmbree, CornellBoxWithinOnePercent) {
 
 // Directional maps (issue 15): the GL backend's L1 targets against the Embree backend's L1 on the same
 // VPLs, and neither backend's map changes by a bit when the L1 pages are asked for. Corner (the spot
-// light's pass and the VPLs, 2×2 samples per texel): 0.05%. Cornell box at this coarse page (128², 14 mm texels): 1.8%, all of it
-// in texels within ~2 cm of the box's inner corners: there L1 is dominated by VPLs on the adjacent wall
-// seen at grazing angles, which L0 weights by cosθ ≈ 0 but L1 does not (E ω, not E cosθ), and which the
-// cube lookups shadow by acne where rays see them (slope bias capped at tanθ = 20: bias × 2 gives 0.9%).
-// On the default Cornell bake (610k texels) the L1 pages differ by 0.5–1.1% per axis (docs/performance.md).
+// light's pass and the VPLs, 2×2 samples per texel): 0.04%. Cornell box at this coarse page (128², 14 mm
+// texels): 1.8%, all of it in texels within ~2 cm of the box's inner corners: there L1 is dominated by
+// VPLs on the adjacent wall seen at grazing angles, which L0 weights by cosθ ≈ 0 but L1 does not (E ω,
+// not E cosθ: a VPL at distance r adds up to Φ cosθy / (π² r²), which the clamp of G does not bound), and
+// which the cube lookups shadow by acne where rays see them (slope bias capped at tanθ = 20: bias × 2
+// gives 0.9%). On the default Cornell bake (610k texels) the L1 pages differ by 0.5–1.1% per axis.
 TEST(GlVsEmbree, DirectionalL1AgreesAndMapsUnchanged) {
   for (bool corner : {false, true}) {
     const Comparison c =
         compareBackends(corner ? samples::makeCorner() : samples::makeCornellBox(), 128, 256, corner ? 2 : 1, true, true);
     EXPECT_TRUE(c.glMapUnchanged) << corner;
     EXPECT_TRUE(c.embreeMapUnchanged) << corner;
-    EXPECT_LT(c.l1RelativeRmse, corner ? 0.005 : 0.025) << corner;
+    EXPECT_LT(c.l1RelativeRmse, corner ? 0.01 : 0.025) << corner;
   }
 }
 
