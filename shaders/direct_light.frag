@@ -26,6 +26,13 @@ uniform float constantBias, slopeBias, normalOffset;
 uniform float texelAngle;      // cube / perspective: angle of one texel (rad); ortho: texel size (m)
 
 layout(location = 0) out vec4 result;
+#ifdef DIRECTIONAL
+// Directional maps: the light's tangential irradiance vector t, world axis k in target 1 + k (as
+// vpl_accumulate.frag).
+layout(location = 1) out vec4 l1x;
+layout(location = 2) out vec4 l1y;
+layout(location = 3) out vec4 l1z;
+#endif
 
 // Contact check of a lit lookup (see ambiguousWeight in vpl_accumulate.frag): the stored surface, put
 // back at the centre of its texel, must not lie in front of the receiver's plane (normal ng through p).
@@ -115,6 +122,9 @@ void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
   float leak = 0.0;
+#ifdef DIRECTIONAL
+  vec3 tx = vec3(0.0), ty = vec3(0.0), tz = vec3(0.0);  // Σ over layers of weight × the sample's t
+#endif
   for (int l = 0; l < layers; ++l) {
     vec4 pw = texelFetch(gPositionWeight, ivec3(px, l), 0);
     if (pw.w <= 0.0) continue;
@@ -143,8 +153,22 @@ void main() {
     if (cosTheta <= 0.0 || cosGeom <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;
     bool ambiguous;
     vec3 unshadowed = pw.w * e * cosTheta;
-    sum += unshadowed * lit(pw.xyz, n, ng, cosGeom, r, ambiguous);
+    float visible = lit(pw.xyz, n, ng, cosGeom, r, ambiguous);
+    sum += unshadowed * visible;
     leak += ambiguous ? dot(unshadowed, vec3(1.0 / 3.0)) : 0.0;  // what the texel gets if the answer is wrong
+#ifdef DIRECTIONAL
+    // g = E ω (E facing the light), its tangential part for the sample's normal, weighted like the map.
+    vec3 g = pw.w * e * visible;
+    vec3 t = toLight - cosTheta * n;
+    tx += g * t.x;
+    ty += g * t.y;
+    tz += g * t.z;
+#endif
   }
   result = vec4(sum / kPi, leak / kPi);
+#ifdef DIRECTIONAL
+  l1x = vec4(tx / kPi, 0.0);
+  l1y = vec4(ty / kPi, 0.0);
+  l1z = vec4(tz / kPi, 0.0);
+#endif
 }

@@ -70,6 +70,13 @@ ivec2 tileOrigin(int cube, int face) {
 }
 
 layout(location = 0) out vec4 result;
+#ifdef DIRECTIONAL
+// Directional maps (transport/directional.h): the tangential irradiance vector t, world axis k in target
+// 1 + k (RGB; alpha unused), summed by the same blending. Only bakes that ask for L1 compile this.
+layout(location = 1) out vec4 l1x;
+layout(location = 2) out vec4 l1y;
+layout(location = 3) out vec4 l1z;
+#endif
 
 #ifdef CONTACT_FLAGS
 // Receiver-plane check of a biased lookup (contact leaks). The depth bias lets through whatever lies
@@ -222,6 +229,9 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
   float leak = 0.0;
+#ifdef DIRECTIONAL
+  vec3 tx = vec3(0.0), ty = vec3(0.0), tz = vec3(0.0);  // Σ over layers of weight × the sample's t
+#endif
   float noClamp = clampBound > 0.0 ? clampBound : 3.0e38;
 #ifdef LAYERS
   const int layerCount = LAYERS;
@@ -235,11 +245,39 @@ void main() {
     vec3 ng = texelFetch(gGeomNormal, ivec3(p, l), 0).xyz;
     vec3 s = vec3(0.0);
     float sampleLeak = 0.0;
+#ifdef DIRECTIONAL
+    // The sample's irradiance vector g = Σ E_i ω_i (per world axis, RGB), E_i facing the VPL: a term is
+    // E_i cosθx, and ω_i = d / r with cosθx = cx / r, so E_i ω_i = (term / cx) · d (as the Embree backend).
+    vec3 gx = vec3(0.0), gy = vec3(0.0), gz = vec3(0.0);
+    for (int k = 0; k < vplCount; ++k) {
+      Vpl v = loadVpl(k);
+      vec3 term = vplTerm(v, k, x, nx, ng, noClamp, sampleLeak);
+      s += term;
+      vec3 d = v.position - x;  // the same d and cx as vplTerm's (the compiler shares them)
+      float cx = dot(nx, d);
+      vec3 e = term * (cx > 0.0 ? 1.0 / cx : 0.0);  // term is 0 wherever cx ≤ 0 (selected in vplTerm)
+      gx += e * d.x;
+      gy += e * d.y;
+      gz += e * d.z;
+    }
+    // Its tangential part t = g − (g·nx) nx, per channel (tangentialPart); weighted like the map.
+    vec3 gn = gx * nx.x + gy * nx.y + gz * nx.z;
+    float wl = pw.w > 0.0 ? pw.w : 0.0;
+    tx += wl * (gx - gn * nx.x);
+    ty += wl * (gy - gn * nx.y);
+    tz += wl * (gz - gn * nx.z);
+#else
     for (int k = 0; k < vplCount; ++k) s += vplTerm(loadVpl(k), k, x, nx, ng, noClamp, sampleLeak);
+#endif
     sum += pw.w > 0.0 ? pw.w * s : vec3(0.0);
     leak += pw.w > 0.0 ? pw.w * sampleLeak : 0.0;
   }
   // alpha: the channel-mean light that lookups let through without being able to tell a contact from
   // the receiver (CONTACT_FLAGS; 0 otherwise), in map units like rgb.
   result = vec4(sum * kInvPi2, leak * kInvPi2);
+#ifdef DIRECTIONAL
+  l1x = vec4(tx * kInvPi2, 0.0);
+  l1y = vec4(ty * kInvPi2, 0.0);
+  l1z = vec4(tz * kInvPi2, 0.0);
+#endif
 }

@@ -79,9 +79,14 @@ const fs::path& cornellBox() {
   return scene;
 }
 
-// The outputs that must match byte for byte (the report's timings differ between any two runs).
-void expectSameOutputs(const fs::path& expected, const fs::path& actual) {
-  for (const char* file : {"lightmap_0.exr", "scene.gltf", "scene.bin", "lightmap_0.png"}) {
+// The outputs that must match byte for byte (the report's timings differ between any two runs); with
+// directional, the L1 pages' EXRs and PNGs too.
+void expectSameOutputs(const fs::path& expected, const fs::path& actual, bool directional = false) {
+  std::vector<std::string> files = {"lightmap_0.exr", "scene.gltf", "scene.bin", "lightmap_0.png"};
+  if (directional)
+    for (const char* axis : {"l1x", "l1y", "l1z"})
+      for (const char* ext : {".exr", ".png"}) files.push_back(std::string("lightmap_0_") + axis + ext);
+  for (const std::string& file : files) {
     const std::string want = fileText(expected / file);
     ASSERT_FALSE(want.empty()) << expected / file;
     EXPECT_TRUE(fileText(actual / file) == want) << actual / file << " differs from " << expected / file;
@@ -238,4 +243,55 @@ TEST(Distributed, ResumeRefusesTheCheckpointOfAnotherBake) {
   EXPECT_NE(refused.output.find("different seed"), std::string::npos) << refused.output;
   EXPECT_FALSE(fs::exists(out / "lightmap_0.exr"));
   EXPECT_TRUE(fs::exists(checkpoint));  // refused, not destroyed
+}
+
+// Directional bakes (issue 15) sum their L1 pages in the same exact block sums as the map: shards merged,
+// and a bake resumed from a checkpoint, give the one-shot bake's bytes, L1 pages included, on both
+// backends. The resume starts from the sums of the first half of the blocks, which is what shard 1/2's
+// partial holds (same header fields as a checkpoint of that bake): deterministic, unlike a SIGKILL.
+TEST(Distributed, DirectionalShardsAndResumeGiveTheBytesOfOneMachine) {
+  ASSERT_TRUE(fs::exists(cornellBox()));
+  for (const std::string backend : {"gl", "embree"}) {
+    const fs::path dir = scratchFolder("directional_" + backend);
+    const std::vector<std::string> options =
+        split(kOptions + kWalk + " --interleave 2 --directional --sun 0.3,-1,-0.4,2 --backend " + backend);
+    auto bake = [&](const fs::path& out, std::vector<std::string> extra) {
+      std::vector<std::string> args{"bake", cornellBox().string(), "-o", out.string()};
+      args.insert(args.end(), options.begin(), options.end());
+      args.insert(args.end(), extra.begin(), extra.end());
+      return irbake(args, out.string() + "_log.txt");
+    };
+    Finished one = bake(dir / "one", {});
+    ASSERT_EQ(one.code, 0) << one.output;
+    ASSERT_TRUE(fs::exists(dir / "one" / "lightmap_0_l1x.exr"));
+
+    std::vector<std::string> merge{"merge"};
+    for (int k : {2, 1}) {
+      const fs::path out = dir / ("shard_" + std::to_string(k));
+      Finished shard = bake(out, {"--shard", std::to_string(k) + "/2"});
+      ASSERT_EQ(shard.code, 0) << shard.output;
+      merge.push_back(out.string());
+    }
+    merge.insert(merge.end(), {"-o", (dir / "merged").string(), "--quiet"});
+    Finished m = irbake(merge, dir / "merged_log.txt");
+    ASSERT_EQ(m.code, 0) << m.output;
+    expectSameOutputs(dir / "one", dir / "merged", true);
+
+    const fs::path resumed = dir / "resumed";
+    fs::create_directories(resumed);
+    fs::copy_file(dir / "shard_1" / "partial_1_of_2.vplsum", resumed / ".irbake.checkpoint");
+    {  // The same bake without --directional: another bake, refused, the checkpoint kept.
+      std::vector<std::string> plain{"bake", cornellBox().string(), "-o", resumed.string(), "--resume"};
+      for (const std::string& a : options)
+        if (a != "--directional") plain.push_back(a);
+      Finished refused = irbake(plain, dir / "refused_log.txt");
+      EXPECT_EQ(refused.code, 2) << refused.output;
+      EXPECT_NE(refused.output.find("different options"), std::string::npos) << refused.output;
+      ASSERT_TRUE(fs::exists(resumed / ".irbake.checkpoint"));
+    }
+    Finished rr = bake(resumed, {"--resume"});
+    ASSERT_EQ(rr.code, 0) << rr.output;
+    expectSameOutputs(dir / "one", resumed, true);
+    EXPECT_FALSE(fs::exists(resumed / ".irbake.checkpoint"));
+  }
 }

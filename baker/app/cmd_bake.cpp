@@ -326,6 +326,9 @@ int runBake(const Args& args) {
       std::string differs = header.mismatch(saved.header);
       if (differs.empty() && (saved.header.firstBlock != begin || saved.header.endBlock > end))
         differs = "share of the VPL blocks";
+      if (differs.empty() && saved.sums.coefficients != sums.coefficients)  // a version-1 --directional checkpoint
+        differs = "coefficients per texel: " + std::to_string(saved.sums.coefficients) + " saved, " +
+                  std::to_string(sums.coefficients) + " needed";
       if (differs.empty() && !saved.sums.sameLayout(sums)) differs = "page layout";
       if (!differs.empty())
         throw Error(ErrorCode::Usage, checkpoint.string(),

@@ -144,6 +144,11 @@ int runMerge(const Args& args) {
                     std::to_string(staged.blockCount()));
   ExactVplSums sums = staged.emptySums();
   for (size_t i = 0; i < partials.size(); ++i) {
+    if (partials[i].sums.coefficients != sums.coefficients)  // e.g. a --directional partial of version 1: L0 only
+      throw Error(ErrorCode::InvalidData, files[i].string(),
+                  "its sums hold " + std::to_string(partials[i].sums.coefficients) +
+                      " coefficient(s) per texel, this bake needs " + std::to_string(sums.coefficients) +
+                      " (a partial written before irbake summed the directional pages: bake the shard again)");
     if (!partials[i].sums.sameLayout(sums))
       throw Error(ErrorCode::InvalidData, files[i].string(), "its pages are not this bake's pages");
     sums.add(partials[i].sums);

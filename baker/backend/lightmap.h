@@ -1,5 +1,6 @@
 // A baked page: irradiance/π (linear RGB) per texel; a white Lambertian surface shows this value.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -14,5 +15,9 @@ struct Lightmap {
   std::vector<uint8_t> valid;     // 1 where computed from valid samples; others are filled by post
   size_t size() const { return static_cast<size_t>(width) * height; }
 };
+
+// Directional maps (transport/directional.h): the L1x, L1y, L1z pages, one Lightmap per page each (axis k
+// holds the k-th world component of the tangential irradiance vector t, per colour channel, / π).
+using L1Pages = std::array<std::vector<Lightmap>, 3>;
 
 }  // namespace irbake

@@ -54,6 +54,8 @@ void checkOptionRanges(const BakeOptions& o) {
   atLeast(o.gl.cubeFaceSize, 1, "GL cube face size");
   atLeast(o.walk.maxBounces, 0, "bounce count");
   atLeast(o.compensation.filterRadius, 0, "compensation filter radius");
+  if (o.directional && o.backend == BackendKind::Reference)  // the L1 pages come from the VPL backends' passes
+    throw Error(ErrorCode::Usage, "", "--directional needs a VPL backend (gl, embree or auto), not reference");
   if (o.clamp == ClampMode::Fixed && !(o.clampBound > 0.0f))
     throw Error(ErrorCode::Usage, "", "a fixed clamp bound must be positive (got " + std::to_string(o.clampBound) +
                                           "; ClampMode::Off for no clamp)");
@@ -278,21 +280,27 @@ struct StagedBake::State {
     return classPages;
   }
 
-  // One call of the GL or Embree backend.
-  std::vector<Lightmap> runVplBackend(const BakeInputs& in) {
+  // One call of the GL or Embree backend; with l1, the same pass also gives the L1 pages (--directional).
+  std::vector<Lightmap> runVplBackend(const BakeInputs& in, L1Pages* l1 = nullptr) {
     if (backend == BackendKind::Gl) {
       GlBakeStats callStats;
       GlBackendOptions o = gl;
       o.stats = &callStats;
       o.context = glContext.get();
+      o.directional = l1;
       std::vector<Lightmap> maps = bakeGl(in, o);
       glStats.add(callStats);
       ++interleaveStats.backendCalls;
       return maps;
     }
     ++interleaveStats.backendCalls;
-    return bakeEmbree(in);
+    EmbreeOptions o;
+    o.directional = l1;
+    return bakeEmbree(in, o);
   }
+
+  // RGB triples per texel in the exact sums: the map, and the three L1 pages with --directional.
+  int coefficients() const { return options.directional ? 1 + 3 : 1; }
 
   void evaluateBlock(size_t index, ExactVplSums& sums, ProgressCallback progress) {
     const VplBlock& block = blocks[index];
@@ -304,7 +312,9 @@ struct StagedBake::State {
     set.vpls.assign(classSet.vpls.begin() + static_cast<std::ptrdiff_t>(block.begin),
                     classSet.vpls.begin() + static_cast<std::ptrdiff_t>(block.end));
     const std::vector<TexelSamples>& pages = pagesOf(block.vplClass);
-    const std::vector<Lightmap> maps = runVplBackend(inputs(pages, set, vplBlockEval(eval), std::move(progress)));
+    L1Pages l1;
+    const std::vector<Lightmap> maps =
+        runVplBackend(inputs(pages, set, vplBlockEval(eval), std::move(progress)), options.directional ? &l1 : nullptr);
     const int n = interleave, cx = block.vplClass % n, cy = block.vplClass / n;
     for (size_t p = 0; p < maps.size() && p < texels.size(); ++p) {
       const Lightmap& m = maps[p];
@@ -314,7 +324,10 @@ struct StagedBake::State {
           const size_t ct = static_cast<size_t>(y) * m.width + x;
           if (ct >= m.valid.size() || !m.valid[ct]) continue;
           const size_t t = static_cast<size_t>(n * y + cy) * fullWidth + (n * x + cx);
-          if (!sums.add(p, t, m.texels[ct]))
+          glm::vec3 value[ExactVplSums::kMaxCoefficients] = {m.texels[ct]};  // L0, then L1x, L1y, L1z
+          if (options.directional)
+            for (int k = 0; k < 3; ++k) value[1 + k] = l1[k][p].texels[ct];
+          if (!sums.add(p, t, value))
             throw Error(ErrorCode::NumericError, scene.sourcePath,
                         "VPL block " + std::to_string(index) + " gave a non-finite or absurd value (≥ 2^40) at page " +
                             std::to_string(p) + " texel " + std::to_string(t % fullWidth) + "," +
@@ -323,17 +336,20 @@ struct StagedBake::State {
     }
   }
 
-  // Punctual lights on every texel, exact and unfiltered (blank valid pages when there are none).
-  std::vector<Lightmap> directStage() {
+  // Punctual lights on every texel, exact and unfiltered (blank valid pages when there are none); with l1,
+  // their L1 pages too.
+  std::vector<Lightmap> directStage(L1Pages* l1) {
     if (eval.includeDirect && !scene.lights.empty()) {
       const VplSet none;
-      return runVplBackend(inputs(texels, none, directEval(eval)));
+      return runVplBackend(inputs(texels, none, directEval(eval)), l1);
     }
     std::vector<Lightmap> maps;
     for (const TexelSamples& ts : texels) {
       maps.push_back(blankLightmap(ts));
       maps.back().valid = ts.valid;
     }
+    if (l1)
+      for (auto& axis : *l1) axis = maps;
     return maps;
   }
 
@@ -355,20 +371,34 @@ struct StagedBake::State {
     return maps;
   }
 
-  // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference).
-  std::vector<Lightmap> backendMaps(const ExactVplSums& sums, nlohmann::json& report) {
+  // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference). With
+  // l1 (--directional) the L1 pages alike, each coefficient mixed on its own. Each page's sums are freed
+  // once rounded: with four coefficients they are the largest thing alive here.
+  std::vector<Lightmap> backendMaps(ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
     if (backend == BackendKind::Reference) return referenceStage(report);
-    std::vector<Lightmap> maps = directStage();
-    if (maps.size() != texels.size())
+    std::vector<Lightmap> maps = directStage(l1);
+    if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
       throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
                                                                 " pages for " + std::to_string(texels.size()));
+    const int coefficients = l1 ? sums.coefficients : 1;
     for (size_t p = 0; p < maps.size(); ++p) {
-      maps[p].page = static_cast<int>(p);
-      if (maps[p].valid.size() != maps[p].size()) maps[p].valid = texels[p].valid;
+      std::vector<Lightmap*> pages;  // this page's map, then its L1 pages
+      for (int c = 0; c < coefficients; ++c) {
+        Lightmap& map = c == 0 ? maps[p] : (*l1)[c - 1][p];
+        map.page = static_cast<int>(p);
+        if (map.valid.size() != map.size()) map.valid = texels[p].valid;
+        pages.push_back(&map);
+      }
       if (blocks.empty()) continue;
-      std::vector<glm::vec3> vplPart(texels[p].layerSize(), glm::vec3(0.0f));
-      for (size_t t = 0; t < vplPart.size(); ++t) vplPart[t] = sums.value(p, t);
-      addMixedClasses(texels[p], interleave, vplPart, sums.pages[p].valid, maps[p]);
+      std::vector<std::vector<glm::vec3>> vplParts(coefficients, std::vector<glm::vec3>(texels[p].layerSize()));
+      std::vector<const std::vector<glm::vec3>*> parts;
+      for (int c = 0; c < coefficients; ++c) {
+        for (size_t t = 0; t < vplParts[c].size(); ++t) vplParts[c][t] = sums.value(p, t, c);
+        parts.push_back(&vplParts[c]);
+      }
+      std::vector<uint8_t> vplValid = std::move(sums.pages[p].valid);
+      sums.pages[p] = {};
+      addMixedClasses(texels[p], interleave, parts, vplValid, pages);
     }
     return maps;
   }
@@ -415,34 +445,18 @@ struct StagedBake::State {
     });
   }
 
-  // Directional maps: the L1 pages from the Embree backend whatever backend baked L0, interleaved like the
-  // L0 VPL sum (one Embree pass fills all three axes; the interleave mixes each), then post-processed
-  // per axis; the sky's part traced again (addSkyLightDirectional). The clamp compensation adds to L0 only:
-  // its light counts as arriving along the normal (docs/units.md).
-  std::array<std::vector<Lightmap>, 3> directionalStage(nlohmann::json& report) {
-    std::array<std::vector<Lightmap>, 3> axes;
-    if (!options.directional) return axes;
-    if (backend == BackendKind::Reference)
-      throw Error(ErrorCode::Usage, scene.sourcePath, "--directional needs a VPL backend (gl, embree or auto)");
+  // Directional maps after the backend stage, whose passes accumulated the L1 pages of the punctual lights
+  // and VPLs beside the map (and the exact sums mixed them per coefficient): the sky's part traced again
+  // (addSkyLightDirectional), then post per axis. The clamp compensation adds to L0 only: its light
+  // counts as arriving along the normal (docs/units.md).
+  void directionalStage(L1Pages& axes, nlohmann::json& report) {
+    if (!options.directional) return;
     timed("directional", [&] {
-      std::vector<std::array<std::vector<Lightmap>, 3>> calls;  // per backend call of the interleave
-      size_t call = 0;
-      int axis = 0;
-      VplBackend embree = [&](const BakeInputs& in) {
-        if (axis == 0) calls.push_back(bakeEmbreeDirectional(in));
-        return std::move(calls[call++][axis]);
-      };
-      for (axis = 0; axis < 3; ++axis) {
-        call = 0;
-        axes[axis] = bakeInterleaved(*wholeInputs, interleave, embree);
-        for (size_t p = 0; p < axes[axis].size(); ++p) axes[axis][p].page = static_cast<int>(p);
-      }
       if (scene.environment.present()) addSkyLightDirectional(*wholeInputs, axes, skyOptions());
       PostStats stats;
       for (auto& pages : axes) stats = postProcess(scene, pages, postOptions());
       report["directional"] = {{"pages", axes[0].size() * 3}, {"seamMismatchAfter", stats.seamMismatchAfter}};
     });
-    return axes;
   }
 
   PostStats postStage(std::vector<Lightmap>& maps) {
@@ -516,7 +530,7 @@ ExactVplSums StagedBake::emptySums() const {
   std::vector<std::vector<uint8_t>> receivers;
   for (const TexelSamples& ts : state_->texels)
     receivers.push_back(ts.valid.size() == ts.layerSize() ? ts.valid : std::vector<uint8_t>(ts.layerSize(), 1));
-  return ExactVplSums::zeros(receivers);
+  return ExactVplSums::zeros(receivers, state_->coefficients());
 }
 
 void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
@@ -564,11 +578,11 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   BakeResult r;
   nlohmann::json& report = r.report;
   s.classPages = {};
-  s.timed("backend", [&] { r.maps = s.backendMaps(sums, report); });
-  sums = {};  // rounded into the maps: its memory is not needed at the peak (compensation)
+  s.timed("backend", [&] { r.maps = s.backendMaps(sums, report, s.options.directional ? &r.directional : nullptr); });
+  sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, report);
-  r.directional = s.directionalStage(report);
+  s.directionalStage(r.directional, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();
   s.describe(report, post);

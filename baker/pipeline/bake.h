@@ -71,8 +71,9 @@ struct BakeOptions {
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams
-  bool directional = false;               // also bake the L1 pages (BakeResult::directional, issue 15);
-                                          // off: no extra work, the same bytes as before
+  bool directional = false;               // also bake the L1 pages (BakeResult::directional, issue 15) in the
+                                          // backend's passes (4 coefficients in the exact sums); the map's
+                                          // bytes are the same. Off: no extra work, the same bytes as before
   ProgressCallback progress;
 };
 
@@ -82,8 +83,8 @@ struct BakeResult {
   VplSet vpls;
   std::vector<Lightmap> maps;        // one per page, post-processed
   // With BakeOptions::directional: the L1x, L1y, L1z pages (transport/directional.h), one per page each,
-  // post-processed like maps; empty otherwise.
-  std::array<std::vector<Lightmap>, 3> directional;
+  // from the backend's own passes and exact sums like maps, post-processed like them; empty otherwise.
+  L1Pages directional;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

@@ -12,7 +12,10 @@ namespace irbake {
 
 namespace {
 
-constexpr char kMagic[16] = "IRBAKE-VPLSUM-1";  // 15 characters + NUL
+// Version 2 (issue 15) adds the coefficient count (1: the map; 4: with the directional L1 pages) after the
+// page count; version 1 files, written before, hold one coefficient and are read as such.
+constexpr char kMagic[16] = "IRBAKE-VPLSUM-2";    // 15 characters + NUL
+constexpr char kMagicV1[16] = "IRBAKE-VPLSUM-1";  // no coefficient count: one
 constexpr char kEnd[8] = "VPLSEND";             // after the last page: a truncated file is refused
 
 constexpr uint64_t kFnvOffset = 1469598103934665603ull, kFnvPrime = 1099511628211ull;
@@ -87,8 +90,9 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
     put(out, static_cast<uint64_t>(text.size()));
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     put(out, static_cast<uint64_t>(sums.pages.size()));
+    put(out, static_cast<uint64_t>(sums.coefficients));
     // Per page: texel count, then per texel 0 (no sums), 1 (receiver, no block found it valid: zero sums
-    // not written) or 2 (valid: its three sums follow at the end of the page, in texel order).
+    // not written) or 2 (valid: its 3 · coefficients sums follow at the end of the page, in texel order).
     for (const ExactVplSums::Page& page : sums.pages) {
       put(out, static_cast<uint64_t>(page.slot.size()));
       std::vector<uint8_t> state(page.slot.size(), 0);
@@ -96,7 +100,9 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
         state[t] = page.slot[t] == ExactVplSums::kNoSum ? 0 : page.valid[t] ? 2 : 1;
       out.write(reinterpret_cast<const char*>(state.data()), static_cast<std::streamsize>(state.size()));
       for (size_t t = 0; t < state.size(); ++t)
-        if (state[t] == 2) out.write(reinterpret_cast<const char*>(&page.rgb[3 * size_t(page.slot[t])]), 3 * sizeof(ExactInt));
+        if (state[t] == 2)
+          out.write(reinterpret_cast<const char*>(&page.values[sums.channels() * page.slot[t]]),
+                    static_cast<std::streamsize>(sums.channels() * sizeof(ExactInt)));
     }
     out.write(kEnd, sizeof kEnd);
     out.close();
@@ -110,8 +116,9 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   Reader in{bytes, path};
   char magic[sizeof kMagic];
   in.take(magic, sizeof magic);
-  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw Error(ErrorCode::Parse, path.string(), "not an irbake VPL sum file (partial or checkpoint)");
+  const bool version1 = std::memcmp(magic, kMagicV1, sizeof kMagicV1) == 0;
+  if (!version1 && std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+    throw Error(ErrorCode::Parse, path.string(), "not an irbake VPL sum file (partial or checkpoint) of this version");
   const uint64_t textSize = in.get<uint64_t>();
   if (textSize > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
   std::string text(textSize, '\0');
@@ -137,6 +144,12 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   }
   const uint64_t pageCount = in.get<uint64_t>();
   if (pageCount > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
+  const uint64_t coefficients = version1 ? 1 : in.get<uint64_t>();
+  if (coefficients != 1 && coefficients != uint64_t(ExactVplSums::kMaxCoefficients))
+    throw Error(ErrorCode::Parse, path.string(),
+                "VPL sum file is damaged (" + std::to_string(coefficients) + " coefficients per texel)");
+  file.sums.coefficients = static_cast<int>(coefficients);
+  const size_t channels = file.sums.channels();
   for (uint64_t p = 0; p < pageCount; ++p) {
     const uint64_t texels = in.get<uint64_t>();
     if (texels > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
@@ -147,10 +160,10 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
       if (state[t] > 2) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is damaged (bad texel state)");
       receivers[t] = state[t] != 0;
     }
-    ExactVplSums::Page page = std::move(ExactVplSums::zeros({receivers}).pages[0]);
+    ExactVplSums::Page page = std::move(ExactVplSums::zeros({receivers}, file.sums.coefficients).pages[0]);
     for (size_t t = 0; t < texels; ++t) {
       if (state[t] != 2) continue;
-      in.take(&page.rgb[3 * size_t(page.slot[t])], 3 * sizeof(ExactInt));
+      in.take(&page.values[channels * page.slot[t]], channels * sizeof(ExactInt));
       page.valid[t] = 1;
     }
     file.sums.pages.push_back(std::move(page));

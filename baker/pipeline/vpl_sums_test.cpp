@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -66,7 +68,7 @@ TEST(ExactVplSums, RefusesValuesItCannotAddExactly) {
   EXPECT_THROW(sums.add(ExactVplSums::zeros({{1, 1, 1}})), std::invalid_argument);
   ExactVplSums someReceive = ExactVplSums::zeros({{1, 0}});
   EXPECT_FALSE(someReceive.add(0, 1, glm::vec3(1.0f)));  // not a receiver: no sums there
-  EXPECT_EQ(someReceive.pages[0].rgb.size(), 3u);
+  EXPECT_EQ(someReceive.pages[0].values.size(), 3u);
 }
 
 TEST(VplSumFile, RoundTripsAndRefusesDamage) {
@@ -104,7 +106,7 @@ TEST(VplSumFile, RoundTripsAndRefusesDamage) {
   for (size_t p = 0; p < 2; ++p) {
     EXPECT_EQ(back.sums.pages[p].valid, sums.pages[p].valid);
     EXPECT_EQ(back.sums.pages[p].slot, sums.pages[p].slot);
-    EXPECT_TRUE(back.sums.pages[p].rgb == sums.pages[p].rgb);
+    EXPECT_TRUE(back.sums.pages[p].values == sums.pages[p].values);
   }
   VplSumHeader other = h;
   other.seed = 10;
@@ -131,5 +133,101 @@ TEST(VplSumFile, RoundTripsAndRefusesDamage) {
       EXPECT_EQ(e.code(), ErrorCode::Parse);
       EXPECT_NE(std::string(e.what()).find(bad.filename().string()), std::string::npos) << e.what();
     }
+  }
+}
+
+// Directional bakes sum four coefficients (L0, L1x, L1y, L1z) per texel: each is exact and order-free like
+// the map, a value that cannot be added leaves every coefficient untouched, and one RGB value is refused.
+TEST(ExactVplSums, FourCoefficientsAreEachExactAndAddedTogether) {
+  const std::vector<glm::vec3> values = blockValues(4 * 300, 11);
+  ExactVplSums forward = ExactVplSums::zeros({{1, 0, 1}}, 4), backward = ExactVplSums::zeros({{1, 0, 1}}, 4);
+  EXPECT_EQ(forward.pages[0].values.size(), 2u * 12u);
+  for (size_t b = 0; b < 300; ++b) ASSERT_TRUE(forward.add(0, 2, &values[4 * b]));
+  for (size_t b = 300; b-- > 0;) ASSERT_TRUE(backward.add(0, 2, &values[4 * b]));
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_TRUE(sameBits(forward.value(0, 2, c), backward.value(0, 2, c))) << c;
+    glm::dvec3 reference(0.0);
+    for (size_t b = 0; b < 300; ++b) reference += glm::dvec3(values[4 * b + c]);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(forward.value(0, 2, c)[k], reference[k], reference[k] * 6e-8) << c;
+  }
+  EXPECT_EQ(forward.value(0, 0, 3), glm::vec3(0.0f));
+  const glm::vec3 bad[4] = {glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(NAN)};
+  EXPECT_FALSE(forward.add(0, 0, bad));
+  EXPECT_EQ(forward.value(0, 0, 0), glm::vec3(0.0f));  // nothing of a refused value
+  EXPECT_EQ(forward.pages[0].valid[0], 0);
+  EXPECT_THROW(forward.add(0, 0, glm::vec3(1.0f)), std::invalid_argument);
+  EXPECT_FALSE(forward.sameLayout(ExactVplSums::zeros({{1, 0, 1}})));  // same receivers, one coefficient
+  EXPECT_THROW(forward.add(ExactVplSums::zeros({{1, 0, 1}})), std::invalid_argument);
+  EXPECT_THROW(ExactVplSums::zeros({{1}}, 5), std::invalid_argument);
+}
+
+namespace {
+std::string fileBytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+VplSumHeader someHeader() {
+  VplSumHeader h;
+  h.kind = "checkpoint";
+  h.sceneHash = "0123456789abcdef";
+  h.optionsHash = hashText("directional=true\n");
+  h.backend = "gl";
+  h.blockCount = 4;
+  h.endBlock = 2;
+  h.command = nlohmann::json::object();
+  h.backendCounts = nlohmann::json::object();
+  return h;
+}
+}  // namespace
+
+// Version 2 files carry the coefficient count: four round-trip bit for bit; a version-1 file (written
+// before, one coefficient, no count) still reads as one; a count other than 1 or 4 is damage.
+TEST(VplSumFile, FourCoefficientsRoundTripAndVersionOneStillReads) {
+  const fs::path dir = fs::current_path() / "test_scratch" / "vpl_sum_file_v2";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ExactVplSums sums = ExactVplSums::zeros({{1, 1, 0, 1}}, 4);
+  const std::vector<glm::vec3> values = blockValues(8, 5);
+  ASSERT_TRUE(sums.add(0, 0, &values[0]));
+  ASSERT_TRUE(sums.add(0, 3, &values[4]));
+  const fs::path file = dir / "four.vplsum";
+  writeVplSumFile(file, someHeader(), sums);
+  const VplSumFile back = readVplSumFile(file);
+  EXPECT_EQ(back.sums.coefficients, 4);
+  ASSERT_TRUE(back.sums.sameLayout(sums));
+  EXPECT_TRUE(back.sums.pages[0].values == sums.pages[0].values);
+  EXPECT_EQ(back.sums.pages[0].valid, sums.pages[0].valid);
+
+  // A version-1 file: the same bytes as a version-2 file of one coefficient, less the count after the
+  // page count, under the old magic.
+  ExactVplSums one = ExactVplSums::zeros({{1, 1, 0, 1}});
+  ASSERT_TRUE(one.add(0, 1, values[2]));
+  writeVplSumFile(dir / "one.vplsum", someHeader(), one);
+  std::string bytes = fileBytes(dir / "one.vplsum");
+  ASSERT_EQ(bytes.substr(0, 15), "IRBAKE-VPLSUM-2");
+  uint64_t textSize = 0;
+  std::memcpy(&textSize, bytes.data() + 16, 8);
+  const size_t countAt = 16 + 8 + textSize + 8;
+  uint64_t count = 0;
+  std::memcpy(&count, bytes.data() + countAt, 8);
+  ASSERT_EQ(count, 1u);
+  std::string v1 = bytes;
+  v1.replace(0, 15, "IRBAKE-VPLSUM-1");
+  v1.erase(countAt, 8);
+  std::ofstream(dir / "v1.vplsum", std::ios::binary) << v1;
+  const VplSumFile old = readVplSumFile(dir / "v1.vplsum");
+  EXPECT_EQ(old.sums.coefficients, 1);
+  EXPECT_TRUE(old.sums.pages[0].values == one.pages[0].values);
+
+  std::string three = bytes;
+  const uint64_t bad = 3;
+  std::memcpy(three.data() + countAt, &bad, 8);
+  std::ofstream(dir / "three.vplsum", std::ios::binary) << three;
+  try {
+    readVplSumFile(dir / "three.vplsum");
+    ADD_FAILURE() << "3 coefficients accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Parse);
+    EXPECT_NE(std::string(e.what()).find("3 coefficients"), std::string::npos) << e.what();
   }
 }

@@ -40,17 +40,26 @@ SurfaceFilter::SurfaceFilter(const TexelSamples& ts) : width_(ts.width), height_
 
 std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values, const std::vector<uint8_t>& valid,
                                             const TexelFilterOptions& options) const {
-  std::vector<glm::vec3> out = values;
+  return std::move(apply(std::vector<const std::vector<glm::vec3>*>{&values}, valid, options)[0]);
+}
+
+std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const std::vector<glm::vec3>*>& sets,
+                                                         const std::vector<uint8_t>& valid,
+                                                         const TexelFilterOptions& options) const {
+  std::vector<std::vector<glm::vec3>> out;
+  for (const std::vector<glm::vec3>* values : sets) out.push_back(*values);
   const int r = std::max(0, options.radius);
   const float h = spacing_;
   if (r == 0 || !(h > 0.0f)) return out;
   const int W = width_, H = height_;
+  const size_t setCount = sets.size();
   tbb::parallel_for(0, H, [&](int y) {
+    std::vector<glm::vec3> sum(setCount);
     for (int x = 0; x < W; ++x) {
       const size_t i = static_cast<size_t>(y) * W + x;
       if (!valid[i] || !hasSample_[i]) continue;
       const glm::vec3 p = position_[i], n = normal_[i];
-      glm::vec3 sum(0.0f);
+      std::fill(sum.begin(), sum.end(), glm::vec3(0.0f));
       float count = 0.0f;
       for (int dy = -r; dy <= r; ++dy) {
         const int yy = y + dy;
@@ -67,11 +76,11 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
             if (glm::dot(d, d) > reach * reach) continue;
           }
           const float w = options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
-          sum += w * values[j];
+          for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
           count += w;
         }
       }
-      out[i] = sum / count;
+      for (size_t s = 0; s < setCount; ++s) out[s][i] = sum[s] / count;
     }
   });
   return out;

@@ -31,6 +31,12 @@ class SurfaceFilter {
   // values and valid: one per texel of the page. Invalid texels are returned unchanged.
   std::vector<glm::vec3> apply(const std::vector<glm::vec3>& values, const std::vector<uint8_t>& valid,
                                const TexelFilterOptions& options = {}) const;
+  // The same filter on several value sets of the page at once (the map and its directional L1 pages): the
+  // neighbour tests, most of the cost, are made once for all of them. Each result has the bits the
+  // one-set apply gives that set.
+  std::vector<std::vector<glm::vec3>> apply(const std::vector<const std::vector<glm::vec3>*>& sets,
+                                            const std::vector<uint8_t>& valid,
+                                            const TexelFilterOptions& options = {}) const;
 
  private:
   int width_ = 0, height_ = 0;

@@ -1,8 +1,9 @@
-// Directional maps from the Embree backend (bakeEmbreeDirectional) against closed forms.
+// Directional maps from the Embree backend (EmbreeOptions::directional) against closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "backend/embree/embree_backend.h"
 #include "common/maths.h"
@@ -19,8 +20,23 @@ glm::vec3 tilted(float degrees, float azimuth) {
   return {std::sin(a) * std::cos(b), std::sin(a) * std::sin(b), std::cos(a)};
 }
 
-L1Vectors texelL1(const std::array<std::vector<Lightmap>, 3>& axes, size_t page, size_t t) {
+L1Vectors texelL1(const L1Pages& axes, size_t page, size_t t) {
   return {axes[0][page].texels[t], axes[1][page].texels[t], axes[2][page].texels[t]};
+}
+
+// The maps and their L1 pages from one pass; the maps must be the bits of a pass without L1.
+std::vector<Lightmap> bakeWithL1(const BakeInputs& in, L1Pages& axes) {
+  EmbreeOptions o;
+  o.directional = &axes;
+  std::vector<Lightmap> maps = bakeEmbree(in, o);
+  const std::vector<Lightmap> plain = bakeEmbree(in);
+  EXPECT_EQ(maps.size(), plain.size());
+  for (size_t p = 0; p < maps.size() && p < plain.size(); ++p) {
+    EXPECT_EQ(maps[p].valid, plain[p].valid);
+    EXPECT_EQ(std::memcmp(maps[p].texels.data(), plain[p].texels.data(), maps[p].size() * sizeof(glm::vec3)), 0) << p;
+    for (const auto& axis : axes) EXPECT_EQ(axis[p].valid, plain[p].valid);
+  }
+  return maps;
 }
 
 }  // namespace
@@ -36,8 +52,8 @@ TEST(EmbreeDirectional, PointLightOverPlaneTiltedNormals) {
   RayTracer rt(s);
   VplSet vpls;
   BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};
-  const std::vector<Lightmap> maps = bakeEmbree(in);
-  const auto axes = bakeEmbreeDirectional(in);
+  L1Pages axes;
+  const std::vector<Lightmap> maps = bakeWithL1(in, axes);
   double worst = 0.0;
   for (size_t t = 0; t < maps[0].size(); ++t) {
     ASSERT_TRUE(axes[0][0].valid[t] && axes[1][0].valid[t] && axes[2][0].valid[t]);
@@ -72,7 +88,8 @@ TEST(EmbreeDirectional, QuadEmitterIrradianceVector) {
   w.paths = 4096;
   VplSet vpls = generateVpls(s, rt, w);
   BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};
-  const auto axes = bakeEmbreeDirectional(in);
+  L1Pages axes;
+  bakeWithL1(in, axes);
   const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
   double se = 0.0, largest = 0.0;
   for (size_t t = 0; t < axes[0][0].size(); ++t) {

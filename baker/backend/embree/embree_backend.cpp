@@ -73,15 +73,10 @@ void visitVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, con
   if (count) flush();
 }
 
-// Adds the VPLs [begin, end) seen from (x, n) into acc, tracing the shadow rays in packets of 8.
-void gatherVplsPackets(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
-                       size_t end, KahanSum& acc) {
-  visitVplsPackets(in, bound, x, n, begin, end, [&](const glm::vec3& value, const Vpl&) { acc.add(value); });
-}
-
-// Adds the VPLs [begin, end) seen from (x, n) into acc.
-void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin, size_t end,
-                KahanSum& acc) {
+// Visits the VPLs [begin, end) visible from (x, n) with their (transmitted) map value, one shadow ray each.
+template <typename Visit>
+void visitVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin, size_t end,
+               Visit&& visit) {
   const auto& vpls = in.vpls.vpls;
   for (size_t k = begin; k < end; ++k) {
     const Vpl& v = vpls[k];
@@ -92,8 +87,37 @@ void gatherVpls(const BakeInputs& in, float bound, const glm::vec3& x, const glm
       if (in.rayTracer.occluded(ray.origin, ray.dir, 0.0f, ray.tmax)) continue;
       value *= in.rayTracer.transmittance(ray.origin, ray.dir, 0.0f, ray.tmax);
     }
-    acc.add(value);
+    visit(value, v);
   }
+}
+
+// What one texel sample gathers: the map value (Kahan, float: the map's bits do not depend on whether the
+// L1 part is wanted) and, for directional maps, the irradiance vector g (transport/directional.h) in
+// double: thousands of small VPL terms, 9 numbers per sample.
+struct SampleGather {
+  KahanSum map;
+  std::array<glm::dvec3, 3> g{};
+  // A source of map value `value` in direction toSource (unit) from a receiver of normal n.
+  void addDirectional(const glm::vec3& value, const glm::vec3& toSource, const glm::vec3& n) {
+    const float c = glm::dot(n, toSource);
+    if (!(c > 0.0f)) return;
+    const glm::dvec3 e = glm::dvec3(value) / double(c);  // E / π facing the source
+    for (int k = 0; k < 3; ++k) g[k] += e * double(toSource[k]);
+  }
+  L1Vectors tangential(const glm::vec3& n) const {
+    return tangentialPart(L1Vectors{glm::vec3(g[0]), glm::vec3(g[1]), glm::vec3(g[2])}, n);
+  }
+};
+
+// Adds the VPLs [begin, end) seen from (x, n) into acc (and its irradiance vector when directional).
+void gatherVplBlock(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, size_t begin,
+                    size_t end, bool packets, bool directional, SampleGather& acc) {
+  auto visit = [&](const glm::vec3& value, const Vpl& v) {
+    acc.map.add(value);
+    if (directional) acc.addDirectional(value, glm::normalize(v.position - x), n);
+  };
+  if (packets) visitVplsPackets(in, bound, x, n, begin, end, visit);
+  else visitVpls(in, bound, x, n, begin, end, visit);
 }
 
 // Visits the punctual lights visible from (x, n): visit(map value, unit direction towards the light).
@@ -118,10 +142,9 @@ glm::vec3 directAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n)
 }
 
 glm::vec3 vplSumAt(const BakeInputs& in, float bound, const glm::vec3& x, const glm::vec3& n, bool packets) {
-  KahanSum acc;
-  if (packets) gatherVplsPackets(in, bound, x, n, 0, in.vpls.vpls.size(), acc);
-  else gatherVpls(in, bound, x, n, 0, in.vpls.vpls.size(), acc);
-  return acc.sum;
+  SampleGather acc;
+  gatherVplBlock(in, bound, x, n, 0, in.vpls.vpls.size(), packets, false, acc);
+  return acc.map.sum;
 }
 
 float clampBoundFor(const BakeInputs& in) { return in.eval.includeVpls ? in.eval.clampBound : 0.0f; }
@@ -153,6 +176,9 @@ PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const gl
 
 std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& options) {
   std::vector<Lightmap> maps;
+  const bool directional = options.directional != nullptr;
+  if (directional)
+    for (auto& axis : *options.directional) axis.clear();
   size_t totalSlots = 0, doneSlots = 0;
   for (const auto& t : in.texels) totalSlots += t.slotCount();
   std::atomic<size_t> progressSlots{0};
@@ -166,6 +192,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
     Lightmap map = blankLightmap(ts);
     const size_t slots = ts.slotCount(), layer = std::max<size_t>(1, ts.layerSize());
     std::vector<glm::vec3> slotValue(slots, glm::vec3(0.0f));
+    std::vector<L1Vectors> slotL1(directional ? slots : 0, L1Vectors{});
     const std::vector<uint8_t>* subset =
         options.texelSubset && page < options.texelSubset->size() ? &(*options.texelSubset)[page] : nullptr;
     auto wanted = [&](size_t t) { return !subset || (t < subset->size() && (*subset)[t] != 0); };
@@ -174,23 +201,31 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
       std::vector<size_t> active;
       for (size_t s = r.begin(); s != r.end(); ++s)
         if (ts.positionWeight[s].w > 0.0f && wanted(s % layer)) active.push_back(s);
-      std::vector<KahanSum> acc(active.size());
+      std::vector<SampleGather> acc(active.size());
       // VPLs in blocks: one block stays hot in cache while every sample of the tile loops over it.
       for (size_t b0 = 0; b0 < numVpls; b0 += block) {
         size_t b1 = std::min(numVpls, b0 + block);
         for (size_t a = 0; a < active.size(); ++a) {
           size_t s = active[a];
           glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
-          if (options.packets) gatherVplsPackets(in, bound, x, n, b0, b1, acc[a]);
-          else gatherVpls(in, bound, x, n, b0, b1, acc[a]);
+          gatherVplBlock(in, bound, x, n, b0, b1, options.packets, directional, acc[a]);
         }
       }
       for (size_t a = 0; a < active.size(); ++a) {
         size_t s = active[a];
         glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
-        glm::vec3 v = acc[a].sum;
-        if (in.eval.includeDirect) v += directAt(in, x, n);
+        glm::vec3 v = acc[a].map.sum;
+        if (in.eval.includeDirect) {
+          // Summed apart and added once, as directAt does: the map's bits as without directional.
+          glm::vec3 direct(0.0f);
+          visitDirect(in, x, n, [&](const glm::vec3& value, const glm::vec3& toLight) {
+            direct += value;
+            if (directional) acc[a].addDirectional(value, toLight, n);
+          });
+          v += direct;
+        }
         slotValue[s] = v;
+        if (directional) slotL1[s] = acc[a].tangential(n);
       }
       size_t d = progressSlots.fetch_add(r.size()) + r.size();
       if (in.progress) in.progress("embree", static_cast<double>(doneSlots + d) / std::max<size_t>(1, totalSlots));
@@ -198,69 +233,33 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
     doneSlots += slots;
     progressSlots = 0;
 
-    for (size_t t = 0; t < ts.layerSize(); ++t) {
-      glm::vec3 value;
-      if (!wanted(t)) continue;
-      if (!texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value)) continue;
-      if (!ts.valid.empty() && ts.valid[t] == 0) continue;
-      if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z))
-        throw Error(ErrorCode::NumericError, in.scene.sourcePath,
-                    "embree backend produced a non-finite value at page " + std::to_string(ts.page) + " texel " +
-                        std::to_string(t % ts.width) + "," + std::to_string(t / ts.width));
-      map.texels[t] = value;
-      map.valid[t] = 1;
-    }
-    maps.push_back(std::move(map));
-  }
-  if (in.progress) in.progress("embree", 1.0);
-  return maps;
-}
-
-std::array<std::vector<Lightmap>, 3> bakeEmbreeDirectional(const BakeInputs& in, const EmbreeOptions& options) {
-  std::array<std::vector<Lightmap>, 3> axes;
-  const float bound = clampBoundFor(in);
-  const size_t tile = static_cast<size_t>(std::max(1, options.tileSlots));
-  const size_t numVpls = in.eval.includeVpls ? in.vpls.vpls.size() : 0;
-  for (size_t page = 0; page < in.texels.size(); ++page) {
-    const TexelSamples& ts = in.texels[page];
-    const size_t slots = ts.slotCount();
-    std::vector<L1Vectors> slotValue(slots, L1Vectors{});
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, tile), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t s = r.begin(); s != r.end(); ++s) {
-        if (!(ts.positionWeight[s].w > 0.0f)) continue;
-        const glm::vec3 x = samplePosition(in, ts, s), n(ts.normal[s]);
-        // Double sums: thousands of small VPL terms, 9 numbers per sample.
-        std::array<glm::dvec3, 3> g{};
-        auto add = [&](const glm::vec3& value, const glm::vec3& toSource) {
-          const float c = glm::dot(n, toSource);
-          if (!(c > 0.0f)) return;
-          const glm::dvec3 e = glm::dvec3(value) / double(c);
-          for (int k = 0; k < 3; ++k) g[k] += e * double(toSource[k]);
-        };
-        if (numVpls)
-          visitVplsPackets(in, bound, x, n, 0, numVpls,
-                           [&](const glm::vec3& value, const Vpl& v) { add(value, glm::normalize(v.position - x)); });
-        if (in.eval.includeDirect) visitDirect(in, x, n, add);
-        slotValue[s] = tangentialPart(L1Vectors{glm::vec3(g[0]), glm::vec3(g[1]), glm::vec3(g[2])}, n);
-      }
-    });
-    for (int k = 0; k < 3; ++k) {
-      Lightmap map = blankLightmap(ts);
+    // The texel means of one per-sample quantity into `into` (only texels wanted and valid).
+    auto resolve = [&](Lightmap& into, const char* what, auto&& sampleValue) {
       for (size_t t = 0; t < ts.layerSize(); ++t) {
         glm::vec3 value;
-        if (!texelMean(ts, t, [&](size_t s) { return slotValue[s][k]; }, value)) continue;
+        if (!wanted(t)) continue;
+        if (!texelMean(ts, t, sampleValue, value)) continue;
         if (!ts.valid.empty() && ts.valid[t] == 0) continue;
         if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z))
           throw Error(ErrorCode::NumericError, in.scene.sourcePath,
-                      "embree backend produced a non-finite directional value at page " + std::to_string(ts.page) +
-                          " texel " + std::to_string(t % ts.width) + "," + std::to_string(t / ts.width));
-        map.texels[t] = value;
-        map.valid[t] = 1;
+                      std::string("embree backend produced a non-finite ") + what + " at page " +
+                          std::to_string(ts.page) + " texel " + std::to_string(t % ts.width) + "," +
+                          std::to_string(t / ts.width));
+        into.texels[t] = value;
+        into.valid[t] = 1;
       }
-      axes[k].push_back(std::move(map));
-    }
+    };
+    resolve(map, "value", [&](size_t s) { return slotValue[s]; });
+    maps.push_back(std::move(map));
+    if (directional)
+      for (int k = 0; k < 3; ++k) {
+        Lightmap axis = blankLightmap(ts);
+        resolve(axis, "directional value", [&](size_t s) { return slotL1[s][k]; });
+        (*options.directional)[k].push_back(std::move(axis));
+      }
   }
-  return axes;
+  if (in.progress) in.progress("embree", 1.0);
+  return maps;
 }
 
 }  // namespace irbake

@@ -3,7 +3,6 @@
 // fallback. Formulas: transport/geometry_term.h. The energy the clamp removes is given back after any backend
 // by backend/compensation (ClampGather); eval.biasCompensation is not read here.
 #pragma once
-#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -22,15 +21,15 @@ struct EmbreeOptions {
   // Per page, per texel: evaluate only texels marked ≠ 0, the rest come back invalid (null: every texel).
   // The GL backend resolves its contact texels this way.
   const std::vector<std::vector<uint8_t>>* texelSubset = nullptr;
+  // Out, optional: the directional maps' L1 pages (transport/directional.h: x, y, z world components of the
+  // tangential irradiance vector t, RGB each) of the same punctual lights and clamped VPLs, gathered in the
+  // same pass (each visible source's direction is at hand there); valid flags as the maps'. The map itself
+  // is the same bits with or without it. The sky and the clamp compensation add none here.
+  L1Pages* directional = nullptr;
 };
 
 // One Lightmap per TexelSamples page; valid = the texel's valid flag. Throws Error(NumericError) on NaN/Inf.
 std::vector<Lightmap> bakeEmbree(const BakeInputs& inputs, const EmbreeOptions& options = {});
-
-// Directional maps (transport/directional.h): per page the three L1 pages (x, y, z world components of the
-// tangential irradiance vector t, RGB each) from the punctual lights (eval.includeDirect) and the clamped
-// VPLs (eval.includeVpls); valid flags as bakeEmbree's. The sky and the clamp compensation add none.
-std::array<std::vector<Lightmap>, 3> bakeEmbreeDirectional(const BakeInputs& inputs, const EmbreeOptions& options = {});
 
 // What one texel sample at (x, n) receives, as irradiance / π. For tests and tools.
 struct PointShading {

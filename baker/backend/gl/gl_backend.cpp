@@ -66,6 +66,7 @@ class GlBaker {
   GlBaker(const BakeInputs& in, const GlBackendOptions& opt, GlBakeStats& stats, GlProgramCache& programs)
       : in_(in), opt_(opt), stats_(stats), programs_(programs) {}
 
+  // The maps, and with GlBackendOptions::directional its L1 pages.
   std::vector<Lightmap> run();
   std::vector<Lightmap> readMaps();
   // Per page, per texel: 1 where the shadow lookups could not tell a contact from the receiver (after run).
@@ -84,6 +85,7 @@ class GlBaker {
   const GlProgram& vplProgram(int layers);
   // The contact check runs on the default lookup (2×2 filter); with the other lookups alpha stays 0.
   bool contactFlags() const { return opt_.resolveContacts && opt_.shadowPcf && opt_.shadowCompare; }
+  bool directional() const { return opt_.directional != nullptr; }
   void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
 
   const BakeInputs& in_;
@@ -252,6 +254,7 @@ const GlProgram& GlBaker::vplProgram(int layers) {
   if (opt_.shadowPcf) defines.push_back(opt_.shadowCompare ? "#define SHADOW_COMPARE 1" : "#define SHADOW_PCF 1");
   if (contactFlags()) defines.push_back("#define CONTACT_FLAGS 1");
   if (seeThroughGeometry_) defines.push_back("#define SEE_THROUGH 1");
+  if (directional()) defines.push_back("#define DIRECTIONAL 1");
   auto constant = [&](const char* name, float value) {
     char text[64];
     std::snprintf(text, sizeof text, "#define %s %.9e", name, double(value));  // round-trips the float
@@ -368,6 +371,8 @@ void GlBaker::bakeDirect(const Light& light) {
 // could not tell a contact from the receiver carried more than contactLeakFraction of the texel's light.
 std::vector<Lightmap> GlBaker::readMaps() {
   std::vector<Lightmap> maps;
+  if (directional())
+    for (auto& axis : *opt_.directional) axis.clear();
   for (const auto& page : pages_) {
     const TexelSamples& s = *page->samples;
     Lightmap m;
@@ -390,6 +395,18 @@ std::vector<Lightmap> GlBaker::readMaps() {
                                                      std::to_string(s.page));
       m.texels[i] = glm::vec3(v);
     }
+    if (directional())
+      for (int k = 0; k < 3; ++k) {
+        Lightmap axis = m;
+        for (size_t i = 0; i < axis.size(); ++i) {
+          const glm::dvec3 v = axis.valid[i] ? page->l1Sum[k][i] : glm::dvec3(0.0);
+          if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+            throw Error(ErrorCode::NumericError, "", "GL backend produced a non-finite directional texel on page " +
+                                                         std::to_string(s.page));
+          axis.texels[i] = glm::vec3(v);
+        }
+        (*opt_.directional)[k].push_back(std::move(axis));
+      }
     maps.push_back(std::move(m));
   }
   return maps;
@@ -410,14 +427,16 @@ std::vector<Lightmap> GlBaker::run() {
     seeThroughGeometry_ = std::make_unique<GpuGeometry>();
     uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *seeThroughGeometry_, true);
   }
-  for (const TexelSamples& s : in_.texels) pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels));
+  for (const TexelSamples& s : in_.texels)
+    pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels, directional()));
 
   const int vplsPerPass = std::clamp(opt_.vplsPerPass, 1, 256);
   depthProgram_ = &programs_.get(
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   shadowViewLocation_ = depthProgram_->uniform("shadowView");
   directProgram_ = &programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                                                           {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "direct_light.frag"}}});
+                                                           {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "direct_light.frag"}}},
+                                  directional() ? std::vector<std::string>{"#define DIRECTIONAL 1"} : std::vector<std::string>{});
   {
     const GlProgram* p = directProgram_;
     p->use();
@@ -506,9 +525,9 @@ std::vector<Lightmap> GlBaker::run() {
 }
 
 // The contact texels again with rays: the Embree backend on the same VPLs and lights (the clamped sum,
-// as here), over those texels only, replaces what the shadow maps gave them.
+// as here), over those texels only, replaces what the shadow maps gave them (and their L1 pages, l1 ≠ null).
 void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<uint8_t>>& contact,
-                          std::vector<Lightmap>& maps, GlBakeStats& stats) {
+                          std::vector<Lightmap>& maps, L1Pages* l1, GlBakeStats& stats) {
   size_t count = 0;
   for (const auto& page : contact) count += static_cast<size_t>(std::count(page.begin(), page.end(), uint8_t{1}));
   stats.contactTexels += count;
@@ -517,10 +536,16 @@ void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<ui
   const BakeInputs rays{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};
   EmbreeOptions eo;
   eo.texelSubset = &contact;
+  L1Pages tracedL1;
+  if (l1) eo.directional = &tracedL1;
   const std::vector<Lightmap> traced = bakeEmbree(rays, eo);
   for (size_t p = 0; p < maps.size() && p < traced.size(); ++p)
-    for (size_t i = 0; i < maps[p].size(); ++i)
-      if (contact[p][i] && traced[p].valid[i]) maps[p].texels[i] = traced[p].texels[i];
+    for (size_t i = 0; i < maps[p].size(); ++i) {
+      if (!contact[p][i] || !traced[p].valid[i]) continue;
+      maps[p].texels[i] = traced[p].texels[i];
+      if (l1)
+        for (int k = 0; k < 3; ++k) (*l1)[k][p].texels[i] = tracedL1[k][p].texels[i];
+    }
   stats.contactSeconds += watch.seconds();
 }
 
@@ -548,7 +573,7 @@ std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& o
     contact = baker.contactTexels();
   }
   stats.setupSeconds += contextSeconds;
-  if (options.resolveContacts) resolveContactTexels(inputs, contact, maps, stats);
+  if (options.resolveContacts) resolveContactTexels(inputs, contact, maps, options.directional, stats);
   return maps;
 }
 

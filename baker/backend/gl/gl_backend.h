@@ -108,6 +108,10 @@ struct GlBackendOptions {
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
   const GlContext* context = nullptr;  // an existing current context; null: bakeGl creates one
   GlBakeStats* stats = nullptr;  // out: timings and counts (may be null)
+  // Out, optional: the directional maps' L1 pages (transport/directional.h), accumulated by the same
+  // passes into three more float targets per page (contact texels: from the same rays as the map). Null:
+  // the plain shaders and targets, nothing more is done.
+  L1Pages* directional = nullptr;
 };
 
 // One Lightmap per TexelSamples page (irradiance/π). Throws Error(Gl) when no GL 4.5 context can be

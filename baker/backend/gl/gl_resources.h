@@ -159,13 +159,18 @@ struct DepthAtlas {
 // One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a
 // validity mask as depth (1 valid, 0 not): the light-map passes draw at depth 0 with GL_LESS, so
 // llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
+// With directional maps, three more float targets (colour attachments 1–3) and double accumulators hold
+// the L1 pages (x, y, z; RGB each), written by the same passes; without, the page is as before.
 struct GpuPage {
   const TexelSamples* samples = nullptr;
   GLuint positionWeight = 0, normal = 0, geomNormal = 0, accum = 0, validDepth = 0, fbo = 0;
+  GLuint l1Accum[3] = {0, 0, 0};  // directional only
   std::vector<glm::dvec3> sum;
   std::vector<double> leak;  // alpha: light of lookups that could not tell a contact from the receiver
+  std::vector<glm::dvec3> l1Sum[3];  // directional only: the L1 pages' double accumulators
   std::vector<glm::vec4> readback;
-  GpuPage(const TexelSamples& s, const Scene& scene, bool validityMask)
+  bool directional() const { return l1Accum[0] != 0; }
+  GpuPage(const TexelSamples& s, const Scene& scene, bool validityMask, bool withL1)
       : samples(&s), sum(s.layerSize(), glm::dvec3(0.0)), leak(s.layerSize(), 0.0) {
     const int layers = s.supersample * s.supersample;
     if (s.positionWeight.size() != s.slotCount() || s.normal.size() != s.slotCount())
@@ -197,6 +202,16 @@ struct GpuPage {
     glTextureStorage2D(accum, 1, GL_RGBA32F, s.width, s.height);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, accum, 0);
+    if (withL1) {
+      glCreateTextures(GL_TEXTURE_2D, 3, l1Accum);
+      for (int k = 0; k < 3; ++k) {
+        glTextureStorage2D(l1Accum[k], 1, GL_RGBA32F, s.width, s.height);
+        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT1 + k, l1Accum[k], 0);
+        l1Sum[k].assign(s.layerSize(), glm::dvec3(0.0));
+      }
+      const GLenum targets[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+      glNamedFramebufferDrawBuffers(fbo, 4, targets);
+    }
     if (validityMask) {
       std::vector<float> depth(s.layerSize(), 1.0f);
       for (size_t i = 0; i < depth.size(); ++i) depth[i] = i < s.valid.size() && s.valid[i] ? 1.0f : 0.0f;
@@ -211,22 +226,32 @@ struct GpuPage {
   }
   ~GpuPage() {
     glDeleteFramebuffers(1, &fbo);
-    GLuint t[5] = {positionWeight, normal, geomNormal, accum, validDepth};
-    glDeleteTextures(5, t);
+    GLuint t[8] = {positionWeight, normal, geomNormal, accum, validDepth, l1Accum[0], l1Accum[1], l1Accum[2]};
+    glDeleteTextures(8, t);  // names 0 are ignored
   }
   void clear() {
     const float zero[4] = {0, 0, 0, 0};
     glClearTexImage(accum, 0, GL_RGBA, GL_FLOAT, zero);
+    if (directional())
+      for (GLuint t : l1Accum) glClearTexImage(t, 0, GL_RGBA, GL_FLOAT, zero);
   }
-  // Adds the float partial sums into the double accumulator and restarts them from zero.
+  // Adds the float partial sums into the double accumulators and restarts them from zero.
   void fold() {
     readback.resize(samples->layerSize());
-    glGetTextureImage(accum, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(readback.size() * sizeof(glm::vec4)),
-                      readback.data());
+    auto read = [&](GLuint texture) {
+      glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(readback.size() * sizeof(glm::vec4)),
+                        readback.data());
+    };
+    read(accum);
     for (size_t i = 0; i < sum.size(); ++i) {
       sum[i] += glm::dvec3(readback[i]);
       leak[i] += readback[i].w;
     }
+    if (directional())
+      for (int k = 0; k < 3; ++k) {
+        read(l1Accum[k]);
+        for (size_t i = 0; i < l1Sum[k].size(); ++i) l1Sum[k][i] += glm::dvec3(readback[i]);
+      }
     clear();
   }
 };

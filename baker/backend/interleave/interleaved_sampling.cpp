@@ -94,19 +94,27 @@ std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n) {
 
 void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec3>& vplPart,
                      const std::vector<uint8_t>& vplValid, Lightmap& map) {
-  std::vector<glm::vec3> mixed;
+  addMixedClasses(page, n, std::vector<const std::vector<glm::vec3>*>{&vplPart}, vplValid, std::vector<Lightmap*>{&map});
+}
+
+void addMixedClasses(const TexelSamples& page, int n, const std::vector<const std::vector<glm::vec3>*>& vplParts,
+                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps) {
+  std::vector<std::vector<glm::vec3>> mixed;
   if (n > 1) {
     TexelFilterOptions fo;
     fo.radius = n - 1;
     fo.tent = true;
-    mixed = filterOnSurface(page, vplPart, vplValid, fo);
+    mixed = SurfaceFilter(page).apply(vplParts, vplValid, fo);
   }
-  const std::vector<glm::vec3>& added = n > 1 ? mixed : vplPart;
-  if (map.valid.size() != map.size()) map.valid = page.valid;
-  for (size_t t = 0; t < map.size() && t < added.size(); ++t) {
-    if (!vplValid[t]) continue;
-    map.texels[t] += added[t];
-    map.valid[t] = 1;
+  for (size_t c = 0; c < maps.size() && c < vplParts.size(); ++c) {
+    const std::vector<glm::vec3>& added = n > 1 ? mixed[c] : *vplParts[c];
+    Lightmap& map = *maps[c];
+    if (map.valid.size() != map.size()) map.valid = page.valid;
+    for (size_t t = 0; t < map.size() && t < added.size(); ++t) {
+      if (!vplValid[t]) continue;
+      map.texels[t] += added[t];
+      map.valid[t] = 1;
+    }
   }
 }
 

@@ -48,6 +48,10 @@ std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n);
 // tent of half-width n on the same surface and adds them to map where vplValid (n ≤ 1: added unfiltered).
 void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec3>& vplPart,
                      const std::vector<uint8_t>& vplValid, Lightmap& map);
+// The same for several coefficients of one page (the map and its directional L1 pages): vplParts[c] into
+// *maps[c], each mixed on its own, the filter's neighbour tests shared (the bits of one call per coefficient).
+void addMixedClasses(const TexelSamples& page, int n, const std::vector<const std::vector<glm::vec3>*>& vplParts,
+                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps);
 
 // n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
 std::vector<Lightmap> bakeInterleaved(const BakeInputs& inputs, int n, const VplBackend& backend,
