@@ -70,7 +70,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--walk-split", a.walkSplit,
                   "paths fork into N where they leave bounce 1, each child carrying 1/N\n"
-                  "(default auto: 1/(share of that light meeting the scene again), at most 8;\n"
+                  "(default auto: 1/(share of that light meeting the scene again), at most 4;\n"
                   "1 in closed scenes; 1 = Keller's plain walk)")
       ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page, or\n64 texels per triangle where that is more, at most 4M)")

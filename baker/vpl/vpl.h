@@ -30,7 +30,8 @@ struct WalkOptions {
   bool geometricTail = true;     // auto: the bounces beyond J added to bounce J as a geometric series
   std::optional<int> split;      // paths fork into this many where they leave bounce 1 (unset: auto, from the
                                  // share of bounce-1 light that meets the scene again; 1 = Keller's walk)
-  int maxAutoSplit = 8;          // auto: at most this many children per path
+  int maxAutoSplit = 4;          // auto: at most this many children per path (on Sponza 8 gave the gallery no
+                                 // less error than 4 and made GL on llvmpipe 2.25× Embree; docs/accuracy.md)
   uint32_t seed = 0;       // Halton scramble / start offset
   ProgressCallback progress;
 };

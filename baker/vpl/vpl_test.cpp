@@ -390,7 +390,7 @@ TEST(Walk, AutoSplitInAnOpenCourtMatchesAPlainWalkOfManyPaths) {
   o.maxBounces = 6;  // the same bounces walked in all, no tail
   const VplSet first = generateVpls(s, rt, o);
   EXPECT_LT(first.rehitFraction, 0.5);
-  EXPECT_EQ(first.split, std::clamp(static_cast<int>(std::floor(1.0 / first.rehitFraction)), 1, 8));
+  EXPECT_EQ(first.split, std::clamp(static_cast<int>(std::floor(1.0 / first.rehitFraction)), 1, o.maxAutoSplit));
   ASSERT_GE(first.split, 2);
   constexpr int kSeeds = 8;
   std::array<double, 4> splitMean{}, spread{};
