@@ -97,6 +97,14 @@ void expectSameOutputs(const fs::path& expected, const fs::path& actual, bool di
 const std::string kOptions = "--texels-per-unit 40 --vpl-block 16 --quiet";
 const std::string kWalk = " --vpls 192 --seed 5";
 
+// `irbake bake` of the Cornell box into `out` with `options`, then `extra`; its output in out_log.txt.
+Finished bakeCornell(const std::vector<std::string>& options, const fs::path& out, const std::vector<std::string>& extra) {
+  std::vector<std::string> args{"bake", cornellBox().string(), "-o", out.string()};
+  args.insert(args.end(), options.begin(), options.end());
+  args.insert(args.end(), extra.begin(), extra.end());
+  return irbake(args, out.string() + "_log.txt");
+}
+
 }  // namespace
 
 TEST(Distributed, ShardsMergeToTheBytesOfOneMachine) {
@@ -105,12 +113,7 @@ TEST(Distributed, ShardsMergeToTheBytesOfOneMachine) {
     const fs::path dir = scratchFolder("shards_" + backend);
     // Interleave 2: the blocks of the four texel classes are split across the shards too.
     std::vector<std::string> options = split(kOptions + kWalk + " --interleave 2 --backend " + backend);
-    auto bake = [&](const fs::path& out, std::vector<std::string> extra) {
-      std::vector<std::string> args{"bake", cornellBox().string(), "-o", out.string()};
-      args.insert(args.end(), options.begin(), options.end());
-      args.insert(args.end(), extra.begin(), extra.end());
-      return irbake(args, out.string() + "_log.txt");
-    };
+    auto bake = [&](const fs::path& out, const std::vector<std::string>& extra) { return bakeCornell(options, out, extra); };
     Finished one = bake(dir / "one", {});
     ASSERT_EQ(one.code, 0) << one.output;
     for (int n : {2, 3}) {
@@ -255,12 +258,7 @@ TEST(Distributed, DirectionalShardsAndResumeGiveTheBytesOfOneMachine) {
     const fs::path dir = scratchFolder("directional_" + backend);
     const std::vector<std::string> options =
         split(kOptions + kWalk + " --interleave 2 --directional --sun 0.3,-1,-0.4,2 --backend " + backend);
-    auto bake = [&](const fs::path& out, std::vector<std::string> extra) {
-      std::vector<std::string> args{"bake", cornellBox().string(), "-o", out.string()};
-      args.insert(args.end(), options.begin(), options.end());
-      args.insert(args.end(), extra.begin(), extra.end());
-      return irbake(args, out.string() + "_log.txt");
-    };
+    auto bake = [&](const fs::path& out, const std::vector<std::string>& extra) { return bakeCornell(options, out, extra); };
     Finished one = bake(dir / "one", {});
     ASSERT_EQ(one.code, 0) << one.output;
     ASSERT_TRUE(fs::exists(dir / "one" / "lightmap_0_l1x.exr"));
