@@ -1,4 +1,4 @@
-// Sampling building blocks shared by the walk and the backends: the Halton sequence (Keller's Φ_b),
+// Sampling building blocks shared by the walk and the backends: the Halton sequence (digit-permuted),
 // alias tables, warps to triangles, hemispheres and spheres, and a small seeded RNG.
 #pragma once
 #include <cstdint>
