@@ -32,7 +32,7 @@ struct WalkOptions {
                                  // share of bounce-1 light that meets the scene again; 1 = Keller's walk)
   int maxAutoSplit = 4;          // auto: at most this many children per path (on Sponza 8 gave the gallery no
                                  // less error than 4 and made GL on llvmpipe 2.25× Embree; docs/accuracy.md)
-  uint32_t seed = 0;       // Halton scramble / start offset
+  uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };
 

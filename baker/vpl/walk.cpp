@@ -164,6 +164,25 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
   return path;
 }
 
+// From `start` along `dir` to the next surface the path bounces on: see-through surfaces let it go straight
+// on with probability `fraction`, tinted (into `throughput`), and that is no bounce; otherwise it meets the
+// surface's Lambertian part. The probabilities come from a hash of (path id, bounce, layer), so the walk
+// stays deterministic and the Halton dimensions keep their meaning. A miss (hit.hit false): escaped.
+RayHit nextBounce(const Scene& scene, const RayTracer& rt, uint64_t seed, uint64_t pathId, int j, const glm::vec3& start,
+                  const glm::vec3& dir, glm::dvec3& throughput) {
+  RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
+  for (int layer = 0; hit.hit && layer < 64; ++layer) {
+    const SurfaceTransmission transmission =
+        scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
+    if (transmission.fraction <= 0.0f) break;
+    Rng pass(hashSeed(seed, pathId, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
+    if (pass.uniform() >= transmission.fraction) break;
+    throughput *= glm::dvec3(transmission.tint);
+    hit = rt.intersect(hit.position + dir * rt.epsilon(), dir, 0.0f, 1e30f);
+  }
+  return hit;
+}
+
 // Follows path i from its start while it is among the survivors of the next bounce, leaving one VPL
 // per bounce in `vpls` (power × albedo products × N / M_j). With split s > 1 the path forks where it
 // leaves bounce 1: child k (index c = i s + k, its own Halton point from there on) carries 1/s of the
@@ -173,41 +192,32 @@ void followPath(const Scene& scene, const RayTracer& rt, const Halton& halton, c
   const int maxBounce = static_cast<int>(survivors.size()) - 1;
   const uint64_t N = survivors[0];
   const float eps = rt.epsilon();
-  const int children = maxBounce >= 2 && i < survivors[2] ? split : 1;
-  for (int k = 0; k < children; ++k) {
+  // The hit of bounce j becomes a VPL of this power share; returns where it sits and its lit side.
+  auto leaveVpl = [&](const RayHit& hit, int j, glm::dvec3& throughput, double share, glm::vec3& at, glm::vec3& n) {
+    throughput *= glm::dvec3(rt.albedoAt(hit));
+    n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;
+    at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
+    const glm::dvec3 power = path.power * throughput * (share * static_cast<double>(N) / static_cast<double>(survivors[j]));
+    vpls.push_back(Vpl{at, n, glm::vec3(power), j});
+  };
+  if (maxBounce < 1 || i >= survivors[1]) return;
+  // Bounce 1, shared by the children (the origin of a start on a surface is already inset).
+  glm::dvec3 throughput1(1.0);
+  const glm::vec3 start = path.onSurface ? path.origin + path.normal * eps : path.origin;
+  const RayHit first = nextBounce(scene, rt, seed, i, 1, start, path.dir, throughput1);
+  if (!first.hit) return;  // escaped: its energy leaves the scene
+  glm::vec3 at1, n1;
+  leaveVpl(first, 1, throughput1, 1.0, at1, n1);
+  if (maxBounce < 2 || i >= survivors[2]) return;
+  for (int k = 0; k < split; ++k) {
     const uint64_t c = i * static_cast<uint64_t>(split) + static_cast<uint64_t>(k);  // Halton index past bounce 1
-    glm::vec3 origin = path.origin, dir = path.dir, normal = path.normal;
-    bool surfaceStart = path.onSurface;
-    glm::dvec3 throughput(1.0);
-    for (int j = 1; j <= maxBounce && i < survivors[j]; ++j) {
-      glm::vec3 start = surfaceStart ? origin + normal * eps : origin;  // origin is already inset
-      RayHit hit = rt.intersect(start, dir, 0.0f, 1e30f);
-      // See-through surfaces: the path goes straight on with probability `fraction`, tinted, and that is
-      // no bounce; otherwise it meets the surface's Lambertian part (probabilities from a hash of the
-      // path, so the walk stays deterministic and the Halton dimensions keep their meaning).
-      const uint64_t pathId = j >= 2 ? c : i;
-      for (int layer = 0; hit.hit && layer < 64; ++layer) {
-        const SurfaceTransmission transmission =
-            scene.transmissionAt(scene.primitives[hit.primitive], hit.triangle, hit.barycentric);
-        if (transmission.fraction <= 0.0f) break;
-        Rng pass(hashSeed(seed, pathId, static_cast<uint64_t>(j) << 8 | static_cast<uint64_t>(layer)));
-        if (pass.uniform() >= transmission.fraction) break;
-        throughput *= glm::dvec3(transmission.tint);
-        hit = rt.intersect(hit.position + dir * eps, dir, 0.0f, 1e30f);
-      }
-      if (!hit.hit) break;  // escaped: its energy leaves the scene
-      throughput *= glm::dvec3(rt.albedoAt(hit));
-      glm::vec3 n = hit.backFace ? -hit.geometricNormal : hit.geometricNormal;  // the lit side
-      const double share = j >= 2 ? 1.0 / children : 1.0;
-      glm::dvec3 power = path.power * throughput * (share * static_cast<double>(N) / static_cast<double>(survivors[j]));
-      glm::vec3 at = rt.insetPoint(hit.primitive, hit.triangle, hit.position);
-      if (j >= 2 || k == 0) vpls.push_back(Vpl{at, n, glm::vec3(power), j});  // bounce 1 is shared: left once
-      if (j + 1 > maxBounce || i >= survivors[j + 1]) break;
-      origin = at;
-      normal = n;
-      surfaceStart = true;
-      const uint64_t next = j + 1 >= 2 ? c : i;
-      dir = cosineHemisphere(n, halton.sample(2 + 2 * j, next), halton.sample(3 + 2 * j, next));
+    glm::dvec3 throughput = throughput1;
+    glm::vec3 at = at1, n = n1;
+    for (int j = 2; j <= maxBounce && i < survivors[j]; ++j) {
+      const glm::vec3 dir = cosineHemisphere(n, halton.sample(2 * j, c), halton.sample(1 + 2 * j, c));
+      const RayHit hit = nextBounce(scene, rt, seed, c, j, at + n * eps, dir, throughput);
+      if (!hit.hit) break;
+      leaveVpl(hit, j, throughput, 1.0 / split, at, n);
     }
   }
 }
