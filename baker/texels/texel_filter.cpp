@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
 
 #include <tbb/parallel_for.h>
 
@@ -43,14 +46,30 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
   return std::move(apply(std::vector<const std::vector<glm::vec3>*>{&values}, valid, options)[0]);
 }
 
+// Inlined: called once per window position per texel, the filter's inner loop.
+[[gnu::always_inline]] inline bool SurfaceFilter::accepts(size_t i, size_t j, int dx, int dy, const std::vector<uint8_t>& valid,
+                            const TexelFilterOptions& options) const {
+  if (!valid[j] || !hasSample_[j]) return false;
+  if (j == i) return true;
+  if (glm::dot(normal_[i], normal_[j]) < options.minNormalCos) return false;
+  const float reach = options.maxSpacings * spacing_ * std::sqrt(static_cast<float>(dx * dx + dy * dy));
+  const glm::vec3 d = position_[j] - position_[i];
+  return glm::dot(d, d) <= reach * reach;
+}
+
+namespace {
+float windowWeight(const TexelFilterOptions& options, int r, int dx, int dy) {
+  return options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
+}
+}  // namespace
+
 std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const std::vector<glm::vec3>*>& sets,
                                                          const std::vector<uint8_t>& valid,
                                                          const TexelFilterOptions& options) const {
   std::vector<std::vector<glm::vec3>> out;
   for (const std::vector<glm::vec3>* values : sets) out.push_back(*values);
   const int r = std::max(0, options.radius);
-  const float h = spacing_;
-  if (r == 0 || !(h > 0.0f)) return out;
+  if (r == 0 || !(spacing_ > 0.0f)) return out;
   const int W = width_, H = height_;
   const size_t setCount = sets.size();
   tbb::parallel_for(0, H, [&](int y) {
@@ -58,7 +77,6 @@ std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const
     for (int x = 0; x < W; ++x) {
       const size_t i = static_cast<size_t>(y) * W + x;
       if (!valid[i] || !hasSample_[i]) continue;
-      const glm::vec3 p = position_[i], n = normal_[i];
       std::fill(sum.begin(), sum.end(), glm::vec3(0.0f));
       float count = 0.0f;
       for (int dy = -r; dy <= r; ++dy) {
@@ -68,19 +86,71 @@ std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const
           const int xx = x + dx;
           if (xx < 0 || xx >= W) continue;
           const size_t j = static_cast<size_t>(yy) * W + xx;
-          if (!valid[j] || !hasSample_[j]) continue;
-          if (j != i) {
-            if (glm::dot(n, normal_[j]) < options.minNormalCos) continue;
-            const float reach = options.maxSpacings * h * std::sqrt(static_cast<float>(dx * dx + dy * dy));
-            const glm::vec3 d = position_[j] - p;
-            if (glm::dot(d, d) > reach * reach) continue;
-          }
-          const float w = options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
+          if (!accepts(i, j, dx, dy, valid, options)) continue;
+          const float w = windowWeight(options, r, dx, dy);
           for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
           count += w;
         }
       }
       for (size_t s = 0; s < setCount; ++s) out[s][i] = sum[s] / count;
+    }
+  });
+  return out;
+}
+
+SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vector<uint8_t>& valid,
+                                     const TexelFilterOptions& options)
+    : width_(filter.width_), radius_(std::max(0, options.radius)) {
+  if (radius_ > kMaxRadius) throw std::invalid_argument("SurfaceFilterPlan: radius above kMaxRadius");
+  if (!(filter.spacing_ > 0.0f)) radius_ = 0;  // SurfaceFilter::apply returns such a page unchanged
+  const int W = filter.width_, H = filter.height_, r = radius_, side = 2 * r + 1;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      offset_.push_back(static_cast<ptrdiff_t>(dy) * W + dx);
+      weight_.push_back(windowWeight(options, r, dx, dy));
+    }
+  const size_t layer = static_cast<size_t>(W) * H;
+  accepted_.assign(layer, {0, 0});
+  filtered_.assign(layer, 0);
+  if (r == 0) return;
+  tbb::parallel_for(0, H, [&](int y) {
+    for (int x = 0; x < W; ++x) {
+      const size_t i = static_cast<size_t>(y) * W + x;
+      if (!valid[i] || !filter.hasSample_[i]) continue;
+      filtered_[i] = 1;
+      for (int dy = -r; dy <= r; ++dy) {
+        const int yy = y + dy;
+        if (yy < 0 || yy >= H) continue;
+        for (int dx = -r; dx <= r; ++dx) {
+          const int xx = x + dx;
+          if (xx < 0 || xx >= W) continue;
+          if (!filter.accepts(i, static_cast<size_t>(yy) * W + xx, dx, dy, valid, options)) continue;
+          const int b = (dy + r) * side + (dx + r);
+          accepted_[i][b >> 6] |= uint64_t(1) << (b & 63);
+        }
+      }
+    }
+  });
+}
+
+std::vector<glm::vec3> SurfaceFilterPlan::apply(const std::vector<glm::vec3>& values) const {
+  std::vector<glm::vec3> out = values;
+  if (radius_ == 0) return out;
+  const size_t layer = filtered_.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      if (!filtered_[i]) continue;
+      glm::vec3 sum(0.0f);
+      float count = 0.0f;
+      // Bits in window order (row by row), so the sums round exactly as SurfaceFilter::apply's.
+      for (int word = 0; word < 2; ++word)
+        for (uint64_t bits = accepted_[i][word]; bits != 0; bits &= bits - 1) {
+          const int b = 64 * word + __builtin_ctzll(bits);
+          const float w = weight_[b];
+          sum += w * values[static_cast<size_t>(static_cast<ptrdiff_t>(i) + offset_[b])];
+          count += w;
+        }
+      out[i] = sum / count;
     }
   });
   return out;
