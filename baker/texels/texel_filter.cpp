@@ -57,6 +57,23 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
   return glm::dot(d, d) <= reach * reach;
 }
 
+template <class Visit>
+void SurfaceFilter::forEachAccepted(int x, int y, int r, const std::vector<uint8_t>& valid,
+                                    const TexelFilterOptions& options, Visit&& visit) const {
+  const int W = width_, H = height_;
+  const size_t i = static_cast<size_t>(y) * W + x;
+  for (int dy = -r; dy <= r; ++dy) {
+    const int yy = y + dy;
+    if (yy < 0 || yy >= H) continue;
+    for (int dx = -r; dx <= r; ++dx) {
+      const int xx = x + dx;
+      if (xx < 0 || xx >= W) continue;
+      const size_t j = static_cast<size_t>(yy) * W + xx;
+      if (accepts(i, j, dx, dy, valid, options)) visit(j, dx, dy);
+    }
+  }
+}
+
 namespace {
 float windowWeight(const TexelFilterOptions& options, int r, int dx, int dy) {
   return options.tent ? static_cast<float>((r + 1 - std::abs(dx)) * (r + 1 - std::abs(dy))) : 1.0f;
@@ -79,19 +96,11 @@ std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const
       if (!valid[i] || !hasSample_[i]) continue;
       std::fill(sum.begin(), sum.end(), glm::vec3(0.0f));
       float count = 0.0f;
-      for (int dy = -r; dy <= r; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= H) continue;
-        for (int dx = -r; dx <= r; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= W) continue;
-          const size_t j = static_cast<size_t>(yy) * W + xx;
-          if (!accepts(i, j, dx, dy, valid, options)) continue;
-          const float w = windowWeight(options, r, dx, dy);
-          for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
-          count += w;
-        }
-      }
+      forEachAccepted(x, y, r, valid, options, [&](size_t j, int dx, int dy) {
+        const float w = windowWeight(options, r, dx, dy);
+        for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
+        count += w;
+      });
       for (size_t s = 0; s < setCount; ++s) out[s][i] = sum[s] / count;
     }
   });
@@ -118,17 +127,10 @@ SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vec
       const size_t i = static_cast<size_t>(y) * W + x;
       if (!valid[i] || !filter.hasSample_[i]) continue;
       filtered_[i] = 1;
-      for (int dy = -r; dy <= r; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= H) continue;
-        for (int dx = -r; dx <= r; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= W) continue;
-          if (!filter.accepts(i, static_cast<size_t>(yy) * W + xx, dx, dy, valid, options)) continue;
-          const int b = (dy + r) * side + (dx + r);
-          accepted_[i][b >> 6] |= uint64_t(1) << (b & 63);
-        }
-      }
+      filter.forEachAccepted(x, y, r, valid, options, [&](size_t, int dx, int dy) {
+        const int b = (dy + r) * side + (dx + r);
+        accepted_[i][b >> 6] |= uint64_t(1) << (b & 63);
+      });
     }
   });
 }

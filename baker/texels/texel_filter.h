@@ -45,6 +45,10 @@ class SurfaceFilter {
   // Whether texel j = i + (dx, dy) counts in i's window (i valid with a sample; j inside the page).
   bool accepts(size_t i, size_t j, int dx, int dy, const std::vector<uint8_t>& valid,
                const TexelFilterOptions& options) const;
+  // Calls visit(j, dx, dy) for every accepted texel j of texel (x, y)'s window of radius r, row by row.
+  template <class Visit>
+  void forEachAccepted(int x, int y, int r, const std::vector<uint8_t>& valid, const TexelFilterOptions& options,
+                       Visit&& visit) const;
 
   int width_ = 0, height_ = 0;
   std::vector<glm::vec3> position_, normal_;  // per texel
