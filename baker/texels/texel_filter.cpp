@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
-
 #include <tbb/parallel_for.h>
 
 namespace irbake {
@@ -47,8 +46,9 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
 }
 
 // Inlined: called once per window position per texel, the filter's inner loop.
-[[gnu::always_inline]] inline bool SurfaceFilter::accepts(size_t i, size_t j, int dx, int dy, const std::vector<uint8_t>& valid,
-                            const TexelFilterOptions& options) const {
+[[gnu::always_inline]] inline bool SurfaceFilter::accepts(size_t i, size_t j, int dx, int dy,
+                                                         const std::vector<uint8_t>& valid,
+                                                         const TexelFilterOptions& options) const {
   if (!valid[j] || !hasSample_[j]) return false;
   if (j == i) return true;
   if (glm::dot(normal_[i], normal_[j]) < options.minNormalCos) return false;
@@ -109,7 +109,7 @@ std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const
 
 SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vector<uint8_t>& valid,
                                      const TexelFilterOptions& options)
-    : width_(filter.width_), radius_(std::max(0, options.radius)) {
+    : radius_(std::max(0, options.radius)) {
   if (radius_ > kMaxRadius) throw std::invalid_argument("SurfaceFilterPlan: radius above kMaxRadius");
   if (!(filter.spacing_ > 0.0f)) radius_ = 0;  // SurfaceFilter::apply returns such a page unchanged
   const int W = filter.width_, H = filter.height_, r = radius_, side = 2 * r + 1;
@@ -120,13 +120,11 @@ SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vec
     }
   const size_t layer = static_cast<size_t>(W) * H;
   accepted_.assign(layer, {0, 0});
-  filtered_.assign(layer, 0);
   if (r == 0) return;
   tbb::parallel_for(0, H, [&](int y) {
     for (int x = 0; x < W; ++x) {
       const size_t i = static_cast<size_t>(y) * W + x;
-      if (!valid[i] || !filter.hasSample_[i]) continue;
-      filtered_[i] = 1;
+      if (!valid[i] || !filter.hasSample_[i]) continue;  // no bits: passed unchanged
       filter.forEachAccepted(x, y, r, valid, options, [&](size_t, int dx, int dy) {
         const int b = (dy + r) * side + (dx + r);
         accepted_[i][b >> 6] |= uint64_t(1) << (b & 63);
@@ -138,10 +136,11 @@ SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vec
 std::vector<glm::vec3> SurfaceFilterPlan::apply(const std::vector<glm::vec3>& values) const {
   std::vector<glm::vec3> out = values;
   if (radius_ == 0) return out;
-  const size_t layer = filtered_.size();
+  const size_t layer = accepted_.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
-      if (!filtered_[i]) continue;
+      // A filtered texel always accepts itself, so no bits means: not filtered, value passes unchanged.
+      if ((accepted_[i][0] | accepted_[i][1]) == 0) continue;
       glm::vec3 sum(0.0f);
       float count = 0.0f;
       // Bits in window order (row by row), so the sums round exactly as SurfaceFilter::apply's.

@@ -68,9 +68,9 @@ class SurfaceFilterPlan {
   std::vector<glm::vec3> apply(const std::vector<glm::vec3>& values) const;
 
  private:
-  int width_ = 0, radius_ = 0;
-  std::vector<std::array<uint64_t, 2>> accepted_;  // per texel: bit b = window position b (row-major) counts
-  std::vector<uint8_t> filtered_;                  // per texel: valid with a sample (others pass unchanged)
+  int radius_ = 0;
+  std::vector<std::array<uint64_t, 2>> accepted_;  // per texel: bit b = window position b (row-major) counts;
+                                                   // none for texels not filtered (invalid, no sample)
   std::vector<ptrdiff_t> offset_;                  // per window position: dy·width + dx
   std::vector<float> weight_;                      // per window position: 1, or the tent weight
 };

@@ -346,12 +346,12 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   constexpr int kFirstTailSweep = 3;  // at least 4 sweeps before the tail: the ratio creeps up over the first few
   std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
   // The filter's neighbour tests, made once for all sweeps (they were 3/4 of a sweep's time on Sponza).
+  std::vector<TexelFilterOptions> filterOptions(maps.size());
   std::vector<std::unique_ptr<SurfaceFilterPlan>> plans(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) {
+    filterOptions[p].radius = radii[p];
     if (!filters[p] || radii[p] > SurfaceFilterPlan::kMaxRadius || options.sweeps < 2) continue;
-    TexelFilterOptions filterOptions;
-    filterOptions.radius = radii[p];
-    plans[p] = std::make_unique<SurfaceFilterPlan>(*filters[p], maps[p].valid, filterOptions);
+    plans[p] = std::make_unique<SurfaceFilterPlan>(*filters[p], maps[p].valid, filterOptions[p]);
   }
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
@@ -385,9 +385,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       if (plans[p]) {
         filtered = plans[p]->apply(residual);
       } else if (filters[p]) {
-        TexelFilterOptions filterOptions;
-        filterOptions.radius = radii[p];
-        filtered = filters[p]->apply(residual, m.valid, filterOptions);
+        filtered = filters[p]->apply(residual, m.valid, filterOptions[p]);
       }
       const std::vector<glm::vec3>& residualUsed = filters[p] ? filtered : residual;
       const std::vector<glm::vec3>& baseMap = base(p);
