@@ -69,7 +69,13 @@ void SurfaceFilter::forEachAccepted(int x, int y, int r, const std::vector<uint8
       const int xx = x + dx;
       if (xx < 0 || xx >= W) continue;
       const size_t j = static_cast<size_t>(yy) * W + xx;
-      if (accepts(i, j, dx, dy, valid, options)) visit(j, dx, dy);
+      if (!accepts(i, j, dx, dy, valid, options)) continue;
+      if (options.symmetric && j != i) {
+        const int mx = x - dx, my = y - dy;
+        if (mx < 0 || my < 0 || mx >= W || my >= H) continue;
+        if (!accepts(i, static_cast<size_t>(my) * W + mx, -dx, -dy, valid, options)) continue;
+      }
+      visit(j, dx, dy);
     }
   }
 }

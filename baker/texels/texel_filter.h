@@ -18,6 +18,10 @@ struct TexelFilterOptions {
   int radius = 1;               // window (2r+1)² texels
   float minNormalCos = 0.95f;   // neighbour's normal within ≈ 18° of the centre's
   float maxSpacings = 1.5f;     // neighbour at most (offset in texels) × this × texel spacing away in space
+  bool symmetric = true;        // a neighbour counts only with its mirror image (−dx, −dy): the window's
+                                // centroid stays on the texel, so a gradient is not biased where the
+                                // window is cut (contact lines, chart borders: a one-sided window read the
+                                // brighter side there; Sponza's column feet +12%, docs/accuracy.md)
   bool tent = false;            // weights (r+1−|dx|)(r+1−|dy|) instead of a box: with r = n−1 every
                                 // texel class (x mod n, y mod n) gets the same total weight
 };

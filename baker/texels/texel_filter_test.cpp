@@ -73,28 +73,65 @@ TEST(SurfaceFilterPlan, GivesTheBitsOfTheFilterItWasMadeFrom) {
   valid[300] = 0;
   const SurfaceFilter filter(ts);
   for (int radius : {1, 4, 5})
-    for (bool tent : {false, true}) {
+    for (int mode = 0; mode < 4; ++mode) {
+      const bool tent = mode & 1, symmetric = mode & 2;
       TexelFilterOptions o;
       o.radius = radius;
       o.tent = tent;
+      o.symmetric = symmetric;
       const std::vector<glm::vec3> direct = filter.apply(values, valid, o);
       const std::vector<glm::vec3> planned = SurfaceFilterPlan(filter, valid, o).apply(values);
       ASSERT_EQ(direct.size(), planned.size());
-      EXPECT_EQ(std::memcmp(direct.data(), planned.data(), direct.size() * sizeof(glm::vec3)), 0) << radius << tent;
+      EXPECT_EQ(std::memcmp(direct.data(), planned.data(), direct.size() * sizeof(glm::vec3)), 0) << radius << mode;
       EXPECT_EQ(planned[300], values[300]);  // invalid: unchanged
-      // Texel (11, 12) is beside the fold: its window holds texels of the tilted half, which must not count.
+      // Texel (11, 12) is beside the fold: its window holds texels of the tilted half, which must not count;
+      // symmetric, their mirror images (dx < 0) do not count either, so the window is its own column.
       const size_t edge = 12 * 24 + 11;
       glm::vec3 flatOnly(0.0f);
       float count = 0.0f;
       for (int dy = -radius; dy <= radius; ++dy)
-        for (int dx = -radius; dx <= 0; ++dx) {
+        for (int dx = symmetric ? 0 : -radius; dx <= 0; ++dx) {
           const size_t j = static_cast<size_t>(12 + dy) * 24 + 11 + dx;
           const float w = tent ? static_cast<float>((radius + 1 - std::abs(dx)) * (radius + 1 - std::abs(dy))) : 1.0f;
           if (valid[j]) flatOnly += w * values[j], count += w;
         }
-      EXPECT_NEAR(planned[edge].x, flatOnly.x / count, 1e-5f) << radius << tent;
+      EXPECT_NEAR(planned[edge].x, flatOnly.x / count, 1e-5f) << radius << mode;
     }
   TexelFilterOptions tooWide;
   tooWide.radius = SurfaceFilterPlan::kMaxRadius + 1;
   EXPECT_THROW(SurfaceFilterPlan(filter, valid, tooWide), std::invalid_argument);
+}
+
+// A light gradient running into a contact line (the texels left of x = 8 invalid, as under a wall standing
+// on the floor): the symmetric window keeps a linear gradient exact up to the line; the one-sided window of
+// the same radius reads the far side only and is biased by radius/2 texels of gradient, as Sponza's column
+// feet were (docs/accuracy.md, "Session 10").
+TEST(SurfaceFilter, SymmetricWindowKeepsAGradientAtAContactLine) {
+  const int size = 24, cut = 8;
+  TexelSamples ts = flatPage(size);
+  std::vector<uint8_t> valid(ts.layerSize(), 1);
+  std::vector<glm::vec3> values(ts.layerSize(), glm::vec3(0.0f));
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const size_t i = static_cast<size_t>(y) * size + x;
+      valid[i] = x >= cut;
+      values[i] = glm::vec3(0.1f + 0.05f * (x - cut) + 0.01f * y);  // brighter away from the line
+    }
+  const SurfaceFilter filter(ts);
+  for (int radius : {1, 3, 5}) {
+    TexelFilterOptions symmetric, oneSided;
+    symmetric.radius = oneSided.radius = radius;
+    oneSided.symmetric = false;
+    const std::vector<glm::vec3> a = filter.apply(values, valid, symmetric);
+    const std::vector<glm::vec3> b = filter.apply(values, valid, oneSided);
+    for (int x = cut; x < cut + radius; ++x) {
+      const size_t i = static_cast<size_t>(12) * size + x;
+      EXPECT_NEAR(a[i].x, values[i].x, 1e-5f) << radius << " " << x;
+      // One-sided: the window's mean column lies (radius − (x − cut)) / 2 texels too far from the line, each
+      // 0.05 brighter; a bias that grows with the texel size in world units.
+      const float biasTexels = 0.5f * static_cast<float>(radius - (x - cut));
+      EXPECT_NEAR(b[i].x - values[i].x, 0.05f * biasTexels, 1e-5f) << radius << " " << x;
+      EXPECT_GT(b[i].x, values[i].x + 0.01f);
+    }
+  }
 }
