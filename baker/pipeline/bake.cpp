@@ -430,15 +430,18 @@ struct StagedBake::State {
   }
 
   // Bias compensation: the clamp's lost near-field light gathered back from the baked map.
-  void compensationStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
+  // With l1 (--directional) the residual's irradiance vector goes into the L1 pages too.
+  void compensationStage(std::vector<Lightmap>& maps, L1Pages* l1, nlohmann::json& report) {
     if (!compensate) return;
     timed("compensation", [&] {  // with an overlapped trace: the sweeps (and any trace not yet done)
       ClampCompensationOptions o = options.compensation;
       o.seed = options.walk.seed;
+      o.directional = l1 != nullptr;
       ClampCompensationStats stats;
       if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
       std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(*wholeInputs, o);
       g->apply(maps, &stats);
+      if (l1) g->applyDirectional(maps, *l1);
       if (options.progress) options.progress("compensate", 1.0);
       seconds["compensationTrace"] = g->traceSeconds();
       report["compensation"] = stats.toJson();
@@ -447,8 +450,8 @@ struct StagedBake::State {
 
   // Directional maps after the backend stage, whose passes accumulated the L1 pages of the punctual lights
   // and VPLs beside the map (and the exact sums mixed them per coefficient): the sky's part traced again
-  // (addSkyLightDirectional), then post per axis. The clamp compensation adds to L0 only: its light
-  // counts as arriving along the normal (docs/units.md).
+  // (addSkyLightDirectional), then post per axis. The clamp compensation added its own share before
+  // (ClampGather::applyDirectional).
   void directionalStage(L1Pages& axes, nlohmann::json& report) {
     if (!options.directional) return;
     timed("directional", [&] {
@@ -541,6 +544,7 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
     const ClampCompensationOptions o = [&] {
       ClampCompensationOptions c = s.options.compensation;
       c.seed = s.options.walk.seed;
+      c.directional = s.options.directional;
       return c;
     }();
     // The gather reads the pages' texel samples and the geometry only: it runs while the GL backend bakes.
@@ -581,7 +585,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   s.timed("backend", [&] { r.maps = s.backendMaps(sums, report, s.options.directional ? &r.directional : nullptr); });
   sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   s.skyStage(r.maps, report);
-  s.compensationStage(r.maps, report);
+  s.compensationStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
   s.directionalStage(r.directional, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();

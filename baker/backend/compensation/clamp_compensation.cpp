@@ -1,6 +1,7 @@
 #include "backend/compensation/clamp_compensation.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -78,6 +79,7 @@ struct Tile {
   size_t page = 0, begin = 0, end = 0;
   std::vector<KeptHit> hits;
   std::vector<EmittedHit> emitted;  // in hit order; hits not listed have Le = 0
+  std::vector<glm::vec3> tangent;   // directional only, per hit: (ω − (ω·n)n) / cosθ
 };
 
 // Ray counts of the two rounds, after the budget.
@@ -145,7 +147,7 @@ void ClampGather::Impl::makeTiles() {
   constexpr size_t kTile = kTileSlots;
   for (size_t p = 0; p < in.texels.size(); ++p)
     for (size_t b = 0; b < in.texels[p].slotCount(); b += kTile)
-      tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}, {}});
+      tiles.push_back({p, b, std::min(in.texels[p].slotCount(), b + kTile), {}, {}, {}});
 }
 
 // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
@@ -212,6 +214,11 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
       kept.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
     }
     out.hits.push_back(kept);
+    if (options.directional) {
+      constexpr float kMinCos = 0.1f;  // bounds the 1/cosθ of the irradiance vector's cosine-ray estimator
+      const float c = glm::dot(dir, n);
+      out.tangent.push_back((dir - c * n) / std::max(c, kMinCos));
+    }
     ++keptCount;
   }
   return keptCount;
@@ -285,6 +292,7 @@ void ClampGather::Impl::divideByRaysOfSlot() {
     // Exact size from here on: the doubling slack of the traced lists would stay for the sweeps.
     tile.hits.shrink_to_fit();
     tile.emitted.shrink_to_fit();
+    tile.tangent.shrink_to_fit();
   });
 }
 
@@ -453,6 +461,60 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     stats->tailExtrapolated = tailAdded;
     stats->addedFraction = before > 0.0 ? added / before : 0.0;
     stats->seconds = g.traceSeconds + clock.seconds();
+  }
+}
+
+void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& axes) const {
+  const Impl& g = *impl_;
+  const BakeInputs& in = g.in;
+  if (!g.enabled || !g.options.directional || maps.size() != in.texels.size()) return;
+  for (const auto& pages : axes)
+    if (pages.size() != maps.size()) return;
+  // Per slot, per axis k: Σ term · τ_k (an RGB triple each), the hits' terms read from the final maps.
+  std::array<std::vector<std::vector<glm::vec3>>, 3> slotVector;
+  for (auto& v : slotVector) {
+    v.resize(maps.size());
+    for (size_t p = 0; p < maps.size(); ++p) v[p].assign(in.texels[p].slotCount(), glm::vec3(0.0f));
+  }
+  tbb::parallel_for(size_t(0), g.tiles.size(), [&](size_t ti) {
+    const Tile& tile = g.tiles[ti];
+    size_t e = 0;
+    for (size_t h = 0; h < tile.hits.size() && h < tile.tangent.size(); ++h) {
+      const KeptHit& kept = tile.hits[h];
+      glm::vec3 L(0.0f);
+      if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
+      if (kept.map >= 0) L += kept.albedo * lookup(maps[kept.map], maps[kept.map].texels, kept.texel);
+      const size_t s = tile.begin + kept.slotInTile;
+      for (int k = 0; k < 3; ++k) slotVector[k][tile.page][s] += L * tile.tangent[h][k];
+    }
+  });
+  for (size_t p = 0; p < maps.size(); ++p) {
+    const TexelSamples& ts = in.texels[p];
+    const Lightmap& m = maps[p];
+    const size_t layer = ts.layerSize();
+    std::array<std::vector<glm::vec3>, 3> texelVector;
+    for (int k = 0; k < 3; ++k) {
+      texelVector[k].assign(layer, glm::vec3(0.0f));
+      tbb::parallel_for(size_t(0), layer, [&](size_t t) {
+        if (t < m.valid.size() && m.valid[t])
+          texelMean(ts, t, [&](size_t s) { return slotVector[k][p][s]; }, texelVector[k][t]);
+      });
+    }
+    if (g.filters[p]) {  // the residual's filter, all three axes in one pass
+      TexelFilterOptions fo;
+      fo.radius = g.radii[p];
+      std::vector<std::vector<glm::vec3>> filtered =
+          g.filters[p]->apply({&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
+      for (int k = 0; k < 3; ++k) texelVector[k] = std::move(filtered[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      Lightmap& page = axes[k][p];
+      for (size_t t = 0; t < layer && t < page.texels.size(); ++t) {
+        const glm::vec3 v = texelVector[k][t];
+        if (t < m.valid.size() && m.valid[t] && std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))
+          page.texels[t] += v;
+      }
+    }
   }
 }
 

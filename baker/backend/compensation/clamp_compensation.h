@@ -12,7 +12,8 @@
 // than the clamp radius (w = 0) cost one intersection and are forgotten; only the few hits with w > 0
 // are kept, so later sweeps cost lookups only. Samples whose first rays found clamped transport get more
 // rays (corners are where the residual is large and its variance lives).
-// Limits: back faces and surfaces without a light map return only what they emit.
+// With --directional the same hits, kept with their directions, give the residual's L1 share
+// (applyDirectional). Limits: back faces and surfaces without a light map return only what they emit.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -58,6 +59,7 @@ struct ClampCompensationOptions {
                                  // or when the extrapolated tail is known to within it
   bool extrapolateTail = true;   // once the sweeps' ratio settles, add the remaining sweeps as a geometric tail
   uint32_t seed = 0;           // rotates the per-sample ray lattices (deterministic per seed)
+  bool directional = false;    // keep each kept hit's direction for applyDirectional (12 bytes a hit)
 };
 
 struct ClampCompensationStats {
@@ -89,6 +91,13 @@ class ClampGather {
   ClampGather& operator=(const ClampGather&) = delete;
   // Adds the residual to maps (one per page of the inputs' texels, same order and size).
   void apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats = nullptr) const;
+  // Directional maps (transport/directional.h): adds the residual's tangential irradiance vector to the L1
+  // pages (axes x, y, z; one Lightmap per page each). Call after apply, with the maps it returned: at the
+  // sweeps' fixed point the residual is one more gather from the final map, R = Σ w (Le + ρ M(y)) / n, and
+  // this is that gather with each hit's term along its direction ω: t += term · (ω − (ω·n)n) / cosθ (the
+  // cosine rays' estimator of the irradiance vector; 1/cosθ held to ≤ 10, which only rays within 6° of the
+  // horizon reach). Filtered like the residual. Needs options.directional; otherwise a no-op.
+  void applyDirectional(const std::vector<Lightmap>& maps, L1Pages& axes) const;
   double traceSeconds() const;  // the construction's wall time
 
  private:
