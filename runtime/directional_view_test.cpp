@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/maths.h"
 #include "glcontext/gl_context.h"
 #include "transport/directional.h"
 #include "view_renderer.h"
@@ -256,6 +257,35 @@ TEST(DirectionalView, GeneratedTangentsFollowTheUvLayout) {
       EXPECT_NEAR(glm::length(glm::cross(n, glm::vec3(v)) * v.w + l.vGrows), 0.0f, 1e-5f);
     }
   }
+}
+
+// MikkTSpace's two rules that a plain sum of dP/du misses. (1) A vertex split only by another attribute (an
+// export's light-map seam: same position, normal and UV) gets one frame on both copies. (2) At a vertex, each
+// triangle's dP/du counts normalised and weighted by its corner angle: the centre of a fan of two triangles,
+// one with a 90° corner and dP/du along e1, one with a 45° corner and dP/du along (e1 + e2)/√2 but a 4× larger
+// gradient, gets t ∝ (π/2) e1 + (π/4) (e1 + e2)/√2, not the gradient-weighted sum.
+TEST(DirectionalView, GeneratedTangentsWeldSeamsAndWeighCornerAngles) {
+  const glm::vec3 n(0, 1, 0), e1(1, 0, 0), e2 = glm::cross(n, e1);  // the plane y = 0
+  Primitive p;
+  // Triangle A: the centre 0, (1, 0), (0, 1) in (e1, e2): a 90° corner at the centre; UV = (a, b): dP/du = e1.
+  // Triangle B: the centre's copy 3, (0, 1), (−1, 1): a 45° corner; its UV is solved from the wanted gradients.
+  auto at = [&](float a, float b) { return e1 * a + e2 * b; };
+  p.positions = {at(0, 0), at(1, 0), at(0, 1), at(0, 0), at(0, 1), at(-1, 1)};
+  p.normals.assign(p.positions.size(), n);
+  p.indices = {0, 1, 2, 3, 4, 5};
+  // UV of B: a linear map with dP/du = g_u, dP/dv = g_v, i.e. (u, v) = M⁻¹ (a, b) for the matrix of columns g_u, g_v.
+  const glm::dvec2 gu = 4.0 * glm::normalize(glm::dvec2(1, 1)), gv = 4.0 * glm::normalize(glm::dvec2(-1, 1));
+  const glm::dmat2 inv = glm::inverse(glm::dmat2(gu, gv));
+  auto uvB = [&](double a, double b) { return glm::vec2(inv * glm::dvec2(a, b)); };
+  const std::vector<glm::vec2> uv = {{0, 0}, {1, 0}, {0, 1}, uvB(0, 0), uvB(0, 1), uvB(-1, 1)};  // uvB(0, 0) = (0, 0)
+  const std::vector<glm::vec4> t = generateTangents(p, uv);
+  ASSERT_EQ(t.size(), p.positions.size());
+  const glm::vec3 expected = glm::normalize(float(kPi / 2) * e1 + float(kPi / 4) * glm::normalize(e1 + e2));
+  EXPECT_NEAR(glm::length(glm::vec3(t[0]) - expected), 0.0f, 1e-5f);
+  EXPECT_EQ(t[0], t[3]);  // welded: one frame on both copies
+  // Vertex 2 and its copy 4 have different UVs, so they stay apart: each follows its own triangle.
+  EXPECT_NEAR(glm::length(glm::vec3(t[2]) - e1), 0.0f, 1e-5f);
+  EXPECT_NEAR(glm::length(glm::vec3(t[4]) - glm::normalize(e1 + e2)), 0.0f, 1e-5f);
 }
 
 }  // namespace

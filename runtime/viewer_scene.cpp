@@ -1,5 +1,6 @@
 #include "viewer_scene.h"
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <numeric>
@@ -99,34 +100,60 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
 
 std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv) {
   const size_t n = p.positions.size();
+  auto normalOf = [&](size_t i) { return i < p.normals.size() ? glm::dvec3(p.normals[i]) : glm::dvec3(0, 1, 0); };
+  // MikkTSpace first welds vertices whose position, normal and UV are the same bits: an irbake export
+  // splits vertices along light-map chart seams (TEXCOORD_1 differs there), which must not split the frame.
+  std::vector<uint32_t> weld(n);
+  {
+    std::map<std::array<float, 8>, uint32_t> first;
+    for (size_t i = 0; i < n; ++i) {
+      const glm::vec3 q = p.positions[i], m = glm::vec3(normalOf(i));
+      const glm::vec2 t = uv.size() == n ? uv[i] : glm::vec2(0.0f);
+      weld[i] = first.emplace(std::array<float, 8>{q.x, q.y, q.z, m.x, m.y, m.z, t.x, t.y}, static_cast<uint32_t>(i))
+                    .first->second;
+    }
+  }
+  // Per corner: the triangle's dP/du and dP/dv projected on the vertex's tangent plane, normalised, weighted
+  // by the corner's angle in that plane (MikkTSpace's weighting), summed on the welded vertex.
   std::vector<glm::dvec3> dPdu(n, glm::dvec3(0.0)), dPdv(n, glm::dvec3(0.0));
+  auto inPlane = [](const glm::dvec3& v, const glm::dvec3& nrm) {
+    const glm::dvec3 w = v - nrm * glm::dot(nrm, v);
+    const double len = glm::length(w);
+    return len > 1e-20 ? w / len : glm::dvec3(0.0);
+  };
   if (uv.size() == n) {
     for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-      const uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
-      if (a >= n || b >= n || c >= n) continue;
-      const glm::dvec3 e1 = glm::dvec3(p.positions[b]) - glm::dvec3(p.positions[a]);
-      const glm::dvec3 e2 = glm::dvec3(p.positions[c]) - glm::dvec3(p.positions[a]);
-      const glm::dvec2 d1 = glm::dvec2(uv[b]) - glm::dvec2(uv[a]), d2 = glm::dvec2(uv[c]) - glm::dvec2(uv[a]);
+      const uint32_t idx[3] = {p.indices[t], p.indices[t + 1], p.indices[t + 2]};
+      if (idx[0] >= n || idx[1] >= n || idx[2] >= n) continue;
+      const glm::dvec3 e1 = glm::dvec3(p.positions[idx[1]]) - glm::dvec3(p.positions[idx[0]]);
+      const glm::dvec3 e2 = glm::dvec3(p.positions[idx[2]]) - glm::dvec3(p.positions[idx[0]]);
+      const glm::dvec2 d1 = glm::dvec2(uv[idx[1]]) - glm::dvec2(uv[idx[0]]), d2 = glm::dvec2(uv[idx[2]]) - glm::dvec2(uv[idx[0]]);
       const double det = d1.x * d2.y - d2.x * d1.y;  // e1 = dPdu d1.x + dPdv d1.y, e2 likewise: solve
       if (!(std::abs(det) > 1e-20)) continue;
       const glm::dvec3 su = (e1 * d2.y - e2 * d1.y) / det, sv = (e2 * d1.x - e1 * d2.x) / det;
-      for (uint32_t v : {a, b, c}) {
-        dPdu[v] += su;
-        dPdv[v] += sv;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = idx[k];
+        const glm::dvec3 nrm = normalOf(v), here(p.positions[v]);
+        const glm::dvec3 a = inPlane(glm::dvec3(p.positions[idx[(k + 1) % 3]]) - here, nrm);
+        const glm::dvec3 b = inPlane(glm::dvec3(p.positions[idx[(k + 2) % 3]]) - here, nrm);
+        const double angle = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        dPdu[weld[v]] += angle * inPlane(su, nrm);
+        dPdv[weld[v]] += angle * inPlane(sv, nrm);
       }
     }
   }
   std::vector<glm::vec4> out(n);
   for (size_t i = 0; i < n; ++i) {
-    const glm::dvec3 nrm = i < p.normals.size() ? glm::dvec3(p.normals[i]) : glm::dvec3(0, 1, 0);
-    glm::dvec3 t = dPdu[i] - nrm * glm::dot(nrm, dPdu[i]);
+    const glm::dvec3 nrm = normalOf(i);
+    const glm::dvec3 du = dPdu[weld[i]], dv = dPdv[weld[i]];
+    glm::dvec3 t = du - nrm * glm::dot(nrm, du);
     if (!(glm::length(t) > 1e-12)) {  // no UV gradient here: any unit vector orthogonal to the normal
       t = std::abs(nrm.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
       t -= nrm * glm::dot(nrm, t);
     }
     t = glm::normalize(t);
     // cross(n, t)·w must point where v decreases.
-    const double w = glm::dot(glm::cross(nrm, t), dPdv[i]) > 0.0 ? -1.0 : 1.0;
+    const double w = glm::dot(glm::cross(nrm, t), dv) > 0.0 ? -1.0 : 1.0;
     out[i] = glm::vec4(glm::vec3(t), static_cast<float>(w));
   }
   return out;

@@ -44,11 +44,13 @@ ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages,
 ViewerScene loadViewerScene(const std::filesystem::path& path);
 
 // Per-vertex tangents (xyz unit and orthogonal to the vertex normal, w = ±1) for a primitive without TANGENT,
-// from the UV set `uv` a normal map reads. An approximation of the MikkTSpace frame that glTF asks for: per
-// triangle dP/du and dP/dv (Lengyel's UV-gradient solve), summed at each vertex, Gram–Schmidt against the
-// vertex normal. The bitangent cross(n, t)·w points towards decreasing v (up in the image: glTF's normal maps
-// have +Y up and UV (0,0) at the top left). Identical to MikkTSpace on planar charts with affine UVs; on curved
-// ones the two differ by how corners are weighted. A vertex whose triangles have no UV area gets any frame.
+// from the UV set `uv` a normal map reads, the way MikkTSpace (which glTF asks for) builds it: vertices with
+// the same position, normal and UV welded first (an export's light-map seams do not split the frame); per
+// triangle dP/du and dP/dv (the UV-gradient solve), at each corner projected on the vertex's tangent plane,
+// normalised and weighted by the corner's angle there, summed; Gram–Schmidt against the vertex normal. The
+// bitangent cross(n, t)·w points towards decreasing v (up in the image: glTF's normal maps have +Y up and
+// UV (0,0) at the top left). Not done: MikkTSpace's split of a vertex shared by mirrored-UV triangles (here
+// they average). A vertex whose triangles have no UV area gets any frame.
 std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv);
 
 // Per-vertex chart id: connected components of triangles sharing a vertex index. After the atlas,

@@ -125,33 +125,52 @@ function makeDirectional(material, l1, scales) {
   material.needsUpdate = true;
 }
 
-// Per-vertex tangents as irview makes them (runtime/viewer_scene.cpp generateTangents): per triangle dP/du
-// and dP/dv from the UV gradients, summed at each vertex, Gram–Schmidt against the vertex normal, w such that
-// cross(n, t)·w points where v decreases (glTF normal maps: +Y up, UV (0, 0) at the image's top left).
-// In the geometry's own space (three transforms it with the normal matrix). An approximation of MikkTSpace.
+// Per-vertex tangents as irview makes them (runtime/viewer_scene.cpp generateTangents), the way MikkTSpace
+// builds them: vertices with the same position, normal and UV welded; per triangle dP/du and dP/dv from the UV
+// gradients, at each corner projected on the vertex's tangent plane, normalised, weighted by the corner's
+// angle there and summed; Gram–Schmidt against the vertex normal; w such that cross(n, t)·w points where v
+// decreases (glTF normal maps: +Y up, UV (0, 0) at the image's top left). In the geometry's own space (three
+// transforms it with the normal matrix). Not done: MikkTSpace's split of vertices shared by mirrored UVs.
 export function generateTangents(geometry, uvName) {
   const pos = geometry.attributes.position, nrm = geometry.attributes.normal, uv = geometry.attributes[uvName];
   const count = pos.count;
   const index = geometry.index ? geometry.index.array : Array.from({ length: count }, (_, i) => i);
-  const dPdu = new Float64Array(3 * count), dPdv = new Float64Array(3 * count);
   const p = i => [pos.getX(i), pos.getY(i), pos.getZ(i)];
+  const nOf = i => [nrm.getX(i), nrm.getY(i), nrm.getZ(i)];
+  const dot = (x, y) => x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  const weld = new Uint32Array(count), first = new Map();
+  for (let i = 0; i < count; ++i) {
+    const key = [...p(i), ...nOf(i), uv.getX(i), uv.getY(i)].join(',');
+    if (!first.has(key)) first.set(key, i);
+    weld[i] = first.get(key);
+  }
+  const inPlane = (v, n) => {
+    const d = dot(n, v), w = v.map((x, k) => x - n[k] * d), len = Math.hypot(...w);
+    return len > 1e-20 ? w.map(x => x / len) : [0, 0, 0];
+  };
+  const dPdu = new Float64Array(3 * count), dPdv = new Float64Array(3 * count);
   for (let t = 0; t + 2 < index.length; t += 3) {
-    const a = index[t], b = index[t + 1], c = index[t + 2];
-    const pa = p(a), pb = p(b), pc = p(c);
+    const idx = [index[t], index[t + 1], index[t + 2]];
+    const pa = p(idx[0]), pb = p(idx[1]), pc = p(idx[2]);
     const e1 = [0, 1, 2].map(k => pb[k] - pa[k]), e2 = [0, 1, 2].map(k => pc[k] - pa[k]);
-    const d1 = [uv.getX(b) - uv.getX(a), uv.getY(b) - uv.getY(a)], d2 = [uv.getX(c) - uv.getX(a), uv.getY(c) - uv.getY(a)];
+    const d1 = [uv.getX(idx[1]) - uv.getX(idx[0]), uv.getY(idx[1]) - uv.getY(idx[0])];
+    const d2 = [uv.getX(idx[2]) - uv.getX(idx[0]), uv.getY(idx[2]) - uv.getY(idx[0])];
     const det = d1[0] * d2[1] - d2[0] * d1[1];
     if (!(Math.abs(det) > 1e-20)) continue;
-    for (let k = 0; k < 3; ++k) {
-      const su = (e1[k] * d2[1] - e2[k] * d1[1]) / det, sv = (e2[k] * d1[0] - e1[k] * d2[0]) / det;
-      for (const v of [a, b, c]) { dPdu[3 * v + k] += su; dPdv[3 * v + k] += sv; }
+    const su = [0, 1, 2].map(k => (e1[k] * d2[1] - e2[k] * d1[1]) / det);
+    const sv = [0, 1, 2].map(k => (e2[k] * d1[0] - e1[k] * d2[0]) / det);
+    for (let c = 0; c < 3; ++c) {
+      const v = idx[c], n = nOf(v), here = p(v), pn = p(idx[(c + 1) % 3]), pp = p(idx[(c + 2) % 3]);
+      const a = inPlane(pn.map((x, k) => x - here[k]), n), b = inPlane(pp.map((x, k) => x - here[k]), n);
+      const angle = Math.acos(Math.min(1, Math.max(-1, dot(a, b))));
+      const u = inPlane(su, n), w = inPlane(sv, n), o = 3 * weld[v];
+      for (let k = 0; k < 3; ++k) { dPdu[o + k] += angle * u[k]; dPdv[o + k] += angle * w[k]; }
     }
   }
   const out = new Float32Array(4 * count);
   for (let i = 0; i < count; ++i) {
-    const n = [nrm.getX(i), nrm.getY(i), nrm.getZ(i)];
-    const dot = (x, y) => x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    const du = [dPdu[3 * i], dPdu[3 * i + 1], dPdu[3 * i + 2]], dv = [dPdv[3 * i], dPdv[3 * i + 1], dPdv[3 * i + 2]];
+    const n = nOf(i), o = 3 * weld[i];
+    const du = [dPdu[o], dPdu[o + 1], dPdu[o + 2]], dv = [dPdv[o], dPdv[o + 1], dPdv[o + 2]];
     let t = du.map((x, k) => x - n[k] * dot(n, du));
     if (!(Math.hypot(...t) > 1e-12)) {  // no UV gradient here: any unit vector orthogonal to the normal
       t = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
