@@ -96,17 +96,24 @@ inline TexelSamples gridSamples(glm::vec3 p0, glm::vec3 e1, glm::vec3 e2, int W,
 
 // Illuminance of a Lambertian polygon of radiance 1 seen from (x, n), divided by π: the point-to-polygon
 // form factor (Lambert's edge formula). The polygon must lie entirely above x's tangent plane.
-inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& poly) {
-  double sum = 0.0;
+// Its irradiance vector g/π (Lambert: ½ Σ edge angle · unit edge-plane normal, / π), oriented towards the
+// polygon (up to its sign the sum's direction depends on the winding). n·(this) = polygonFormFactor(x, n, poly).
+inline glm::dvec3 polygonIrradianceVector(glm::dvec3 x, const std::vector<glm::dvec3>& poly) {
+  glm::dvec3 sum(0.0), centre(0.0);
   for (size_t i = 0; i < poly.size(); ++i) {
     glm::dvec3 a = glm::normalize(poly[i] - x), b = glm::normalize(poly[(i + 1) % poly.size()] - x);
     glm::dvec3 c = glm::cross(a, b);
     double len = glm::length(c);
+    centre += poly[i];
     if (len < 1e-15) continue;
-    double angle = std::atan2(len, glm::dot(a, b));
-    sum += angle * glm::dot(n, c / len);
+    sum += std::atan2(len, glm::dot(a, b)) * c / len;
   }
-  return std::abs(sum) / (2.0 * 3.14159265358979323846);
+  sum /= 2.0 * 3.14159265358979323846;
+  return glm::dot(sum, centre / double(poly.size()) - x) < 0.0 ? -sum : sum;
+}
+
+inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& poly) {
+  return std::abs(glm::dot(n, polygonIrradianceVector(x, poly)));
 }
 
 }  // namespace irbake::testing

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "atlas/atlas.h"
@@ -49,31 +50,45 @@ TEST(ClampCompensation, NoClampAddsNothing) {
   EXPECT_EQ(stats.raysTraced, 0u);
 }
 
+// A unit emitter square (Le = 1) 5 cm over a black 2 m floor of 24² texels, 1024 paths, clamp B = 3/m² (G = 1/h²
+// = 400 near the square, so almost all of its light is clamped away).
+struct EmitterOverFloor {
+  static constexpr float h = 0.05f;
+  Scene s;
+  std::vector<TexelSamples> texels;
+  std::unique_ptr<RayTracer> rt;
+  VplSet vpls;
+  VplEvalOptions eval;
+  const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
+  EmitterOverFloor() {
+    const int lamp = addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
+    const int floor = addMaterial(s, glm::vec3(0.0f));
+    addQuad(s, lamp, glm::vec3(-0.5f, -0.5f, h), glm::vec3(0, 1, 0), glm::vec3(1, 0, 0));
+    addQuad(s, floor, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
+    texels = {gridSamples(glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0), 24, 24)};
+    rt = std::make_unique<RayTracer>(s);
+    WalkOptions walk;
+    walk.paths = 1024;
+    vpls = generateVpls(s, *rt, walk);
+    eval.clampBound = 3.0f;
+  }
+  BakeInputs inputs() const { return BakeInputs{s, *rt, texels, vpls, eval, {}}; }
+};
+
 // A unit emitter square (Le = 1) 5 cm over a black floor: all the floor receives is direct emission,
 // which the VPLs on the emitter carry. A tight clamp (r_c ≈ 0.3 m ≫ h) removes most of it near the
 // square; the residual (w · Le at emitter hits) must restore the exact form factor.
 TEST(ClampCompensation, EmitterCloseToFloorMatchesFormFactor) {
-  const float h = 0.05f;
-  Scene s;
-  const int lamp = addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
-  const int floor = addMaterial(s, glm::vec3(0.0f));
-  addQuad(s, lamp, glm::vec3(-0.5f, -0.5f, h), glm::vec3(0, 1, 0), glm::vec3(1, 0, 0));
-  addQuad(s, floor, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
-  std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0), 24, 24)};
-  RayTracer rt(s);
-  WalkOptions walk;
-  walk.paths = 1024;
-  const VplSet vpls = generateVpls(s, rt, walk);
-  VplEvalOptions eval;
-  eval.clampBound = 3.0f;  // 1/m²: G = 1/h² = 400 near the square, so almost all of it is clamped away
-  BakeInputs in{s, rt, texels, vpls, eval, {}};
+  const EmitterOverFloor scene;
+  const std::vector<TexelSamples>& texels = scene.texels;
+  const BakeInputs in = scene.inputs();
   std::vector<Lightmap> maps = bakeEmbree(in);
   const std::vector<Lightmap> clamped = maps;
   ClampCompensationOptions options;
   options.rays = 64;
   options.refineRays = 448;
   compensateClamp(in, maps, options);
-  const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
+  const std::vector<glm::dvec3>& poly = scene.poly;
   double se = 0, se0 = 0, ref2 = 0;
   for (size_t i = 0; i < maps[0].size(); ++i) {
     const glm::dvec3 x(glm::vec3(texels[0].positionWeight[i]));
@@ -93,20 +108,9 @@ TEST(ClampCompensation, EmitterCloseToFloorMatchesFormFactor) {
 // (ClampGather::applyDirectional) must give it back: against the polygon's irradiance vector (Lambert:
 // ½ Σ edge angle · edge-plane normal), RMSE within 3% of its largest magnitude; without it > 10%.
 TEST(ClampCompensation, DirectionalShareRestoresTheIrradianceVector) {
-  const float h = 0.05f;
-  Scene s;
-  const int lamp = addMaterial(s, glm::vec3(0.0f), glm::vec3(1.0f));
-  const int floor = addMaterial(s, glm::vec3(0.0f));
-  addQuad(s, lamp, glm::vec3(-0.5f, -0.5f, h), glm::vec3(0, 1, 0), glm::vec3(1, 0, 0));
-  addQuad(s, floor, glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
-  std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0), 24, 24)};
-  RayTracer rt(s);
-  WalkOptions walk;
-  walk.paths = 1024;
-  const VplSet vpls = generateVpls(s, rt, walk);
-  VplEvalOptions eval;
-  eval.clampBound = 3.0f;
-  BakeInputs in{s, rt, texels, vpls, eval, {}};
+  const EmitterOverFloor scene;
+  const std::vector<TexelSamples>& texels = scene.texels;
+  const BakeInputs in = scene.inputs();
   L1Pages axes;
   EmbreeOptions eo;
   eo.directional = &axes;
@@ -121,18 +125,11 @@ TEST(ClampCompensation, DirectionalShareRestoresTheIrradianceVector) {
   const std::vector<Lightmap> l0 = maps;
   gather.applyDirectional(maps, axes);
   for (size_t t = 0; t < maps[0].size(); ++t) EXPECT_EQ(maps[0].texels[t], l0[0].texels[t]);  // L0 untouched
-  const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
+  const std::vector<glm::dvec3>& poly = scene.poly;
   double se = 0.0, se0 = 0.0, largest = 0.0;
   for (size_t t = 0; t < maps[0].size(); ++t) {
     const glm::dvec3 x(glm::vec3(texels[0].positionWeight[t]));
-    glm::dvec3 v(0.0);
-    for (size_t i = 0; i < poly.size(); ++i) {
-      const glm::dvec3 a = glm::normalize(poly[i] - x), b = glm::normalize(poly[(i + 1) % poly.size()] - x);
-      const glm::dvec3 c = glm::cross(a, b);
-      v += std::atan2(glm::length(c), glm::dot(a, b)) * c / glm::length(c);
-    }
-    v /= 2.0 * kPi;         // Le = 1: g / π
-    if (v.z < 0.0) v = -v;  // towards the emitter
+    const glm::dvec3 v = polygonIrradianceVector(x, poly);  // Le = 1: g / π, towards the emitter
     const glm::dvec2 got(axes[0][0].texels[t].x, axes[1][0].texels[t].x), got0(clampedAxes[0][0].texels[t].x,
                                                                                clampedAxes[1][0].texels[t].x);
     EXPECT_NEAR(axes[2][0].texels[t].x, 0.0, 1e-6);  // tangential to the floor

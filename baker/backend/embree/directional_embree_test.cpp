@@ -94,14 +94,7 @@ TEST(EmbreeDirectional, QuadEmitterIrradianceVector) {
   double se = 0.0, largest = 0.0;
   for (size_t t = 0; t < axes[0][0].size(); ++t) {
     const glm::dvec3 x(glm::vec3(texels[0].positionWeight[t]));
-    glm::dvec3 v(0.0);
-    for (size_t i = 0; i < poly.size(); ++i) {
-      const glm::dvec3 a = glm::normalize(poly[i] - x), b = glm::normalize(poly[(i + 1) % poly.size()] - x);
-      const glm::dvec3 c = glm::cross(a, b);
-      v += std::atan2(glm::length(c), glm::dot(a, b)) * c / glm::length(c);
-    }
-    v /= 2.0 * kPi;          // Le = 1: g / π
-    if (v.z < 0.0) v = -v;   // towards the emitter
+    const glm::dvec3 v = polygonIrradianceVector(x, poly);  // Le = 1: g / π, towards the emitter
     const L1Vectors tv = texelL1(axes, 0, t);
     const glm::dvec3 got(tv[0].x, tv[1].x, tv[2].x);
     EXPECT_NEAR(got.z, 0.0, 1e-6);
