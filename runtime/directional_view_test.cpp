@@ -288,5 +288,34 @@ TEST(DirectionalView, GeneratedTangentsWeldSeamsAndWeighCornerAngles) {
   EXPECT_NEAR(glm::length(glm::vec3(t[4]) - glm::normalize(e1 + e2)), 0.0f, 1e-5f);
 }
 
+// MikkTSpace keeps a UV mirror's halves apart. A strip of two quads on a plane whose u runs 1 → 0 → 1
+// (mirrored at the middle line, whose vertices both halves share): split, each half's vertices get its own
+// dP/du (−e1 on the left, +e1 on the right) and the same bitangent. Unsplit, or with the copies welded back
+// (same position, normal and UV), the shared vertices would sum −e1 and +e1 (90° of corners each) to nothing.
+TEST(DirectionalView, GeneratedTangentsKeepUvMirrorHalvesApart) {
+  const glm::vec3 n(0, 1, 0), e1(1, 0, 0), e2 = glm::cross(n, e1);
+  Primitive p;
+  for (float b : {0.0f, 1.0f})
+    for (float a : {-1.0f, 0.0f, 1.0f}) p.positions.push_back(e1 * a + e2 * b);  // 0 1 2 / 3 4 5
+  p.normals.assign(p.positions.size(), n);
+  p.indices = {0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4};
+  for (const glm::vec3& q : p.positions) p.uv0.push_back(glm::vec2(std::abs(glm::dot(q, e1)), glm::dot(q, e2)));
+  const Primitive s = splitMirroredUvVertices(p, 0);
+  ASSERT_EQ(s.positions.size(), 8u);  // vertices 1 and 4 copied
+  ASSERT_EQ(s.normals.size(), 8u);
+  ASSERT_EQ(s.uv0.size(), 8u);
+  const std::vector<glm::vec4> t = generateTangents(s, s.uv0);
+  for (size_t c = 0; c < s.indices.size(); ++c) {
+    const size_t tri = c / 3;
+    const glm::vec3 uGrows = tri < 2 ? -e1 : e1;  // triangles 0-1: the left half, u = −x
+    const glm::vec4 v = t[s.indices[c]];
+    EXPECT_NEAR(glm::length(glm::vec3(v) - uGrows), 0.0f, 1e-5f) << "corner " << c;
+    // v grows along e2 on both halves: cross(n, t)·w = −dP/dv.
+    EXPECT_NEAR(glm::length(glm::cross(n, glm::vec3(v)) * v.w + e2), 0.0f, 1e-5f) << "corner " << c;
+  }
+  // The split changed nothing else: same triangles in space, mirrored ones on the copies.
+  for (size_t c = 0; c < p.indices.size(); ++c) EXPECT_EQ(s.positions[s.indices[c]], p.positions[p.indices[c]]);
+}
+
 }  // namespace
 }  // namespace irbake::view

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <epoxy/gl.h>
 
@@ -327,8 +328,16 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
   }
 
   uint32_t chartBase = 0, nextChartBase = 0;
-  for (const Primitive& p : v.scene.primitives) {
-    if (p.indices.empty()) continue;
+  for (const Primitive& source : v.scene.primitives) {
+    if (source.indices.empty()) continue;
+    // Tangents generated the MikkTSpace way need the vertices that a UV mirror's two halves share split
+    // before the vertex buffer is built.
+    const Material& sm = v.scene.materials.at(source.material);
+    std::optional<Primitive> split;
+    if (source.tangents.size() != source.positions.size() && sm.normalTexture >= 0 &&
+        directionalSourceOf(v, source) != DirectionalSource::None)
+      split = splitMirroredUvVertices(source, sm.normalTexCoord == 1 ? 1 : 0);
+    const Primitive& p = split ? *split : source;
     Impl::GpuPrimitive g;
     g.material = p.material;
     const Material& m = v.scene.materials.at(p.material);

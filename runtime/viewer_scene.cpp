@@ -98,23 +98,89 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
   return v;
 }
 
+namespace {
+
+// The orientation of triangle t in UV space: +1 counter-clockwise, -1 mirrored, 0 no UV area.
+int uvOrientation(const Primitive& p, const std::vector<glm::vec2>& uv, size_t t) {
+  const uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
+  if (a >= uv.size() || b >= uv.size() || c >= uv.size()) return 0;
+  const glm::dvec2 d1 = glm::dvec2(uv[b]) - glm::dvec2(uv[a]), d2 = glm::dvec2(uv[c]) - glm::dvec2(uv[a]);
+  const double det = d1.x * d2.y - d2.x * d1.y;
+  return det > 1e-20 ? 1 : det < -1e-20 ? -1 : 0;
+}
+
+// Per vertex: which UV orientations its triangles have (bit 0: +1, bit 1: -1; 0: none with UV area).
+std::vector<uint8_t> orientationBits(const Primitive& p, const std::vector<glm::vec2>& uv) {
+  std::vector<uint8_t> bits(p.positions.size(), 0);
+  for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+    const int s = uvOrientation(p, uv, t);
+    if (s == 0) continue;
+    for (int k = 0; k < 3; ++k)
+      if (p.indices[t + k] < bits.size()) bits[p.indices[t + k]] |= s > 0 ? 1 : 2;
+  }
+  return bits;
+}
+
+}  // namespace
+
+Primitive splitMirroredUvVertices(const Primitive& p, int uvSet) {
+  const std::vector<glm::vec2>& uv = uvSet == 1 ? p.uv1 : p.uv0;
+  Primitive out = p;
+  const size_t n = p.positions.size();
+  if (uv.size() != n) return out;
+  const std::vector<uint8_t> seen = orientationBits(p, uv);
+  // A vertex used by both orientations gets a copy (appended, every per-vertex array with it) that the
+  // mirrored triangles use.
+  std::vector<uint32_t> copyOf(n, UINT32_MAX);
+  auto append = [&](auto& to, const auto& from, size_t i) {  // arrays that are per vertex in `p`
+    if (from.size() == n) to.push_back(from[i]);
+  };
+  for (size_t i = 0; i < n; ++i) {
+    if (seen[i] != 3) continue;
+    copyOf[i] = static_cast<uint32_t>(out.positions.size());
+    out.positions.push_back(p.positions[i]);
+    append(out.normals, p.normals, i);
+    append(out.uv0, p.uv0, i);
+    append(out.uv1, p.uv1, i);
+    append(out.tangents, p.tangents, i);
+    append(out.sourceVertex, p.sourceVertex, i);
+  }
+  for (size_t t = 0; t + 2 < p.indices.size(); t += 3)
+    if (uvOrientation(p, uv, t) < 0)
+      for (int k = 0; k < 3; ++k)
+        if (p.indices[t + k] < n && copyOf[p.indices[t + k]] != UINT32_MAX)
+          out.indices[t + k] = copyOf[p.indices[t + k]];
+  return out;
+}
+
 std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv) {
   const size_t n = p.positions.size();
   auto normalOf = [&](size_t i) { return i < p.normals.size() ? glm::dvec3(p.normals[i]) : glm::dvec3(0, 1, 0); };
   // MikkTSpace first welds vertices whose position, normal and UV are the same bits: an irbake export
   // splits vertices along light-map chart seams (TEXCOORD_1 differs there), which must not split the frame.
+  // It keeps the two sides of a UV mirror apart: a vertex's orientation (the sign of its triangles' UV area)
+  // is part of the key, so a mirrored half never cancels the other's dP/du.
+  std::vector<int> orientation(n, 0);  // the one orientation of a vertex's triangles; 0: none or both
+  if (uv.size() == n) {
+    const std::vector<uint8_t> bits = orientationBits(p, uv);
+    for (size_t i = 0; i < n; ++i) orientation[i] = bits[i] == 1 ? 1 : bits[i] == 2 ? -1 : 0;
+  }
   std::vector<uint32_t> weld(n);
   {
-    std::map<std::array<float, 8>, uint32_t> first;
+    std::map<std::array<float, 9>, uint32_t> first;
     for (size_t i = 0; i < n; ++i) {
       const glm::vec3 q = p.positions[i], m = glm::vec3(normalOf(i));
       const glm::vec2 t = uv.size() == n ? uv[i] : glm::vec2(0.0f);
-      weld[i] = first.emplace(std::array<float, 8>{q.x, q.y, q.z, m.x, m.y, m.z, t.x, t.y}, static_cast<uint32_t>(i))
+      weld[i] = first.emplace(std::array<float, 9>{q.x, q.y, q.z, m.x, m.y, m.z, t.x, t.y,
+                                                   static_cast<float>(orientation[i])},
+                              static_cast<uint32_t>(i))
                     .first->second;
     }
   }
   // Per corner: the triangle's dP/du and dP/dv projected on the vertex's tangent plane, normalised, weighted
-  // by the corner's angle in that plane (MikkTSpace's weighting), summed on the welded vertex.
+  // by the corner's angle in that plane (MikkTSpace's weighting), summed on the welded vertex. A vertex
+  // shared by both orientations (not split by splitMirroredUvVertices) sums only the triangles of the
+  // orientation it was given (0: all of them).
   std::vector<glm::dvec3> dPdu(n, glm::dvec3(0.0)), dPdv(n, glm::dvec3(0.0));
   auto inPlane = [](const glm::dvec3& v, const glm::dvec3& nrm) {
     const glm::dvec3 w = v - nrm * glm::dot(nrm, v);
@@ -130,9 +196,11 @@ std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<gl
       const glm::dvec2 d1 = glm::dvec2(uv[idx[1]]) - glm::dvec2(uv[idx[0]]), d2 = glm::dvec2(uv[idx[2]]) - glm::dvec2(uv[idx[0]]);
       const double det = d1.x * d2.y - d2.x * d1.y;  // e1 = dPdu d1.x + dPdv d1.y, e2 likewise: solve
       if (!(std::abs(det) > 1e-20)) continue;
+      const int side = det > 0.0 ? 1 : -1;
       const glm::dvec3 su = (e1 * d2.y - e2 * d1.y) / det, sv = (e2 * d1.x - e1 * d2.x) / det;
       for (int k = 0; k < 3; ++k) {
         const uint32_t v = idx[k];
+        if (orientation[v] != 0 && orientation[v] != side) continue;
         const glm::dvec3 nrm = normalOf(v), here(p.positions[v]);
         const glm::dvec3 a = inPlane(glm::dvec3(p.positions[idx[(k + 1) % 3]]) - here, nrm);
         const glm::dvec3 b = inPlane(glm::dvec3(p.positions[idx[(k + 2) % 3]]) - here, nrm);

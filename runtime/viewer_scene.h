@@ -49,9 +49,16 @@ ViewerScene loadViewerScene(const std::filesystem::path& path);
 // triangle dP/du and dP/dv (the UV-gradient solve), at each corner projected on the vertex's tangent plane,
 // normalised and weighted by the corner's angle there, summed; Gram–Schmidt against the vertex normal. The
 // bitangent cross(n, t)·w points towards decreasing v (up in the image: glTF's normal maps have +Y up and
-// UV (0,0) at the top left). Not done: MikkTSpace's split of a vertex shared by mirrored-UV triangles (here
-// they average). A vertex whose triangles have no UV area gets any frame.
+// UV (0,0) at the top left). Vertices of a UV mirror's two sides are kept apart (the orientation of the
+// UV triangle is part of the weld key); a vertex that both sides share should be split first
+// (splitMirroredUvVertices), else it sums both. A vertex whose triangles have no UV area gets any frame.
 std::vector<glm::vec4> generateTangents(const Primitive& p, const std::vector<glm::vec2>& uv);
+
+// MikkTSpace's vertex split: a copy of `p` in which every vertex used by triangles of both UV orientations
+// in UV set `uvSet` (0 or 1; a mirror line whose vertices both halves share) is duplicated, every
+// per-vertex array with it, and the mirrored (clockwise in UV) triangles use the copy. Unchanged when no
+// vertex is shared so, or the UV set is absent.
+Primitive splitMirroredUvVertices(const Primitive& p, int uvSet);
 
 // Per-vertex chart id: connected components of triangles sharing a vertex index. After the atlas,
 // vertices are split along chart seams, so these are the atlas charts.

@@ -5,14 +5,16 @@
 // looking down at the plane. Pure node (zlib for the PNG), no dependencies.
 // With --tangent the primitive carries TANGENT = (+x, w = +1), the frame a client would generate (B = cross(N, T)·w = −z,
 // where v decreases), so the given-tangent path shows the same image.
-// Usage: node make_directional_scene.mjs OUT_DIR [--tangent]   → OUT_DIR/plane.gltf, plane.bin, normal.png
+// With --mirror TEXCOORD_0's u is mirrored at x = 0 (u = 0.5 + |x|/4), the column of vertices there shared by both
+// halves: generated tangents must split them (MikkTSpace) or that column's quads get a frame of neither half.
+// Usage: node make_directional_scene.mjs OUT_DIR [--tangent | --mirror]   → OUT_DIR/plane.gltf, plane.bin, normal.png
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 
 const out = process.argv[2];
-if (!out) { console.error('usage: node make_directional_scene.mjs OUT_DIR [--tangent]'); process.exit(2); }
-const withTangent = process.argv.includes('--tangent');
+if (!out) { console.error('usage: node make_directional_scene.mjs OUT_DIR [--tangent | --mirror]'); process.exit(2); }
+const withTangent = process.argv.includes('--tangent'), mirror = process.argv.includes('--mirror');
 fs.mkdirSync(out, { recursive: true });
 
 // Tangent-space normal (x towards +u, y towards −v, z out): 35° off the normal, 30° around it from +x.
@@ -61,7 +63,7 @@ for (let j = 0; j <= cells; ++j)
     positions.push(x, 0, z);
     normals.push(0, 1, 0);
     tangents.push(1, 0, 0, 1);
-    uvs.push((x + half) / (2 * half), (z + half) / (2 * half));
+    uvs.push(mirror ? 0.5 + Math.abs(x) / (2 * half) : (x + half) / (2 * half), (z + half) / (2 * half));
   }
 for (let j = 0; j < cells; ++j)
   for (let i = 0; i < cells; ++i) {

@@ -76,6 +76,7 @@ export class MozLightmapExtension {
       if (!mesh.geometry.attributes.tangent) {
         if (!mesh.geometry.attributes[uvName] || !mesh.geometry.attributes.normal)
           throw new Error(`mesh ${mesh.name}: a directional light map needs NORMAL and the normal map's ${uvName}`);
+        splitMirroredUvVertices(mesh.geometry, uvName);
         mesh.geometry.setAttribute('tangent', generateTangents(mesh.geometry, uvName));
         ++this.generatedTangents;
       }
@@ -130,7 +131,8 @@ function makeDirectional(material, l1, scales) {
 // gradients, at each corner projected on the vertex's tangent plane, normalised, weighted by the corner's
 // angle there and summed; Gram–Schmidt against the vertex normal; w such that cross(n, t)·w points where v
 // decreases (glTF normal maps: +Y up, UV (0, 0) at the image's top left). In the geometry's own space (three
-// transforms it with the normal matrix). Not done: MikkTSpace's split of vertices shared by mirrored UVs.
+// transforms it with the normal matrix). A UV mirror's two halves stay apart: the UV triangle's orientation
+// is part of the weld key, and splitMirroredUvVertices (run first) copies the vertices both halves share.
 export function generateTangents(geometry, uvName) {
   const pos = geometry.attributes.position, nrm = geometry.attributes.normal, uv = geometry.attributes[uvName];
   const count = pos.count;
@@ -138,9 +140,11 @@ export function generateTangents(geometry, uvName) {
   const p = i => [pos.getX(i), pos.getY(i), pos.getZ(i)];
   const nOf = i => [nrm.getX(i), nrm.getY(i), nrm.getZ(i)];
   const dot = (x, y) => x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  const bits = orientationBits(index, uv, count);
+  const side = i => (bits[i] === 1 ? 1 : bits[i] === 2 ? -1 : 0);  // 0: no UV area, or both orientations
   const weld = new Uint32Array(count), first = new Map();
   for (let i = 0; i < count; ++i) {
-    const key = [...p(i), ...nOf(i), uv.getX(i), uv.getY(i)].join(',');
+    const key = [...p(i), ...nOf(i), uv.getX(i), uv.getY(i), side(i)].join(',');
     if (!first.has(key)) first.set(key, i);
     weld[i] = first.get(key);
   }
@@ -157,10 +161,13 @@ export function generateTangents(geometry, uvName) {
     const d2 = [uv.getX(idx[2]) - uv.getX(idx[0]), uv.getY(idx[2]) - uv.getY(idx[0])];
     const det = d1[0] * d2[1] - d2[0] * d1[1];
     if (!(Math.abs(det) > 1e-20)) continue;
+    const orientation = det > 0 ? 1 : -1;
     const su = [0, 1, 2].map(k => (e1[k] * d2[1] - e2[k] * d1[1]) / det);
     const sv = [0, 1, 2].map(k => (e2[k] * d1[0] - e1[k] * d2[0]) / det);
     for (let c = 0; c < 3; ++c) {
-      const v = idx[c], n = nOf(v), here = p(v), pn = p(idx[(c + 1) % 3]), pp = p(idx[(c + 2) % 3]);
+      const v = idx[c];
+      if (side(v) !== 0 && side(v) !== orientation) continue;
+      const n = nOf(v), here = p(v), pn = p(idx[(c + 1) % 3]), pp = p(idx[(c + 2) % 3]);
       const a = inPlane(pn.map((x, k) => x - here[k]), n), b = inPlane(pp.map((x, k) => x - here[k]), n);
       const angle = Math.acos(Math.min(1, Math.max(-1, dot(a, b))));
       const u = inPlane(su, n), w = inPlane(sv, n), o = 3 * weld[v];
@@ -183,4 +190,51 @@ export function generateTangents(geometry, uvName) {
     out.set([...t, dot(b, dv) > 0 ? -1 : 1], 4 * i);
   }
   return new BufferAttribute(out, 4);
+}
+
+// Per vertex: which UV orientations its triangles have (bit 0: counter-clockwise, bit 1: mirrored).
+function orientationBits(index, uv, count) {
+  const bits = new Uint8Array(count);
+  for (let t = 0; t + 2 < index.length; t += 3) {
+    const a = index[t], b = index[t + 1], c = index[t + 2];
+    const d1x = uv.getX(b) - uv.getX(a), d1y = uv.getY(b) - uv.getY(a);
+    const d2x = uv.getX(c) - uv.getX(a), d2y = uv.getY(c) - uv.getY(a);
+    const det = d1x * d2y - d2x * d1y;
+    if (!(Math.abs(det) > 1e-20)) continue;
+    const bit = det > 0 ? 1 : 2;
+    bits[a] |= bit; bits[b] |= bit; bits[c] |= bit;
+  }
+  return bits;
+}
+
+// MikkTSpace's vertex split (irview: splitMirroredUvVertices): every vertex that triangles of both UV
+// orientations share (a mirror line) is copied, with every attribute, and the mirrored triangles use the
+// copy. In place; an unindexed geometry shares no vertex.
+export function splitMirroredUvVertices(geometry, uvName) {
+  if (!geometry.index) return 0;
+  const uv = geometry.attributes[uvName], count = geometry.attributes.position.count;
+  const index = Array.from(geometry.index.array);
+  const bits = orientationBits(index, uv, count);
+  const copyOf = new Map();
+  for (let i = 0; i < count; ++i) if (bits[i] === 3) copyOf.set(i, count + copyOf.size);
+  if (copyOf.size === 0) return 0;
+  for (let t = 0; t + 2 < index.length; t += 3) {
+    const a = index[t], b = index[t + 1], c = index[t + 2];
+    const det = (uv.getX(b) - uv.getX(a)) * (uv.getY(c) - uv.getY(a)) - (uv.getX(c) - uv.getX(a)) * (uv.getY(b) - uv.getY(a));
+    if (det < -1e-20) for (let k = 0; k < 3; ++k) if (copyOf.has(index[t + k])) index[t + k] = copyOf.get(index[t + k]);
+  }
+  const sources = [...copyOf.keys()];
+  for (const name of Object.keys(geometry.attributes)) {
+    const a = geometry.attributes[name], size = a.itemSize;
+    // Stored values (normalised integers stay integers), interleaved or not.
+    const raw = a.isInterleavedBufferAttribute ? a.data.array : a.array;
+    const stride = a.isInterleavedBufferAttribute ? a.data.stride : size, offset = a.isInterleavedBufferAttribute ? a.offset : 0;
+    const at = (i, k) => raw[i * stride + offset + k];
+    const array = new raw.constructor((count + sources.length) * size);
+    for (let i = 0; i < count; ++i) for (let k = 0; k < size; ++k) array[i * size + k] = at(i, k);
+    sources.forEach((from, j) => { for (let k = 0; k < size; ++k) array[(count + j) * size + k] = at(from, k); });
+    geometry.setAttribute(name, new BufferAttribute(array, size, a.normalized));
+  }
+  geometry.setIndex(index);
+  return sources.length;
 }
