@@ -29,7 +29,7 @@ struct BakeArguments {
   std::vector<std::string> scenes;
   std::string backend = "auto", shard;
   long long seed = 0;
-  double tpu = 0.0, clamp = 0.0;
+  double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
   int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
@@ -73,6 +73,17 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "(default auto: 1/(share of that light meeting the scene again), at most 4;\n"
                   "1 in closed scenes; 1 = Keller's plain walk)")
       ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
+  app->add_option("--vpl-importance", a.vplImportance,
+                  "importance-driven VPLs: the walk places F times the VPLs and about the\n"
+                  "plain walk's count is kept, chosen by what they add to dim texels\n"
+                  "(default auto: up to 16 while probes × candidates ≤ 64M; 1 = the plain walk)")
+      ->transform(cli::numberOrAuto(1.0, 64.0, 0.0))->type_name("F|auto");
+  app->add_option("--vpl-probes", o.vplImportance.probes,
+                  "importance-driven VPLs: texel samples the candidates are measured at (default 1024)")
+      ->transform(cli::integerIn(16, 65536))->type_name("N");
+  app->add_option("--vpl-keep", o.vplImportance.keepShare,
+                  "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default 0.5)")
+      ->transform(cli::numberIn(0.05, 4.0))->type_name("S");
   app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page, or\n64 texels per triangle where that is more, at most 4M)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
@@ -192,6 +203,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.texels.leakControl = !a.noLeakControl;
   if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
   if (a.walkSplit > 0) o.walk.split = a.walkSplit;
+  if (a.vplImportance >= 1.0) o.vplImportance.candidateFactor = a.vplImportance;
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;

@@ -105,6 +105,22 @@ CLI::Validator numberIn(double lo, double hi) {
       "in " + range);
 }
 
+CLI::Validator numberOrAuto(double lo, double hi, double autoValue) {
+  const std::string range = "[" + formatNumber(lo) + ", " + formatNumber(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range, autoValue](std::string& text) -> std::string {
+        if (text == "auto") {
+          text = formatNumber(autoValue);
+          return {};
+        }
+        double v = 0.0;
+        if (!parseFinite(text, v) || v < lo || v > hi)
+          return "must be 'auto' or a finite number in " + range + ", got '" + text + "'";
+        return {};
+      },
+      "auto or " + range);
+}
+
 CLI::Validator numberList(size_t count) {
   return CLI::Validator(
       [count](std::string& text) -> std::string {

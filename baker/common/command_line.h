@@ -24,6 +24,7 @@ bool parse(CLI::App& app, const std::vector<std::string>& args);
 CLI::Validator integerIn(long long lo, long long hi);                      // an integer in [lo, hi]
 CLI::Validator integerOrAuto(long long lo, long long hi, long long autoValue);  // or "auto" → autoValue
 CLI::Validator numberIn(double lo, double hi);                             // a finite number in [lo, hi]
+CLI::Validator numberOrAuto(double lo, double hi, double autoValue);      // or "auto" → autoValue
 CLI::Validator numberList(size_t count);                                  // "x,y,z": count finite numbers
 
 // The numbers of a list that numberList(count) accepted.

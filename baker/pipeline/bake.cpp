@@ -10,6 +10,7 @@
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
 #include "transport/geometry_term.h"
+#include "transport/vpl_importance.h"
 #include "backend/gl/gl_backend.h"
 #include "backend/interleave/interleaved_sampling.h"
 #include "glcontext/gl_context.h"
@@ -137,6 +138,8 @@ struct StagedBake::State {
   VplEvalOptions eval;        // with the derived clamp
   double clampK = 0.0;
   bool clampDerived = false;
+  double importanceFactor = 1.0;       // candidates per kept VPL of the importance selection (1: plain walk)
+  VplImportanceStats importanceStats;
   BackendKind backend = BackendKind::Auto;
   std::string backendReason = "asked for";
   std::unique_ptr<GlContext> glContext;
@@ -180,18 +183,48 @@ struct StagedBake::State {
       o.progress = withProgress(o.progress);
       texels = buildTexelSamples(scene, *rayTracer, o);
     });
+    // The backend first (the GL context is made here: its time counts to the backend, as it did): the
+    // reference backend reads no VPLs, so it needs no VPL selection.
+    timed("backend", [&] { chooseBackend(); });
     timed("vpls", [&] {
       WalkOptions o = options.walk;
       o.progress = withProgress(o.progress);
       vpls = generateVpls(scene, *rayTracer, o);
+      // Importance-driven selection: where the plain walk's VPLs matter unevenly (its pilot), the walk again
+      // with f times the paths, then about the plain walk's count kept where they matter
+      // (transport/vpl_importance.h).
+      if (backend != BackendKind::Reference && options.eval.includeVpls && !vpls.vpls.empty()) {
+        double evenness = 0.0;
+        if (!options.vplImportance.candidateFactor) {
+          deriveClamp();
+          evenness = vplImportanceEvenness(scene, *rayTracer, texels, vpls.vpls, options.vplImportance,
+                                           eval.clampBound, options.walk.seed);
+        }
+        importanceFactor = chooseCandidateFactor(options.vplImportance, vpls.vpls.size(), evenness);
+        importanceStats.evenness = evenness;
+      }
+      if (importanceFactor > 1.0) {
+        o.paths = static_cast<int>(std::min(double(1 << 26), std::round(o.paths * importanceFactor)));
+        vpls = generateVpls(scene, *rayTracer, o);
+      }
     });
+    if (importanceFactor > 1.0)
+      timed("vplImportance", [&] {
+        deriveClamp();  // the candidates' bound: the kept set's is about 1/f of it (B ∝ VPL count)
+        VplSelection selection;
+        selection.keepFraction = options.vplImportance.keepShare / importanceFactor;
+        selection.clampBound =
+            clampDerived ? static_cast<float>(eval.clampBound * selection.keepFraction) : eval.clampBound;
+        selection.seed = options.walk.seed;
+        const double evenness = importanceStats.evenness;
+        selectVplsByImportance(scene, *rayTracer, texels, vpls, options.vplImportance, selection, &importanceStats);
+        importanceStats.evenness = evenness;
+        importanceStats.factor = importanceFactor;
+      });
     deriveClamp();
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
-    timed("backend", [&] {  // the GL context is made here: its time counts to the backend, as it did
-      chooseBackend();
-      planBlocks();
-    });
+    timed("backend", [&] { planBlocks(); });
   }
 
   void deriveClamp() {
@@ -236,12 +269,12 @@ struct StagedBake::State {
       }
       log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
     }
-    compensate = eval.biasCompensation && backend != BackendKind::Reference;
+    compensate = options.eval.biasCompensation && backend != BackendKind::Reference;
     if (backend != BackendKind::Gl) return;
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
     // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/performance.md).
-    if (glContext->softwareRenderer() && scene.triangleCount() > kSoftwareGlTriangleHint && !vpls.vpls.empty())
+    if (glContext->softwareRenderer() && scene.triangleCount() > kSoftwareGlTriangleHint && options.eval.includeVpls)
       log::warn("GL backend on a software renderer with " + std::to_string(scene.triangleCount()) +
                 " triangles: its shadow pass draws them for every VPL cube (on the 2-core bench machine the Embree "
                 "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");
@@ -505,6 +538,7 @@ struct StagedBake::State {
     report["vpls"] = vpls.toJson();
     report["vpls"]["paths"] = options.walk.paths;
     report["vpls"]["seed"] = options.walk.seed;
+    if (importanceFactor > 1.0 || importanceStats.evenness > 0.0) report["vplImportance"] = importanceStats.toJson();
     report["eval"] = {{"clampBound", eval.clampBound},
                       {"clampVplsPerMean", clampK},
                       {"clampDerived", clampDerived},

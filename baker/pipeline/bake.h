@@ -20,6 +20,7 @@
 #include "texels/texel_samples.h"
 #include "pipeline/vpl_sums.h"
 #include "vpl/vpl.h"
+#include "transport/vpl_importance.h"
 
 namespace irbake {
 
@@ -54,6 +55,8 @@ struct BakeOptions {
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
+  VplImportanceOptions vplImportance;     // the walk's candidates thinned to where they matter (auto: on where
+                                          // the probes × candidates budget allows ≥ 2 candidates per VPL)
   VplEvalOptions eval = compensatedEval();  // bias compensation (on), direct, VPLs; its clampBound is not read
                                             // (the bake sets it from clamp)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
