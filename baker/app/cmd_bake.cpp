@@ -29,7 +29,7 @@ struct BakeArguments {
   std::vector<std::string> scenes;
   std::string backend = "auto", shard;
   long long seed = 0;
-  double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
+  double tpu = 0.0, clamp = 0.0, vplImportance = 1.0;  // 0: auto
   int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
@@ -74,9 +74,10 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "1 in closed scenes; 1 = Keller's plain walk)")
       ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
   app->add_option("--vpl-importance", a.vplImportance,
-                  "importance-driven VPLs: the walk places F times the VPLs and about the\n"
-                  "plain walk's count is kept, chosen by what they add to dim texels\n"
-                  "(default auto: up to 16 while probes × candidates ≤ 64M; 1 = the plain walk)")
+                  "importance-driven VPLs: the walk places F times the VPLs and --vpl-keep of\n"
+                  "the plain walk's count is kept, chosen by what they add to dim texels\n"
+                  "(default 1: the plain walk; auto: where a pilot finds them uneven, F up to 16\n"
+                  "while probes × candidates ≤ 64M)")
       ->transform(cli::numberOrAuto(1.0, 64.0, 0.0))->type_name("F|auto");
   app->add_option("--vpl-probes", o.vplImportance.probes,
                   "importance-driven VPLs: texel samples the candidates are measured at (default 1024)")
@@ -204,6 +205,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
   if (a.walkSplit > 0) o.walk.split = a.walkSplit;
   if (a.vplImportance >= 1.0) o.vplImportance.candidateFactor = a.vplImportance;
+  else o.vplImportance.candidateFactor.reset();  // auto
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;

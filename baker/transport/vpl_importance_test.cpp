@@ -124,6 +124,7 @@ TEST(VplImportance, ClosedBoxIsEvenSoAutoKeepsThePlainWalk) {
   walk.paths = 2048;
   const VplSet set = generateVpls(p.scene, *p.rt, walk);
   VplImportanceOptions options;
+  options.candidateFactor.reset();  // auto (the default is off)
   // With the bound a compensated bake derives for a scene with emitters (k = 256): unclamped, a VPL's
   // singular near field makes any walk look uneven.
   const float bound = deriveClampBound(p.scene, set, 256.0);
