@@ -216,10 +216,8 @@ struct StagedBake::State {
         selection.clampBound =
             clampDerived ? static_cast<float>(eval.clampBound * selection.keepFraction) : eval.clampBound;
         selection.seed = options.walk.seed;
-        const double evenness = importanceStats.evenness;
-        selectVplsByImportance(scene, *rayTracer, texels, vpls, options.vplImportance, selection, &importanceStats);
-        importanceStats.evenness = evenness;
         importanceStats.factor = importanceFactor;
+        selectVplsByImportance(scene, *rayTracer, texels, vpls, options.vplImportance, selection, &importanceStats);
       });
     deriveClamp();
     // The gather keeps a reference to its inputs, so they live as long as the bake.

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numeric>
 
 #include <tbb/parallel_for.h>
 
@@ -18,13 +17,32 @@ struct Probe {
   glm::vec3 x, n;
 };
 
-double luminance(const glm::vec3& c) { return (double(c.x) + double(c.y) + double(c.z)) / 3.0; }
+double luminance(const glm::vec3& c) { return channelMean(glm::dvec3(c)); }
+
+// Up to `count` probes drawn uniformly over the pages' weighted texel samples: a slot uniform over all slots,
+// redrawn while it carries no weight (no list of the millions of weighted slots; a bounded number of draws).
+std::vector<Probe> drawProbes(const Scene& scene, const RayTracer& rt, const std::vector<TexelSamples>& pages,
+                              int count, uint64_t seed) {
+  std::vector<size_t> end;  // running slot count after each page
+  for (const TexelSamples& ts : pages) end.push_back((end.empty() ? 0 : end.back()) + ts.positionWeight.size());
+  std::vector<Probe> probes;
+  if (end.empty() || end.back() == 0 || count <= 0) return probes;
+  Rng rng(hashSeed(seed, 0x1e5c7ull));
+  for (size_t draws = 0; probes.size() < static_cast<size_t>(count) && draws < 64 * static_cast<size_t>(count); ++draws) {
+    const size_t global = std::min(end.back() - 1, static_cast<size_t>(rng.uniform() * double(end.back())));
+    const size_t p = static_cast<size_t>(std::upper_bound(end.begin(), end.end(), global) - end.begin());
+    const TexelSamples& ts = pages[p];
+    const size_t s = global - (p == 0 ? 0 : end[p - 1]);
+    if (!(ts.positionWeight[s].w > 0.0f)) continue;
+    glm::vec3 x(ts.positionWeight[s]);
+    if (s < ts.primitive.size() && ts.primitive[s] < scene.primitives.size())
+      x = rt.insetPoint(ts.primitive[s], ts.triangle[s], x);
+    probes.push_back({x, glm::vec3(ts.normal[s])});
+  }
+  return probes;
+}
 
 }  // namespace
-
-std::vector<double> measureVplImportance(const Scene& scene, const RayTracer& rt, const std::vector<TexelSamples>& pages,
-                                         const std::vector<Vpl>& vpls, const VplImportanceOptions& options,
-                                         int probeCount, float clampBound, uint64_t seed, size_t* litProbes);
 
 double vplImportanceEvenness(const Scene& scene, const RayTracer& rt, const std::vector<TexelSamples>& pages,
                              const std::vector<Vpl>& vpls, const VplImportanceOptions& options, float clampBound,
@@ -52,22 +70,8 @@ std::vector<double> measureVplImportance(const Scene& scene, const RayTracer& rt
                                          int probeCount, float clampBound, uint64_t seed, size_t* litProbes) {
   std::vector<double> importance(vpls.size(), 0.0);
   if (litProbes) *litProbes = 0;
-  // Probes: uniform over the weighted texel samples of every page.
-  std::vector<std::pair<uint32_t, size_t>> slots;  // (page, slot)
-  for (size_t p = 0; p < pages.size(); ++p)
-    for (size_t s = 0; s < pages[p].positionWeight.size(); ++s)
-      if (pages[p].positionWeight[s].w > 0.0f) slots.emplace_back(static_cast<uint32_t>(p), s);
-  if (slots.empty() || vpls.empty() || probeCount <= 0) return importance;
-  Rng rng(hashSeed(seed, 0x1e5c7ull));
-  std::vector<Probe> probes;
-  for (int i = 0; i < probeCount; ++i) {
-    const auto [p, s] = slots[std::min(slots.size() - 1, static_cast<size_t>(rng.uniform() * slots.size()))];
-    const TexelSamples& ts = pages[p];
-    glm::vec3 x(ts.positionWeight[s]);
-    if (s < ts.primitive.size() && ts.primitive[s] < scene.primitives.size())
-      x = rt.insetPoint(ts.primitive[s], ts.triangle[s], x);
-    probes.push_back({x, glm::vec3(ts.normal[s])});
-  }
+  const std::vector<Probe> probes = drawProbes(scene, rt, pages, probeCount, seed);
+  if (probes.empty() || vpls.empty()) return importance;
   // Each probe's visible candidates and their (clamped) contributions, and its total: direct light + all
   // candidates.
   std::vector<std::vector<std::pair<uint32_t, float>>> seen(probes.size());
@@ -147,20 +151,16 @@ void selectVplsByImportance(const Scene& scene, const RayTracer& rt, const std::
                             VplSet& set, const VplImportanceOptions& options, const VplSelection& selection,
                             VplImportanceStats* stats) {
   const auto start = std::chrono::steady_clock::now();
-  VplImportanceStats st;
+  VplImportanceStats unused;
+  VplImportanceStats& st = stats ? *stats : unused;  // only the selection's own fields are written
   std::vector<Vpl>& vpls = set.vpls;
   st.candidates = vpls.size();
-  if (vpls.empty() || !(selection.keepFraction < 1.0)) {
-    if (stats) *stats = st;
-    return;
-  }
+  st.kept = vpls.size();
+  if (vpls.empty() || !(selection.keepFraction < 1.0)) return;
   st.probes = static_cast<size_t>(std::max(0, options.probes));
   const std::vector<double> importance = measureVplImportance(scene, rt, pages, vpls, options, options.probes,
                                                               selection.clampBound, selection.seed, &st.litProbes);
-  if (st.litProbes == 0) {
-    if (stats) *stats = st;
-    return;
-  }
+  if (st.litProbes == 0) return;
   // I* such that the expected kept count is keepFraction of the candidates.
   const double target = selection.keepFraction * static_cast<double>(vpls.size());
   const double pMin = std::clamp(selection.keepFraction / std::max(1.0, options.maxBoost), 1e-9, 1.0);
@@ -218,7 +218,6 @@ void selectVplsByImportance(const Scene& scene, const RayTracer& rt, const std::
   }
   st.kept = vpls.size();
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (stats) *stats = st;
 }
 
 }  // namespace irbake

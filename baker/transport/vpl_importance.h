@@ -80,6 +80,7 @@ double vplImportanceEvenness(const Scene& scene, const RayTracer& rt, const std:
 double chooseCandidateFactor(const VplImportanceOptions& options, size_t plainVpls, double evenness);
 
 // Thins `vpls` in place (order kept, so bounces stay contiguous); counts and powers per bounce updated.
+// Writes the selection's fields of *stats (candidates, kept, probes, litProbes, seconds), not the bake's.
 void selectVplsByImportance(const Scene& scene, const RayTracer& rt, const std::vector<TexelSamples>& pages,
                             VplSet& vpls, const VplImportanceOptions& options, const VplSelection& selection,
                             VplImportanceStats* stats = nullptr);

@@ -192,17 +192,20 @@ export function generateTangents(geometry, uvName) {
   return new BufferAttribute(out, 4);
 }
 
+// Twice the signed UV area of triangle t: > 0 counter-clockwise, < 0 mirrored.
+function uvDeterminant(index, uv, t) {
+  const a = index[t], b = index[t + 1], c = index[t + 2];
+  return (uv.getX(b) - uv.getX(a)) * (uv.getY(c) - uv.getY(a)) - (uv.getX(c) - uv.getX(a)) * (uv.getY(b) - uv.getY(a));
+}
+
 // Per vertex: which UV orientations its triangles have (bit 0: counter-clockwise, bit 1: mirrored).
 function orientationBits(index, uv, count) {
   const bits = new Uint8Array(count);
   for (let t = 0; t + 2 < index.length; t += 3) {
-    const a = index[t], b = index[t + 1], c = index[t + 2];
-    const d1x = uv.getX(b) - uv.getX(a), d1y = uv.getY(b) - uv.getY(a);
-    const d2x = uv.getX(c) - uv.getX(a), d2y = uv.getY(c) - uv.getY(a);
-    const det = d1x * d2y - d2x * d1y;
+    const det = uvDeterminant(index, uv, t);
     if (!(Math.abs(det) > 1e-20)) continue;
     const bit = det > 0 ? 1 : 2;
-    bits[a] |= bit; bits[b] |= bit; bits[c] |= bit;
+    for (let k = 0; k < 3; ++k) bits[index[t + k]] |= bit;
   }
   return bits;
 }
@@ -218,11 +221,9 @@ export function splitMirroredUvVertices(geometry, uvName) {
   const copyOf = new Map();
   for (let i = 0; i < count; ++i) if (bits[i] === 3) copyOf.set(i, count + copyOf.size);
   if (copyOf.size === 0) return 0;
-  for (let t = 0; t + 2 < index.length; t += 3) {
-    const a = index[t], b = index[t + 1], c = index[t + 2];
-    const det = (uv.getX(b) - uv.getX(a)) * (uv.getY(c) - uv.getY(a)) - (uv.getX(c) - uv.getX(a)) * (uv.getY(b) - uv.getY(a));
-    if (det < -1e-20) for (let k = 0; k < 3; ++k) if (copyOf.has(index[t + k])) index[t + k] = copyOf.get(index[t + k]);
-  }
+  for (let t = 0; t + 2 < index.length; t += 3)
+    if (uvDeterminant(index, uv, t) < -1e-20)
+      for (let k = 0; k < 3; ++k) if (copyOf.has(index[t + k])) index[t + k] = copyOf.get(index[t + k]);
   const sources = [...copyOf.keys()];
   for (const name of Object.keys(geometry.attributes)) {
     const a = geometry.attributes[name], size = a.itemSize;
