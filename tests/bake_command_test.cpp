@@ -201,6 +201,9 @@ TEST(BakeCommand, BadArgumentsGiveTheUsageExitCode) {
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --backend vulkan", &log), 2) << log;
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --vpls 0", &log), 2) << log;
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --bounces -3", &log), 2) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --final-gather sometimes", &log), 2) << log;
+  EXPECT_NE(log.find("--final-gather"), std::string::npos) << log;
+  EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --gather-rays 0", &log), 2) << log;
   EXPECT_EQ(runIrbake("bake " + q(scene) + " -o " + q(dir) + " --sun 0,-1,0", &log), 2) << log;
   EXPECT_NE(log.find("--sun: needs 4 comma-separated numbers"), std::string::npos) << log;
   // Integers beyond int range are refused as typed, never wrapped (4294967297 used to run 1 path,

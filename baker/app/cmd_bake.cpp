@@ -27,13 +27,14 @@ namespace {
 // What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
 struct BakeArguments {
   std::vector<std::string> scenes;
-  std::string backend = "auto", shard;
+  std::string backend = "auto", shard, finalGather = "auto";
   long long seed = 0;
-  double tpu = 0.0, clamp = 0.0, vplImportance = 1.0;  // 0: auto
+  double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
   int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
+  CLI::Option* pathsOption = nullptr;
 };
 
 // Every option of `irbake bake`, with its range and help.
@@ -64,8 +65,11 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
-  app->add_option("--vpls", o.walk.paths, "light paths of the quasi-random walk (default 6144)")
-      ->transform(cli::integerIn(1, 1 << 26))->type_name("N");
+  a.pathsOption = app->add_option("--vpls", o.walk.paths,
+                                  "light paths of the quasi-random walk (default 6144; 3072 where the\n"
+                                  "final gather runs, which reads their map averaged)")
+                      ->transform(cli::integerIn(1, 1 << 26))
+                      ->type_name("N");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--walk-split", a.walkSplit,
@@ -76,8 +80,8 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--vpl-importance", a.vplImportance,
                   "importance-driven VPLs: the walk places F times the VPLs and --vpl-keep of\n"
                   "the plain walk's count is kept, chosen by what they add to dim texels\n"
-                  "(default 1: the plain walk; auto: where a pilot finds them uneven, F up to 16\n"
-                  "while probes × candidates ≤ 64M)")
+                  "(default auto: where the final gather runs and a pilot finds them uneven,\n"
+                  "F up to 16 while probes × candidates ≤ 64M; 1: the plain walk)")
       ->transform(cli::numberOrAuto(1.0, 64.0, 0.0))->type_name("F|auto");
   app->add_option("--vpl-probes", o.vplImportance.probes,
                   "importance-driven VPLs: texel samples the candidates are measured at (default 1024)")
@@ -117,6 +121,20 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "the same surface (default auto: up to 4 where the rays per sample are\n"
                   "few and R texels stay within 1/20 of the clamp radius; 0 = none)")
       ->transform(cli::integerOrAuto(0, 8, -1))->type_name("R|auto");
+  app->add_option("--final-gather", a.finalGather,
+                  "bounced light gathered from the baked map one bounce away instead of\n"
+                  "read from the VPLs that reach each texel (docs/units.md): on, off,\n"
+                  "or auto (default: on in scenes without emissive or see-through surfaces)")
+      ->check(CLI::IsMember({"off", "on", "auto"}))->type_name("off|on|auto");
+  app->add_option("--gather-rays", o.gather.rays, "final gather: cosine rays per texel sample (default 16)")
+      ->transform(cli::integerIn(1, 4096))->type_name("N");
+  app->add_option("--gather-ray-budget", o.gather.rayBudget,
+                  "final gather: rays over all samples (default 50331648; a large\n"
+                  "page gets fewer per sample, never below 4; 0 = no cap)")
+      ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
+  app->add_option("--gather-filter", o.gather.filterRadius,
+                  "final gather: the gathered light averaged over (2R+1)² texels on\nthe same surface (default 3; 0 = none)")
+      ->transform(cli::integerIn(0, 8))->type_name("R");
   app->add_option("--interleave", a.interleave,
                   "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                   "of the VPLs, then a filter on the surface mixes them\n"
@@ -133,6 +151,12 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
   app->add_option("--sky", sky, "a uniform sky of that radiance (W/(m² sr)): direct light\ntraced, bounces as VPLs")
       ->transform(cli::numberList(3))->type_name("R,G,B");
+  app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default 64)")
+      ->transform(cli::integerIn(8, 4096))->type_name("N");
+  app->add_option("--sky-ray-budget", o.sky.maxRays,
+                  "sky and environment: rays over all samples (default 8388608; a large\n"
+                  "page gets fewer per sample, never below 8)")
+      ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
   app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up, centre\ntowards −Z) instead of --sky")
       ->type_name("FILE");
   app->add_option("--env-intensity", envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
@@ -199,6 +223,9 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (command.out.empty()) throw Error(ErrorCode::Usage, "", "bake needs -o OUTDIR");
   command.scene = a.scenes[0];
   o.backend = parseBackend(a.backend);
+  o.finalGather = a.finalGather == "on"     ? FinalGatherMode::On
+                  : a.finalGather == "auto" ? FinalGatherMode::Auto
+                                            : FinalGatherMode::Off;
   o.walk.seed = static_cast<uint32_t>(a.seed);
   o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
   o.texels.leakControl = !a.noLeakControl;
@@ -209,6 +236,10 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;
+  // Where the final gather runs, half the default paths: it reads the VPLs' map averaged over each texel's
+  // hemisphere (Sponza sun + sky, views 2 / 3 against Cycles: 3072 paths 2.01-2.05 / 4.07-4.24%, 6144
+  // 1.96-2.11 / 3.97-4.13%, 1536 one seed 4.62%; docs/accuracy.md, session 12).
+  if (a.pathsOption->count() == 0) o.finalGatherPaths = 3072;
   if (a.clampOption->count() > 0) {  // --clamp 0: no clamp; none given: derived
     o.clamp = a.clamp > 0.0 ? ClampMode::Fixed : ClampMode::Off;
     o.clampBound = static_cast<float>(a.clamp);
@@ -231,8 +262,9 @@ std::optional<BakeCommand> parseBakeCommand(const Args& args) {
   BakeArguments arguments;
   const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
   if (!cli::parse(*app, args)) return std::nullopt;
-  command.optionsHash = resultOptionsHash(*app);
   applyArguments(command, arguments);
+  // CLI11 writes --vpls with its default whether typed or not; the final gather's half default is not typed.
+  command.optionsHash = hashText(resultOptionsHash(*app) + (command.options.finalGatherPaths ? "gatherPaths=default" : ""));
   return command;
 }
 

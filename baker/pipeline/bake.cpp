@@ -9,6 +9,7 @@
 
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
+#include "backend/gather/final_gather.h"
 #include "transport/geometry_term.h"
 #include "transport/vpl_importance.h"
 #include "backend/gl/gl_backend.h"
@@ -154,6 +155,8 @@ struct StagedBake::State {
   std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
   std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
   bool compensate = false, overlap = false;
+  bool finalGatherOn = false;                       // decided with the backend (FinalGatherMode)
+  std::vector<Lightmap> directMaps;                 // the final gather's D: punctual lights and sky, exact
   nlohmann::json seconds = nlohmann::json::object();
   Stopwatch total;
 
@@ -188,6 +191,7 @@ struct StagedBake::State {
     timed("backend", [&] { chooseBackend(); });
     timed("vpls", [&] {
       WalkOptions o = options.walk;
+      if (finalGatherOn && options.finalGatherPaths) o.paths = *options.finalGatherPaths;
       o.progress = withProgress(o.progress);
       vpls = generateVpls(scene, *rayTracer, o);
       // Importance-driven selection: where the plain walk's VPLs matter unevenly (its pilot), the walk again
@@ -195,12 +199,17 @@ struct StagedBake::State {
       // (transport/vpl_importance.h).
       if (backend != BackendKind::Reference && options.eval.includeVpls && !vpls.vpls.empty()) {
         double evenness = 0.0;
-        if (!options.vplImportance.candidateFactor) {
+        // auto: only under the final gather. Without it the selection thins the VPLs that light bright texels,
+        // which costs a plain bake's close-ups more than it gives (Sponza view 2: +0.3-0.4 points, session 11);
+        // with it view 2 holds (1.96-2.11%) and view 3's swing goes (4.4-5.1% -> 4.0-4.1%, session 12).
+        const bool pilot = !options.vplImportance.candidateFactor;
+        if (pilot && finalGatherOn) {
           deriveClamp();
           evenness = vplImportanceEvenness(scene, *rayTracer, texels, vpls.vpls, options.vplImportance,
                                            eval.clampBound, options.walk.seed);
         }
-        importanceFactor = chooseCandidateFactor(options.vplImportance, vpls.vpls.size(), evenness);
+        if (!pilot || finalGatherOn)
+          importanceFactor = chooseCandidateFactor(options.vplImportance, vpls.vpls.size(), evenness);
         importanceStats.evenness = evenness;
       }
       if (importanceFactor > 1.0) {
@@ -268,6 +277,13 @@ struct StagedBake::State {
       log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
     }
     compensate = options.eval.biasCompensation && backend != BackendKind::Reference;
+    finalGatherOn = backend != BackendKind::Reference && options.eval.includeVpls && !options.directional &&
+                    (options.finalGather == FinalGatherMode::On ||
+                     (options.finalGather == FinalGatherMode::Auto && !scene.hasEmissiveSurface() &&
+                      seeThroughMaterials(scene).empty()));
+    if (options.finalGather != FinalGatherMode::Off)
+      log::info(std::string("final gather: ") + (finalGatherOn ? "on" : "off") +
+                (options.directional && options.finalGather == FinalGatherMode::On ? " (not with --directional)" : ""));
     if (backend != BackendKind::Gl) return;
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
@@ -411,6 +427,11 @@ struct StagedBake::State {
     if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
       throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
                                                                 " pages for " + std::to_string(texels.size()));
+    if (finalGatherOn) {
+      directMaps = maps;
+      for (size_t p = 0; p < directMaps.size(); ++p)
+        if (directMaps[p].valid.size() != directMaps[p].size()) directMaps[p].valid = texels[p].valid;
+    }
     const int coefficients = l1 ? sums.coefficients : 1;
     for (size_t p = 0; p < maps.size(); ++p) {
       std::vector<Lightmap*> pages;  // this page's map, then its L1 pages
@@ -434,6 +455,17 @@ struct StagedBake::State {
     return maps;
   }
 
+  // The clamp compensation's options as this bake runs it. With the final gather its refinement is off: the
+  // extra rays sharpen the residual at the texel itself, which the final gather replaces; only the map it
+  // reads one bounce away needs the residual (Sponza views 2 / 3: 1.92 / 4.55% without, 1.92 / 4.56% with).
+  ClampCompensationOptions compensationOptions() const {
+    ClampCompensationOptions o = options.compensation;
+    o.seed = options.walk.seed;
+    o.directional = options.directional;
+    if (finalGatherOn) o.refineRays = 0;
+    return o;
+  }
+
   SkyLightOptions skyOptions() const {
     SkyLightOptions o = options.sky;
     o.seed = options.walk.seed;
@@ -452,7 +484,21 @@ struct StagedBake::State {
     if (!scene.environment.present() || backend == BackendKind::Reference) return;
     timed("sky", [&] {
       SkyLightStats stats;
-      addSkyLight(*wholeInputs, maps, skyOptions(), &stats);
+      if (finalGatherOn && directMaps.size() == maps.size() && !skyByGather()) {
+        // An environment map's light goes into D as well (its importance sampling beats the gather's cosine
+        // rays): traced once into blank pages, added to both. A uniform sky stays out of D: the final
+        // gather's rays that leave the scene count it (finalGatherStage).
+        std::vector<Lightmap> sky = maps;
+        for (Lightmap& m : sky) std::fill(m.texels.begin(), m.texels.end(), glm::vec3(0.0f));
+        addSkyLight(*wholeInputs, sky, skyOptions(), &stats);
+        for (size_t p = 0; p < maps.size(); ++p)
+          for (size_t t = 0; t < maps[p].size(); ++t) {
+            maps[p].texels[t] += sky[p].texels[t];
+            directMaps[p].texels[t] += sky[p].texels[t];
+          }
+      } else {
+        addSkyLight(*wholeInputs, maps, skyOptions(), &stats);
+      }
       report["sky"] = stats.toJson();
       report["sky"]["uniform"] = scene.environment.isUniform();
       report["sky"]["source"] = scene.environment.source();
@@ -465,9 +511,7 @@ struct StagedBake::State {
   void compensationStage(std::vector<Lightmap>& maps, L1Pages* l1, nlohmann::json& report) {
     if (!compensate) return;
     timed("compensation", [&] {  // with an overlapped trace: the sweeps (and any trace not yet done)
-      ClampCompensationOptions o = options.compensation;
-      o.seed = options.walk.seed;
-      o.directional = l1 != nullptr;
+      const ClampCompensationOptions o = compensationOptions();
       ClampCompensationStats stats;
       if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
       std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(*wholeInputs, o);
@@ -491,6 +535,29 @@ struct StagedBake::State {
       for (auto& pages : axes) stats = postProcess(scene, pages, postOptions());
       report["directional"] = {{"pages", axes[0].size() * 3}, {"seamMismatchAfter", stats.seamMismatchAfter}};
     });
+  }
+
+  // Whether the final gather's rays that leave the scene count the sky, which then stays out of D: a uniform
+  // sky (its cosine rays are the sky stage's own estimator) in a scene without see-through surfaces (the
+  // gather's closest hits stop at glass, where the sky stage's rays pass with its transmittance).
+  bool skyByGather() const {
+    return finalGatherOn && scene.environment.present() && scene.environment.isUniform() && !rayTracer->hasTransmission();
+  }
+
+  // Final gather: each texel's bounced light read from the finished map one bounce away (backend/gather).
+  void finalGatherStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
+    if (!finalGatherOn || directMaps.size() != maps.size()) return;
+    timed("finalGather", [&] {
+      FinalGatherOptions o = options.gather;
+      o.seed = options.walk.seed;
+      if (skyByGather()) o.missRadiance = scene.environment.uniformRadiance();
+      FinalGatherStats stats;
+      if (options.progress) options.progress("gather", 0.0);
+      finalGather(*wholeInputs, directMaps, maps, o, &stats);
+      if (options.progress) options.progress("gather", 1.0);
+      report["finalGather"] = stats.toJson();
+    });
+    directMaps = {};
   }
 
   PostStats postStage(std::vector<Lightmap>& maps) {
@@ -534,7 +601,7 @@ struct StagedBake::State {
                         {"supersample", std::max(1, options.texels.supersample)},
                         {"leakControl", options.texels.leakControl}};
     report["vpls"] = vpls.toJson();
-    report["vpls"]["paths"] = options.walk.paths;
+    report["vpls"]["paths"] = finalGatherOn && options.finalGatherPaths ? *options.finalGatherPaths : options.walk.paths;
     report["vpls"]["seed"] = options.walk.seed;
     if (importanceFactor > 1.0 || importanceStats.evenness > 0.0) report["vplImportance"] = importanceStats.toJson();
     report["eval"] = {{"clampBound", eval.clampBound},
@@ -573,12 +640,7 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
   State& s = *state_;
   end = std::min(end, s.blocks.size());
   if (s.overlap && !s.gather.valid() && begin == 0 && end == s.blocks.size()) {
-    const ClampCompensationOptions o = [&] {
-      ClampCompensationOptions c = s.options.compensation;
-      c.seed = s.options.walk.seed;
-      c.directional = s.options.directional;
-      return c;
-    }();
+    const ClampCompensationOptions o = s.compensationOptions();
     // The gather reads the pages' texel samples and the geometry only: it runs while the GL backend bakes.
     s.gather = std::async(std::launch::async, [&s, o] { return std::make_unique<ClampGather>(*s.wholeInputs, o); });
   }
@@ -618,6 +680,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
+  s.finalGatherStage(r.maps, report);
   s.directionalStage(r.directional, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();

@@ -13,6 +13,7 @@
 #include "atlas/atlas.h"
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
+#include "backend/gather/final_gather.h"
 #include "backend/gl/gl_backend.h"
 #include "backend/sky/sky_light.h"
 #include "backend/lightmap.h"
@@ -43,6 +44,15 @@ enum class OverlapCompensation {
   Always,  // beside the VPL blocks, whatever the renderer
 };
 
+// Whether the bounced light of each texel is gathered from the baked map one bounce away (final gather,
+// backend/gather) instead of read from the VPLs that reach it.
+enum class FinalGatherMode {
+  Off,   // the VPL sum (+ clamp compensation) is the map
+  On,    // in every scene the VPL backends bake (not with --directional)
+  Auto,  // on where the scene has no emissive surface (the rays would find small emitters by chance) and no
+         // see-through one (the gather reads the glass's own map, not what lies behind it)
+};
+
 // The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
 inline VplEvalOptions compensatedEval() {
   VplEvalOptions e;
@@ -55,12 +65,16 @@ struct BakeOptions {
   AtlasOptions atlas;                     // texel density, padding, page size
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
-  VplImportanceOptions vplImportance;     // the walk's candidates thinned to where they matter (auto: on where
-                                          // the probes × candidates budget allows ≥ 2 candidates per VPL)
+  std::optional<int> finalGatherPaths;    // the walk's paths where the final gather runs (unset: walk.paths)
+  VplImportanceOptions vplImportance;     // the walk's candidates thinned to where they matter (auto: where the
+                                          // final gather runs, the pilot finds the walk uneven and the probes ×
+                                          // candidates budget allows ≥ 2 candidates per VPL)
   VplEvalOptions eval = compensatedEval();  // bias compensation (on), direct, VPLs; its clampBound is not read
                                             // (the bake sets it from clamp)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
+  FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (backend/gather)
+  FinalGatherOptions gather;              // its rays and filter
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
   float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)
   double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: with bias

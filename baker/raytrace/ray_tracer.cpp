@@ -147,13 +147,51 @@ RayHit RayTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->scene, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{};
+  return completeHit(dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, glm::vec2(rh.hit.u, rh.hit.v));
+}
+
+void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs, size_t n, RayHit* hits) const {
+  if (!impl_->packets8) {
+    for (size_t i = 0; i < n; ++i) hits[i] = intersect(origin, dirs[i], 0.0f, 1e30f);
+    return;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (size_t base = 0; base < n; base += 8) {
+    alignas(32) RTCRayHit8 packet;
+    alignas(32) int valid[8];
+    const size_t count = std::min<size_t>(8, n - base);
+    for (size_t k = 0; k < 8; ++k) {
+      const glm::vec3& d = dirs[base + std::min(k, count - 1)];
+      valid[k] = k < count ? -1 : 0;
+      packet.ray.org_x[k] = origin.x; packet.ray.org_y[k] = origin.y; packet.ray.org_z[k] = origin.z;
+      packet.ray.dir_x[k] = d.x; packet.ray.dir_y[k] = d.y; packet.ray.dir_z[k] = d.z;
+      packet.ray.tnear[k] = 0.0f;
+      packet.ray.tfar[k] = 1e30f;
+      packet.ray.time[k] = 0.0f;
+      packet.ray.mask[k] = 0xFFFFFFFFu;
+      packet.ray.id[k] = static_cast<unsigned>(k);
+      packet.ray.flags[k] = 0;
+      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, impl_->scene, &ctx, &packet);
+    for (size_t k = 0; k < count; ++k)
+      hits[base + k] = packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
+                           ? RayHit{}
+                           : completeHit(dirs[base + k], packet.ray.tfar[k], packet.hit.geomID[k], packet.hit.primID[k],
+                                         glm::vec2(packet.hit.u[k], packet.hit.v[k]));
+  }
+}
+
+RayHit RayTracer::completeHit(const glm::vec3& dir, float t, uint32_t geomID, uint32_t primID, glm::vec2 uv) const {
   RayHit out;
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
   out.hit = true;
-  out.t = rh.ray.tfar;
-  out.primitive = rh.hit.geomID;
-  out.triangle = rh.hit.primID;
-  out.barycentric = glm::vec2(rh.hit.u, rh.hit.v);
+  out.t = t;
+  out.primitive = geomID;
+  out.triangle = primID;
+  out.barycentric = uv;
   const Primitive& prim = scene_.primitives[out.primitive];
   const uint32_t* idx = &prim.indices[3 * out.triangle];
   float w = 1.0f - out.barycentric.x - out.barycentric.y;

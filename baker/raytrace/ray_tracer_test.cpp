@@ -124,3 +124,43 @@ TEST(RayTracer, ClosedBoxDoesNotLeakRays) {
   EXPECT_EQ(misses, 0);
   EXPECT_EQ(backHits, 0);
 }
+
+// intersectPackets (the final gather's rays, 8 to a packet) gives what intersect gives ray by ray, MASK holes
+// included: 37 rays (four full packets and a partial one) from inside a box with a cut-out pane in it.
+TEST(RayTracer, PacketHitsEqualSingleRayHits) {
+  Scene s;
+  const int wall = addMaterial(s, glm::vec3(0.5f));
+  addBox(s, wall, glm::vec3(-2.0f), glm::vec3(2.0f), true);
+  const int pane = addMaterial(s, glm::vec3(1.0f));
+  s.materials[pane].alphaMode = AlphaMode::Mask;
+  s.materials[pane].alphaCutoff = 0.5f;
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  t.texels = {glm::vec4(1.0f, 1.0f, 1.0f, 0.0f), glm::vec4(1.0f)};  // left half a hole
+  s.textures.push_back(t);
+  s.materials[pane].baseColorTexture = 0;
+  addQuad(s, pane, glm::vec3(-1, -1, 1), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
+  RayTracer rt(s);
+  const glm::vec3 origin(0.1f, -0.2f, 0.0f);
+  std::vector<glm::vec3> dirs;
+  for (int i = 0; i < 37; ++i) {
+    const float z = 1.0f - 2.0f * (i + 0.5f) / 37.0f, phi = 2.39996f * i, r = std::sqrt(1.0f - z * z);
+    dirs.push_back(glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
+  }
+  std::vector<RayHit> hits(dirs.size());
+  rt.intersectPackets(origin, dirs.data(), dirs.size(), hits.data());
+  int paneHits = 0;
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const RayHit one = rt.intersect(origin, dirs[i], 0.0f, 1e30f);
+    ASSERT_EQ(hits[i].hit, one.hit) << i;
+    EXPECT_EQ(hits[i].primitive, one.primitive) << i;
+    EXPECT_EQ(hits[i].triangle, one.triangle) << i;
+    EXPECT_NEAR(hits[i].t, one.t, 1e-5f) << i;
+    EXPECT_NEAR(glm::length(hits[i].position - one.position), 0.0f, 1e-5f) << i;
+    EXPECT_EQ(hits[i].backFace, one.backFace) << i;
+    paneHits += one.primitive == 6u;
+  }
+  EXPECT_GT(paneHits, 0);  // some rays stop at the pane's solid half, others pass its hole
+}

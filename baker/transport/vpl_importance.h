@@ -25,9 +25,10 @@ namespace irbake {
 struct VplImportanceOptions {
   std::optional<double> candidateFactor = 1.0;  // f: the walk runs f × the paths and about keepShare × the
                                                 // plain walk's count is kept; 1 (default): off, the plain
-                                                // walk; unset: auto (a pilot, chooseCandidateFactor). Off by
-                                                // default: on Sponza it trades view 2 for view 3 and 2–3 s
-                                                // (docs/accuracy.md, session 11)
+                                                // walk; unset: auto (a pilot, chooseCandidateFactor; the bake
+                                                // runs it only under the final gather). Off in the library:
+                                                // without the final gather it trades Sponza's view 2 for
+                                                // view 3 (docs/accuracy.md, sessions 11-12)
   int probes = 1024;             // texel samples the candidates are measured at (uniform over valid samples)
   int pilotProbes = 256;         // auto: the plain walk's VPLs measured at this many probes first, and
   double maxEvenness = 0.3;      // the selection runs only where their evenness (below) is at most this

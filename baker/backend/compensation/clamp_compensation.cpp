@@ -9,6 +9,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "backend/lightmap_read.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/maths.h"
@@ -38,38 +39,6 @@ struct EmittedHit {
   uint32_t hit = 0;          // index into its tile's hits
   glm::vec3 emitted{0.0f};
 };
-
-// Bilinear read of irradiance/π over the valid texels of a map; the nearest valid texel of the 3×3
-// neighbourhood when none of the four is valid (chart borders); 0 when none at all.
-glm::vec3 lookup(const Lightmap& m, const std::vector<glm::vec3>& value, glm::vec2 t) {
-  int x0 = static_cast<int>(std::floor(t.x)), y0 = static_cast<int>(std::floor(t.y));
-  float fx = t.x - x0, fy = t.y - y0;
-  glm::vec3 sum(0.0f);
-  float weight = 0.0f;
-  for (int dy = 0; dy < 2; ++dy)
-    for (int dx = 0; dx < 2; ++dx) {
-      int x = x0 + dx, y = y0 + dy;
-      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
-      size_t i = static_cast<size_t>(y) * m.width + x;
-      if (!m.valid[i]) continue;
-      float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) + 1e-6f;
-      sum += w * value[i];
-      weight += w;
-    }
-  if (weight > 0.0f) return sum / weight;
-  int cx = static_cast<int>(std::lround(t.x)), cy = static_cast<int>(std::lround(t.y));
-  float best = 1e30f;
-  glm::vec3 nearest(0.0f);
-  for (int y = cy - 1; y <= cy + 1; ++y)
-    for (int x = cx - 1; x <= cx + 1; ++x) {
-      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
-      size_t i = static_cast<size_t>(y) * m.width + x;
-      if (!m.valid[i]) continue;
-      float d = (x - t.x) * (x - t.x) + (y - t.y) * (y - t.y);
-      if (d < best) best = d, nearest = value[i];
-    }
-  return nearest;
-}
 
 constexpr size_t kTileSlots = 256;  // slots per tile (KeptHit::slotInTile is 16 bits)
 constexpr size_t kMaxPages = 32767;  // KeptHit::map is 16 bits
@@ -103,18 +72,6 @@ RayPlan planRays(const std::vector<TexelSamples>& texels, const ClampCompensatio
   plan.extraRays = static_cast<int>(std::lround(std::max(0, options.refineRays) * rayScale));
   plan.refineHits = static_cast<int>(std::ceil(options.refineFraction * plan.baseRays));
   return plan;
-}
-
-// Light-map page number → index of its texel page (= its map, in the same order); −1 where none.
-std::vector<int32_t> mapIndexOfPages(const std::vector<TexelSamples>& texels) {
-  std::vector<int32_t> mapOfPage;
-  for (size_t i = 0; i < texels.size(); ++i) {
-    int page = texels[i].page;
-    if (page < 0) continue;
-    if (static_cast<size_t>(page) >= mapOfPage.size()) mapOfPage.resize(page + 1, -1);
-    mapOfPage[page] = static_cast<int32_t>(i);
-  }
-  return mapOfPage;
 }
 
 }  // namespace
@@ -203,16 +160,9 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
     const glm::vec3 emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
     if (emitted != glm::vec3(0.0f)) out.emitted.push_back({static_cast<uint32_t>(out.hits.size()), emitted});
     kept.albedo = w * rt.albedoAt(hit);
-    int page = prim.lightmap.page;
-    if (page >= 0 && static_cast<size_t>(page) < mapOfPage.size() && mapOfPage[page] >= 0 &&
-        prim.uv1.size() == prim.positions.size()) {
-      const uint32_t* idx = &prim.indices[3 * static_cast<size_t>(hit.triangle)];
-      float b1 = hit.barycentric.x, b2 = hit.barycentric.y;
-      glm::vec2 uv = (1.0f - b1 - b2) * prim.uv1[idx[0]] + b1 * prim.uv1[idx[1]] + b2 * prim.uv1[idx[2]];
-      const TexelSamples& m = in.texels[mapOfPage[page]];
-      kept.map = static_cast<int16_t>(mapOfPage[page]);
-      kept.texel = glm::vec2(uv.x * m.width - 0.5f, uv.y * m.height - 0.5f);
-    }
+    const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
+    kept.map = static_cast<int16_t>(point.map);
+    kept.texel = point.texel;
     out.hits.push_back(kept);
     if (options.directional) {
       constexpr float kMinCos = 0.1f;  // bounds the 1/cosθ of the irradiance vector's cosine-ray estimator
@@ -372,7 +322,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         const KeptHit& kept = tile.hits[h];
         glm::vec3 L(0.0f);
         if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
-        if (kept.map >= 0) L += kept.albedo * lookup(maps[kept.map], current[kept.map], kept.texel);
+        if (kept.map >= 0) L += kept.albedo * readLightmap(maps[kept.map], current[kept.map], kept.texel);
         res[tile.begin + kept.slotInTile] += L;
       }
     });
@@ -483,7 +433,7 @@ void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& a
       const KeptHit& kept = tile.hits[h];
       glm::vec3 L(0.0f);
       if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
-      if (kept.map >= 0) L += kept.albedo * lookup(maps[kept.map], maps[kept.map].texels, kept.texel);
+      if (kept.map >= 0) L += kept.albedo * readLightmap(maps[kept.map], maps[kept.map].texels, kept.texel);
       const size_t s = tile.begin + kept.slotInTile;
       for (int k = 0; k < 3; ++k) slotVector[k][tile.page][s] += L * tile.tangent[h][k];
     }

@@ -1,0 +1,129 @@
+#include "backend/gather/final_gather.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "backend/lightmap_read.h"
+#include "common/error.h"
+#include "common/maths.h"
+#include "common/progress.h"
+#include "texels/texel_filter.h"
+#include "vpl/sampling.h"
+
+namespace irbake {
+namespace {
+
+constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
+
+}  // namespace
+
+glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
+                   const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
+                   const glm::vec3& missRadiance) {
+  const Scene& scene = in.scene;
+  const RayTracer& rt = in.rayTracer;
+  const glm::vec3 origin = x + n * rt.epsilon();
+  glm::vec3 sum(0.0f);
+  constexpr int kChunk = 32;  // rays traced together, 8 to a packet (one origin: the packets stay coherent)
+  glm::vec3 dirs[kChunk];
+  RayHit hits[kChunk];
+  for (int begin = 0; begin < rays; begin += kChunk) {
+    const int count = std::min(kChunk, rays - begin);
+    for (int k = 0; k < count; ++k) {
+      const int i = begin + k;
+      const double u = std::fmod((i + 0.5) / rays + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
+      dirs[k] = cosineHemisphere(n, u, v);
+    }
+    rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits);
+    for (int k = 0; k < count; ++k) {
+      const RayHit& hit = hits[k];
+      if (!hit.hit) {
+        sum += missRadiance;
+        continue;
+      }
+      if (hit.backFace) continue;  // back faces hold no map
+      const Primitive& prim = scene.primitives[hit.primitive];
+      glm::vec3 L = scene.emissionAt(prim, hit.triangle, hit.barycentric);
+      const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
+      if (point.map >= 0 && static_cast<size_t>(point.map) < maps.size())
+        L += rt.albedoAt(hit) * readLightmap(maps[point.map], maps[point.map].texels, point.texel);
+      sum += L;
+    }
+  }
+  return sum / static_cast<float>(std::max(1, rays));
+}
+
+void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std::vector<Lightmap>& maps,
+                 const FinalGatherOptions& options, FinalGatherStats* stats) {
+  Stopwatch watch;
+  if (maps.size() != in.texels.size() || direct.size() != maps.size())
+    throw Error(ErrorCode::InvalidData, "", "final gather: " + std::to_string(maps.size()) + " maps and " +
+                                                std::to_string(direct.size()) + " direct pages for " +
+                                                std::to_string(in.texels.size()) + " texel pages");
+  for (size_t p = 0; p < maps.size(); ++p)
+    if (maps[p].size() != in.texels[p].layerSize() || maps[p].valid.size() != maps[p].size() ||
+        direct[p].size() != maps[p].size())
+      throw Error(ErrorCode::InvalidData, "", "final gather: page " + std::to_string(p) + " does not match its texels");
+  const std::vector<int32_t> mapOfPage = mapIndexOfPages(in.texels);
+  size_t samples = 0;
+  for (const TexelSamples& ts : in.texels)
+    for (const glm::vec4& pw : ts.positionWeight) samples += pw.w > 0.0f;
+  int rays = std::max(1, options.rays);
+  if (options.rayBudget > 0 && samples > 0)
+    rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::max(1, options.minRays)),
+                                               static_cast<size_t>(rays)));
+  // Every page's gather reads the maps as they came in, so the new pages are built apart and swapped in last.
+  std::vector<std::vector<glm::vec3>> gathered(maps.size());
+  for (size_t p = 0; p < maps.size(); ++p) {
+    const TexelSamples& ts = in.texels[p];
+    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t s = r.begin(); s != r.end(); ++s) {
+        if (!(ts.positionWeight[s].w > 0.0f)) continue;
+        glm::vec3 x(ts.positionWeight[s]);
+        const glm::vec3 n(ts.normal[s]);
+        if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
+          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+        Rng rng(hashSeed(options.seed, 0xf9ull << 8 | static_cast<uint64_t>(ts.page), s));
+        const double r1 = rng.uniform(), r2 = rng.uniform();
+        slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance);
+      }
+    });
+    std::vector<glm::vec3>& value = gathered[p];
+    value.assign(ts.layerSize(), glm::vec3(0.0f));
+    const std::vector<uint8_t>& valid = maps[p].valid;
+    tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
+      if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value[t]);
+    });
+    if (options.filterRadius > 0) {
+      TexelFilterOptions fo;
+      fo.radius = options.filterRadius;
+      value = filterOnSurface(ts, value, valid, fo);
+    }
+  }
+  double total = 0.0, gatheredSum = 0.0, change = 0.0, before = 0.0;
+  for (size_t p = 0; p < maps.size(); ++p)
+    for (size_t t = 0; t < maps[p].size(); ++t) {
+      if (!maps[p].valid[t]) continue;
+      const glm::vec3 next = direct[p].texels[t] + gathered[p][t];
+      if (!std::isfinite(next.x) || !std::isfinite(next.y) || !std::isfinite(next.z)) continue;  // post reports
+      before += channelMean(maps[p].texels[t]);
+      change += channelMean(glm::abs(next - maps[p].texels[t]));
+      gatheredSum += channelMean(gathered[p][t]);
+      total += channelMean(next);
+      maps[p].texels[t] = next;
+    }
+  if (stats) {
+    stats->rays = samples * static_cast<size_t>(rays);
+    stats->raysPerSample = rays;
+    stats->filterRadius = options.filterRadius;
+    stats->gatheredFraction = total > 0.0 ? gatheredSum / total : 0.0;
+    stats->changeFraction = before > 0.0 ? change / before : 0.0;
+    stats->seconds = watch.seconds();
+  }
+}
+
+}  // namespace irbake

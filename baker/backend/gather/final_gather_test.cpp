@@ -1,0 +1,136 @@
+// The final gather against closed forms: a furnace's exact map is its fixed point (no noise: every ray
+// reads the same value), a floor under a parallel square gathers ρ·M·F with F the point-to-square view
+// factor, and rays that leave the scene add nothing (the sky is D's, not the gather's).
+#include "backend/gather/final_gather.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "atlas/atlas.h"
+#include "backend/lightmap_read.h"
+#include "common/maths.h"
+#include "raytrace/test_scenes.h"
+#include "samples/sample_scenes.h"
+
+namespace irbake {
+namespace {
+using namespace irbake::testing;
+
+struct Atlased {
+  Scene scene;
+  std::unique_ptr<RayTracer> rt;
+  std::vector<TexelSamples> pages;
+  VplSet none;
+  Atlased(Scene s, int pageSize) : scene(std::move(s)) {
+    AtlasOptions atlas;
+    atlas.targetPageSize = atlas.maxPageSize = pageSize;
+    buildAtlas(scene, atlas);
+    rt = std::make_unique<RayTracer>(scene);
+    pages = buildTexelSamples(scene, *rt, {});
+  }
+  BakeInputs inputs() const { return BakeInputs{scene, *rt, pages, none, VplEvalOptions{}, {}}; }
+  // Maps with value(primitive) at every valid texel whose first sample lies on that primitive.
+  template <class Value>
+  std::vector<Lightmap> maps(Value&& value) const {
+    std::vector<Lightmap> out;
+    for (const TexelSamples& ts : pages) {
+      Lightmap m = blankLightmap(ts);
+      m.valid = ts.valid;
+      for (size_t t = 0; t < m.size(); ++t)
+        if (m.valid[t] && t < ts.primitive.size()) m.texels[t] = value(ts.primitive[t]);
+      out.push_back(std::move(m));
+    }
+    return out;
+  }
+};
+
+// Closed cube, ρ = 0.6, Le = 0.4: the exact map is Le/(1 − ρ) = 1 everywhere. Every ray of the gather
+// reads Le + ρ·1 = 1, so over any set of rays M' = D + 1 exactly, texel for texel (D = 0.25 here, so a
+// stage that left the map alone fails; with D = 0 the exact map is the gather's fixed point).
+TEST(FinalGather, FurnaceGathersLePlusRhoTimesTheMap) {
+  const float rho = 0.6f, Le = 0.4f;
+  Atlased a(samples::makeFurnace(rho, Le), 64);
+  std::vector<Lightmap> maps = a.maps([](uint32_t) { return glm::vec3(1.0f); });
+  const std::vector<Lightmap> direct = a.maps([](uint32_t) { return glm::vec3(0.25f); });
+  FinalGatherOptions o;
+  o.rays = 8;
+  FinalGatherStats stats;
+  finalGather(a.inputs(), direct, maps, o, &stats);
+  double worst = 0.0;
+  size_t n = 0;
+  for (const Lightmap& m : maps)
+    for (size_t t = 0; t < m.size(); ++t)
+      if (m.valid[t]) worst = std::max(worst, std::abs(channelMean(m.texels[t]) - 1.25)), ++n;
+  std::printf("[ figure ] furnace: %zu texels, worst |M' − 1.25| %.2e, gathered share %.4f\n", n, worst,
+              stats.gatheredFraction);
+  ASSERT_GT(n, 1000u);
+  EXPECT_LT(worst, 2e-3);  // hits on a chart's border texel read a neighbour's value: still 1
+  EXPECT_NEAR(stats.gatheredFraction, 0.8, 1e-5);
+  EXPECT_EQ(stats.raysPerSample, 8);
+}
+
+// A point under a parallel square (side 2a, height h, map value m, albedo ρ): the gather is ρ m F, F the
+// differential-area-to-parallel-square view factor, four corner rectangles of
+// F_c = 1/(2π) [X/√(1+X²) atan(Y/√(1+X²)) + Y/√(1+Y²) atan(X/√(1+Y²))], X = Y = a/h.
+TEST(FinalGather, FloorUnderASquareGathersItsViewFactor) {
+  const float a = 0.5f, h = 0.4f, rho = 0.7f, m = 2.0f;
+  Scene s;
+  const int grey = addMaterial(s, glm::vec3(rho));
+  const int floorPrim = addQuad(s, grey, glm::vec3(-2, -2, 0), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0));
+  const int squarePrim = addQuad(s, grey, glm::vec3(-a, -a, h), glm::vec3(0, 2 * a, 0), glm::vec3(2 * a, 0, 0));
+  Atlased at(std::move(s), 128);
+  const std::vector<Lightmap> maps =
+      at.maps([&](uint32_t p) { return p == static_cast<uint32_t>(squarePrim) ? glm::vec3(m) : glm::vec3(0.0f); });
+  const double X = a / h, q = std::sqrt(1.0 + X * X);
+  const double F = 4.0 * (2.0 * X / q * std::atan(X / q)) / (2.0 * kPi);
+  const glm::vec3 g = gatherAt(at.inputs(), maps, mapIndexOfPages(at.pages), glm::vec3(0, 0, 0), glm::vec3(0, 0, 1),
+                               1 << 16, 0.25, 0.5);
+  std::printf("[ figure ] floor under a square: gathered %.5f, ρ m F = %.5f (F = %.5f)\n", g.x, rho * m * F, F);
+  EXPECT_NEAR(g.x / (rho * m * F), 1.0, 0.01);
+  (void)floorPrim;
+
+  // The whole stage on the floor's texels near the centre (filter off): the same within the rays' noise.
+  std::vector<Lightmap> gathered = maps;
+  const std::vector<Lightmap> direct = at.maps([](uint32_t) { return glm::vec3(0.0f); });
+  FinalGatherOptions o;
+  o.rays = 256;
+  o.filterRadius = 0;
+  finalGather(at.inputs(), direct, gathered, o);
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t p = 0; p < at.pages.size(); ++p) {
+    const TexelSamples& ts = at.pages[p];
+    for (size_t t = 0; t < ts.layerSize(); ++t) {
+      if (!ts.valid[t] || ts.primitive[t] != static_cast<uint32_t>(floorPrim)) continue;
+      const glm::vec3 x(ts.positionWeight[t]);
+      if (glm::length(glm::vec2(x)) > 0.05f) continue;
+      sum += gathered[p].texels[t].x;
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 3u);
+  std::printf("[ figure ] floor under a square, %zu texels within 5 cm of the centre: mean %.5f\n", n, sum / n);
+  EXPECT_NEAR(sum / n / (rho * m * F), 1.0, 0.02);  // F moves by < 0.5% within 5 cm
+}
+
+// A single plane: every ray leaves the scene, so the map is D exactly, whatever M held.
+TEST(FinalGather, RaysThatLeaveTheSceneAddNothing) {
+  Atlased a(samples::makePointOverPlane(), 64);
+  std::vector<Lightmap> maps = a.maps([](uint32_t) { return glm::vec3(5.0f); });
+  const std::vector<Lightmap> direct = a.maps([](uint32_t) { return glm::vec3(0.25f, 0.5f, 1.0f); });
+  finalGather(a.inputs(), direct, maps);
+  size_t n = 0;
+  for (size_t p = 0; p < maps.size(); ++p)
+    for (size_t t = 0; t < maps[p].size(); ++t)
+      if (maps[p].valid[t]) {
+        EXPECT_EQ(maps[p].texels[t], direct[p].texels[t]);
+        ++n;
+      }
+  EXPECT_GT(n, 100u);
+}
+
+}  // namespace
+}  // namespace irbake
