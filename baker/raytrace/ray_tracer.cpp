@@ -42,6 +42,18 @@ void errorCallback(void*, RTCError code, const char* str) {
   (void)str;
 }
 
+// Lane k of an 8-wide ray packet: from origin along dir over [0, tmax], every mask bit.
+void setPacketLane(RTCRay8& packet, size_t k, const glm::vec3& origin, const glm::vec3& dir, float tmax) {
+  packet.org_x[k] = origin.x; packet.org_y[k] = origin.y; packet.org_z[k] = origin.z;
+  packet.dir_x[k] = dir.x; packet.dir_y[k] = dir.y; packet.dir_z[k] = dir.z;
+  packet.tnear[k] = 0.0f;
+  packet.tfar[k] = tmax;
+  packet.time[k] = 0.0f;
+  packet.mask[k] = 0xFFFFFFFFu;
+  packet.id[k] = static_cast<unsigned>(k);
+  packet.flags[k] = 0;
+}
+
 }  // namespace
 
 struct RayTracer::Impl {
@@ -163,16 +175,8 @@ void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs,
     alignas(32) int valid[8];
     const size_t count = std::min<size_t>(8, n - base);
     for (size_t k = 0; k < 8; ++k) {
-      const glm::vec3& d = dirs[base + std::min(k, count - 1)];
       valid[k] = k < count ? -1 : 0;
-      packet.ray.org_x[k] = origin.x; packet.ray.org_y[k] = origin.y; packet.ray.org_z[k] = origin.z;
-      packet.ray.dir_x[k] = d.x; packet.ray.dir_y[k] = d.y; packet.ray.dir_z[k] = d.z;
-      packet.ray.tnear[k] = 0.0f;
-      packet.ray.tfar[k] = 1e30f;
-      packet.ray.time[k] = 0.0f;
-      packet.ray.mask[k] = 0xFFFFFFFFu;
-      packet.ray.id[k] = static_cast<unsigned>(k);
-      packet.ray.flags[k] = 0;
+      setPacketLane(packet.ray, k, origin, dirs[base + std::min(k, count - 1)], 1e30f);
       packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
@@ -278,14 +282,7 @@ void RayTracer::occludedPackets(const ShadowRay* rays, size_t n, uint8_t* occlud
     for (size_t k = 0; k < 8; ++k) {
       const ShadowRay& r = rays[base + std::min(k, count - 1)];
       valid[k] = k < count ? -1 : 0;
-      packet.org_x[k] = r.origin.x; packet.org_y[k] = r.origin.y; packet.org_z[k] = r.origin.z;
-      packet.dir_x[k] = r.dir.x; packet.dir_y[k] = r.dir.y; packet.dir_z[k] = r.dir.z;
-      packet.tnear[k] = 0.0f;
-      packet.tfar[k] = r.tmax;
-      packet.time[k] = 0.0f;
-      packet.mask[k] = 0xFFFFFFFFu;
-      packet.id[k] = static_cast<unsigned>(k);
-      packet.flags[k] = 0;
+      setPacketLane(packet, k, r.origin, r.dir, r.tmax);
     }
     rtcOccluded8(valid, impl_->scene, &ctx, &packet);
     for (size_t k = 0; k < count; ++k) occluded[base + k] = packet.tfar[k] < 0.0f ? 1 : 0;

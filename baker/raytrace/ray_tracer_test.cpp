@@ -7,6 +7,25 @@
 using namespace irbake;
 using namespace irbake::testing;
 
+namespace {
+// An alpha-MASK material (cutoff 0.5) whose base colour is factor × a 2×1 clamped texture (left, right texels;
+// uv0.x < 0.25 reads left only, > 0.75 right only).
+int addMaskedMaterial(Scene& s, glm::vec4 factor, glm::vec4 left, glm::vec4 right) {
+  const int m = addMaterial(s, glm::vec3(1.0f));
+  s.materials[m].baseColorFactor = factor;
+  s.materials[m].alphaMode = AlphaMode::Mask;
+  s.materials[m].alphaCutoff = 0.5f;
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  t.texels = {left, right};
+  s.materials[m].baseColorTexture = static_cast<int>(s.textures.size());
+  s.textures.push_back(t);
+  return m;
+}
+}  // namespace
+
 TEST(RayTracer, HitsQuadWithExactDistanceBarycentricsAndNormals) {
   Scene s;
   int m = addMaterial(s, glm::vec3(0.25f, 0.5f, 0.75f));
@@ -68,17 +87,8 @@ TEST(RayTracer, EpsilonScalesWithTheScene) {
 
 TEST(RayTracer, TexturedAlbedoAndAlphaMaskHoles) {
   Scene s;
-  int m = addMaterial(s, glm::vec3(1.0f));
-  s.materials[m].baseColorFactor = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);
-  s.materials[m].alphaMode = AlphaMode::Mask;
-  s.materials[m].alphaCutoff = 0.5f;
-  Texture t;
-  t.width = 2;
-  t.height = 1;
-  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
-  t.texels = {glm::vec4(0.2f, 0.2f, 0.2f, 0.0f), glm::vec4(0.8f, 0.8f, 0.8f, 1.0f)};  // left: hole
-  s.textures.push_back(t);
-  s.materials[m].baseColorTexture = 0;
+  const int m = addMaskedMaterial(s, glm::vec4(0.5f, 1.0f, 1.0f, 1.0f), glm::vec4(0.2f, 0.2f, 0.2f, 0.0f),
+                                  glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));  // left: hole
   addQuad(s, m, glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0));  // uv0 = (x, y)
   // A floor below to catch rays through the hole.
   int f = addMaterial(s, glm::vec3(0.3f));
@@ -131,16 +141,7 @@ TEST(RayTracer, PacketHitsEqualSingleRayHits) {
   Scene s;
   const int wall = addMaterial(s, glm::vec3(0.5f));
   addBox(s, wall, glm::vec3(-2.0f), glm::vec3(2.0f), true);
-  const int pane = addMaterial(s, glm::vec3(1.0f));
-  s.materials[pane].alphaMode = AlphaMode::Mask;
-  s.materials[pane].alphaCutoff = 0.5f;
-  Texture t;
-  t.width = 2;
-  t.height = 1;
-  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
-  t.texels = {glm::vec4(1.0f, 1.0f, 1.0f, 0.0f), glm::vec4(1.0f)};  // left half a hole
-  s.textures.push_back(t);
-  s.materials[pane].baseColorTexture = 0;
+  const int pane = addMaskedMaterial(s, glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f), glm::vec4(1.0f));  // left: hole
   addQuad(s, pane, glm::vec3(-1, -1, 1), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
   RayTracer rt(s);
   const glm::vec3 origin(0.1f, -0.2f, 0.0f);

@@ -1,11 +1,15 @@
 // Hand-built scenes and texel-sample grids for the light-transport tests (header only, test use).
 // Plain geometry with closed-form answers: a quad is two triangles, boxes are six quads.
 #pragma once
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "atlas/atlas.h"
+#include "raytrace/ray_tracer.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
 
@@ -115,5 +119,19 @@ inline glm::dvec3 polygonIrradianceVector(glm::dvec3 x, const std::vector<glm::d
 inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& poly) {
   return std::abs(glm::dot(n, polygonIrradianceVector(x, poly)));
 }
+
+// A scene with its light-map atlas (pages of pageSize² texels), the ray tracer and the pages' samples.
+struct AtlasedScene {
+  Scene scene;
+  std::unique_ptr<RayTracer> rayTracer;
+  std::vector<TexelSamples> pages;
+  AtlasedScene(Scene s, int pageSize) : scene(std::move(s)) {
+    AtlasOptions atlas;
+    atlas.targetPageSize = atlas.maxPageSize = pageSize;
+    buildAtlas(scene, atlas);
+    rayTracer = std::make_unique<RayTracer>(scene);
+    pages = buildTexelSamples(scene, *rayTracer, {});
+  }
+};
 
 }  // namespace irbake::testing

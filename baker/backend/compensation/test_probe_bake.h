@@ -10,23 +10,10 @@
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
 #include "raytrace/ray_tracer.h"
+#include "raytrace/test_scenes.h"
 #include "texels/texel_samples.h"
 
 namespace irbake::testing {
-
-// A scene with its light-map atlas (pages of pageSize² texels), the ray tracer and the pages' samples.
-struct AtlasedScene {
-  Scene scene;
-  std::unique_ptr<RayTracer> rayTracer;
-  std::vector<TexelSamples> pages;
-  AtlasedScene(Scene s, int pageSize) : scene(std::move(s)) {
-    AtlasOptions atlas;
-    atlas.targetPageSize = atlas.maxPageSize = pageSize;
-    buildAtlas(scene, atlas);
-    rayTracer = std::make_unique<RayTracer>(scene);
-    pages = buildTexelSamples(scene, *rayTracer, {});
-  }
-};
 
 // The probes baked by the Embree backend with eval's clamp, then with the residual ClampGather adds back.
 struct ProbeBake {

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "backend/lightmap_read.h"
+#include "backend/sample_lattice.h"
 #include "common/error.h"
 #include "common/maths.h"
 #include "common/progress.h"
@@ -17,6 +18,7 @@ namespace irbake {
 namespace {
 
 constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
+constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotations (forEachSampleLattice)
 
 }  // namespace
 
@@ -80,18 +82,10 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
   for (size_t p = 0; p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t s = r.begin(); s != r.end(); ++s) {
-        if (!(ts.positionWeight[s].w > 0.0f)) continue;
-        glm::vec3 x(ts.positionWeight[s]);
-        const glm::vec3 n(ts.normal[s]);
-        if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
-          x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
-        Rng rng(hashSeed(options.seed, 0xf9ull << 8 | static_cast<uint64_t>(ts.page), s));
-        const double r1 = rng.uniform(), r2 = rng.uniform();
-        slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance);
-      }
-    });
+    forEachSampleLattice(in, ts, options.seed, kGatherStream,
+                         [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+                           slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance);
+                         });
     std::vector<glm::vec3>& value = gathered[p];
     value.assign(ts.layerSize(), glm::vec3(0.0f));
     const std::vector<uint8_t>& valid = maps[p].valid;

@@ -19,19 +19,11 @@ namespace irbake {
 namespace {
 using namespace irbake::testing;
 
-struct Atlased {
-  Scene scene;
-  std::unique_ptr<RayTracer> rt;
-  std::vector<TexelSamples> pages;
+// A scene with its atlas and texel pages, no VPLs, and maps written by hand.
+struct Atlased : AtlasedScene {
   VplSet none;
-  Atlased(Scene s, int pageSize) : scene(std::move(s)) {
-    AtlasOptions atlas;
-    atlas.targetPageSize = atlas.maxPageSize = pageSize;
-    buildAtlas(scene, atlas);
-    rt = std::make_unique<RayTracer>(scene);
-    pages = buildTexelSamples(scene, *rt, {});
-  }
-  BakeInputs inputs() const { return BakeInputs{scene, *rt, pages, none, VplEvalOptions{}, {}}; }
+  Atlased(Scene s, int pageSize) : AtlasedScene(std::move(s), pageSize) {}
+  BakeInputs inputs() const { return BakeInputs{scene, *rayTracer, pages, none, VplEvalOptions{}, {}}; }
   // Maps with value(primitive) at every valid texel whose first sample lies on that primitive.
   template <class Value>
   std::vector<Lightmap> maps(Value&& value) const {

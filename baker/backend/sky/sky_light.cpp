@@ -5,6 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "backend/sample_lattice.h"
 #include "common/maths.h"
 #include "common/progress.h"
 #include "texels/texel_filter.h"
@@ -63,6 +64,8 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
     if (valid[t]) page.texels[t] += texelValue[t];
 }
 
+constexpr uint64_t kSkyStream = 0x5c7;  // the sky's lattice rotations (forEachSampleLattice)
+
 // Texel samples that carry weight (the ones the sky is traced from), over every page.
 size_t weightedSamples(const BakeInputs& in) {
   size_t count = 0;
@@ -77,23 +80,6 @@ int skyRaysPerSample(const BakeInputs& in, const SkyLightOptions& options) {
                               static_cast<int>(options.maxRays / std::max<size_t>(1, weightedSamples(in)))));
 }
 
-// Calls at(s, x, n, r1, r2) for every weighted sample s of a page, in parallel: x its position inset into its
-// triangle, n its normal, r1 r2 its lattice rotation (the same for the map and the directional pages).
-template <class At>
-void forEachSkySample(const BakeInputs& in, const TexelSamples& ts, uint64_t seed, At&& at) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t s = r.begin(); s != r.end(); ++s) {
-      if (!(ts.positionWeight[s].w > 0.0f)) continue;
-      glm::vec3 x(ts.positionWeight[s]);
-      const glm::vec3 n(ts.normal[s]);
-      if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
-        x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
-      Rng rng(hashSeed(seed, 0x5c7ull << 8 | static_cast<uint64_t>(ts.page), s));
-      const double r1 = rng.uniform(), r2 = rng.uniform();
-      at(s, x, n, r1, r2);
-    }
-  });
-}
 }  // namespace
 
 glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2) {
@@ -124,7 +110,7 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
   for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
-    forEachSkySample(in, ts, options.seed, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+    forEachSampleLattice(in, ts, options.seed, kSkyStream, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
       slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
     });
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
@@ -183,7 +169,7 @@ void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightma
   for (size_t p = 0; p < in.texels.size() && p < axes[0].size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<L1Vectors> slotValue(ts.slotCount(), L1Vectors{});
-    forEachSkySample(in, ts, options.seed, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+    forEachSampleLattice(in, ts, options.seed, kSkyStream, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
       slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
     });
     for (int k = 0; k < 3; ++k)
