@@ -221,6 +221,23 @@ TEST(BakePipeline, FinalGatherAgreesWithThePlainBakeAndTheReference) {
   std::printf("[ figure ] corner mean map: plain %.5f, final gather %.5f, reference %.5f\n", means[0], means[1], means[2]);
   EXPECT_NEAR(means[1] / means[0], 1.0, 0.01);
   EXPECT_NEAR(means[1] / means[2], 1.0, 0.02);
+  // With --directional the map keeps the plain bake's bytes and the L1 pages come from the same rays.
+  BakeOptions directional = smallEmbreeBake(12.0f, 4096);
+  directional.finalGather = FinalGatherMode::Auto;
+  BakeOptions plain = directional;
+  directional.directional = true;
+  const BakeResult withL1 = bake(samples::makeCorner(), directional), withoutL1 = bake(samples::makeCorner(), plain);
+  ASSERT_EQ(withL1.maps.size(), withoutL1.maps.size());
+  for (size_t p = 0; p < withL1.maps.size(); ++p) EXPECT_EQ(withL1.maps[p].texels, withoutL1.maps[p].texels) << p;
+  ASSERT_TRUE(withL1.report.contains("finalGather"));
+  double tangential = 0.0;
+  for (const auto& axis : withL1.directional)
+    for (const Lightmap& page : axis)
+      for (size_t t = 0; t < page.size(); ++t) {
+        ASSERT_TRUE(std::isfinite(page.texels[t].x));
+        tangential = std::max(tangential, double(std::abs(page.texels[t].x)));
+      }
+  EXPECT_GT(tangential, 0.01);  // the corner's wall lights the floor from the side
   BakeOptions furnace = smallEmbreeBake(4.0f, 256);
   furnace.finalGather = FinalGatherMode::Auto;
   EXPECT_FALSE(bake(loadSample("furnace"), furnace).report.contains("finalGather"));

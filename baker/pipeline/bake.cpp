@@ -157,6 +157,7 @@ struct StagedBake::State {
   bool compensate = false, overlap = false;
   bool finalGatherOn = false;                       // decided with the backend (FinalGatherMode)
   std::vector<Lightmap> directMaps;                 // the final gather's D: punctual lights and sky, exact
+  L1Pages directL1;                                 // with --directional: D's L1 pages
   nlohmann::json seconds = nlohmann::json::object();
   Stopwatch total;
 
@@ -277,13 +278,12 @@ struct StagedBake::State {
       log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
     }
     compensate = options.eval.biasCompensation && backend != BackendKind::Reference;
-    finalGatherOn = backend != BackendKind::Reference && options.eval.includeVpls && !options.directional &&
+    finalGatherOn = backend != BackendKind::Reference && options.eval.includeVpls &&
                     (options.finalGather == FinalGatherMode::On ||
                      (options.finalGather == FinalGatherMode::Auto && !scene.hasEmissiveSurface() &&
                       seeThroughMaterials(scene).empty()));
     if (options.finalGather != FinalGatherMode::Off)
-      log::info(std::string("final gather: ") + (finalGatherOn ? "on" : "off") +
-                (options.directional && options.finalGather == FinalGatherMode::On ? " (not with --directional)" : ""));
+      log::info(std::string("final gather: ") + (finalGatherOn ? "on" : "off"));
     if (backend != BackendKind::Gl) return;
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
@@ -431,6 +431,7 @@ struct StagedBake::State {
       directMaps = maps;
       for (size_t p = 0; p < directMaps.size(); ++p)
         if (directMaps[p].valid.size() != directMaps[p].size()) directMaps[p].valid = texels[p].valid;
+      if (l1) directL1 = *l1;
     }
     const int coefficients = l1 ? sums.coefficients : 1;
     for (size_t p = 0; p < maps.size(); ++p) {
@@ -461,7 +462,7 @@ struct StagedBake::State {
   ClampCompensationOptions compensationOptions() const {
     ClampCompensationOptions o = options.compensation;
     o.seed = options.walk.seed;
-    o.directional = options.directional;
+    o.directional = options.directional && !finalGatherOn;  // the gather writes the bounced light's L1 itself
     if (finalGatherOn) o.refineRays = 0;
     return o;
   }
@@ -516,7 +517,7 @@ struct StagedBake::State {
       if (options.progress) options.progress("compensate", 0.0);  // coarse: start and end of the stage
       std::unique_ptr<ClampGather> g = gather.valid() ? gather.get() : std::make_unique<ClampGather>(*wholeInputs, o);
       g->apply(maps, &stats);
-      if (l1) g->applyDirectional(maps, *l1);
+      if (l1 && !finalGatherOn) g->applyDirectional(maps, *l1);
       if (options.progress) options.progress("compensate", 1.0);
       seconds["compensationTrace"] = g->traceSeconds();
       report["compensation"] = stats.toJson();
@@ -545,7 +546,8 @@ struct StagedBake::State {
   }
 
   // Final gather: each texel's bounced light read from the finished map one bounce away (backend/gather).
-  void finalGatherStage(std::vector<Lightmap>& maps, nlohmann::json& report) {
+  // With l1 (--directional) the L1 pages become D's plus the same rays' tangential vector.
+  void finalGatherStage(std::vector<Lightmap>& maps, L1Pages* l1, nlohmann::json& report) {
     if (!finalGatherOn || directMaps.size() != maps.size()) return;
     timed("finalGather", [&] {
       FinalGatherOptions o = options.gather;
@@ -553,11 +555,12 @@ struct StagedBake::State {
       if (skyByGather()) o.missRadiance = scene.environment.uniformRadiance();
       FinalGatherStats stats;
       if (options.progress) options.progress("gather", 0.0);
-      finalGather(*wholeInputs, directMaps, maps, o, &stats);
+      finalGather(*wholeInputs, directMaps, maps, o, &stats, l1 ? &directL1 : nullptr, l1);
       if (options.progress) options.progress("gather", 1.0);
       report["finalGather"] = stats.toJson();
     });
     directMaps = {};
+    directL1 = {};
   }
 
   PostStats postStage(std::vector<Lightmap>& maps) {
@@ -680,7 +683,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
-  s.finalGatherStage(r.maps, report);
+  s.finalGatherStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
   s.directionalStage(r.directional, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();

@@ -48,7 +48,7 @@ enum class OverlapCompensation {
 // backend/gather) instead of read from the VPLs that reach it.
 enum class FinalGatherMode {
   Off,   // the VPL sum (+ clamp compensation) is the map
-  On,    // in every scene the VPL backends bake (not with --directional)
+  On,    // in every scene the VPL backends bake
   Auto,  // on where the scene has no emissive surface (the rays would find small emitters by chance) and no
          // see-through one (the gather reads the glass's own map, not what lies behind it)
 };

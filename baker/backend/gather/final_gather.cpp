@@ -1,6 +1,7 @@
 #include "backend/gather/final_gather.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
@@ -24,11 +25,12 @@ constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotation
 
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                   const glm::vec3& missRadiance) {
+                   const glm::vec3& missRadiance, L1Vectors* tangential) {
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
   const glm::vec3 origin = x + n * rt.epsilon();
   glm::vec3 sum(0.0f);
+  L1Vectors t{};
   constexpr int kChunk = 32;  // rays traced together, 8 to a packet (one origin: the packets stay coherent)
   glm::vec3 dirs[kChunk];
   RayHit hits[kChunk];
@@ -53,13 +55,22 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
       if (point.map >= 0 && static_cast<size_t>(point.map) < maps.size())
         L += rt.albedoAt(hit) * readLightmap(maps[point.map], maps[point.map].texels, point.texel);
       sum += L;
+      if (tangential) {
+        constexpr float kMinCos = 0.1f;  // as the compensation's: bounds 1/cosθ near the horizon
+        const float c = glm::dot(dirs[k], n);
+        const glm::vec3 w = (dirs[k] - c * n) / std::max(c, kMinCos);
+        for (int a = 0; a < 3; ++a) t[a] += L * w[a];
+      }
     }
   }
-  return sum / static_cast<float>(std::max(1, rays));
+  const float inv = 1.0f / static_cast<float>(std::max(1, rays));
+  if (tangential)
+    for (int a = 0; a < 3; ++a) (*tangential)[a] = t[a] * inv;
+  return sum * inv;
 }
 
 void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std::vector<Lightmap>& maps,
-                 const FinalGatherOptions& options, FinalGatherStats* stats) {
+                 const FinalGatherOptions& options, FinalGatherStats* stats, const L1Pages* directL1, L1Pages* l1) {
   Stopwatch watch;
   if (maps.size() != in.texels.size() || direct.size() != maps.size())
     throw Error(ErrorCode::InvalidData, "", "final gather: " + std::to_string(maps.size()) + " maps and " +
@@ -77,14 +88,24 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
   if (options.rayBudget > 0 && samples > 0)
     rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::max(1, options.minRays)),
                                                static_cast<size_t>(rays)));
+  const bool directional = l1 && directL1;
+  if (directional)
+    for (int k = 0; k < 3; ++k)
+      if ((*l1)[k].size() != maps.size() || (*directL1)[k].size() != maps.size())
+        throw Error(ErrorCode::InvalidData, "", "final gather: the L1 pages do not match the maps");
   // Every page's gather reads the maps as they came in, so the new pages are built apart and swapped in last.
   std::vector<std::vector<glm::vec3>> gathered(maps.size());
+  std::array<std::vector<std::vector<glm::vec3>>, 3> gatheredL1;
+  if (directional)
+    for (auto& axis : gatheredL1) axis.resize(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
+    std::vector<L1Vectors> slotVector(directional ? ts.slotCount() : 0, L1Vectors{});
     forEachSampleLattice(in, ts, options.seed, kGatherStream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-                           slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance);
+                           slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
+                                                   directional ? &slotVector[s] : nullptr);
                          });
     std::vector<glm::vec3>& value = gathered[p];
     value.assign(ts.layerSize(), glm::vec3(0.0f));
@@ -96,6 +117,22 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
       TexelFilterOptions fo;
       fo.radius = options.filterRadius;
       value = filterOnSurface(ts, value, valid, fo);
+    }
+    if (directional) {
+      std::array<std::vector<glm::vec3>, 3> axes;
+      for (int k = 0; k < 3; ++k) {
+        axes[k].assign(ts.layerSize(), glm::vec3(0.0f));
+        tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
+          if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotVector[s][k]; }, axes[k][t]);
+        });
+      }
+      if (options.filterRadius > 0) {  // the map's filter, the three axes in one pass
+        TexelFilterOptions fo;
+        fo.radius = options.filterRadius;
+        std::vector<std::vector<glm::vec3>> filtered = SurfaceFilter(ts).apply({&axes[0], &axes[1], &axes[2]}, valid, fo);
+        for (int k = 0; k < 3; ++k) axes[k] = std::move(filtered[k]);
+      }
+      for (int k = 0; k < 3; ++k) gatheredL1[k][p] = std::move(axes[k]);
     }
   }
   double total = 0.0, gatheredSum = 0.0, change = 0.0, before = 0.0;
@@ -109,6 +146,11 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
       gatheredSum += channelMean(gathered[p][t]);
       total += channelMean(next);
       maps[p].texels[t] = next;
+      if (directional)
+        for (int k = 0; k < 3; ++k) {
+          const glm::vec3 v = (*directL1)[k][p].texels[t] + gatheredL1[k][p][t];
+          if (std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z)) (*l1)[k][p].texels[t] = v;
+        }
     }
   if (stats) {
     stats->rays = samples * static_cast<size_t>(rays);

@@ -23,6 +23,7 @@
 
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
+#include "transport/directional.h"
 
 namespace irbake {
 
@@ -55,13 +56,19 @@ struct FinalGatherStats {
 
 // maps: the full bake M on entry (one per page of in.texels), D + the gather on return, at valid texels.
 // direct: D, the same pages' direct light (valid texels read). Invalid texels are left as they are.
+// Directional maps (transport/directional.h): with l1 and directL1 (D's L1 pages), the same rays' tangential
+// irradiance vector, t = mean of (Le + ρ M) (ω − (ω·n)n) / cosθ over the rays that hit (1/cosθ held to ≤ 10, as
+// the compensation's), filtered like the map, replaces l1 at valid texels by directL1 + t. The rays that leave
+// add nothing to t: a sky's L1 comes from its own stage. The map's bytes are the same with and without l1.
 void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std::vector<Lightmap>& maps,
-                 const FinalGatherOptions& options = {}, FinalGatherStats* stats = nullptr);
+                 const FinalGatherOptions& options = {}, FinalGatherStats* stats = nullptr,
+                 const L1Pages* directL1 = nullptr, L1Pages* l1 = nullptr);
 
 // The gathered term at one point (x on a surface with normal n), `rays` cosine rays with lattice rotation
 // (r1, r2), reading maps; a ray that misses brings missRadiance (for tests and tools).
+// With tangential, also the rays' tangential irradiance vector (finalGather's t).
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                   const glm::vec3& missRadiance = glm::vec3(0.0f));
+                   const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr);
 
 }  // namespace irbake

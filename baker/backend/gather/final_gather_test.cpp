@@ -108,6 +108,32 @@ TEST(FinalGather, FloorUnderASquareGathersItsViewFactor) {
   EXPECT_NEAR(sum / n / (rho * m * F), 1.0, 0.02);  // F moves by < 0.5% within 5 cm
 }
 
+// The same square seen from 0.3 m off its axis: the gathered tangential irradiance vector is ρ m times the
+// tangential part of the square's irradiance vector (Lambert's edge formula, polygonIrradianceVector).
+TEST(FinalGather, OffAxisFloorPointGathersTheSquaresIrradianceVector) {
+  const float a = 0.5f, h = 0.4f, rho = 0.7f, m = 2.0f;
+  Scene s;
+  const int grey = addMaterial(s, glm::vec3(rho));
+  addQuad(s, grey, glm::vec3(-2, -2, 0), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0));
+  const int squarePrim = addQuad(s, grey, glm::vec3(-a, -a, h), glm::vec3(0, 2 * a, 0), glm::vec3(2 * a, 0, 0));
+  Atlased at(std::move(s), 128);
+  const std::vector<Lightmap> maps =
+      at.maps([&](uint32_t p) { return p == static_cast<uint32_t>(squarePrim) ? glm::vec3(m) : glm::vec3(0.0f); });
+  const glm::dvec3 x(0.3, 0.1, 0.0);
+  const std::vector<glm::dvec3> square = {{-a, -a, h}, {a, -a, h}, {a, a, h}, {-a, a, h}};
+  const glm::dvec3 g = polygonIrradianceVector(x, square) * double(rho * m);
+  L1Vectors t{};
+  const glm::vec3 e = gatherAt(at.inputs(), maps, mapIndexOfPages(at.pages), glm::vec3(x), glm::vec3(0, 0, 1), 1 << 16,
+                               0.25, 0.5, glm::vec3(0.0f), &t);
+  std::printf("[ figure ] off-axis floor point: gathered %.5f (ρ m F %.5f), t = (%.5f, %.5f, %.5f), exact (%.5f, %.5f, 0)\n",
+              e.x, g.z, t[0].x, t[1].x, t[2].x, g.x, g.y);
+  EXPECT_NEAR(e.x / g.z, 1.0, 0.01);
+  EXPECT_NEAR(t[0].x / g.x, 1.0, 0.02);  // towards the square: −x, −y
+  EXPECT_NEAR(t[1].x / g.y, 1.0, 0.03);
+  EXPECT_NEAR(t[2].x, 0.0, 1e-6);  // tangential only
+  EXPECT_LT(g.x, -0.05);
+}
+
 // A single plane: every ray leaves the scene, so the map is D exactly, whatever M held.
 TEST(FinalGather, RaysThatLeaveTheSceneAddNothing) {
   Atlased a(samples::makePointOverPlane(), 64);
