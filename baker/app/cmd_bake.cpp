@@ -40,11 +40,13 @@ struct BakeArguments {
 // Every option of `irbake bake`, with its range and help.
 std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
-  // The command's default light paths: 6144. Against Blender Cycles in our own atlas (docs/accuracy.md) the
+  // The command's default light paths: 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
   // sample Cornell box is 4.0% at 1024 paths (3.9 s), 2.0% at 4096 (4×4 interleave classes) and 1.6% at
-  // 6144 with 6×6 classes, which costs less than 4096 with 4×4 (each texel meets 1/36 of the VPLs); the
-  // library's 1024 stays for callers that choose their own budget.
-  o.walk.paths = 6144;
+  // 6144 with 6×6 classes, which costs less than 4096 with 4×4 (each texel meets 1/36 of the VPLs). Session 12:
+  // 4096 paths now get 6×6 classes too (the automatic interleave), 2.07% against 6144's 2.02% on the sample box
+  // and 1.75% against 1.60% on McGuire's, in 7.9–8.9 s end to end instead of 11.4–11.9 s on the 2-core machine
+  // (issue 11's ≤ 2.5% in ≤ 10 s). The library's 1024 stays for callers that choose their own budget.
+  o.walk.paths = 4096;
   std::vector<std::string>& scenes = a.scenes;
   std::string &backend = a.backend, &shard = a.shard;
   std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
@@ -66,7 +68,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
   a.pathsOption = app->add_option("--vpls", o.walk.paths,
-                                  "light paths of the quasi-random walk (default 6144; 3072 where the\n"
+                                  "light paths of the quasi-random walk (default 4096; 3072 where the\n"
                                   "final gather runs, which reads their map averaged)")
                       ->transform(cli::integerIn(1, 1 << 26))
                       ->type_name("N");
