@@ -24,29 +24,30 @@ namespace irbake::app {
 
 namespace {
 
+// The command's default light paths (--vpls auto): 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
+// sample Cornell box is 4.0% at 1024 paths (3.9 s), 2.0% at 4096 (4×4 interleave classes) and 1.6% at
+// 6144 with 6×6 classes, which costs less than 4096 with 4×4 (each texel meets 1/36 of the VPLs). Session 12:
+// 4096 paths now get 6×6 classes too (the automatic interleave), 2.07% against 6144's 2.02% on the sample box
+// and 1.75% against 1.60% on McGuire's, in 7.9–8.9 s end to end instead of 11.4–11.9 s on the 2-core machine
+// (issue 11's ≤ 2.5% in ≤ 10 s). The library's 1024 stays for callers that choose their own budget.
+constexpr int kDefaultPaths = 4096;
+constexpr int kDefaultPathsUnderGather = 3072;  // --vpls auto where the final gather runs
+
 // What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
 struct BakeArguments {
   std::vector<std::string> scenes;
   std::string backend = "auto", shard, finalGather = "auto";
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
-  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
+  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0, paths = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
-  CLI::Option* pathsOption = nullptr;
 };
 
 // Every option of `irbake bake`, with its range and help.
 std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
-  // The command's default light paths: 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
-  // sample Cornell box is 4.0% at 1024 paths (3.9 s), 2.0% at 4096 (4×4 interleave classes) and 1.6% at
-  // 6144 with 6×6 classes, which costs less than 4096 with 4×4 (each texel meets 1/36 of the VPLs). Session 12:
-  // 4096 paths now get 6×6 classes too (the automatic interleave), 2.07% against 6144's 2.02% on the sample box
-  // and 1.75% against 1.60% on McGuire's, in 7.9–8.9 s end to end instead of 11.4–11.9 s on the 2-core machine
-  // (issue 11's ≤ 2.5% in ≤ 10 s). The library's 1024 stays for callers that choose their own budget.
-  o.walk.paths = 4096;
   std::vector<std::string>& scenes = a.scenes;
   std::string &backend = a.backend, &shard = a.shard;
   std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
@@ -67,11 +68,10 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
-  a.pathsOption = app->add_option("--vpls", o.walk.paths,
-                                  "light paths of the quasi-random walk (default 4096; 3072 where the\n"
-                                  "final gather runs, which reads their map averaged)")
-                      ->transform(cli::integerIn(1, 1 << 26))
-                      ->type_name("N");
+  app->add_option("--vpls", a.paths,
+                  "light paths of the quasi-random walk (default auto: 4096; 3072 where the\n"
+                  "final gather runs, which reads their map averaged)")
+      ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--walk-split", a.walkSplit,
@@ -241,7 +241,8 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   // Where the final gather runs, half the default paths: it reads the VPLs' map averaged over each texel's
   // hemisphere (Sponza sun + sky, views 2 / 3 against Cycles: 3072 paths 2.01-2.05 / 4.07-4.24%, 6144
   // 1.96-2.11 / 3.97-4.13%, 1536 one seed 4.62%; docs/accuracy.md, session 12).
-  if (a.pathsOption->count() == 0) o.finalGatherPaths = 3072;
+  o.walk.paths = a.paths > 0 ? a.paths : kDefaultPaths;
+  if (a.paths == 0) o.finalGatherPaths = kDefaultPathsUnderGather;
   if (a.clampOption->count() > 0) {  // --clamp 0: no clamp; none given: derived
     o.clamp = a.clamp > 0.0 ? ClampMode::Fixed : ClampMode::Off;
     o.clampBound = static_cast<float>(a.clamp);
@@ -264,9 +265,8 @@ std::optional<BakeCommand> parseBakeCommand(const Args& args) {
   BakeArguments arguments;
   const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
   if (!cli::parse(*app, args)) return std::nullopt;
+  command.optionsHash = resultOptionsHash(*app);
   applyArguments(command, arguments);
-  // CLI11 writes --vpls with its default whether typed or not; the final gather's half default is not typed.
-  command.optionsHash = hashText(resultOptionsHash(*app) + (command.options.finalGatherPaths ? "gatherPaths=default" : ""));
   return command;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <tbb/blocked_range.h>
@@ -12,6 +13,14 @@
 #include "vpl/sampling.h"
 
 namespace irbake {
+
+// Texel samples that carry weight (the ones these stages trace from), over every page.
+inline size_t weightedSampleCount(const std::vector<TexelSamples>& pages) {
+  size_t count = 0;
+  for (const TexelSamples& ts : pages)
+    for (const glm::vec4& pw : ts.positionWeight) count += pw.w > 0.0f;
+  return count;
+}
 
 // Calls at(s, x, n, r1, r2) for every weighted sample s of a page, in parallel: x its position inset into its
 // triangle, n its normal, (r1, r2) its lattice rotation, drawn from (seed, stream << 8 | page, s): a stage's own

@@ -191,8 +191,7 @@ struct StagedBake::State {
     // reference backend reads no VPLs, so it needs no VPL selection.
     timed("backend", [&] { chooseBackend(); });
     timed("vpls", [&] {
-      WalkOptions o = options.walk;
-      if (finalGatherOn && options.finalGatherPaths) o.paths = *options.finalGatherPaths;
+      WalkOptions o = walkOptions();
       o.progress = withProgress(o.progress);
       vpls = generateVpls(scene, *rayTracer, o);
       // Importance-driven selection: where the plain walk's VPLs matter unevenly (its pilot), the walk again
@@ -203,14 +202,15 @@ struct StagedBake::State {
         // auto: only under the final gather. Without it the selection thins the VPLs that light bright texels,
         // which costs a plain bake's close-ups more than it gives (Sponza view 2: +0.3-0.4 points, session 11);
         // with it view 2 holds (1.96-2.11%) and view 3's swing goes (4.4-5.1% -> 4.0-4.1%, session 12).
-        const bool pilot = !options.vplImportance.candidateFactor;
-        if (pilot && finalGatherOn) {
-          deriveClamp();
-          evenness = vplImportanceEvenness(scene, *rayTracer, texels, vpls.vpls, options.vplImportance,
-                                           eval.clampBound, options.walk.seed);
-        }
-        if (!pilot || finalGatherOn)
+        const bool pilot = !options.vplImportance.candidateFactor;  // auto; a fixed factor needs none
+        if (!pilot || finalGatherOn) {
+          if (pilot) {
+            deriveClamp();
+            evenness = vplImportanceEvenness(scene, *rayTracer, texels, vpls.vpls, options.vplImportance,
+                                             eval.clampBound, options.walk.seed);
+          }
           importanceFactor = chooseCandidateFactor(options.vplImportance, vpls.vpls.size(), evenness);
+        }
         importanceStats.evenness = evenness;
       }
       if (importanceFactor > 1.0) {
@@ -233,6 +233,13 @@ struct StagedBake::State {
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
     timed("backend", [&] { planBlocks(); });
+  }
+
+  // The walk as this bake runs it: finalGatherPaths where the final gather runs (decided with the backend).
+  WalkOptions walkOptions() const {
+    WalkOptions o = options.walk;
+    if (finalGatherOn && options.finalGatherPaths) o.paths = *options.finalGatherPaths;
+    return o;
   }
 
   void deriveClamp() {
@@ -604,7 +611,7 @@ struct StagedBake::State {
                         {"supersample", std::max(1, options.texels.supersample)},
                         {"leakControl", options.texels.leakControl}};
     report["vpls"] = vpls.toJson();
-    report["vpls"]["paths"] = finalGatherOn && options.finalGatherPaths ? *options.finalGatherPaths : options.walk.paths;
+    report["vpls"]["paths"] = walkOptions().paths;
     report["vpls"]["seed"] = options.walk.seed;
     if (importanceFactor > 1.0 || importanceStats.evenness > 0.0) report["vplImportance"] = importanceStats.toJson();
     report["eval"] = {{"clampBound", eval.clampBound},

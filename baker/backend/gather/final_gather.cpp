@@ -81,9 +81,7 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
         direct[p].size() != maps[p].size())
       throw Error(ErrorCode::InvalidData, "", "final gather: page " + std::to_string(p) + " does not match its texels");
   const std::vector<int32_t> mapOfPage = mapIndexOfPages(in.texels);
-  size_t samples = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (const glm::vec4& pw : ts.positionWeight) samples += pw.w > 0.0f;
+  const size_t samples = weightedSampleCount(in.texels);
   int rays = std::max(1, options.rays);
   if (options.rayBudget > 0 && samples > 0)
     rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::max(1, options.minRays)),

@@ -66,18 +66,10 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
 
 constexpr uint64_t kSkyStream = 0x5c7;  // the sky's lattice rotations (forEachSampleLattice)
 
-// Texel samples that carry weight (the ones the sky is traced from), over every page.
-size_t weightedSamples(const BakeInputs& in) {
-  size_t count = 0;
-  for (const TexelSamples& ts : in.texels)
-    for (const glm::vec4& pw : ts.positionWeight) count += pw.w > 0.0f;
-  return count;
-}
-
 // Rays per texel sample: options.raysPerSample, fewer where the scene's samples would exceed maxRays (≥ 8).
 int skyRaysPerSample(const BakeInputs& in, const SkyLightOptions& options) {
   return std::max(8, std::min(options.raysPerSample,
-                              static_cast<int>(options.maxRays / std::max<size_t>(1, weightedSamples(in)))));
+                              static_cast<int>(options.maxRays / std::max<size_t>(1, weightedSampleCount(in.texels)))));
 }
 
 }  // namespace
@@ -116,7 +108,7 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
-    stats->rays = weightedSamples(in) * static_cast<size_t>(rays);  // every weighted sample traces `rays`
+    stats->rays = weightedSampleCount(in.texels) * static_cast<size_t>(rays);  // every weighted sample traces `rays`
     stats->raysPerSample = rays;
     stats->seconds = watch.seconds();
   }
