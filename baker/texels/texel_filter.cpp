@@ -52,9 +52,9 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
   if (!valid[j] || !hasSample_[j]) return false;
   if (j == i) return true;
   if (glm::dot(normal_[i], normal_[j]) < options.minNormalCos) return false;
-  const float reach = options.maxSpacings * spacing_ * std::sqrt(static_cast<float>(dx * dx + dy * dy));
+  const float unit = options.maxSpacings * spacing_;  // reach = unit × |(dx, dy)|, compared squared
   const glm::vec3 d = position_[j] - position_[i];
-  return glm::dot(d, d) <= reach * reach;
+  return glm::dot(d, d) <= unit * unit * static_cast<float>(dx * dx + dy * dy);
 }
 
 template <class Visit>

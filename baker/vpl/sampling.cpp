@@ -149,6 +149,28 @@ glm::vec3 cosineHemisphere(const glm::vec3& n, double u, double v) {
   return glm::normalize(t * float(r * std::cos(phi)) + b * float(r * std::sin(phi)) + n * float(z));
 }
 
+namespace {
+constexpr double kInverseGolden = 0.6180339887498949;  // 1/φ: the lattice's azimuth step, in turns
+}  // namespace
+
+CosineLattice::CosineLattice(const glm::vec3& n, int count, double r1, double r2)
+    : n_(n), r1_(r1), step_(1.0 / std::max(1, count)), cos_(std::cos(2.0 * kPi * r2)), sin_(std::sin(2.0 * kPi * r2)) {
+  orthonormalBasis(n, t_, b_);
+}
+
+glm::vec3 CosineLattice::next() {
+  static const double kTurnCos = std::cos(2.0 * kPi * kInverseGolden), kTurnSin = std::sin(2.0 * kPi * kInverseGolden);
+  double u = r1_ + (i_ + 0.5) * step_;  // < 2: one wrap at most
+  if (u >= 1.0) u -= 1.0;
+  const double r = std::sqrt(u), z = std::sqrt(std::max(0.0, 1.0 - u));
+  const glm::vec3 dir = glm::normalize(t_ * float(r * cos_) + b_ * float(r * sin_) + n_ * float(z));
+  const double c = cos_ * kTurnCos - sin_ * kTurnSin;
+  sin_ = sin_ * kTurnCos + cos_ * kTurnSin;
+  cos_ = c;
+  ++i_;
+  return dir;
+}
+
 glm::vec3 uniformSphere(double u, double v) {
   double z = 1.0 - 2.0 * u, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * v;
   return glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));

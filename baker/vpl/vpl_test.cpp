@@ -77,6 +77,26 @@ TEST(Halton, EveryDimensionIsStratifiedOverFullDigitBlocks) {
   EXPECT_GT(differ, 10);
 }
 
+// The lattice the per-sample stages trace: ray for ray cosineHemisphere's directions at the lattice's (u, v),
+// and a cosine-weighted estimator over it is exact for cosθ (∫ cosθ · cosθ/π dω / ∫ cosθ/π dω = 2/3).
+TEST(CosineLattice, MatchesCosineHemisphereAtTheLatticePoints) {
+  const glm::vec3 normals[] = {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::normalize(glm::vec3(0.3f, -0.8f, 0.2f))};
+  for (const glm::vec3& n : normals)
+    for (int count : {1, 16, 64, 1000}) {
+      const double r1 = 0.73, r2 = 0.41;
+      CosineLattice lattice(n, count, r1, r2);
+      double meanCos = 0.0;
+      for (int i = 0; i < count; ++i) {
+        const double u = std::fmod((i + 0.5) / count + r1, 1.0), v = std::fmod(i * 0.6180339887498949 + r2, 1.0);
+        const glm::vec3 want = cosineHemisphere(n, u, v), got = lattice.next();
+        EXPECT_NEAR(glm::length(got - want), 0.0, 2e-6) << "ray " << i << " of " << count;
+        EXPECT_NEAR(glm::length(got), 1.0, 1e-6);
+        meanCos += glm::dot(got, n) / count;
+      }
+      if (count >= 1000) EXPECT_NEAR(meanCos, 2.0 / 3.0, 1e-4);
+    }
+}
+
 TEST(AliasTable, ProbabilitiesAndResidualsAreExact) {
   std::vector<double> w = {1.0, 3.0, 0.0, 4.0};
   AliasTable t(w);

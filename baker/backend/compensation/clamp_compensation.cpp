@@ -21,7 +21,6 @@
 namespace irbake {
 namespace {
 
-constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
 
 // A hit inside the clamp radius, kept for the sweeps: residual(slot) += Le + albedo ⊙ M(page, texel).
 // Le and albedo are already multiplied by w / (rays of the slot). 24 bytes: the kept hits are the
@@ -145,9 +144,9 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
   Rng rng(hashSeed(options.seed, (static_cast<uint64_t>(ts.page) << 8) | round, s));
   const double r1 = rng.uniform(), r2 = rng.uniform();
   int keptCount = 0;
+  CosineLattice lattice(n, count, r1, r2);
   for (int i = 0; i < count; ++i) {
-    double u = std::fmod((i + 0.5) / count + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
-    glm::vec3 dir = cosineHemisphere(n, u, v);
+    const glm::vec3 dir = lattice.next();
     RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
     if (!hit.hit || hit.backFace) continue;
     // The same G as the clamp the VPL sum applied (0 when either surface faces away, so never kept).

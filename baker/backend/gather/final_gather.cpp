@@ -18,7 +18,6 @@
 namespace irbake {
 namespace {
 
-constexpr double kGolden = 0.6180339887498949;  // Fibonacci lattice step
 constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotations (forEachSampleLattice)
 
 }  // namespace
@@ -31,16 +30,13 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
   const glm::vec3 origin = x + n * rt.epsilon();
   glm::vec3 sum(0.0f);
   L1Vectors t{};
+  CosineLattice lattice(n, rays, r1, r2);
   constexpr int kChunk = 32;  // rays traced together, 8 to a packet (one origin: the packets stay coherent)
   glm::vec3 dirs[kChunk];
   RayHit hits[kChunk];
   for (int begin = 0; begin < rays; begin += kChunk) {
     const int count = std::min(kChunk, rays - begin);
-    for (int k = 0; k < count; ++k) {
-      const int i = begin + k;
-      const double u = std::fmod((i + 0.5) / rays + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
-      dirs[k] = cosineHemisphere(n, u, v);
-    }
+    for (int k = 0; k < count; ++k) dirs[k] = lattice.next();
     rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits);
     for (int k = 0; k < count; ++k) {
       const RayHit& hit = hits[k];

@@ -82,9 +82,9 @@ glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& 
   if (sky.isUniform()) {
     // Cosine rays: (L cosθ / p) / π = L for p = cosθ/π, so the value is L × the visible fraction.
     glm::vec3 visible(0.0f);  // Σ transmittance over the rays (1 per clear ray without see-through surfaces)
+    CosineLattice lattice(n, rays, r1, r2);
     for (int i = 0; i < rays; ++i) {
-      const double u = std::fmod((i + 0.5) / rays + r1, 1.0), v = std::fmod(i * kGolden + r2, 1.0);
-      const glm::vec3 dir = cosineHemisphere(n, u, v);
+      const glm::vec3 dir = lattice.next();
       if (!rt.occluded(origin, dir, 0.0f, 1e30f)) visible += rt.transmittance(origin, dir, 0.0f, 1e30f);
     }
     return sky.uniformRadiance() * visible / static_cast<float>(std::max(1, rays));
