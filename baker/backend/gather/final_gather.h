@@ -23,6 +23,7 @@
 
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
+#include "scene/footprint_albedo.h"
 #include "transport/directional.h"
 
 namespace irbake {
@@ -66,9 +67,11 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
 
 // The gathered term at one point (x on a surface with normal n), `rays` cosine rays with lattice rotation
 // (r1, r2), reading maps; a ray that misses brings missRadiance (for tests and tools).
-// With tangential, also the rays' tangential irradiance vector (finalGather's t).
+// With tangential, also the rays' tangential irradiance vector (finalGather's t). With albedo, the hits' base
+// colour is read at one map texel's footprint (scene/footprint_albedo.h; finalGather does), else at the point.
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                   const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr);
+                   const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr,
+                   const FootprintAlbedo* albedo = nullptr);
 
 }  // namespace irbake
