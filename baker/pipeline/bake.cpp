@@ -477,6 +477,9 @@ struct StagedBake::State {
   SkyLightOptions skyOptions() const {
     SkyLightOptions o = options.sky;
     o.seed = options.walk.seed;
+    // The gather counts a uniform sky at every texel itself; this stage's light is then read only at its hits,
+    // averaged over a hemisphere of them, so half the rays do (Sponza: sky 2.6 -> 1.4 s, views unchanged).
+    if (skyByGather()) o.minRays = std::min(o.minRays, 4);
     return o;
   }
   PostOptions postOptions() const {

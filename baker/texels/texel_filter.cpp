@@ -62,6 +62,30 @@ void SurfaceFilter::forEachAccepted(int x, int y, int r, const std::vector<uint8
                                     const TexelFilterOptions& options, Visit&& visit) const {
   const int W = width_, H = height_;
   const size_t i = static_cast<size_t>(y) * W + x;
+  constexpr int kBitRadius = 8;  // windows up to 17² = 289 positions: 5 words of bits
+  if (options.symmetric && r <= kBitRadius) {
+    // Each window position tested once; a position counts with its mirror image (−dx, −dy), which is position
+    // n − 1 − b in row-major order: half the tests of testing each mirror again, the same set in the same order.
+    const int side = 2 * r + 1, n = side * side;
+    uint64_t bits[5] = {0, 0, 0, 0, 0};
+    for (int dy = -r; dy <= r; ++dy) {
+      const int yy = y + dy;
+      if (yy < 0 || yy >= H) continue;
+      for (int dx = -r; dx <= r; ++dx) {
+        const int xx = x + dx;
+        if (xx < 0 || xx >= W) continue;
+        const int b = (dy + r) * side + (dx + r);
+        if (accepts(i, static_cast<size_t>(yy) * W + xx, dx, dy, valid, options)) bits[b >> 6] |= uint64_t(1) << (b & 63);
+      }
+    }
+    auto has = [&](int b) { return (bits[b >> 6] >> (b & 63)) & 1; };
+    for (int b = 0; b < n; ++b) {
+      if (!has(b) || !has(n - 1 - b)) continue;
+      const int dy = b / side - r, dx = b % side - r;
+      visit(static_cast<size_t>(static_cast<ptrdiff_t>(i) + static_cast<ptrdiff_t>(dy) * W + dx), dx, dy);
+    }
+    return;
+  }
   for (int dy = -r; dy <= r; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= H) continue;

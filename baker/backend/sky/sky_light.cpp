@@ -66,9 +66,10 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
 
 constexpr uint64_t kSkyStream = 0x5c7;  // the sky's lattice rotations (forEachSampleLattice)
 
-// Rays per texel sample: options.raysPerSample, fewer where the scene's samples would exceed maxRays (≥ 8).
+// Rays per texel sample: options.raysPerSample, fewer where the scene's samples would exceed maxRays (≥ minRays,
+// and ≥ 2: a map splits its rays between two strategies).
 int skyRaysPerSample(const BakeInputs& in, const SkyLightOptions& options) {
-  return std::max(8, std::min(options.raysPerSample,
+  return std::max(std::max(2, options.minRays), std::min(options.raysPerSample,
                               static_cast<int>(options.maxRays / std::max<size_t>(1, weightedSampleCount(in.texels)))));
 }
 
