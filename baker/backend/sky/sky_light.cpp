@@ -103,9 +103,17 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
   for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
-    forEachSampleLattice(in, ts, options.seed, kSkyStream, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-      slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
-    });
+    // Interleaved over the filter's windows (sample_lattice.h); an environment map's lattices are half the rays
+    // each (cosine and sky strategies).
+    const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
+    const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
+                                           latticeRays);
+    forEachSampleLattice(
+        in, ts, options.seed, kSkyStream,
+        [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+          slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
+        },
+        &interleaved);
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
@@ -162,9 +170,15 @@ void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightma
   for (size_t p = 0; p < in.texels.size() && p < axes[0].size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<L1Vectors> slotValue(ts.slotCount(), L1Vectors{});
-    forEachSampleLattice(in, ts, options.seed, kSkyStream, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-      slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
-    });
+    const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
+    const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
+                                           latticeRays);
+    forEachSampleLattice(
+        in, ts, options.seed, kSkyStream,
+        [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+          slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
+        },
+        &interleaved);
     for (int k = 0; k < 3; ++k)
       addToPage(ts, axes[k][p], options.filterRadius, [&](size_t s) { return slotValue[s][k]; });
   }
