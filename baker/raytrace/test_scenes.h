@@ -1,6 +1,7 @@
 // Hand-built scenes and texel-sample grids for the light-transport tests (header only, test use).
 // Plain geometry with closed-form answers: a quad is two triangles, boxes are six quads.
 #pragma once
+#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
@@ -121,6 +122,24 @@ inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<gl
 }
 
 // A scene with its light-map atlas (pages of pageSize² texels), the ray tracer and the pages' samples.
+// A floor point d from a long wall of height h sees (1 + d/√(d² + h²))/2 of a uniform sky, cosine-weighted
+// (view factor from a strip element to a parallel infinite strip, Hottel's crossed strings).
+inline double skyFractionBesideWall(double d, double h) { return 0.5 * (1.0 + d / std::sqrt(d * d + h * h)); }
+
+// Relative errors value/exact − 1 over a set of texels: their RMS and mean.
+struct RelativeErrors {
+  double squares = 0.0, sum = 0.0;
+  size_t count = 0;
+  void add(double value, double exact) {
+    const double e = value / exact - 1.0;
+    squares += e * e;
+    sum += e;
+    ++count;
+  }
+  double rms() const { return count ? std::sqrt(squares / count) : 0.0; }
+  double mean() const { return count ? sum / count : 0.0; }
+};
+
 struct AtlasedScene {
   Scene scene;
   std::unique_ptr<RayTracer> rayTracer;

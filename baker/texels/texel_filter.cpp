@@ -62,22 +62,29 @@ void SurfaceFilter::forEachAccepted(int x, int y, int r, const std::vector<uint8
                                     const TexelFilterOptions& options, Visit&& visit) const {
   const int W = width_, H = height_;
   const size_t i = static_cast<size_t>(y) * W + x;
-  constexpr int kBitRadius = 8;  // windows up to 17² = 289 positions: 5 words of bits
-  if (options.symmetric && r <= kBitRadius) {
-    // Each window position tested once; a position counts with its mirror image (−dx, −dy), which is position
-    // n − 1 − b in row-major order: half the tests of testing each mirror again, the same set in the same order.
-    const int side = 2 * r + 1, n = side * side;
-    uint64_t bits[5] = {0, 0, 0, 0, 0};
+  // The window's positions inside the page, row by row, with i's own test.
+  auto forEachTested = [&](auto&& f) {
     for (int dy = -r; dy <= r; ++dy) {
       const int yy = y + dy;
       if (yy < 0 || yy >= H) continue;
       for (int dx = -r; dx <= r; ++dx) {
         const int xx = x + dx;
         if (xx < 0 || xx >= W) continue;
-        const int b = (dy + r) * side + (dx + r);
-        if (accepts(i, static_cast<size_t>(yy) * W + xx, dx, dy, valid, options)) bits[b >> 6] |= uint64_t(1) << (b & 63);
+        const size_t j = static_cast<size_t>(yy) * W + xx;
+        if (accepts(i, j, dx, dy, valid, options)) f(j, dx, dy);
       }
     }
+  };
+  constexpr int kBitRadius = 8;  // windows up to 17² = 289 positions: 5 words of bits
+  if (options.symmetric && r <= kBitRadius) {
+    // Each window position tested once; a position counts with its mirror image (−dx, −dy), which is position
+    // n − 1 − b in row-major order: half the tests of testing each mirror again, the same set in the same order.
+    const int side = 2 * r + 1, n = side * side;
+    uint64_t bits[5] = {0, 0, 0, 0, 0};
+    forEachTested([&](size_t, int dx, int dy) {
+      const int b = (dy + r) * side + (dx + r);
+      bits[b >> 6] |= uint64_t(1) << (b & 63);
+    });
     auto has = [&](int b) { return (bits[b >> 6] >> (b & 63)) & 1; };
     for (int b = 0; b < n; ++b) {
       if (!has(b) || !has(n - 1 - b)) continue;
@@ -86,22 +93,14 @@ void SurfaceFilter::forEachAccepted(int x, int y, int r, const std::vector<uint8
     }
     return;
   }
-  for (int dy = -r; dy <= r; ++dy) {
-    const int yy = y + dy;
-    if (yy < 0 || yy >= H) continue;
-    for (int dx = -r; dx <= r; ++dx) {
-      const int xx = x + dx;
-      if (xx < 0 || xx >= W) continue;
-      const size_t j = static_cast<size_t>(yy) * W + xx;
-      if (!accepts(i, j, dx, dy, valid, options)) continue;
-      if (options.symmetric && j != i) {
-        const int mx = x - dx, my = y - dy;
-        if (mx < 0 || my < 0 || mx >= W || my >= H) continue;
-        if (!accepts(i, static_cast<size_t>(my) * W + mx, -dx, -dy, valid, options)) continue;
-      }
-      visit(j, dx, dy);
+  forEachTested([&](size_t j, int dx, int dy) {
+    if (options.symmetric && j != i) {  // windows wider than the bits hold: the mirror tested again
+      const int mx = x - dx, my = y - dy;
+      if (mx < 0 || my < 0 || mx >= W || my >= H) return;
+      if (!accepts(i, static_cast<size_t>(my) * W + mx, -dx, -dy, valid, options)) return;
     }
-  }
+    visit(j, dx, dy);
+  });
 }
 
 namespace {

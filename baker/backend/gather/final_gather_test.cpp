@@ -157,21 +157,16 @@ TEST(FinalGather, InterleavedLatticesBeatIndependentRotationsBesideAWall) {
     o.missRadiance = glm::vec3(1.0f);
     o.interleave = interleave == 1;
     finalGather(at.inputs(), zero, maps, o);
-    double sq = 0.0, sum = 0.0;
-    n = 0;
+    RelativeErrors errors;
     for (size_t p = 0; p < at.pages.size(); ++p) {
       const TexelSamples& ts = at.pages[p];
-      for (size_t t = 0; t < ts.layerSize(); ++t) {
-        if (!ts.valid[t] || ts.primitive[t] != static_cast<uint32_t>(floorPrim)) continue;
-        const double d = ts.positionWeight[t].x, exact = 0.5 * (1.0 + d / std::sqrt(d * d + h * h));
-        const double e = maps[p].texels[t].x / exact - 1.0;
-        sq += e * e;
-        sum += e;
-        ++n;
-      }
+      for (size_t t = 0; t < ts.layerSize(); ++t)
+        if (ts.valid[t] && ts.primitive[t] == static_cast<uint32_t>(floorPrim))
+          errors.add(maps[p].texels[t].x, skyFractionBesideWall(ts.positionWeight[t].x, h));
     }
-    rms[interleave] = std::sqrt(sq / n);
-    bias[interleave] = sum / n;
+    n = errors.count;
+    rms[interleave] = errors.rms();
+    bias[interleave] = errors.mean();
   }
   std::printf("[ figure ] floor beside a wall, %zu texels, 4 rays, 5x5 filter: relative RMS error independent %.4f, "
               "interleaved %.4f; mean error %.5f / %.5f\n", n, rms[0], rms[1], bias[0], bias[1]);

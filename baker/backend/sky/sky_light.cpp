@@ -95,6 +95,16 @@ glm::vec3 skyLightAt(const BakeInputs& in, const glm::vec3& x, const glm::vec3& 
   return glm::vec3(sum / kPi);
 }
 
+// The page's samples with their lattice rotations, interleaved over the filter's windows (sample_lattice.h); an
+// environment map's lattices are half the rays each (the cosine and the sky strategy).
+template <class At>
+void forEachSkySample(const BakeInputs& in, const TexelSamples& ts, const SkyLightOptions& options, int rays, At&& at) {
+  const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
+  const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
+                                         latticeRays);
+  forEachSampleLattice(in, ts, options.seed, kSkyStream, at, &interleaved);
+}
+
 void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLightOptions& options,
                  SkyLightStats* stats) {
   if (!in.scene.environment.present()) return;
@@ -103,17 +113,9 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
   for (size_t p = 0; p < in.texels.size() && p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
-    // Interleaved over the filter's windows (sample_lattice.h); an environment map's lattices are half the rays
-    // each (cosine and sky strategies).
-    const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
-    const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
-                                           latticeRays);
-    forEachSampleLattice(
-        in, ts, options.seed, kSkyStream,
-        [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-          slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
-        },
-        &interleaved);
+    forEachSkySample(in, ts, options, rays, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+      slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
+    });
     addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
@@ -170,15 +172,9 @@ void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightma
   for (size_t p = 0; p < in.texels.size() && p < axes[0].size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     std::vector<L1Vectors> slotValue(ts.slotCount(), L1Vectors{});
-    const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
-    const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
-                                           latticeRays);
-    forEachSampleLattice(
-        in, ts, options.seed, kSkyStream,
-        [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-          slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
-        },
-        &interleaved);
+    forEachSkySample(in, ts, options, rays, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
+      slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
+    });
     for (int k = 0; k < 3; ++k)
       addToPage(ts, axes[k][p], options.filterRadius, [&](size_t s) { return slotValue[s][k]; });
   }

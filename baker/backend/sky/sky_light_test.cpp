@@ -92,7 +92,7 @@ TEST(SkyLight, FloorBesideALongWallMatchesTheViewFactor) {
   BakeInputs in = f.inputs();
   for (float d : {0.25f, 1.0f, 3.0f}) {
     const glm::vec3 v = skyLightAt(in, {d, 0.0f, 0.0f}, {0, 0, 1}, 8192, 0.37, 0.61);
-    const double exact = 0.5 * (1.0 + d / std::sqrt(d * d + h * h));
+    const double exact = skyFractionBesideWall(d, h);
     std::printf("[ figure ] floor %.2f m from a %.0f m wall: sky %.5f, view factor %.5f\n", d, h, v.x, exact);
     EXPECT_NEAR(v.x, exact, 0.005 * exact) << d;
   }
@@ -119,18 +119,12 @@ TEST(SkyLight, InterleavedLatticesBeatIndependentRotationsBesideAWall) {
     o.filterRadius = 2;
     o.interleave = interleave == 1;
     addSkyLight(f.inputs(), maps, o);
-    double sq = 0.0, sum = 0.0;
-    n = 0;
-    for (size_t t = 0; t < maps[0].size(); ++t) {
-      if (!maps[0].valid[t]) continue;
-      const double d = f.pages[0].positionWeight[t].x, exact = 0.5 * (1.0 + d / std::sqrt(d * d + h * h));
-      const double e = maps[0].texels[t].x / exact - 1.0;
-      sq += e * e;
-      sum += e;
-      ++n;
-    }
-    rms[interleave] = std::sqrt(sq / n);
-    mean[interleave] = sum / n;
+    RelativeErrors errors;
+    for (size_t t = 0; t < maps[0].size(); ++t)
+      if (maps[0].valid[t]) errors.add(maps[0].texels[t].x, skyFractionBesideWall(f.pages[0].positionWeight[t].x, h));
+    n = errors.count;
+    rms[interleave] = errors.rms();
+    mean[interleave] = errors.mean();
   }
   std::printf("[ figure ] floor beside a wall, %zu texels, 4 rays, 5x5 filter: relative RMS error independent %.4f, "
               "interleaved %.4f; mean error %.5f / %.5f\n", n, rms[0], rms[1], mean[0], mean[1]);
