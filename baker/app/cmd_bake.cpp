@@ -157,7 +157,8 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(8, 4096))->type_name("N");
   app->add_option("--sky-ray-budget", o.sky.maxRays,
                   "sky and environment: rays over all samples (default 8388608; a large\n"
-                  "page gets fewer per sample, never below 8)")
+                  "page gets fewer per sample, never below 8, or 4 where the final\n"
+                  "gather counts a uniform sky itself)")
       ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
   app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up, centre\ntowards −Z) instead of --sky")
       ->type_name("FILE");
