@@ -5,6 +5,7 @@
 #include "backend/lightmap.h"
 #include "common/progress.h"
 #include "raytrace/ray_tracer.h"
+#include "scene/footprint_albedo.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
 #include "vpl/vpl.h"
@@ -26,6 +27,12 @@ struct BakeInputs {
   const VplSet& vpls;
   VplEvalOptions eval;
   ProgressCallback progress;
+  // The base colour at the hits of the stages that multiply it by the map read there (the clamp compensation,
+  // the final gather), at one map texel's footprint; the pipeline builds one for both. Null: read at the point.
+  const FootprintAlbedo* footprintAlbedo = nullptr;
+  glm::vec3 albedoAtHit(const RayHit& hit) const {
+    return footprintAlbedo ? footprintAlbedo->at(hit.primitive, hit.triangle, hit.barycentric) : rayTracer.albedoAt(hit);
+  }
 };
 
 // A page's map with every texel 0 and invalid, sized like its texel samples.

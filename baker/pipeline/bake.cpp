@@ -152,6 +152,7 @@ struct StagedBake::State {
   std::vector<VplBlock> blocks;
   GlBakeStats glStats;
   InterleaveStats interleaveStats;
+  std::unique_ptr<FootprintAlbedo> footprintAlbedo;  // hit albedo for the compensation and the gather (one for both)
   std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
   std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
   bool compensate = false, overlap = false;
@@ -232,6 +233,10 @@ struct StagedBake::State {
     deriveClamp();
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
+    if (compensate || finalGatherOn) {
+      footprintAlbedo = std::make_unique<FootprintAlbedo>(scene);
+      wholeInputs->footprintAlbedo = footprintAlbedo.get();
+    }
     timed("backend", [&] { planBlocks(); });
   }
 

@@ -121,7 +121,6 @@ inline double polygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<gl
   return std::abs(glm::dot(n, polygonIrradianceVector(x, poly)));
 }
 
-// A scene with its light-map atlas (pages of pageSize² texels), the ray tracer and the pages' samples.
 // A floor point d from a long wall of height h sees (1 + d/√(d² + h²))/2 of a uniform sky, cosine-weighted
 // (view factor from a strip element to a parallel infinite strip, Hottel's crossed strings).
 inline double skyFractionBesideWall(double d, double h) { return 0.5 * (1.0 + d / std::sqrt(d * d + h * h)); }
@@ -140,6 +139,7 @@ struct RelativeErrors {
   double mean() const { return count ? sum / count : 0.0; }
 };
 
+// A scene with its light-map atlas (pages of pageSize² texels), the ray tracer and the pages' samples.
 struct AtlasedScene {
   Scene scene;
   std::unique_ptr<RayTracer> rayTracer;

@@ -14,7 +14,6 @@
 #include "common/log.h"
 #include "common/maths.h"
 #include "common/progress.h"
-#include "scene/footprint_albedo.h"
 #include "texels/texel_filter.h"
 #include "transport/geometry_term.h"
 #include "vpl/sampling.h"
@@ -89,8 +88,7 @@ struct ClampGather::Impl {
   int filterRadius = 0, baseRays = 0;
   size_t rays = 0, refined = 0;
   double traceSeconds = 0.0;
-  FootprintAlbedo albedo;          // the kept hits' base colour at one map texel's footprint (the map read there)
-  Impl(const BakeInputs& i, const ClampCompensationOptions& o) : in(i), options(o), albedo(i.scene) {}
+  Impl(const BakeInputs& i, const ClampCompensationOptions& o) : in(i), options(o) {}
 
   void makeTiles();
   void chooseFilters();
@@ -160,7 +158,7 @@ int ClampGather::Impl::traceSlot(size_t p, size_t s, int count, uint64_t round, 
     const Primitive& prim = scene.primitives[hit.primitive];
     const glm::vec3 emitted = w * scene.emissionAt(prim, hit.triangle, hit.barycentric);
     if (emitted != glm::vec3(0.0f)) out.emitted.push_back({static_cast<uint32_t>(out.hits.size()), emitted});
-    kept.albedo = w * albedo.at(hit.primitive, hit.triangle, hit.barycentric);
+    kept.albedo = w * in.albedoAtHit(hit);
     const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
     kept.map = static_cast<int16_t>(point.map);
     kept.texel = point.texel;

@@ -12,7 +12,6 @@
 #include "common/error.h"
 #include "common/maths.h"
 #include "common/progress.h"
-#include "scene/footprint_albedo.h"
 #include "texels/texel_filter.h"
 #include "vpl/sampling.h"
 
@@ -25,7 +24,7 @@ constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotation
 
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                   const glm::vec3& missRadiance, L1Vectors* tangential, const FootprintAlbedo* albedo) {
+                   const glm::vec3& missRadiance, L1Vectors* tangential) {
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
   const glm::vec3 origin = x + n * rt.epsilon();
@@ -50,8 +49,7 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
       glm::vec3 L = scene.emissionAt(prim, hit.triangle, hit.barycentric);
       const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
       if (point.map >= 0 && static_cast<size_t>(point.map) < maps.size())
-        L += (albedo ? albedo->at(hit.primitive, hit.triangle, hit.barycentric) : rt.albedoAt(hit)) *
-             readLightmap(maps[point.map], maps[point.map].texels, point.texel);
+        L += in.albedoAtHit(hit) * readLightmap(maps[point.map], maps[point.map].texels, point.texel);
       sum += L;
       if (tangential) {
         constexpr float kMinCos = 0.1f;  // as the compensation's: bounds 1/cosθ near the horizon
@@ -79,7 +77,6 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
         direct[p].size() != maps[p].size())
       throw Error(ErrorCode::InvalidData, "", "final gather: page " + std::to_string(p) + " does not match its texels");
   const std::vector<int32_t> mapOfPage = mapIndexOfPages(in.texels);
-  const FootprintAlbedo albedo(in.scene);
   const size_t samples = weightedSampleCount(in.texels);
   int rays = std::max(1, options.rays);
   if (options.rayBudget > 0 && samples > 0)
@@ -105,7 +102,7 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
     forEachSampleLattice(in, ts, options.seed, kGatherStream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
                            slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
-                                                   directional ? &slotVector[s] : nullptr, &albedo);
+                                                   directional ? &slotVector[s] : nullptr);
                          },
                          &interleaved);
     std::vector<glm::vec3>& value = gathered[p];

@@ -23,7 +23,6 @@
 
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
-#include "scene/footprint_albedo.h"
 #include "transport/directional.h"
 
 namespace irbake {
@@ -70,11 +69,10 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
 
 // The gathered term at one point (x on a surface with normal n), `rays` cosine rays with lattice rotation
 // (r1, r2), reading maps; a ray that misses brings missRadiance (for tests and tools).
-// With tangential, also the rays' tangential irradiance vector (finalGather's t). With albedo, the hits' base
-// colour is read at one map texel's footprint (scene/footprint_albedo.h; finalGather does), else at the point.
+// With tangential, also the rays' tangential irradiance vector (finalGather's t). The hits' base colour is
+// in.albedoAtHit's (at one map texel's footprint where the pipeline gives one).
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                   const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr,
-                   const FootprintAlbedo* albedo = nullptr);
+                   const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr);
 
 }  // namespace irbake
