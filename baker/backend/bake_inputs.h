@@ -7,6 +7,7 @@
 #include "raytrace/ray_tracer.h"
 #include "scene/footprint_albedo.h"
 #include "scene/scene.h"
+#include "texels/surface_filter_cache.h"
 #include "texels/texel_samples.h"
 #include "vpl/vpl.h"
 
@@ -33,6 +34,10 @@ struct BakeInputs {
   glm::vec3 albedoAtHit(const RayHit& hit) const {
     return footprintAlbedo ? footprintAlbedo->at(hit.primitive, hit.triangle, hit.barycentric) : rayTracer.albedoAt(hit);
   }
+  // The pages' surface filters, each page's neighbour tests made once for every stage that filters it (the
+  // interleave's mix, the sky, the compensation, the final gather); the pipeline makes one per bake. Null: each
+  // filter makes its own (the same bits).
+  SurfaceFilterCache* surfaceFilters = nullptr;
 };
 
 // A page's map with every texel 0 and invalid, sized like its texel samples.

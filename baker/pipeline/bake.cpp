@@ -154,6 +154,7 @@ struct StagedBake::State {
   InterleaveStats interleaveStats;
   std::unique_ptr<FootprintAlbedo> footprintAlbedo;  // hit albedo for the compensation and the gather (one for both)
   std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
+  std::unique_ptr<SurfaceFilterCache> surfaceFilters;  // each page's neighbour tests, made once for all filters
   std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
   bool compensate = false, overlap = false;
   bool finalGatherOn = false;                       // decided with the backend (FinalGatherMode)
@@ -233,6 +234,8 @@ struct StagedBake::State {
     deriveClamp();
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, eval));
+    surfaceFilters = std::make_unique<SurfaceFilterCache>(texels);
+    wholeInputs->surfaceFilters = surfaceFilters.get();
     if (compensate || finalGatherOn) {
       footprintAlbedo = std::make_unique<FootprintAlbedo>(scene);
       wholeInputs->footprintAlbedo = footprintAlbedo.get();
@@ -315,7 +318,7 @@ struct StagedBake::State {
   // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
   void planBlocks() {
     if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
-    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound);
+    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound, 6, surfaceFilters.get());
     classVpls = classVplSubsets(vpls, interleave);
     const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
     for (size_t c = 0; c < classVpls.size(); ++c)
@@ -463,7 +466,7 @@ struct StagedBake::State {
       }
       std::vector<uint8_t> vplValid = std::move(sums.pages[p].valid);
       sums.pages[p] = {};
-      addMixedClasses(texels[p], interleave, parts, vplValid, pages);
+      addMixedClasses(texels[p], interleave, parts, vplValid, pages, surfaceFilters.get());
     }
     return maps;
   }
@@ -699,6 +702,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   s.skyStage(r.maps, report);
   s.compensationStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
   s.finalGatherStage(r.maps, s.options.directional ? &r.directional : nullptr, report);
+  report["surfaceFilters"] = {{"plans", s.surfaceFilters->plansMade()}, {"fallbacks", s.surfaceFilters->fallbacks()}};
   s.directionalStage(r.directional, report);
   const PostStats post = s.postStage(r.maps);
   s.seconds["bake"] = s.total.seconds();

@@ -1,7 +1,9 @@
 #include "texels/texel_filter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
@@ -138,49 +140,115 @@ std::vector<std::vector<glm::vec3>> SurfaceFilter::apply(const std::vector<const
 
 SurfaceFilterPlan::SurfaceFilterPlan(const SurfaceFilter& filter, const std::vector<uint8_t>& valid,
                                      const TexelFilterOptions& options)
-    : radius_(std::max(0, options.radius)) {
+    : radius_(std::max(0, options.radius)),
+      unchanged_(!(filter.spacing_ > 0.0f)),  // as SurfaceFilter::apply leaves such a page
+      options_(options),
+      hasSample_(filter.hasSample_) {
   if (radius_ > kMaxRadius) throw std::invalid_argument("SurfaceFilterPlan: radius above kMaxRadius");
-  if (!(filter.spacing_ > 0.0f)) radius_ = 0;  // SurfaceFilter::apply returns such a page unchanged
-  const int W = filter.width_, H = filter.height_, r = radius_, side = 2 * r + 1;
-  for (int dy = -r; dy <= r; ++dy)
-    for (int dx = -r; dx <= r; ++dx) {
+  const int W = filter.width_, H = filter.height_, r = radius_;
+  for (int dy = 0; dy <= r; ++dy)  // forward: the rest of the centre's row, then the rows below
+    for (int dx = dy == 0 ? 1 : -r; dx <= r; ++dx) {
       offset_.push_back(static_cast<ptrdiff_t>(dy) * W + dx);
-      weight_.push_back(windowWeight(options, r, dx, dy));
+      dx_.push_back(dx);
+      dy_.push_back(dy);
     }
   const size_t layer = static_cast<size_t>(W) * H;
-  accepted_.assign(layer, {0, 0});
-  if (r == 0) return;
+  forward_.assign(layer, 0);
+  backward_.assign(layer, 0);
+  const int neighbours = static_cast<int>(offset_.size());
+  // Forward: each pair tested once, from its earlier texel.
   tbb::parallel_for(0, H, [&](int y) {
     for (int x = 0; x < W; ++x) {
       const size_t i = static_cast<size_t>(y) * W + x;
-      if (!valid[i] || !filter.hasSample_[i]) continue;  // no bits: passed unchanged
-      filter.forEachAccepted(x, y, r, valid, options, [&](size_t, int dx, int dy) {
-        const int b = (dy + r) * side + (dx + r);
-        accepted_[i][b >> 6] |= uint64_t(1) << (b & 63);
-      });
+      if (i >= valid.size() || !valid[i] || !hasSample_[i]) continue;  // not filtered: passed unchanged
+      uint64_t bits = kFiltered;
+      if (!unchanged_)
+        for (int k = 0; k < neighbours; ++k) {
+          const int xx = x + dx_[k], yy = y + dy_[k];
+          if (xx < 0 || xx >= W || yy >= H) continue;
+          const size_t j = i + offset_[k];
+          if (j < valid.size() && filter.accepts(i, j, dx_[k], dy_[k], valid, options_)) bits |= uint64_t(1) << k;
+        }
+      forward_[i] = bits;
+    }
+  });
+  // Backward: the same pair read from the later texel (accepts() is symmetric for two filtered texels).
+  tbb::parallel_for(0, H, [&](int y) {
+    for (int x = 0; x < W; ++x) {
+      const size_t i = static_cast<size_t>(y) * W + x;
+      if (!(forward_[i] & kFiltered)) continue;
+      uint64_t bits = 0;
+      for (int k = 0; k < neighbours; ++k) {
+        const int xx = x - dx_[k], yy = y - dy_[k];
+        if (xx < 0 || xx >= W || yy < 0) continue;
+        if ((forward_[i - offset_[k]] >> k) & 1) bits |= uint64_t(1) << k;
+      }
+      backward_[i] = bits;
     }
   });
 }
 
+bool SurfaceFilterPlan::serves(const std::vector<uint8_t>& valid, const TexelFilterOptions& options) const {
+  if (std::max(0, options.radius) > radius_ || options.minNormalCos != options_.minNormalCos ||
+      options.maxSpacings != options_.maxSpacings)
+    return false;
+  if (valid.size() != forward_.size()) return false;
+  for (size_t i = 0; i < valid.size(); ++i)
+    if ((valid[i] && hasSample_[i]) != static_cast<bool>(forward_[i] & kFiltered)) return false;
+  return true;
+}
+
 std::vector<glm::vec3> SurfaceFilterPlan::apply(const std::vector<glm::vec3>& values) const {
-  std::vector<glm::vec3> out = values;
-  if (radius_ == 0) return out;
-  const size_t layer = accepted_.size();
+  return apply(values, options_);
+}
+
+std::vector<glm::vec3> SurfaceFilterPlan::apply(const std::vector<glm::vec3>& values, const TexelFilterOptions& options) const {
+  return std::move(apply(std::vector<const std::vector<glm::vec3>*>{&values}, options)[0]);
+}
+
+std::vector<std::vector<glm::vec3>> SurfaceFilterPlan::apply(const std::vector<const std::vector<glm::vec3>*>& sets,
+                                                             const TexelFilterOptions& options) const {
+  std::vector<std::vector<glm::vec3>> out;
+  for (const std::vector<glm::vec3>* values : sets) out.push_back(*values);
+  const int r = std::max(0, options.radius);
+  if (r > radius_) throw std::invalid_argument("SurfaceFilterPlan: radius above the plan's");
+  if (r == 0 || unchanged_) return out;
+  // The window of radius r inside the plan's: its forward neighbours and their weights (the mirror's alike).
+  uint64_t window = 0;
+  std::array<float, 64> weight{};
+  for (size_t k = 0; k < offset_.size(); ++k)
+    if (std::abs(dx_[k]) <= r && dy_[k] <= r) {
+      window |= uint64_t(1) << k;
+      weight[k] = windowWeight(options, r, dx_[k], dy_[k]);
+    }
+  const float centreWeight = windowWeight(options, r, 0, 0);
+  const bool symmetric = options.symmetric;
+  const size_t layer = forward_.size(), setCount = sets.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<glm::vec3> sum(setCount);
     for (size_t i = range.begin(); i != range.end(); ++i) {
-      // A filtered texel always accepts itself, so no bits means: not filtered, value passes unchanged.
-      if ((accepted_[i][0] | accepted_[i][1]) == 0) continue;
-      glm::vec3 sum(0.0f);
+      if (!(forward_[i] & kFiltered)) continue;
+      uint64_t ahead = forward_[i] & window, behind = backward_[i] & window;
+      if (symmetric) ahead = behind = ahead & behind;
+      std::fill(sum.begin(), sum.end(), glm::vec3(0.0f));
       float count = 0.0f;
-      // Bits in window order (row by row), so the sums round exactly as SurfaceFilter::apply's.
-      for (int word = 0; word < 2; ++word)
-        for (uint64_t bits = accepted_[i][word]; bits != 0; bits &= bits - 1) {
-          const int b = 64 * word + __builtin_ctzll(bits);
-          const float w = weight_[b];
-          sum += w * values[static_cast<size_t>(static_cast<ptrdiff_t>(i) + offset_[b])];
-          count += w;
-        }
-      out[i] = sum / count;
+      auto add = [&](size_t j, float w) {
+        for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
+        count += w;
+      };
+      // Row-major window order, as SurfaceFilter::apply sums (so the sums round alike): the mirror images of
+      // the forward neighbours last to first, the centre, the forward neighbours.
+      for (uint64_t bits = behind; bits != 0;) {
+        const int k = 63 - __builtin_clzll(bits);
+        bits &= ~(uint64_t(1) << k);
+        add(i - offset_[k], weight[k]);
+      }
+      add(i, centreWeight);
+      for (uint64_t bits = ahead; bits != 0; bits &= bits - 1) {
+        const int k = __builtin_ctzll(bits);
+        add(i + offset_[k], weight[k]);
+      }
+      for (size_t s = 0; s < setCount; ++s) out[s][i] = sum[s] / count;
     }
   });
   return out;

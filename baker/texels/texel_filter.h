@@ -60,23 +60,40 @@ class SurfaceFilter {
   float spacing_ = 0.0f;
 };
 
-// A SurfaceFilter's neighbour tests for one set of options and one validity mask, made once (a bit per window
-// position per texel): a page filtered many times with the same window (the compensation's sweeps: 5 on
-// Sponza's 3.2M-texel page) then pays only for the sums, not for a normal, a distance and a square root per
-// neighbour. apply() gives the bits of SurfaceFilter::apply with the same arguments. Costs 16 bytes per texel.
+// A SurfaceFilter's neighbour tests over one validity mask, made once for every window up to a radius: a page
+// filtered several times (the interleave's mix, the sky, the compensation's sweeps, the final gather: four
+// filters, 250 tests per texel on Sponza's 3.2M-texel page) then pays only for the sums. The test is symmetric
+// (normals and distance compare the same both ways, and both texels must be valid), so each pair of texels is
+// tested once: 60 tests per texel at radius 5. apply() gives the bits of SurfaceFilter::apply with the same
+// arguments for any radius up to the plan's, symmetric or not, box or tent. Costs 16 bytes per texel.
 class SurfaceFilterPlan {
  public:
-  static constexpr int kMaxRadius = 5;  // (2r + 1)² ≤ 128 window positions per texel
-  // options.radius ≤ kMaxRadius (std::invalid_argument otherwise). The plan copies what it needs from filter.
+  static constexpr int kMaxRadius = 5;  // (2r + 1)² − 1 = 120 neighbours: 60 forward, a 64-bit word each way
+  // Tests every window position up to options.radius ≤ kMaxRadius (std::invalid_argument otherwise) with
+  // options' thresholds; options.symmetric and options.tent are only apply()'s default. Copies what it needs.
   SurfaceFilterPlan(const SurfaceFilter& filter, const std::vector<uint8_t>& valid, const TexelFilterOptions& options);
+  int radius() const { return radius_; }
+  // Whether apply(…, options) gives SurfaceFilter::apply(…, valid, options): the same thresholds, a radius
+  // within the plan's, and the same texels filtered (valid with a sample: masks may differ where none is).
+  bool serves(const std::vector<uint8_t>& valid, const TexelFilterOptions& options) const;
+  // With the options the plan was made with, or with options as served (serves()).
   std::vector<glm::vec3> apply(const std::vector<glm::vec3>& values) const;
+  std::vector<glm::vec3> apply(const std::vector<glm::vec3>& values, const TexelFilterOptions& options) const;
+  // options as served (serves()); several value sets share the window walk, each gets its one-set bits.
+  std::vector<std::vector<glm::vec3>> apply(const std::vector<const std::vector<glm::vec3>*>& sets,
+                                            const TexelFilterOptions& options) const;
 
  private:
+  static constexpr uint64_t kFiltered = uint64_t(1) << 63;  // in forward_: the texel is filtered (valid, sampled)
   int radius_ = 0;
-  std::vector<std::array<uint64_t, 2>> accepted_;  // per texel: bit b = window position b (row-major) counts;
-                                                   // none for texels not filtered (invalid, no sample)
-  std::vector<ptrdiff_t> offset_;                  // per window position: dy·width + dx
-  std::vector<float> weight_;                      // per window position: 1, or the tent weight
+  bool unchanged_ = false;  // the page has no spacing: every filter returns it as it is
+  TexelFilterOptions options_;
+  std::vector<uint8_t> hasSample_;  // the filter's, per texel (serves())
+  // Per texel, bit k: the pair with forward neighbour k (window positions after the centre, row-major) counts;
+  // backward_ bit k: the pair with its mirror image (−dx, −dy) counts. Symmetric windows take forward & backward.
+  std::vector<uint64_t> forward_, backward_;
+  std::vector<ptrdiff_t> offset_;  // per forward neighbour: dy·width + dx
+  std::vector<int> dx_, dy_;       // per forward neighbour
 };
 
 // One-off forms of the above.

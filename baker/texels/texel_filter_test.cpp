@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "texels/surface_filter_cache.h"
 #include "texels/texel_filter.h"
 
 using namespace irbake;
@@ -72,7 +73,10 @@ TEST(SurfaceFilterPlan, GivesTheBitsOfTheFilterItWasMadeFrom) {
   for (size_t i = 30; i < 40; ++i) valid[i] = 0;
   valid[300] = 0;
   const SurfaceFilter filter(ts);
-  for (int radius : {1, 4, 5})
+  TexelFilterOptions widestOptions;
+  widestOptions.radius = SurfaceFilterPlan::kMaxRadius;
+  const SurfaceFilterPlan widest(filter, valid, widestOptions);
+  for (int radius : {1, 2, 3, 4, 5})
     for (int mode = 0; mode < 4; ++mode) {
       const bool tent = mode & 1, symmetric = mode & 2;
       TexelFilterOptions o;
@@ -83,6 +87,10 @@ TEST(SurfaceFilterPlan, GivesTheBitsOfTheFilterItWasMadeFrom) {
       const std::vector<glm::vec3> planned = SurfaceFilterPlan(filter, valid, o).apply(values);
       ASSERT_EQ(direct.size(), planned.size());
       EXPECT_EQ(std::memcmp(direct.data(), planned.data(), direct.size() * sizeof(glm::vec3)), 0) << radius << mode;
+      // One plan at the widest radius serves every narrower window, either mode (the bake's shared plans).
+      ASSERT_TRUE(widest.serves(valid, o));
+      const std::vector<glm::vec3> fromWidest = widest.apply(values, o);
+      EXPECT_EQ(std::memcmp(direct.data(), fromWidest.data(), direct.size() * sizeof(glm::vec3)), 0) << radius << mode;
       EXPECT_EQ(planned[300], values[300]);  // invalid: unchanged
       // Texel (11, 12) is beside the fold: its window holds texels of the tilted half, which must not count;
       // symmetric, their mirror images (dx < 0) do not count either, so the window is its own column.
@@ -100,6 +108,59 @@ TEST(SurfaceFilterPlan, GivesTheBitsOfTheFilterItWasMadeFrom) {
   TexelFilterOptions tooWide;
   tooWide.radius = SurfaceFilterPlan::kMaxRadius + 1;
   EXPECT_THROW(SurfaceFilterPlan(filter, valid, tooWide), std::invalid_argument);
+  EXPECT_FALSE(widest.serves(valid, tooWide));
+  EXPECT_THROW(widest.apply(values, tooWide), std::invalid_argument);
+  // Another mask or other thresholds: the plan does not serve them.
+  std::vector<uint8_t> other = valid;
+  other[77] = 0;
+  EXPECT_FALSE(widest.serves(other, widestOptions));
+  TexelFilterOptions looser = widestOptions;
+  looser.minNormalCos = 0.5f;
+  EXPECT_FALSE(widest.serves(valid, looser));
+}
+
+// The bake's cache: every request gives SurfaceFilter's bits; one plan per page, made once; a mask the plan was
+// not made for is filtered without it (counted), with the same bits.
+TEST(SurfaceFilterCache, GivesTheFiltersBitsWithOnePlanPerPage) {
+  std::vector<TexelSamples> pages = {flatPage(20), flatPage(16)};
+  pages[1].positionWeight[40].z = 0.3f;  // a texel off the plane: its neighbours must not take it
+  SurfaceFilterCache cache(pages);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> value(0.0f, 1.0f);
+  for (size_t p = 0; p < pages.size(); ++p) {
+    const TexelSamples& ts = pages[p];
+    std::vector<glm::vec3> values(ts.layerSize());
+    for (auto& v : values) v = glm::vec3(value(rng), value(rng), value(rng));
+    EXPECT_EQ(cache.spacing(ts), SurfaceFilter(ts).spacing());
+    for (int radius : {1, 3, 5, 6})
+      for (bool symmetric : {false, true}) {
+        TexelFilterOptions o;
+        o.radius = radius;
+        o.symmetric = symmetric;
+        o.tent = !symmetric;
+        const std::vector<glm::vec3> direct = SurfaceFilter(ts).apply(values, ts.valid, o);
+        const std::vector<glm::vec3> cached = cache.apply(ts, values, ts.valid, o);
+        EXPECT_EQ(std::memcmp(direct.data(), cached.data(), direct.size() * sizeof(glm::vec3)), 0) << p << radius;
+      }
+  }
+  EXPECT_EQ(cache.plansMade(), 2u);
+  EXPECT_EQ(cache.fallbacks(), 4u);  // radius 6, both modes, both pages: wider than the plans
+  std::vector<uint8_t> holes = pages[0].valid;
+  holes[33] = 0;
+  TexelFilterOptions o;
+  o.radius = 2;
+  std::vector<glm::vec3> values(pages[0].layerSize(), glm::vec3(1.0f));
+  values[34] = glm::vec3(5.0f);
+  const std::vector<glm::vec3> direct = SurfaceFilter(pages[0]).apply(values, holes, o);
+  const std::vector<glm::vec3> cached = cache.apply(pages[0], values, holes, o);
+  EXPECT_EQ(std::memcmp(direct.data(), cached.data(), direct.size() * sizeof(glm::vec3)), 0);
+  EXPECT_EQ(cache.fallbacks(), 5u);
+  EXPECT_EQ(cache.plansMade(), 2u);
+  // A page the cache does not hold is filtered all the same.
+  const TexelSamples stranger = flatPage(8);
+  const std::vector<glm::vec3> strangerValues(stranger.layerSize(), glm::vec3(2.0f));
+  const std::vector<glm::vec3> alone = cache.apply(stranger, strangerValues, stranger.valid, o);
+  EXPECT_FLOAT_EQ(alone[10].x, 2.0f);
 }
 
 // A light gradient running into a contact line (the texels left of x = 8 invalid, as under a wall standing

@@ -14,7 +14,7 @@
 #include "common/log.h"
 #include "common/maths.h"
 #include "common/progress.h"
-#include "texels/texel_filter.h"
+#include "texels/surface_filter_cache.h"
 #include "transport/geometry_term.h"
 #include "vpl/sampling.h"
 
@@ -84,7 +84,13 @@ struct ClampGather::Impl {
   std::vector<Tile> tiles;         // kept hits, by tile of slots
   std::vector<std::vector<uint16_t>> raysOf;  // rays traced per slot
   std::vector<int> radii;          // residual filter radius per page
-  std::vector<std::unique_ptr<SurfaceFilter>> filters;
+  // The bake's surface filters (in.surfaceFilters), or this gather's own where the inputs have none.
+  mutable std::unique_ptr<SurfaceFilterCache> ownFilters;
+  SurfaceFilterCache* filters() const {
+    if (in.surfaceFilters) return in.surfaceFilters;
+    if (!ownFilters) ownFilters = std::make_unique<SurfaceFilterCache>(in.texels);
+    return ownFilters.get();
+  }
   int filterRadius = 0, baseRays = 0;
   size_t rays = 0, refined = 0;
   double traceSeconds = 0.0;
@@ -115,17 +121,14 @@ void ClampGather::Impl::makeTiles() {
 void ClampGather::Impl::chooseFilters() {
   const float clampRadius = 1.0f / std::sqrt(bound);
   radii.assign(in.texels.size(), 0);
-  filters.resize(in.texels.size());
   for (size_t p = 0; p < in.texels.size(); ++p) {
     const std::optional<int>& fixedRadius = options.filterRadius;
     if (fixedRadius ? *fixedRadius <= 0 : baseRays >= 32) continue;
-    auto filter = std::make_unique<SurfaceFilter>(in.texels[p]);
-    const float h = filter->spacing();
+    const float h = filters()->spacing(in.texels[p]);
     radii[p] = fixedRadius ? *fixedRadius
                : h > 0.0f ? static_cast<int>(std::min(4.0f, std::floor(0.05f * clampRadius / h)))
                           : 0;
     filterRadius = std::max(filterRadius, radii[p]);
-    if (radii[p] > 0) filters[p] = std::move(filter);
   }
 }
 
@@ -280,7 +283,6 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       throw Error(ErrorCode::InvalidData, "", "clamp compensation: map " + std::to_string(p) + " does not match its texel page");
   const std::vector<Tile>& tiles = g.tiles;
   const auto& radii = g.radii;
-  const auto& filters = g.filters;
 
   // Sweeps: residual per slot from the current maps, folded into texels; the next sweep reads base + residual.
   // The base is maps[p].texels itself (unchanged until the end): no third copy of every page.
@@ -302,13 +304,13 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   bool tailAdded = false;
   constexpr int kFirstTailSweep = 3;  // at least 4 sweeps before the tail: the ratio creeps up over the first few
   std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
-  // The filter's neighbour tests, made once for all sweeps (they were 3/4 of a sweep's time on Sponza).
+  // The filter's neighbour tests, made once for all sweeps (they were 3/4 of a sweep's time on Sponza) and
+  // shared with the bake's other filters (SurfaceFilterCache).
   std::vector<TexelFilterOptions> filterOptions(maps.size());
-  std::vector<std::unique_ptr<SurfaceFilterPlan>> plans(maps.size());
+  std::vector<const SurfaceFilterPlan*> plans(maps.size(), nullptr);
   for (size_t p = 0; p < maps.size(); ++p) {
     filterOptions[p].radius = radii[p];
-    if (!filters[p] || radii[p] > SurfaceFilterPlan::kMaxRadius || options.sweeps < 2) continue;
-    plans[p] = std::make_unique<SurfaceFilterPlan>(*filters[p], maps[p].valid, filterOptions[p]);
+    if (radii[p] > 0) plans[p] = g.filters()->plan(in.texels[p], maps[p].valid, filterOptions[p]);
   }
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
@@ -340,11 +342,11 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       });
       std::vector<glm::vec3> filtered;
       if (plans[p]) {
-        filtered = plans[p]->apply(residual);
-      } else if (filters[p]) {
-        filtered = filters[p]->apply(residual, m.valid, filterOptions[p]);
+        filtered = plans[p]->apply(residual, filterOptions[p]);
+      } else if (radii[p] > 0) {
+        filtered = filterOnSurface(g.filters(), ts, residual, m.valid, filterOptions[p]);
       }
-      const std::vector<glm::vec3>& residualUsed = filters[p] ? filtered : residual;
+      const std::vector<glm::vec3>& residualUsed = radii[p] > 0 ? filtered : residual;
       const std::vector<glm::vec3>& baseMap = base(p);
       for (size_t t = 0; t < layer; ++t) {
         if (t < m.valid.size() && m.valid[t]) {
@@ -449,11 +451,11 @@ void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& a
           texelMean(ts, t, [&](size_t s) { return slotVector[k][p][s]; }, texelVector[k][t]);
       });
     }
-    if (g.filters[p]) {  // the residual's filter, all three axes in one pass
+    if (g.radii[p] > 0) {  // the residual's filter, all three axes in one pass
       TexelFilterOptions fo;
       fo.radius = g.radii[p];
       std::vector<std::vector<glm::vec3>> filtered =
-          g.filters[p]->apply({&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
+          filterOnSurface(g.filters(), in.texels[p], {&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
       for (int k = 0; k < 3; ++k) texelVector[k] = std::move(filtered[k]);
     }
     for (int k = 0; k < 3; ++k) {

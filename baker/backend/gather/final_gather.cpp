@@ -12,7 +12,7 @@
 #include "common/error.h"
 #include "common/maths.h"
 #include "common/progress.h"
-#include "texels/texel_filter.h"
+#include "texels/surface_filter_cache.h"
 #include "vpl/sampling.h"
 
 namespace irbake {
@@ -114,7 +114,7 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
     if (options.filterRadius > 0) {
       TexelFilterOptions fo;
       fo.radius = options.filterRadius;
-      value = filterOnSurface(ts, value, valid, fo);
+      value = filterOnSurface(in.surfaceFilters, ts, value, valid, fo);
     }
     if (directional) {
       std::array<std::vector<glm::vec3>, 3> axes;
@@ -127,7 +127,8 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
       if (options.filterRadius > 0) {  // the map's filter, the three axes in one pass
         TexelFilterOptions fo;
         fo.radius = options.filterRadius;
-        std::vector<std::vector<glm::vec3>> filtered = SurfaceFilter(ts).apply({&axes[0], &axes[1], &axes[2]}, valid, fo);
+        std::vector<std::vector<glm::vec3>> filtered =
+            filterOnSurface(in.surfaceFilters, ts, {&axes[0], &axes[1], &axes[2]}, valid, fo);
         for (int k = 0; k < 3; ++k) axes[k] = std::move(filtered[k]);
       }
       for (int k = 0; k < 3; ++k) gatheredL1[k][p] = std::move(axes[k]);

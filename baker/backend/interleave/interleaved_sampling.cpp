@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "texels/texel_filter.h"
+#include "texels/surface_filter_cache.h"
 
 namespace irbake {
 
@@ -42,10 +42,10 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
   return out;
 }
 
-int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN) {
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN, SurfaceFilterCache* filters) {
   std::vector<float> spacings;
   for (const TexelSamples& ts : pages)
-    if (float h = texelSpacing(ts); h > 0.0f) spacings.push_back(h);
+    if (float h = texelSpacing(filters, ts); h > 0.0f) spacings.push_back(h);
   if (spacings.empty()) return 1;
   std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
   const float h = spacings[spacings.size() / 2];
@@ -98,7 +98,8 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec
 }
 
 void addMixedClasses(const TexelSamples& page, int n, const std::vector<const std::vector<glm::vec3>*>& vplParts,
-                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps) {
+                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps,
+                     SurfaceFilterCache* filters) {
   std::vector<std::vector<glm::vec3>> mixed;
   if (n > 1) {
     TexelFilterOptions fo;
@@ -106,7 +107,7 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<const st
     fo.tent = true;
     fo.symmetric = false;  // here every class must keep its share of the window, which mirror pairs do not
                            // (the emitter-over-floor test: bias −0.22% at the page border with them)
-    mixed = SurfaceFilter(page).apply(vplParts, vplValid, fo);
+    mixed = filterOnSurface(filters, page, vplParts, vplValid, fo);
   }
   for (size_t c = 0; c < maps.size() && c < vplParts.size(); ++c) {
     const std::vector<glm::vec3>& added = n > 1 ? mixed[c] : *vplParts[c];
@@ -179,7 +180,7 @@ std::vector<Lightmap> bakeInterleaved(const BakeInputs& in, int n, const VplBack
   }
 
   for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p)
-    addMixedClasses(in.texels[p], n, vplPart[p], vplValid[p], maps[p]);
+    addMixedClasses(in.texels[p], n, {&vplPart[p]}, vplValid[p], {&maps[p]}, in.surfaceFilters);
   if (stats) {
     stats->classes = m;
     stats->backendCalls = calls;

@@ -38,7 +38,9 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
 // 6144 paths (r_c = 10.6 cm) → 6. Session 6, against Cycles in our atlas: 6×6 classes with 6144 paths
 // cost less than 4×4 with 4096 and are more accurate (sample box 1.99 → 1.63%, McGuire 1.79 → 1.65%),
 // while 8×8 blurs (4096 paths: 2.24%; docs/accuracy.md).
-int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 6);
+// filters: the bake's surface filters (their spacings), or null.
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 6,
+                     SurfaceFilterCache* filters = nullptr);
 
 // The VPLs of each of the n² classes (class c = cx + n·cy): per bounce the c-th contiguous chunk in path
 // order, power × bounce count / chunk count. n ≤ 1: one class with every VPL, unscaled, in path order.
@@ -50,8 +52,10 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec
                      const std::vector<uint8_t>& vplValid, Lightmap& map);
 // The same for several coefficients of one page (the map and its directional L1 pages): vplParts[c] into
 // *maps[c], each mixed on its own, the filter's neighbour tests shared (the bits of one call per coefficient).
+// filters: the bake's surface filters (page must be one of their pages to use them), or null.
 void addMixedClasses(const TexelSamples& page, int n, const std::vector<const std::vector<glm::vec3>*>& vplParts,
-                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps);
+                     const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps,
+                     SurfaceFilterCache* filters = nullptr);
 
 // n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
 std::vector<Lightmap> bakeInterleaved(const BakeInputs& inputs, int n, const VplBackend& backend,

@@ -8,7 +8,7 @@
 #include "backend/sample_lattice.h"
 #include "common/maths.h"
 #include "common/progress.h"
-#include "texels/texel_filter.h"
+#include "texels/surface_filter_cache.h"
 #include "vpl/sampling.h"
 
 namespace irbake {
@@ -45,7 +45,7 @@ void visitEnvironmentSamples(const Environment& sky, const RayTracer& rt, const 
 // Adds per-slot values to a page: averaged over each valid texel's samples, filtered on the surface
 // (filterRadius > 0), added where the page is valid.
 template <class SlotValue>
-void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotValue&& slotValue) {
+void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SurfaceFilterCache* filters, SlotValue&& slotValue) {
   std::vector<glm::vec3> texelValue(ts.layerSize(), glm::vec3(0.0f));
   std::vector<uint8_t> valid(ts.layerSize(), 0);
   for (size_t t = 0; t < ts.layerSize(); ++t) {
@@ -58,7 +58,7 @@ void addToPage(const TexelSamples& ts, Lightmap& page, int filterRadius, SlotVal
   if (filterRadius > 0) {
     TexelFilterOptions fo;
     fo.radius = filterRadius;
-    texelValue = filterOnSurface(ts, texelValue, valid, fo);
+    texelValue = filterOnSurface(filters, ts, texelValue, valid, fo);
   }
   for (size_t t = 0; t < ts.layerSize(); ++t)
     if (valid[t]) page.texels[t] += texelValue[t];
@@ -116,7 +116,7 @@ void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLig
     forEachSkySample(in, ts, options, rays, [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
       slotValue[s] = skyLightAt(in, x, n, rays, r1, r2);
     });
-    addToPage(ts, maps[p], options.filterRadius, [&](size_t s) { return slotValue[s]; });
+    addToPage(ts, maps[p], options.filterRadius, in.surfaceFilters, [&](size_t s) { return slotValue[s]; });
   }
   if (stats) {
     stats->rays = weightedSampleCount(in.texels) * static_cast<size_t>(rays);  // every weighted sample traces `rays`
@@ -176,7 +176,7 @@ void addSkyLightDirectional(const BakeInputs& in, std::array<std::vector<Lightma
       slotValue[s] = skyDirectionalAt(in, x, n, rays, r1, r2);
     });
     for (int k = 0; k < 3; ++k)
-      addToPage(ts, axes[k][p], options.filterRadius, [&](size_t s) { return slotValue[s][k]; });
+      addToPage(ts, axes[k][p], options.filterRadius, in.surfaceFilters, [&](size_t s) { return slotValue[s][k]; });
   }
 }
 
