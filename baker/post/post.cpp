@@ -5,6 +5,8 @@
 #include <string>
 
 #include "common/error.h"
+#include "common/log.h"
+#include "common/progress.h"
 
 namespace irbake {
 
@@ -38,14 +40,21 @@ void checkFinite(const Lightmap& map, const std::string& what) {
 
 PostStats postProcess(const Scene& scene, std::vector<Lightmap>& maps, const PostOptions& options) {
   PostStats stats;
+  Stopwatch watch;
   for (const auto& m : maps) checkFinite(m, "backend output");
   if (options.dilate)
     for (auto& m : maps) stats.texelsFilled += dilate(m, options.dilation);
+  const double dilated = watch.seconds();
   if (options.stitchSeams) {
     std::vector<SeamEdge> seams = findSeams(scene, options.seams);
+    const double found = watch.seconds();
     stats.seamEdges = seams.size();
     stats.seamMismatchBefore = seamMismatch(maps, seams, options.seams);
+    const double measured = watch.seconds();
     stats.seamMismatchAfter = stitchSeams(maps, seams, options.seams);
+    log::debug("post: dilate " + std::to_string(dilated) + " s, find seams " + std::to_string(found - dilated) +
+               " s, mismatch " + std::to_string(measured - found) + " s, stitch " +
+               std::to_string(watch.seconds() - measured) + " s");
   }
   for (const auto& m : maps) checkFinite(m, "post-processed light map");
   return stats;
