@@ -224,30 +224,47 @@ std::vector<std::vector<glm::vec3>> SurfaceFilterPlan::apply(const std::vector<c
   const float centreWeight = windowWeight(options, r, 0, 0);
   const bool symmetric = options.symmetric;
   const size_t layer = forward_.size(), setCount = sets.size();
+  // Calls add(j, w) for texel i's window in row-major order, as SurfaceFilter::apply sums (so the sums round
+  // alike): the mirror images of the forward neighbours last to first, the centre, the forward neighbours.
+  auto forEachInWindow = [&](size_t i, auto&& add) {
+    uint64_t ahead = forward_[i] & window, behind = backward_[i] & window;
+    if (symmetric) ahead = behind = ahead & behind;
+    for (uint64_t bits = behind; bits != 0;) {
+      const int k = 63 - __builtin_clzll(bits);
+      bits &= ~(uint64_t(1) << k);
+      add(i - offset_[k], weight[k]);
+    }
+    add(i, centreWeight);
+    for (uint64_t bits = ahead; bits != 0; bits &= bits - 1) {
+      const int k = __builtin_ctzll(bits);
+      add(i + offset_[k], weight[k]);
+    }
+  };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    if (setCount == 1) {  // the common case, without the per-set loop
+      const std::vector<glm::vec3>& values = *sets[0];
+      std::vector<glm::vec3>& result = out[0];
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        if (!(forward_[i] & kFiltered)) continue;
+        glm::vec3 sum(0.0f);
+        float count = 0.0f;
+        forEachInWindow(i, [&](size_t j, float w) {
+          sum += w * values[j];
+          count += w;
+        });
+        result[i] = sum / count;
+      }
+      return;
+    }
     std::vector<glm::vec3> sum(setCount);
     for (size_t i = range.begin(); i != range.end(); ++i) {
       if (!(forward_[i] & kFiltered)) continue;
-      uint64_t ahead = forward_[i] & window, behind = backward_[i] & window;
-      if (symmetric) ahead = behind = ahead & behind;
       std::fill(sum.begin(), sum.end(), glm::vec3(0.0f));
       float count = 0.0f;
-      auto add = [&](size_t j, float w) {
+      forEachInWindow(i, [&](size_t j, float w) {
         for (size_t s = 0; s < setCount; ++s) sum[s] += w * (*sets[s])[j];
         count += w;
-      };
-      // Row-major window order, as SurfaceFilter::apply sums (so the sums round alike): the mirror images of
-      // the forward neighbours last to first, the centre, the forward neighbours.
-      for (uint64_t bits = behind; bits != 0;) {
-        const int k = 63 - __builtin_clzll(bits);
-        bits &= ~(uint64_t(1) << k);
-        add(i - offset_[k], weight[k]);
-      }
-      add(i, centreWeight);
-      for (uint64_t bits = ahead; bits != 0; bits &= bits - 1) {
-        const int k = __builtin_ctzll(bits);
-        add(i + offset_[k], weight[k]);
-      }
+      });
       for (size_t s = 0; s < setCount; ++s) out[s][i] = sum[s] / count;
     }
   });
