@@ -3,11 +3,14 @@
 #include "common/error.h"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+
+#include <tbb/parallel_for.h>
 
 namespace irbake::atlas {
 namespace {
@@ -276,7 +279,8 @@ struct Placement {
 
 // Packs masks (in order) into pages of the given width; returns the total page area.
 double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<size_t>& order, int width, int maxPage,
-               int padding, double giveUpArea, std::vector<Placement>& placement, std::vector<PageGrid>& pages) {
+               int padding, const std::atomic<double>& giveUp, std::vector<Placement>& placement,
+               std::vector<PageGrid>& pages) {
   pages.clear();
   placement.assign(masks.size(), Placement{});
   for (size_t c : order) {
@@ -304,10 +308,11 @@ double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<
         break;
       }
     }
-    // Pages only grow: once this trial is larger than the best one so far it cannot win.
+    // Pages only grow: once this trial is larger than a finished one it cannot win (strictly larger: an equal
+    // area may still win the tie, which goes to the narrower width whatever order the trials finish in).
     double partial = 0.0;
     for (const PageGrid& g : pages) partial += double(roundUp4(g.usedWidth())) * roundUp4(g.usedHeight());
-    if (partial >= giveUpArea) return 1e300;
+    if (partial > giveUp.load(std::memory_order_relaxed)) return 1e300;
   }
   double area = 0.0;
   for (const PageGrid& g : pages) area += double(roundUp4(g.usedWidth())) * roundUp4(g.usedHeight());
@@ -377,17 +382,26 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
     std::sort(widths.begin(), widths.end());
     widths.erase(std::unique(widths.begin(), widths.end()), widths.end());
   }
-  double bestArea = 1e300;
-  std::vector<Placement> best, placement;
-  std::vector<PageGrid> grids, bestGrids;
-  for (int w : widths) {
-    const double area = packAll(masks, order, w, limit, pad, bestArea, placement, grids);
-    if (area < bestArea) {
-      bestArea = area;
-      best = placement;
-      bestGrids = grids;
+  // The trials run in parallel (Sponza's 6,685 charts: 1.2 s one after another); a finished trial's area lets
+  // the others give up early; the smallest area wins, the narrowest width on a tie.
+  struct Trial {
+    double area = 1e300;
+    std::vector<Placement> placement;
+    std::vector<PageGrid> grids;
+  };
+  std::vector<Trial> trials(widths.size());
+  std::atomic<double> finished{1e300};
+  tbb::parallel_for(size_t(0), widths.size(), [&](size_t i) {
+    Trial& t = trials[i];
+    t.area = packAll(masks, order, widths[i], limit, pad, finished, t.placement, t.grids);
+    for (double seen = finished.load(); t.area < seen && !finished.compare_exchange_weak(seen, t.area);) {
     }
-  }
+  });
+  size_t winner = 0;
+  for (size_t i = 1; i < trials.size(); ++i)
+    if (trials[i].area < trials[winner].area) winner = i;
+  const std::vector<Placement>& best = trials[winner].placement;
+  const std::vector<PageGrid>& bestGrids = trials[winner].grids;
   for (const PageGrid& g : bestGrids) result.pages.push_back({roundUp4(g.usedWidth()), roundUp4(g.usedHeight())});
   result.chartPage.resize(charts.size());
   for (size_t i = 0; i < charts.size(); ++i) {

@@ -177,6 +177,10 @@ TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, 
   std::vector<glm::vec2> nearestBary(layer);
 
   const glm::vec2 size(width, height);
+  // The page in bands of rows, one task each; every band takes the triangles that reach it in scene order, so
+  // each texel sees its triangles in the order of a single pass ("first wins" and the nearest point alike).
+  std::vector<RasterTriangle> triangles;
+  std::vector<glm::ivec4> boxes;  // texel bounds x0, x1, y0, y1 (inclusive)
   for (uint32_t pi = 0; pi < scene.primitives.size(); ++pi) {
     const Primitive& prim = scene.primitives[pi];
     if (prim.lightmap.page != page || prim.uv1.size() != prim.positions.size()) continue;
@@ -186,10 +190,26 @@ TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, 
       t.area2 = cross2(t.t1 - t.t0, t.t2 - t.t0);
       if (!(std::abs(t.area2) > 1e-12f)) continue;  // no texel area: nothing to rasterise
       glm::vec2 lo = glm::min(t.t0, glm::min(t.t1, t.t2)), hi = glm::max(t.t0, glm::max(t.t1, t.t2));
-      int x0 = std::max(0, int(std::floor(lo.x))), x1 = std::min(width - 1, int(std::floor(hi.x)));
-      int y0 = std::max(0, int(std::floor(lo.y))), y1 = std::min(height - 1, int(std::floor(hi.y)));
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) {
+      const glm::ivec4 box(std::max(0, int(std::floor(lo.x))), std::min(width - 1, int(std::floor(hi.x))),
+                           std::max(0, int(std::floor(lo.y))), std::min(height - 1, int(std::floor(hi.y))));
+      if (box.x > box.y || box.z > box.w) continue;
+      triangles.push_back(t);
+      boxes.push_back(box);
+    }
+  }
+  constexpr int kBandRows = 32;
+  const int bands = (height + kBandRows - 1) / kBandRows;
+  std::vector<std::vector<uint32_t>> inBand(static_cast<size_t>(std::max(0, bands)));
+  for (uint32_t k = 0; k < triangles.size(); ++k)
+    for (int b = boxes[k].z / kBandRows; b <= boxes[k].w / kBandRows; ++b) inBand[static_cast<size_t>(b)].push_back(k);
+  tbb::parallel_for(0, bands, [&](int band) {
+    const int bandY0 = band * kBandRows, bandY1 = std::min(height - 1, bandY0 + kBandRows - 1);
+    for (uint32_t k : inBand[static_cast<size_t>(band)]) {
+      const RasterTriangle& t = triangles[k];
+      const uint32_t pi = t.primitive, tri = t.triangle;
+      const glm::ivec4& box = boxes[k];
+      for (int y = std::max(box.z, bandY0); y <= std::min(box.w, bandY1); ++y)
+        for (int x = box.x; x <= box.y; ++x) {
           if (!overlapsTexel(t, x, y)) continue;
           size_t texel = size_t(y) * width + x;
           ts.covered[texel] = 1;
@@ -217,7 +237,7 @@ TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, 
           }
         }
     }
-  }
+  });
   for (size_t texel = 0; texel < layer; ++texel) {
     bool any = false;
     for (int l = 0; l < S * S && !any; ++l) any = ts.primitive[l * layer + texel] != kNone;

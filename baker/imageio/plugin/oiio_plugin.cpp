@@ -45,11 +45,16 @@ Pixels decodeMemory(const uint8_t* bytes, size_t size, const char* format, const
 }
 
 std::vector<uint8_t> encodePngMemory(const uint8_t* rgba, int width, int height, const std::string& name) {
+  // zlib level 3, not libpng's 6: Sponza's 1700×1908 page encodes in 0.3 s instead of 0.7 s (serial, at the end
+  // of the bake) for 14% more bytes (2.04 against 1.78 MB); level 1 was no faster.
+  constexpr int level = 3;
   std::vector<unsigned char> out;
   OIIO::Filesystem::IOVecOutput writer(out);
   // The PNG writer takes the memory proxy through create(); the name only selects the format.
   auto png = OIIO::ImageOutput::create("png", &writer);
-  if (!png || !png->open("image.png", OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::UINT8)))
+  OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
+  spec.attribute("png:compressionLevel", level);
+  if (!png || !png->open("image.png", spec))
     throw Error(ErrorCode::Io, name, "cannot encode PNG: " + OIIO::geterror());
   if (!png->write_image(OIIO::TypeDesc::UINT8, rgba) || !png->close())
     throw Error(ErrorCode::Io, name, "cannot encode PNG: " + png->geterror());
