@@ -7,6 +7,8 @@
 #include <future>
 #include <memory>
 
+#include <tbb/parallel_for.h>
+
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/embree/embree_backend.h"
 #include "backend/gather/final_gather.h"
@@ -461,7 +463,7 @@ struct StagedBake::State {
       std::vector<std::vector<glm::vec3>> vplParts(coefficients, std::vector<glm::vec3>(texels[p].layerSize()));
       std::vector<const std::vector<glm::vec3>*> parts;
       for (int c = 0; c < coefficients; ++c) {
-        for (size_t t = 0; t < vplParts[c].size(); ++t) vplParts[c][t] = sums.value(p, t, c);
+        tbb::parallel_for(size_t(0), vplParts[c].size(), [&](size_t t) { vplParts[c][t] = sums.value(p, t, c); });
         parts.push_back(&vplParts[c]);
       }
       std::vector<uint8_t> vplValid = std::move(sums.pages[p].valid);

@@ -163,7 +163,8 @@ RayHit RayTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float
   return completeHit(dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, glm::vec2(rh.hit.u, rh.hit.v));
 }
 
-void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs, size_t n, RayHit* hits) const {
+void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs, size_t n, RayHit* hits,
+                                 HitDetail detail) const {
   if (!impl_->packets8) {
     for (size_t i = 0; i < n; ++i) hits[i] = intersect(origin, dirs[i], 0.0f, 1e30f);
     return;
@@ -185,17 +186,23 @@ void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs,
       hits[base + k] = packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
                            ? RayHit{}
                            : completeHit(dirs[base + k], packet.ray.tfar[k], packet.hit.geomID[k], packet.hit.primID[k],
-                                         glm::vec2(packet.hit.u[k], packet.hit.v[k]));
+                                         glm::vec2(packet.hit.u[k], packet.hit.v[k]), detail);
   }
 }
 
-RayHit RayTracer::completeHit(const glm::vec3& dir, float t, uint32_t geomID, uint32_t primID, glm::vec2 uv) const {
+RayHit RayTracer::completeHit(const glm::vec3& dir, float t, uint32_t geomID, uint32_t primID, glm::vec2 uv,
+                              HitDetail detail) const {
   RayHit out;
   out.hit = true;
   out.t = t;
   out.primitive = geomID;
   out.triangle = primID;
   out.barycentric = uv;
+  if (detail == HitDetail::Surface) {
+    out.geometricNormal = impl_->faceNormals[impl_->faceOffset[out.primitive] + out.triangle];
+    out.backFace = glm::dot(dir, out.geometricNormal) > 0.0f;
+    return out;
+  }
   const Primitive& prim = scene_.primitives[out.primitive];
   const uint32_t* idx = &prim.indices[3 * out.triangle];
   float w = 1.0f - out.barycentric.x - out.barycentric.y;

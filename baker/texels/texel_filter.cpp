@@ -16,13 +16,13 @@ SurfaceFilter::SurfaceFilter(const TexelSamples& ts) : width_(ts.width), height_
   position_.assign(layer, glm::vec3(0.0f));
   normal_.assign(layer, glm::vec3(0.0f));
   hasSample_.assign(layer, 0);
-  for (size_t t = 0; t < layer; ++t) {
-    if (!texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.positionWeight[s]); }, position_[t])) continue;
+  tbb::parallel_for(size_t(0), layer, [&](size_t t) {
+    if (!texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.positionWeight[s]); }, position_[t])) return;
     texelMean(ts, t, [&](size_t s) { return glm::vec3(ts.normal[s]); }, normal_[t]);
     const float len = glm::length(normal_[t]);
     if (len > 0.0f) normal_[t] /= len;
     hasSample_[t] = 1;
-  }
+  });
   // Spacing: median over every other texel's right and lower neighbours on the same surface.
   std::vector<float> d;
   const int W = width_, H = height_;

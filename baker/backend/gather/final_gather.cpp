@@ -37,7 +37,7 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
   for (int begin = 0; begin < rays; begin += kChunk) {
     const int count = std::min(kChunk, rays - begin);
     for (int k = 0; k < count; ++k) dirs[k] = lattice.next();
-    rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits);
+    rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Surface);
     for (int k = 0; k < count; ++k) {
       const RayHit& hit = hits[k];
       if (!hit.hit) {

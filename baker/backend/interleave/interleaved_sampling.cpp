@@ -1,3 +1,5 @@
+#include <tbb/parallel_for.h>
+
 #include "backend/interleave/interleaved_sampling.h"
 
 #include <algorithm>
@@ -113,11 +115,11 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<const st
     const std::vector<glm::vec3>& added = n > 1 ? mixed[c] : *vplParts[c];
     Lightmap& map = *maps[c];
     if (map.valid.size() != map.size()) map.valid = page.valid;
-    for (size_t t = 0; t < map.size() && t < added.size(); ++t) {
-      if (!vplValid[t]) continue;
+    tbb::parallel_for(size_t(0), std::min(map.size(), added.size()), [&](size_t t) {
+      if (!vplValid[t]) return;
       map.texels[t] += added[t];
       map.valid[t] = 1;
-    }
+    });
   }
 }
 
