@@ -476,11 +476,17 @@ struct StagedBake::State {
   // The clamp compensation's options as this bake runs it. With the final gather its refinement is off: the
   // extra rays sharpen the residual at the texel itself, which the final gather replaces; only the map it
   // reads one bounce away needs the residual (Sponza views 2 / 3: 1.92 / 4.55% without, 1.92 / 4.56% with).
+  // For the same reason a large page's samples may get 2 first rays instead of 4: the gather reads the
+  // residual averaged over its rays and its window (Sponza: 6.0 -> 4.2 s, peak 850 -> 758 MiB; views 2 / 3
+  // 1.56 / 2.73% -> 1.55 / 2.71%; 1 ray: 1.60 / 2.98%).
   ClampCompensationOptions compensationOptions() const {
     ClampCompensationOptions o = options.compensation;
     o.seed = options.walk.seed;
     o.directional = options.directional && !finalGatherOn;  // the gather writes the bounced light's L1 itself
-    if (finalGatherOn) o.refineRays = 0;
+    if (finalGatherOn) {
+      o.refineRays = 0;
+      o.minRays = std::min(o.minRays, 2);
+    }
     return o;
   }
 

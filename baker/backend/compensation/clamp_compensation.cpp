@@ -65,7 +65,7 @@ RayPlan planRays(const std::vector<TexelSamples>& texels, const ClampCompensatio
   plan.baseRays = std::max(1, options.rays);
   if (options.rayBudget > 0 && activeSamples > 0)
     plan.baseRays = static_cast<int>(std::clamp<size_t>(options.rayBudget / activeSamples,
-                                                        static_cast<size_t>(std::max(1, options.minRays)),
+                                                        static_cast<size_t>(std::clamp(options.minRays, 1, plan.baseRays)),
                                                         static_cast<size_t>(plan.baseRays)));
   const double rayScale = static_cast<double>(plan.baseRays) / std::max(1, options.rays);
   plan.extraRays = static_cast<int>(std::lround(std::max(0, options.refineRays) * rayScale));

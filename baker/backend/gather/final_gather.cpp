@@ -80,7 +80,7 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
   const size_t samples = weightedSampleCount(in.texels);
   int rays = std::max(1, options.rays);
   if (options.rayBudget > 0 && samples > 0)
-    rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::max(1, options.minRays)),
+    rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::clamp(options.minRays, 1, rays)),
                                                static_cast<size_t>(rays)));
   const bool directional = l1 && directL1;
   if (directional)
