@@ -126,10 +126,12 @@ bool leaks(const RayTracer& rt, const Scene& scene, const SurfacePoint& s, float
   glm::vec3 dirs[kLeakRays];
   leakDirections(s.geometricNormal, dirs);
   const glm::vec3 origin = s.position + s.geometricNormal * rt.epsilon();
+  // One packet from one origin (and the ninth ray alone), sides and distances only: 21M rays on Sponza's page.
+  RayHit hits[kLeakRays];
+  rt.intersectPackets(origin, dirs, kLeakRays, hits, RayTracer::HitDetail::Surface);
   int backHits = 0;
-  for (const glm::vec3& d : dirs) {
-    RayHit h = rt.intersect(origin, d, 0.0f, farDistance);
-    if (!h.hit || !h.backFace) continue;
+  for (const RayHit& h : hits) {
+    if (!h.hit || !h.backFace || h.t > farDistance) continue;
     if (h.primitive < scene.primitives.size()) {
       const Primitive& p = scene.primitives[h.primitive];
       if (p.material >= 0 && p.material < int(scene.materials.size()) && scene.materials[p.material].doubleSided) continue;
