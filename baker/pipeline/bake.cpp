@@ -320,7 +320,7 @@ struct StagedBake::State {
   // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
   void planBlocks() {
     if (backend == BackendKind::Reference || !eval.includeVpls || vpls.vpls.empty()) return;
-    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound, 6, surfaceFilters.get());
+    interleave = options.interleave ? *options.interleave : chooseInterleave(texels, eval.clampBound, surfaceFilters.get());
     classVpls = classVplSubsets(vpls, interleave);
     const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
     for (size_t c = 0; c < classVpls.size(); ++c)

@@ -262,8 +262,8 @@ double stitchSeams(std::vector<Lightmap>& maps, const std::vector<SeamEdge>& sea
     t.index = it->second;  // rows now index unknowns
   }
   const size_t n = globalOf.size();
-  // The rows' transpose: each unknown's taps in row order, so that Rᵀd sums them in the order the rows add
-  // them (the same bits as scattering row by row) and every unknown is summed by one thread.
+  // The rows' transpose: each unknown's taps in row order, so that every unknown of Rᵀd is summed by one thread
+  // in a fixed order (the same bits for any thread count).
   std::vector<size_t> columnStart(n + 1, 0);
   for (const Tap& t : rows.taps) ++columnStart[t.index + 1];
   for (size_t i = 0; i < n; ++i) columnStart[i + 1] += columnStart[i];
@@ -318,22 +318,18 @@ double stitchSeams(std::vector<Lightmap>& maps, const std::vector<SeamEdge>& sea
   apply(x, ap);
   std::array<double, 3> rz{}, stop{};
   std::array<bool, 3> active{};
-  auto residualNorm = [&](int c) {
-    double sum = 0.0;
-    for (size_t i = 0; i < n; ++i) sum += r[i][c] * r[i][c];
-    return sum;
-  };
   for (int c = 0; c < 3; ++c) {
-    double bnorm = 0.0;
+    double bnorm = 0.0, rr = 0.0;
     for (size_t i = 0; i < n; ++i) {
       r[i][c] = wd * x0[i][c] - ap[i][c];
       z[i][c] = inverseDiagonal[i] * r[i][c];
       p[i][c] = z[i][c];
       rz[c] += r[i][c] * z[i][c];
+      rr += r[i][c] * r[i][c];
       bnorm += (wd * x0[i][c]) * (wd * x0[i][c]);
     }
     stop[c] = options.tolerance * options.tolerance * std::max(bnorm, 1e-30);
-    active[c] = residualNorm(c) > stop[c];
+    active[c] = rr > stop[c];
   }
   int its = 0;
   for (int it = 0; it < options.iterations; ++it) {

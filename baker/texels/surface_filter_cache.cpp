@@ -10,14 +10,13 @@ SurfaceFilterCache::Page* SurfaceFilterCache::pageOf(const TexelSamples& ts) {
     if (&pages_[p] != &ts) continue;
     Page& page = cache_[p];
     const std::lock_guard<std::mutex> lock(making_);
-    if (!page.made) {
+    if (!page.plan) {
       // The filter's texel means (24 bytes a texel) live only while the plan is made.
       const SurfaceFilter filter(ts);
       page.spacing = filter.spacing();
       TexelFilterOptions o;
       o.radius = SurfaceFilterPlan::kMaxRadius;
       page.plan = std::make_unique<SurfaceFilterPlan>(filter, ts.valid, o);
-      page.made = true;
       ++plansMade_;
     }
     return &page;

@@ -31,20 +31,18 @@ class SurfaceFilterCache {
                                             const std::vector<uint8_t>& valid, const TexelFilterOptions& options);
   std::vector<glm::vec3> apply(const TexelSamples& ts, const std::vector<glm::vec3>& values,
                                const std::vector<uint8_t>& valid, const TexelFilterOptions& options);
-  // The page's plan when it serves (valid, options) (SurfaceFilterPlan::serves), else null: for a page
-  // filtered many times alike (the compensation's sweeps).
-  const SurfaceFilterPlan* plan(const TexelSamples& ts, const std::vector<uint8_t>& valid,
-                                const TexelFilterOptions& options);
   size_t plansMade() const { return plansMade_; }
   size_t fallbacks() const { return fallbacks_; }  // requests filtered without a plan (each makes a SurfaceFilter)
 
  private:
   struct Page {
-    bool made = false;
     float spacing = 0.0f;
-    std::unique_ptr<SurfaceFilterPlan> plan;
+    std::unique_ptr<SurfaceFilterPlan> plan;  // null until the page's first use
   };
   Page* pageOf(const TexelSamples& ts);  // made on first use; null for a page not in the list
+  // The page's plan when it serves (valid, options) (SurfaceFilterPlan::serves), else null.
+  const SurfaceFilterPlan* plan(const TexelSamples& ts, const std::vector<uint8_t>& valid,
+                                const TexelFilterOptions& options);
   const std::vector<TexelSamples>& pages_;
   std::vector<Page> cache_;
   std::mutex making_;  // a page's plan is made once, by the first caller

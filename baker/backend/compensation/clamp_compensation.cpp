@@ -304,14 +304,10 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   bool tailAdded = false;
   constexpr int kFirstTailSweep = 3;  // at least 4 sweeps before the tail: the ratio creeps up over the first few
   std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
-  // The filter's neighbour tests, made once for all sweeps (they were 3/4 of a sweep's time on Sponza) and
-  // shared with the bake's other filters (SurfaceFilterCache).
+  // The filter's neighbour tests are made once for all sweeps (they were 3/4 of a sweep's time on Sponza) and
+  // shared with the bake's other filters: the page's plan in SurfaceFilterCache.
   std::vector<TexelFilterOptions> filterOptions(maps.size());
-  std::vector<const SurfaceFilterPlan*> plans(maps.size(), nullptr);
-  for (size_t p = 0; p < maps.size(); ++p) {
-    filterOptions[p].radius = radii[p];
-    if (radii[p] > 0) plans[p] = g.filters()->plan(in.texels[p], maps[p].valid, filterOptions[p]);
-  }
+  for (size_t p = 0; p < maps.size(); ++p) filterOptions[p].radius = radii[p];
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
@@ -341,11 +337,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
       std::vector<glm::vec3> filtered;
-      if (plans[p]) {
-        filtered = plans[p]->apply(residual, filterOptions[p]);
-      } else if (radii[p] > 0) {
-        filtered = filterOnSurface(g.filters(), ts, residual, m.valid, filterOptions[p]);
-      }
+      if (radii[p] > 0) filtered = g.filters()->apply(ts, residual, m.valid, filterOptions[p]);
       const std::vector<glm::vec3>& residualUsed = radii[p] > 0 ? filtered : residual;
       const std::vector<glm::vec3>& baseMap = base(p);
       for (size_t t = 0; t < layer; ++t) {
@@ -455,7 +447,7 @@ void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& a
       TexelFilterOptions fo;
       fo.radius = g.radii[p];
       std::vector<std::vector<glm::vec3>> filtered =
-          filterOnSurface(g.filters(), in.texels[p], {&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
+          g.filters()->apply(in.texels[p], {&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
       for (int k = 0; k < 3; ++k) texelVector[k] = std::move(filtered[k]);
     }
     for (int k = 0; k < 3; ++k) {

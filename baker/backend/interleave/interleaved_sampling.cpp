@@ -44,7 +44,7 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
   return out;
 }
 
-int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN, SurfaceFilterCache* filters) {
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, SurfaceFilterCache* filters, int maxN) {
   std::vector<float> spacings;
   for (const TexelSamples& ts : pages)
     if (float h = texelSpacing(filters, ts); h > 0.0f) spacings.push_back(h);

@@ -39,8 +39,8 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
 // cost less than 4×4 with 4096 and are more accurate (sample box 1.99 → 1.63%, McGuire 1.79 → 1.65%),
 // while 8×8 blurs (4096 paths: 2.24%; docs/accuracy.md).
 // filters: the bake's surface filters (their spacings), or null.
-int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, int maxN = 6,
-                     SurfaceFilterCache* filters = nullptr);
+int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, SurfaceFilterCache* filters = nullptr,
+                     int maxN = 6);
 
 // The VPLs of each of the n² classes (class c = cx + n·cy): per bounce the c-th contiguous chunk in path
 // order, power × bounce count / chunk count. n ≤ 1: one class with every VPL, unscaled, in path order.
