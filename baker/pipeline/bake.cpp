@@ -31,10 +31,6 @@ namespace {
 
 nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
-// Above this many triangles, GL on llvmpipe is slower than Embree on the benches (Cornell box, 32: GL ≈ 10%
-// faster; DamagedHelmet, 15k: Embree 1.8× faster; furnished room, 58k: Embree 4–17× faster).
-constexpr size_t kSoftwareGlTriangleHint = 10000;
-
 // The first see-through material (MASK cut-outs, BLEND, transmission) a primitive uses, as a phrase for the
 // log; empty when there is none. The GL backend sends the texels they shade to rays (contact texels).
 std::string seeThroughMaterials(const Scene& scene) {
@@ -270,28 +266,20 @@ struct StagedBake::State {
   void chooseBackend() {
     backend = options.backend;
     if (backend == BackendKind::Auto) {
-      backend = BackendKind::Embree;
-      if (std::string why = seeThroughMaterials(scene); !why.empty()) {
-        backendReason = why + ": the GL backend would trace most texels it shades anyway (red pane test: 64%)";
-      } else {
-        try {
-          glContext = std::make_unique<GlContext>();
-          if (!glContext->softwareRenderer()) {
-            backend = BackendKind::Gl;
-            backendReason = "hardware GL renderer";
-          } else if (scene.triangleCount() <= kSoftwareGlTriangleHint) {
-            backend = BackendKind::Gl;
-            backendReason = "software GL renderer, " + std::to_string(scene.triangleCount()) + " triangles (≤ " +
-                            std::to_string(kSoftwareGlTriangleHint) + ": GL as fast as Embree)";
-          } else {
-            backendReason = "software GL renderer with " + std::to_string(scene.triangleCount()) +
-                            " triangles: its shadow pass draws them for every VPL cube (docs/performance.md)";
-          }
-        } catch (const Error& e) {
-          backendReason = std::string("no GL context: ") + e.what();
-        }
-        if (backend != BackendKind::Gl) glContext.reset();
-      }
+      const AutoBackendChoice choice =
+          chooseAutoBackend(scene.triangleCount(), seeThroughMaterials(scene), [&] {
+            GlProbe probe;
+            try {
+              glContext = std::make_unique<GlContext>();
+              probe.softwareRenderer = glContext->softwareRenderer();
+            } catch (const Error& e) {
+              probe.error = e.what();
+            }
+            return probe;
+          });
+      backend = choice.backend;
+      backendReason = choice.reason;
+      if (backend != BackendKind::Gl) glContext.reset();
       log::info(std::string("backend auto: ") + toString(backend) + " (" + backendReason + ")");
     }
     compensate = options.eval.biasCompensation && backend != BackendKind::Reference;
@@ -305,7 +293,7 @@ struct StagedBake::State {
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
     // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/performance.md).
-    if (glContext->softwareRenderer() && scene.triangleCount() > kSoftwareGlTriangleHint && options.eval.includeVpls)
+    if (glContext->softwareRenderer() && scene.triangleCount() > kGlTriangleHint && options.eval.includeVpls)
       log::warn("GL backend on a software renderer with " + std::to_string(scene.triangleCount()) +
                 " triangles: its shadow pass draws them for every VPL cube (on the 2-core bench machine the Embree "
                 "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");

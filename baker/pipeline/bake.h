@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/backend_choice.h"
 #include "atlas/atlas.h"
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
@@ -28,7 +29,6 @@ namespace irbake {
 // Auto: GL on a hardware renderer, or on a software one for small scenes (≤ 10k triangles); Embree for
 // larger scenes on a software renderer, without a GL context, or with see-through materials (MASK, BLEND,
 // transmission), whose texels the GL backend would mostly trace with rays anyway.
-enum class BackendKind { Auto, Gl, Embree, Reference };
 
 // How the bake bounds the VPL geometry term (VplEvalOptions::clampBound of every backend call).
 enum class ClampMode {

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Run on a lent GPU machine (bench/gpu/README.md), after unpacking the bundle into /tmp/g and the glvnd
+# packages into /: the GL backend on the GPU against Embree on the same machine's CPUs, same VPLs.
+# Writes logs and every report.json into $OUT/gpu_results.tar.gz.
+set -uo pipefail
+G=/tmp/g
+R=$G/results
+mkdir -p $R
+export LD_LIBRARY_PATH=$G/lib IRBAKE_IMAGEIO_PLUGIN=$G/lib/libirbake_imageio_min.so IRBAKE_SOURCE_DIR=$G/src
+export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+B=$G/bin/irbake
+S=$G/shared/scenes
+nvidia-smi -L; nproc; uname -r
+bake() {  # tag timeout args...
+  local tag=$1 lim=$2; shift 2
+  local t0=$(date +%s.%N)
+  timeout $lim "$@" -o $R/$tag --quiet > $R/$tag.log 2>&1
+  local rc=$?
+  echo "$tag rc=$rc wall=$(awk -v a=$t0 -v b=$(date +%s.%N) 'BEGIN{printf "%.2f", b-a}') $(grep -o '"backend": *"[a-z]*"' $R/$tag/report.json 2>/dev/null)"
+  grep -v -E "^/tmp/g/results" $R/$tag.log | tail -2
+}
+timeout 60 $G/bin/glcontext_test --gtest_brief=1 2>&1 | tail -15
+$B samples $G/samples > /dev/null
+bake cornell_auto 60 $B bake $G/samples/cornell_box.gltf
+bake cornell_gl 60 $B bake $G/samples/cornell_box.gltf --backend gl
+bake cornell_embree 60 $B bake $G/samples/cornell_box.gltf --backend embree
+$B diff $R/cornell_embree $R/cornell_gl
+SP="$S/dabrovic_sponza/sponza.glb --sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7"
+for i in 1 2; do
+  bake sponza_gl_$i 120 $B bake $SP --backend gl
+  bake sponza_embree_$i 120 $B bake $SP --backend embree
+done
+$B diff $R/sponza_embree_1 $R/sponza_gl_1
+# The CI-class machine's two cores with this GPU beside them.
+for i in 1 2; do
+  bake sponza_gl_2cpu_$i 150 taskset -c 0,1 $B bake $SP --backend gl --threads 2
+  bake sponza_embree_2cpu_$i 150 taskset -c 0,1 $B bake $SP --backend embree --threads 2
+done
+# Larger VPL cubes are nearly free on a GPU: fewer texels the depth test cannot resolve.
+bake sponza_gl_2cpu_cube256 150 taskset -c 0,1 $B bake $SP --backend gl --threads 2 --cube-face 256
+SB="$S/sibenik/sibenik_lamp.glb --sky 1,1,1"
+bake sibenik_gl 120 $B bake $SB --backend gl
+bake sibenik_embree 120 $B bake $SB --backend embree
+$B diff $R/sibenik_embree $R/sibenik_gl
+( cd $G/src && timeout 150 $G/bin/gl_test --gtest_brief=1 ) > $R/gl_test.log 2>&1; echo "gl_test rc=$?"
+grep -E "figure|FAILED|PASSED|SKIPPED|tests ran" $R/gl_test.log | head -40
+nvidia-smi --query-gpu=name,driver_version,memory.used --format=csv
+rm -f $R/*/*.exr $R/*/*.png $R/*/*.bin $R/*/*.glb
+tar -C $G -czf $OUT/gpu_results.tar.gz results
