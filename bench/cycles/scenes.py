@@ -4,6 +4,7 @@
 usage (from the repository root):
   /usr/bin/python3 bench/cycles/scenes.py mcguire OUTDIR   -> OUTDIR/mcguire_cornell.gltf + .bin
   /usr/bin/python3 bench/cycles/scenes.py sponza  OUTDIR   -> OUTDIR/sponza_sun.glb (+ OUTDIR/textures link)
+  /usr/bin/python3 bench/cycles/scenes.py sibenik OUTDIR   -> OUTDIR/sibenik/sibenik_lamp.glb (+ its textures link)
   /usr/bin/python3 bench/cycles/scenes.py all     OUTDIR
 
 Inputs are read from ../shared/scenes (relative to the repository root; --shared overrides) and never copied
@@ -41,6 +42,16 @@ SPONZA_CAMERAS = [
     ("gallery", (-9.0, 7.0, -4.8), (8.0, 6.5, -4.2), 55.0),
 ]
 SPONZA_ASPECT = 1.6
+
+# Sibenik for the Cycles comparison: the interior lamp of bench/levels (2000 cd, 7 m above the nave floor) and
+# no sky; its two BLEND glass materials made opaque, since Cycles' importer passes BLEND light untinted where
+# irbake tints it by the base colour (docs/units.md): the comparison is of the estimator, not of the glass.
+SIBENIK_LAMP = ((0.0, -8.0, 0.0), 2000.0)
+SIBENIK_CAMERAS = [
+    ("choir", (14.0, -12.5, 0.0), (-6.0, -15.3, 0.0), 60.0),
+    ("aisle", (-14.0, -12.0, 5.0), (6.0, -14.0, -4.0), 60.0),
+    ("across", (0.0, -14.0, 6.5), (0.0, -10.0, -8.0), 60.0),
+]
 
 
 def fail(msg):
@@ -268,9 +279,52 @@ def build_sponza(shared, out):
     return path
 
 
+def build_sibenik(shared, out):
+    src = os.path.join(shared, "sibenik")
+    glb = os.path.join(src, "sibenik.glb")
+    if not os.path.isfile(glb):
+        fail("missing %s" % glb)
+    doc, binchunk = read_glb(glb)
+    for m in doc.get("materials", []):
+        m.get("extensions", {}).pop("KHR_materials_pbrSpecularGlossiness", None)
+        if "extensions" in m and not m["extensions"]:
+            del m["extensions"]
+        if m.get("alphaMode") == "BLEND":
+            del m["alphaMode"]
+            m.setdefault("pbrMetallicRoughness", {}).setdefault("baseColorFactor", [1.0, 1.0, 1.0, 1.0])[3] = 1.0
+    used = [e for e in doc.get("extensionsUsed", []) if e != "KHR_materials_pbrSpecularGlossiness"]
+    used.append("KHR_lights_punctual")
+    doc["extensionsUsed"] = used
+    pos, cd = SIBENIK_LAMP
+    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"type": "point", "name": "interior lamp", "intensity": cd, "color": [1.0, 1.0, 1.0]}]}}
+    root = doc["scenes"][doc.get("scene", 0)]["nodes"]
+    doc["nodes"].append({"name": "interior lamp", "translation": list(pos), "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    root.append(len(doc["nodes"]) - 1)
+    doc["cameras"] = []
+    for name, eye, target, fov in SIBENIK_CAMERAS:
+        doc["cameras"].append({"name": name, "type": "perspective", "perspective": {
+            "yfov": math.radians(fov), "aspectRatio": SPONZA_ASPECT, "znear": 0.05, "zfar": 200.0}})
+        doc["nodes"].append({"name": "camera_" + name, "camera": len(doc["cameras"]) - 1, "translation": list(eye),
+                             "rotation": list(look_at_quat(eye, target))})
+        root.append(len(doc["nodes"]) - 1)
+    doc["asset"]["generator"] = doc["asset"].get("generator", "") + " + irbake bench/cycles/scenes.py (lamp, cameras, opaque glass)"
+    out = os.path.join(out, "sibenik")  # a folder of its own: its textures link is not Sponza's
+    os.makedirs(out, exist_ok=True)
+    link = os.path.join(out, "textures")
+    if os.path.islink(link):
+        os.remove(link)
+    if not os.path.exists(link):
+        os.symlink(os.path.abspath(os.path.join(src, "textures")), link)
+    path = os.path.join(out, "sibenik_lamp.glb")
+    write_glb(path, doc, binchunk)
+    print("wrote", path, "(%d cameras, %g cd lamp at %s, glass opaque)" % (len(SIBENIK_CAMERAS), cd, pos))
+    return path
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("which", choices=["mcguire", "sponza", "all"])
+    ap.add_argument("which", choices=["mcguire", "sponza", "sibenik", "all"])
     ap.add_argument("outdir")
     ap.add_argument("--shared", help="shared scenes folder (default: ../shared/scenes from the repository root)")
     args = ap.parse_args()
@@ -279,6 +333,8 @@ def main():
         build_mcguire(shared, args.outdir)
     if args.which in ("sponza", "all"):
         build_sponza(shared, args.outdir)
+    if args.which in ("sibenik", "all"):
+        build_sibenik(shared, args.outdir)
 
 
 if __name__ == "__main__":
