@@ -130,6 +130,9 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->check(CLI::IsMember({"off", "on", "auto"}))->type_name("off|on|auto");
   app->add_option("--gather-rays", o.gather.rays, "final gather: cosine rays per texel sample (default 16)")
       ->transform(cli::integerIn(1, 4096))->type_name("N");
+  app->add_option("--gather-pre-rays", o.gather.preRays,
+                  "final gather: rays per sample of a first, cheaper gather whose map\nthe final rays read (default 2; 0 = none)")
+      ->transform(cli::integerIn(0, 4096))->type_name("N");
   app->add_option("--gather-ray-budget", o.gather.rayBudget,
                   "final gather: rays over all samples (default 50331648; a large\n"
                   "page gets fewer per sample, never below 4; 0 = no cap)")

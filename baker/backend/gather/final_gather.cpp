@@ -19,6 +19,7 @@ namespace irbake {
 namespace {
 
 constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotations (forEachSampleLattice)
+constexpr uint64_t kPreGatherStream = 0xfa;     // the first pass's (independent of the final pass's)
 
 }  // namespace
 
@@ -65,17 +66,12 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
   return sum * inv;
 }
 
-void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std::vector<Lightmap>& maps,
-                 const FinalGatherOptions& options, FinalGatherStats* stats, const L1Pages* directL1, L1Pages* l1) {
-  Stopwatch watch;
-  if (maps.size() != in.texels.size() || direct.size() != maps.size())
-    throw Error(ErrorCode::InvalidData, "", "final gather: " + std::to_string(maps.size()) + " maps and " +
-                                                std::to_string(direct.size()) + " direct pages for " +
-                                                std::to_string(in.texels.size()) + " texel pages");
-  for (size_t p = 0; p < maps.size(); ++p)
-    if (maps[p].size() != in.texels[p].layerSize() || maps[p].valid.size() != maps[p].size() ||
-        direct[p].size() != maps[p].size())
-      throw Error(ErrorCode::InvalidData, "", "final gather: page " + std::to_string(p) + " does not match its texels");
+namespace {
+
+// One gather: maps ← D + gather(source) at valid texels, the lattice rotations from stream.
+void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const std::vector<Lightmap>& source,
+                std::vector<Lightmap>& maps, const FinalGatherOptions& options, uint64_t stream,
+                FinalGatherStats& stats, const L1Pages* directL1, L1Pages* l1) {
   const std::vector<int32_t> mapOfPage = mapIndexOfPages(in.texels);
   const size_t samples = weightedSampleCount(in.texels);
   int rays = std::max(1, options.rays);
@@ -83,11 +79,7 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
     rays = static_cast<int>(std::clamp<size_t>(options.rayBudget / samples, static_cast<size_t>(std::clamp(options.minRays, 1, rays)),
                                                static_cast<size_t>(rays)));
   const bool directional = l1 && directL1;
-  if (directional)
-    for (int k = 0; k < 3; ++k)
-      if ((*l1)[k].size() != maps.size() || (*directL1)[k].size() != maps.size())
-        throw Error(ErrorCode::InvalidData, "", "final gather: the L1 pages do not match the maps");
-  // Every page's gather reads the maps as they came in, so the new pages are built apart and swapped in last.
+  // Every page's gather reads the source as it came in (it may be maps), so the new pages are built apart.
   std::vector<std::vector<glm::vec3>> gathered(maps.size());
   std::array<std::vector<std::vector<glm::vec3>>, 3> gatheredL1;
   if (directional)
@@ -98,10 +90,10 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
     std::vector<L1Vectors> slotVector(directional ? ts.slotCount() : 0, L1Vectors{});
     // Interleaved rotations (sample_lattice.h): every filter window averages one stratified lattice of rays
     // (Sponza's gallery against Cycles 3.6–3.9% → 3.0–3.3%, docs/accuracy.md session 13).
-    const InterleavedRotations interleaved(ts, options.seed, kGatherStream, options.interleave ? options.filterRadius : 0, rays);
-    forEachSampleLattice(in, ts, options.seed, kGatherStream,
+    const InterleavedRotations interleaved(ts, options.seed, stream, options.interleave ? options.filterRadius : 0, rays);
+    forEachSampleLattice(in, ts, options.seed, stream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
-                           slotValue[s] = gatherAt(in, maps, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
+                           slotValue[s] = gatherAt(in, source, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
                                                    directional ? &slotVector[s] : nullptr);
                          },
                          &interleaved);
@@ -151,12 +143,46 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
           if (std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z)) (*l1)[k][p].texels[t] = v;
         }
     }
+  stats.rays = samples * static_cast<size_t>(rays);
+  stats.raysPerSample = rays;
+  stats.filterRadius = options.filterRadius;
+  stats.gatheredFraction = total > 0.0 ? gatheredSum / total : 0.0;
+  stats.changeFraction = before > 0.0 ? change / before : 0.0;
+}
+
+}  // namespace
+
+void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std::vector<Lightmap>& maps,
+                 const FinalGatherOptions& options, FinalGatherStats* stats, const L1Pages* directL1, L1Pages* l1) {
+  Stopwatch watch;
+  if (maps.size() != in.texels.size() || direct.size() != maps.size())
+    throw Error(ErrorCode::InvalidData, "", "final gather: " + std::to_string(maps.size()) + " maps and " +
+                                                std::to_string(direct.size()) + " direct pages for " +
+                                                std::to_string(in.texels.size()) + " texel pages");
+  for (size_t p = 0; p < maps.size(); ++p)
+    if (maps[p].size() != in.texels[p].layerSize() || maps[p].valid.size() != maps[p].size() ||
+        direct[p].size() != maps[p].size())
+      throw Error(ErrorCode::InvalidData, "", "final gather: page " + std::to_string(p) + " does not match its texels");
+  if (l1 && directL1)
+    for (int k = 0; k < 3; ++k)
+      if ((*l1)[k].size() != maps.size() || (*directL1)[k].size() != maps.size())
+        throw Error(ErrorCode::InvalidData, "", "final gather: the L1 pages do not match the maps");
+  // The first pass: M1, the map the final pass reads; the stats' "before" stays M, the maps as they came in.
+  FinalGatherStats first;
+  std::vector<Lightmap> firstMaps;
+  if (options.preRays > 0) {
+    firstMaps = maps;
+    FinalGatherOptions o = options;
+    o.rays = options.preRays;
+    o.filterRadius = options.preFilterRadius;
+    gatherPass(in, direct, maps, firstMaps, o, kPreGatherStream, first, nullptr, nullptr);
+  }
+  FinalGatherStats last;
+  gatherPass(in, direct, options.preRays > 0 ? firstMaps : maps, maps, options, kGatherStream, last, directL1, l1);
   if (stats) {
-    stats->rays = samples * static_cast<size_t>(rays);
-    stats->raysPerSample = rays;
-    stats->filterRadius = options.filterRadius;
-    stats->gatheredFraction = total > 0.0 ? gatheredSum / total : 0.0;
-    stats->changeFraction = before > 0.0 ? change / before : 0.0;
+    *stats = last;
+    stats->rays += first.rays;
+    stats->preRaysPerSample = first.raysPerSample;
     stats->seconds = watch.seconds();
   }
 }

@@ -11,6 +11,7 @@
 
 #include "atlas/atlas.h"
 #include "backend/lightmap_read.h"
+#include "backend/sample_lattice.h"
 #include "common/maths.h"
 #include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
@@ -49,6 +50,7 @@ TEST(FinalGather, FurnaceGathersLePlusRhoTimesTheMap) {
   const std::vector<Lightmap> direct = a.maps([](uint32_t) { return glm::vec3(0.25f); });
   FinalGatherOptions o;
   o.rays = 8;
+  o.preRays = 0;  // one pass (the two passes: the next test)
   FinalGatherStats stats;
   finalGather(a.inputs(), direct, maps, o, &stats);
   double worst = 0.0;
@@ -62,6 +64,33 @@ TEST(FinalGather, FurnaceGathersLePlusRhoTimesTheMap) {
   EXPECT_LT(worst, 2e-3);  // hits on a chart's border texel read a neighbour's value: still 1
   EXPECT_NEAR(stats.gatheredFraction, 0.8, 1e-5);
   EXPECT_EQ(stats.raysPerSample, 8);
+}
+
+// The two passes compose: the first gives M1 = D + Le + ρM, the final pass reads it, so in the furnace every
+// texel ends at D + Le + ρ(D + Le + ρM) exactly (1.4 here), and at the exact map with D = 0 (the fixed point).
+TEST(FinalGather, TwoPassesComposeInTheFurnace) {
+  const float rho = 0.6f, Le = 0.4f;
+  Atlased a(samples::makeFurnace(rho, Le), 64);
+  for (float d : {0.25f, 0.0f}) {
+    std::vector<Lightmap> maps = a.maps([](uint32_t) { return glm::vec3(1.0f); });
+    const std::vector<Lightmap> direct = a.maps([&](uint32_t) { return glm::vec3(d); });
+    FinalGatherOptions o;
+    o.rays = 8;
+    o.preRays = 2;
+    FinalGatherStats stats;
+    finalGather(a.inputs(), direct, maps, o, &stats);
+    const double expected = d + Le + rho * (d + Le + rho * 1.0);
+    double worst = 0.0;
+    size_t n = 0;
+    for (const Lightmap& m : maps)
+      for (size_t t = 0; t < m.size(); ++t)
+        if (m.valid[t]) worst = std::max(worst, std::abs(channelMean(m.texels[t]) - expected)), ++n;
+    ASSERT_GT(n, 1000u);
+    EXPECT_LT(worst, 2e-3) << "D = " << d << ", expected " << expected;
+    EXPECT_EQ(stats.raysPerSample, 8);
+    EXPECT_EQ(stats.preRaysPerSample, 2);
+    EXPECT_EQ(stats.rays, weightedSampleCount(a.pages) * 10);
+  }
 }
 
 // A point under a parallel square (side 2a, height h, map value m, albedo ρ): the gather is ρ m F, F the
@@ -90,6 +119,7 @@ TEST(FinalGather, FloorUnderASquareGathersItsViewFactor) {
   FinalGatherOptions o;
   o.rays = 256;
   o.filterRadius = 0;
+  o.preRays = 0;  // one gather of this M
   finalGather(at.inputs(), direct, gathered, o);
   double sum = 0.0;
   size_t n = 0;
