@@ -39,3 +39,11 @@ struct Api {
 const Api& api();
 
 }  // namespace irbake::imageio
+
+// A plugin's entry point, the one symbol api() looks up: at global scope in the plugin's source, with its
+// four functions (which may sit in an unnamed namespace).
+#define IRBAKE_IMAGEIO_PLUGIN_ENTRY(decodeMemory, encodePngMemory, writeFile, readFile)                     \
+  extern "C" __attribute__((visibility("default"))) const irbake::imageio::Api* irbake_imageio_api() {     \
+    static const irbake::imageio::Api api{decodeMemory, encodePngMemory, writeFile, readFile};             \
+    return &api;                                                                                          \
+  }

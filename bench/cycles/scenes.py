@@ -240,9 +240,10 @@ def write_glb(path, doc, binchunk):
     write_atomic(path, out)
 
 
-def build_sponza(shared, out):
-    src = os.path.join(shared, "dabrovic_sponza")
-    glb = os.path.join(src, "sponza.glb")
+def read_level(shared, folder, name):
+    """The level's GLB without KHR_materials_pbrSpecularGlossiness (neither renderer uses it), its root nodes."""
+    src = os.path.join(shared, folder)
+    glb = os.path.join(src, name)
     if not os.path.isfile(glb):
         fail("missing %s" % glb)
     doc, binchunk = read_glb(glb)
@@ -253,71 +254,63 @@ def build_sponza(shared, out):
     used = [e for e in doc.get("extensionsUsed", []) if e != "KHR_materials_pbrSpecularGlossiness"]
     used.append("KHR_lights_punctual")
     doc["extensionsUsed"] = used
-    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"type": "directional", "name": "sun", "intensity": SUN_IRRADIANCE, "color": [1.0, 1.0, 1.0]}]}}
-    root = doc["scenes"][doc.get("scene", 0)]["nodes"]
-    doc["nodes"].append({"name": "sun", "rotation": list(rotation_to(SUN_DIR)),
-                         "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    return src, doc, binchunk, doc["scenes"][doc.get("scene", 0)]["nodes"]
+
+
+def add_light(doc, root, light, node):
+    """One KHR_lights_punctual light (the level's only one) on a new root node."""
+    doc["extensions"] = {"KHR_lights_punctual": {"lights": [light]}}
+    node["extensions"] = {"KHR_lights_punctual": {"light": 0}}
+    doc["nodes"].append(node)
     root.append(len(doc["nodes"]) - 1)
+
+
+def add_cameras(doc, root, cameras):
     doc["cameras"] = []
-    for name, eye, target, fov in SPONZA_CAMERAS:
+    for name, eye, target, fov in cameras:
         doc["cameras"].append({"name": name, "type": "perspective", "perspective": {
             "yfov": math.radians(fov), "aspectRatio": SPONZA_ASPECT, "znear": 0.05, "zfar": 200.0}})
         doc["nodes"].append({"name": "camera_" + name, "camera": len(doc["cameras"]) - 1, "translation": list(eye),
                              "rotation": list(look_at_quat(eye, target))})
         root.append(len(doc["nodes"]) - 1)
-    doc["asset"]["generator"] = doc["asset"].get("generator", "") + " + irbake bench/cycles/scenes.py (sun, cameras)"
+
+
+def write_level(src, out, name, doc, binchunk, generated):
+    """OUT/name beside OUT/textures, a link to the level's own textures folder."""
+    doc["asset"]["generator"] = doc["asset"].get("generator", "") + " + irbake bench/cycles/scenes.py (%s)" % generated
     os.makedirs(out, exist_ok=True)
     link = os.path.join(out, "textures")
     if os.path.islink(link):
         os.remove(link)
     if not os.path.exists(link):
         os.symlink(os.path.abspath(os.path.join(src, "textures")), link)
-    path = os.path.join(out, "sponza_sun.glb")
+    path = os.path.join(out, name)
     write_glb(path, doc, binchunk)
+    return path
+
+
+def build_sponza(shared, out):
+    src, doc, binchunk, root = read_level(shared, "dabrovic_sponza", "sponza.glb")
+    add_light(doc, root, {"type": "directional", "name": "sun", "intensity": SUN_IRRADIANCE, "color": [1.0, 1.0, 1.0]},
+              {"name": "sun", "rotation": list(rotation_to(SUN_DIR))})
+    add_cameras(doc, root, SPONZA_CAMERAS)
+    path = write_level(src, out, "sponza_sun.glb", doc, binchunk, "sun, cameras")
     print("wrote", path, "(%d cameras, sun along %s, E = %g W/m^2)" % (len(SPONZA_CAMERAS), SUN_DIR, SUN_IRRADIANCE))
     return path
 
 
 def build_sibenik(shared, out):
-    src = os.path.join(shared, "sibenik")
-    glb = os.path.join(src, "sibenik.glb")
-    if not os.path.isfile(glb):
-        fail("missing %s" % glb)
-    doc, binchunk = read_glb(glb)
+    src, doc, binchunk, root = read_level(shared, "sibenik", "sibenik.glb")
     for m in doc.get("materials", []):
-        m.get("extensions", {}).pop("KHR_materials_pbrSpecularGlossiness", None)
-        if "extensions" in m and not m["extensions"]:
-            del m["extensions"]
         if m.get("alphaMode") == "BLEND":
             del m["alphaMode"]
             m.setdefault("pbrMetallicRoughness", {}).setdefault("baseColorFactor", [1.0, 1.0, 1.0, 1.0])[3] = 1.0
-    used = [e for e in doc.get("extensionsUsed", []) if e != "KHR_materials_pbrSpecularGlossiness"]
-    used.append("KHR_lights_punctual")
-    doc["extensionsUsed"] = used
     pos, cd = SIBENIK_LAMP
-    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"type": "point", "name": "interior lamp", "intensity": cd, "color": [1.0, 1.0, 1.0]}]}}
-    root = doc["scenes"][doc.get("scene", 0)]["nodes"]
-    doc["nodes"].append({"name": "interior lamp", "translation": list(pos), "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    root.append(len(doc["nodes"]) - 1)
-    doc["cameras"] = []
-    for name, eye, target, fov in SIBENIK_CAMERAS:
-        doc["cameras"].append({"name": name, "type": "perspective", "perspective": {
-            "yfov": math.radians(fov), "aspectRatio": SPONZA_ASPECT, "znear": 0.05, "zfar": 200.0}})
-        doc["nodes"].append({"name": "camera_" + name, "camera": len(doc["cameras"]) - 1, "translation": list(eye),
-                             "rotation": list(look_at_quat(eye, target))})
-        root.append(len(doc["nodes"]) - 1)
-    doc["asset"]["generator"] = doc["asset"].get("generator", "") + " + irbake bench/cycles/scenes.py (lamp, cameras, opaque glass)"
-    out = os.path.join(out, "sibenik")  # a folder of its own: its textures link is not Sponza's
-    os.makedirs(out, exist_ok=True)
-    link = os.path.join(out, "textures")
-    if os.path.islink(link):
-        os.remove(link)
-    if not os.path.exists(link):
-        os.symlink(os.path.abspath(os.path.join(src, "textures")), link)
-    path = os.path.join(out, "sibenik_lamp.glb")
-    write_glb(path, doc, binchunk)
+    add_light(doc, root, {"type": "point", "name": "interior lamp", "intensity": cd, "color": [1.0, 1.0, 1.0]},
+              {"name": "interior lamp", "translation": list(pos)})
+    add_cameras(doc, root, SIBENIK_CAMERAS)
+    # A folder of its own: its textures link is not Sponza's.
+    path = write_level(src, os.path.join(out, "sibenik"), "sibenik_lamp.glb", doc, binchunk, "lamp, cameras, opaque glass")
     print("wrote", path, "(%d cameras, %g cd lamp at %s, glass opaque)" % (len(SIBENIK_CAMERAS), cd, pos))
     return path
 

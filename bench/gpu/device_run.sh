@@ -3,22 +3,9 @@
 # packages into /: the GL backend on the GPU against Embree on the same machine's CPUs, same VPLs.
 # Writes logs and every report.json into $OUT/gpu_results.tar.gz.
 set -uo pipefail
-G=/tmp/g
-R=$G/results
-mkdir -p $R
-export LD_LIBRARY_PATH=$G/lib IRBAKE_IMAGEIO_PLUGIN=$G/lib/libirbake_imageio_min.so IRBAKE_SOURCE_DIR=$G/src
-export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-B=$G/bin/irbake
-S=$G/shared/scenes
+R=/tmp/g/results
+source "$(dirname "$0")/device_env.sh"
 nvidia-smi -L; nproc; uname -r
-bake() {  # tag timeout args...
-  local tag=$1 lim=$2; shift 2
-  local t0=$(date +%s.%N)
-  timeout $lim "$@" -o $R/$tag --quiet > $R/$tag.log 2>&1
-  local rc=$?
-  echo "$tag rc=$rc wall=$(awk -v a=$t0 -v b=$(date +%s.%N) 'BEGIN{printf "%.2f", b-a}') $(grep -o '"backend": *"[a-z]*"' $R/$tag/report.json 2>/dev/null)"
-  grep -v -E "^/tmp/g/results" $R/$tag.log | tail -2
-}
 timeout 60 $G/bin/glcontext_test --gtest_brief=1 2>&1 | tail -15
 $B samples $G/samples > /dev/null
 bake cornell_auto 60 $B bake $G/samples/cornell_box.gltf

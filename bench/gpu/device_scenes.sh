@@ -3,21 +3,8 @@
 # of other sizes and at other CPU counts, to place --backend auto's rule on a hardware renderer.
 # Writes logs and every report.json into $OUT/gpu_scenes.tar.gz.
 set -uo pipefail
-G=/tmp/g
-R=$G/results_scenes
-mkdir -p $R
-export LD_LIBRARY_PATH=$G/lib IRBAKE_IMAGEIO_PLUGIN=$G/lib/libirbake_imageio_min.so IRBAKE_SOURCE_DIR=$G/src
-export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
-B=$G/bin/irbake
-S=$G/shared/scenes
-bake() {  # tag timeout args...
-  local tag=$1 lim=$2; shift 2
-  local t0=$(date +%s.%N)
-  timeout $lim "$@" -o $R/$tag --quiet > $R/$tag.log 2>&1
-  local rc=$?
-  echo "$tag rc=$rc wall=$(awk -v a=$t0 -v b=$(date +%s.%N) 'BEGIN{printf "%.2f", b-a}')"
-  grep -v -E "^/tmp/g/results" $R/$tag.log | tail -2
-}
+R=/tmp/g/results_scenes
+source "$(dirname "$0")/device_env.sh"
 pair() {  # tag threads args...
   local tag=$1 th=$2; shift 2
   local cpus=0-$((th - 1))

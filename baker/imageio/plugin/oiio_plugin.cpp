@@ -119,11 +119,8 @@ Pixels readFile(const std::string& file) {
   return px;
 }
 
-const Api kApi{decodeMemory, encodePngMemory, writeFile, readFile};
-
 }  // namespace
 }  // namespace irbake::imageio
 
-extern "C" __attribute__((visibility("default"))) const irbake::imageio::Api* irbake_imageio_api() {
-  return &irbake::imageio::kApi;
-}
+IRBAKE_IMAGEIO_PLUGIN_ENTRY(irbake::imageio::decodeMemory, irbake::imageio::encodePngMemory, irbake::imageio::writeFile,
+                            irbake::imageio::readFile)
