@@ -10,7 +10,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/backend_choice.h"
 #include "atlas/atlas.h"
 #include "backend/bake_inputs.h"
 #include "backend/compensation/clamp_compensation.h"
@@ -20,15 +19,13 @@
 #include "backend/lightmap.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
+#include "pipeline/backend_choice.h"
 #include "pipeline/vpl_sums.h"
 #include "vpl/vpl.h"
 #include "transport/vpl_importance.h"
 
 namespace irbake {
 
-// Auto: GL on a hardware renderer, or on a software one for small scenes (≤ 10k triangles); Embree for
-// larger scenes on a software renderer, without a GL context, or with see-through materials (MASK, BLEND,
-// transmission), whose texels the GL backend would mostly trace with rays anyway.
 
 // How the bake bounds the VPL geometry term (VplEvalOptions::clampBound of every backend call).
 enum class ClampMode {

@@ -34,14 +34,14 @@ import sys
 SUN_DIR = (0.35, -1.0, 0.2)
 SUN_IRRADIANCE = 5.0
 
-# name, eye, target, yfov (degrees); glTF frame (Y up). Aspect 1.6 (160x100 renders).
+# name, eye, target, yfov (degrees); glTF frame (Y up). Every level camera: aspect 1.6 (160x100 renders).
 SPONZA_CAMERAS = [
     ("overview", (-9.5, 5.0, 0.0), (8.0, 2.5, 0.0), 65.0),
     ("arcade", (-8.5, 1.6, 4.6), (6.0, 2.2, 4.6), 55.0),
     ("arches", (-2.0, 1.4, -4.2), (1.5, 5.0, -5.6), 65.0),
     ("gallery", (-9.0, 7.0, -4.8), (8.0, 6.5, -4.2), 55.0),
 ]
-SPONZA_ASPECT = 1.6
+VIEW_ASPECT = 1.6
 
 # Sibenik for the Cycles comparison: the interior lamp of bench/levels (2000 cd, 7 m above the nave floor) and
 # no sky; its two BLEND glass materials made opaque, since Cycles' importer passes BLEND light untinted where
@@ -269,7 +269,7 @@ def add_cameras(doc, root, cameras):
     doc["cameras"] = []
     for name, eye, target, fov in cameras:
         doc["cameras"].append({"name": name, "type": "perspective", "perspective": {
-            "yfov": math.radians(fov), "aspectRatio": SPONZA_ASPECT, "znear": 0.05, "zfar": 200.0}})
+            "yfov": math.radians(fov), "aspectRatio": VIEW_ASPECT, "znear": 0.05, "zfar": 200.0}})
         doc["nodes"].append({"name": "camera_" + name, "camera": len(doc["cameras"]) - 1, "translation": list(eye),
                              "rotation": list(look_at_quat(eye, target))})
         root.append(len(doc["nodes"]) - 1)

@@ -44,9 +44,10 @@ struct FinalGatherOptions {
   uint32_t seed = 0;           // rotates the per-sample ray lattices
   int preRays = 2;             // a first, cheaper gather (these rays per sample, preFilterRadius) whose map the
                                // final pass reads instead of M: the walk's blotches averaged once more before the
-                               // final rays see them. Sponza views 2 / 3, seeds 0 / 1 / 2: 1.46 / 1.60 / 1.90% and
-                               // 2.57 / 2.50 / 2.70% against 1.51 / 1.68 / 2.05% and 2.71 / 3.15 / 2.96% without
-                               // (0: off); 2 rays at filter 3: 2.74 / 2.80% (seeds 0 / 1), 4 rays: 2.61 / 2.70%
+                               // final rays see them. Sponza views 2 / 3, seeds 0 / 1 / 2: 1.46 / 1.60 / 1.95% and
+                               // 2.57 / 2.78 / 2.74% against 1.51 / 1.68 / 2.05% and 2.71 / 3.15 / 2.96% without
+                               // (0: off); 1 ray: view 3 2.84 / 2.92 / 3.06%; 2 rays at filter 3: 2.74 / 2.80%
+                               // (seeds 0 / 1). Costs Sponza 5.3M rays, ≈ 2.3 s (docs/performance.md)
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
 };
 
