@@ -474,6 +474,7 @@ struct StagedBake::State {
     if (finalGatherOn) {
       o.refineRays = 0;
       o.minRays = std::min(o.minRays, 2);
+      o.filterEachSweep = false;
     }
     return o;
   }

@@ -308,8 +308,11 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   // shared with the bake's other filters: the page's plan in SurfaceFilterCache.
   std::vector<TexelFilterOptions> filterOptions(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) filterOptions[p].radius = radii[p];
+  // Filtered once after the last sweep instead of in each (linear: the same in expectation, noisier between sweeps).
+  const bool endFilter = !options.filterEachSweep;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
+    const std::vector<PackedLightmap> packed = packLightmaps(maps, &current);  // the hits' reads (lightmap_read.h)
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
@@ -319,7 +322,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         const KeptHit& kept = tile.hits[h];
         glm::vec3 L(0.0f);
         if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
-        if (kept.map >= 0) L += kept.albedo * readLightmap(maps[kept.map], current[kept.map], kept.texel);
+        if (kept.map >= 0) L += kept.albedo * packed[kept.map].read(kept.texel);
         res[tile.begin + kept.slotInTile] += L;
       }
     });
@@ -337,8 +340,9 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
       std::vector<glm::vec3> filtered;
-      if (radii[p] > 0) filtered = g.filters()->apply(ts, residual, m.valid, filterOptions[p]);
-      const std::vector<glm::vec3>& residualUsed = radii[p] > 0 ? filtered : residual;
+      const bool filterNow = radii[p] > 0 && !endFilter;
+      if (filterNow) filtered = g.filters()->apply(ts, residual, m.valid, filterOptions[p]);
+      const std::vector<glm::vec3>& residualUsed = filterNow ? filtered : residual;
       const std::vector<glm::vec3>& baseMap = base(p);
       for (size_t t = 0; t < layer; ++t) {
         if (t < m.valid.size() && m.valid[t]) {
@@ -383,6 +387,16 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     if (converged) break;
   }
 
+  if (endFilter)
+    for (size_t p = 0; p < maps.size(); ++p) {
+      if (radii[p] <= 0) continue;
+      std::vector<glm::vec3> r(maps[p].size(), glm::vec3(0.0f));
+      for (size_t t = 0; t < r.size(); ++t)
+        if (maps[p].valid[t]) r[t] = current[p][t] - base(p)[t];
+      r = g.filters()->apply(in.texels[p], r, maps[p].valid, filterOptions[p]);
+      for (size_t t = 0; t < r.size(); ++t)
+        if (maps[p].valid[t]) current[p][t] = base(p)[t] + r[t];
+    }
   double before = 0.0, added = 0.0;
   for (size_t p = 0; p < maps.size(); ++p) {
     for (size_t t = 0; t < maps[p].size(); ++t) {
