@@ -59,11 +59,13 @@ void setPacketLane(RTCRay8& packet, size_t k, const glm::vec3& origin, const glm
 struct RayTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  RTCScene fastScene = nullptr;  // the same geometries without RTC_SCENE_FLAG_ROBUST (Traversal::Fast)
   std::vector<MaskGeometry> masks;  // one per primitive (stable addresses: sized before use)
   std::vector<glm::vec3> faceNormals;  // per primitive, per triangle: unit geometric normal
   std::vector<size_t> faceOffset;      // primitive -> first index in faceNormals
   bool packets8 = false;               // native rtcOccluded8 support
   ~Impl() {
+    if (fastScene) rtcReleaseScene(fastScene);
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
@@ -78,6 +80,8 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()), scen
   // Robust traversal: rays that graze edges between triangles do not slip through (energy closure).
   rtcSetSceneFlags(I.scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(I.scene, RTC_BUILD_QUALITY_HIGH);
+  I.fastScene = rtcNewScene(I.device);
+  rtcSetSceneBuildQuality(I.fastScene, RTC_BUILD_QUALITY_HIGH);
 
   // Offsets: relative to the larger of the scene size and its distance from the origin, since float
   // spacing grows with the coordinate magnitude (huge scale ranges).
@@ -134,9 +138,11 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()), scen
     }
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(I.scene, g, static_cast<unsigned>(p));  // geomID = primitive index
+    rtcAttachGeometryByID(I.fastScene, g, static_cast<unsigned>(p));
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(I.scene);
+  rtcCommitScene(I.fastScene);
   I.packets8 = rtcGetDeviceProperty(I.device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
   if (rtcGetDeviceError(I.device) != RTC_ERROR_NONE)
     throw Error(ErrorCode::InvalidData, scene.sourcePath, "Embree failed to build the scene");
@@ -164,7 +170,8 @@ RayHit RayTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float
 }
 
 void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs, size_t n, RayHit* hits,
-                                 HitDetail detail) const {
+                                 HitDetail detail, Traversal traversal) const {
+  RTCScene scene = traversal == Traversal::Fast ? impl_->fastScene : impl_->scene;
   if (!impl_->packets8) {
     for (size_t i = 0; i < n; ++i) hits[i] = intersect(origin, dirs[i], 0.0f, 1e30f);
     return;
@@ -181,7 +188,7 @@ void RayTracer::intersectPackets(const glm::vec3& origin, const glm::vec3* dirs,
       packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect8(valid, impl_->scene, &ctx, &packet);
+    rtcIntersect8(valid, scene, &ctx, &packet);
     for (size_t k = 0; k < count; ++k)
       hits[base + k] = packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
                            ? RayHit{}

@@ -41,8 +41,15 @@ class RayTracer {
   // HitDetail::Surface leaves position and shadingNormal unset (the final gather reads the map and the
   // material at the hit's triangle and barycentrics only: 42M hits on Sponza).
   enum class HitDetail { Full, Surface };
+  // Traversal::Robust: Embree's robust mode (RTC_SCENE_FLAG_ROBUST), as every other query here: a ray through an
+  // edge or a corner shared by two triangles never slips between them. Traversal::Fast: a second BVH over the
+  // same geometries without it, ~13% faster on Sponza's gather rays, where a ray aimed exactly through a shared
+  // edge may slip (RayTracer.FastTraversalHitsWhereRobustDoesOffExactEdges: 5 of 4096 such rays, none of a grid
+  // that passes beside the edges). For the final gather's tens of millions of cosine rays from jittered samples,
+  // each one of a texel's 16 and filtered over 49 texels; not for leak tests or visibility.
+  enum class Traversal { Robust, Fast };
   void intersectPackets(const glm::vec3& origin, const glm::vec3* dirs, size_t n, RayHit* hits,
-                        HitDetail detail = HitDetail::Full) const;
+                        HitDetail detail = HitDetail::Full, Traversal traversal = Traversal::Robust) const;
   // Opaque occlusion: see-through surfaces (Material::isTransmissive) are skipped, MASK holes too.
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tmin, float tmax) const;
   // The product of the see-through surfaces' transmittances along a ray that occluded() found clear

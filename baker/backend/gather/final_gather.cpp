@@ -90,7 +90,8 @@ glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>
   for (int begin = 0; begin < rays; begin += kChunk) {
     const int count = std::min(kChunk, rays - begin);
     for (int k = 0; k < count; ++k) dirs[k] = lattice.next();
-    rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Surface);
+    rt.intersectPackets(origin, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Surface,
+                        RayTracer::Traversal::Fast);
     for (int k = 0; k < count; ++k) {
       const RayHit& hit = hits[k];
       if (!hit.hit) {
