@@ -53,22 +53,21 @@ inline MapPoint mapPointOf(const Scene& scene, const std::vector<int32_t>& mapOf
   return point;
 }
 
-// Bilinear read of irradiance/π over the valid texels of a map (values: one per texel of m, e.g. m.texels);
-// the nearest valid texel of the 3×3 neighbourhood when none of the four is valid (chart borders); 0 when
-// none at all.
-inline glm::vec3 readLightmap(const Lightmap& m, const std::vector<glm::vec3>& value, glm::vec2 t) {
+// Bilinear read over the valid texels of a width × height page, at(x, y, v) saying whether texel (x, y) is
+// valid and putting its value in v; the nearest valid texel of the 3×3 neighbourhood when none of the four is
+// valid (chart borders); 0 when none at all. Shared by both map forms below.
+template <class ValidValue>
+glm::vec3 readBilinearOverValid(int width, int height, glm::vec2 t, ValidValue&& at) {
   const int x0 = static_cast<int>(std::floor(t.x)), y0 = static_cast<int>(std::floor(t.y));
   const float fx = t.x - x0, fy = t.y - y0;
-  glm::vec3 sum(0.0f);
+  glm::vec3 sum(0.0f), v(0.0f);
   float weight = 0.0f;
   for (int dy = 0; dy < 2; ++dy)
     for (int dx = 0; dx < 2; ++dx) {
       const int x = x0 + dx, y = y0 + dy;
-      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
-      const size_t i = static_cast<size_t>(y) * m.width + x;
-      if (!m.valid[i]) continue;
+      if (x < 0 || y < 0 || x >= width || y >= height || !at(x, y, v)) continue;
       const float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) + 1e-6f;
-      sum += w * value[i];
+      sum += w * v;
       weight += w;
     }
   if (weight > 0.0f) return sum / weight;
@@ -77,13 +76,21 @@ inline glm::vec3 readLightmap(const Lightmap& m, const std::vector<glm::vec3>& v
   glm::vec3 nearest(0.0f);
   for (int y = cy - 1; y <= cy + 1; ++y)
     for (int x = cx - 1; x <= cx + 1; ++x) {
-      if (x < 0 || y < 0 || x >= m.width || y >= m.height) continue;
-      const size_t i = static_cast<size_t>(y) * m.width + x;
-      if (!m.valid[i]) continue;
+      if (x < 0 || y < 0 || x >= width || y >= height || !at(x, y, v)) continue;
       const float d = (x - t.x) * (x - t.x) + (y - t.y) * (y - t.y);
-      if (d < best) best = d, nearest = value[i];
+      if (d < best) best = d, nearest = v;
     }
   return nearest;
+}
+
+// Bilinear read of irradiance/π over the valid texels of a map (values: one per texel of m, e.g. m.texels).
+inline glm::vec3 readLightmap(const Lightmap& m, const std::vector<glm::vec3>& value, glm::vec2 t) {
+  return readBilinearOverValid(m.width, m.height, t, [&](int x, int y, glm::vec3& v) {
+    const size_t i = static_cast<size_t>(y) * m.width + x;
+    if (!m.valid[i]) return false;
+    v = value[i];
+    return true;
+  });
 }
 
 // A page's map packed for the gathers' random reads (tens of millions of hits, each a bilinear footprint at an
@@ -134,31 +141,12 @@ class PackedLightmap {
   glm::vec3 at(int x, int y) const { return decode(word(x, y)); }  // x, y inside; a valid texel
 
   glm::vec3 read(glm::vec2 t) const {
-    const int x0 = static_cast<int>(std::floor(t.x)), y0 = static_cast<int>(std::floor(t.y));
-    const float fx = t.x - x0, fy = t.y - y0;
-    glm::vec3 sum(0.0f);
-    float weight = 0.0f;
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx) {
-        const int x = x0 + dx, y = y0 + dy;
-        if (x < 0 || y < 0 || x >= width_ || y >= height_) continue;
-        const uint32_t w32 = word(x, y);
-        if (w32 == kInvalid) continue;
-        const float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) + 1e-6f;
-        sum += w * decode(w32);
-        weight += w;
-      }
-    if (weight > 0.0f) return sum / weight;
-    const int cx = static_cast<int>(std::lround(t.x)), cy = static_cast<int>(std::lround(t.y));
-    float best = 1e30f;
-    glm::vec3 nearest(0.0f);
-    for (int y = cy - 1; y <= cy + 1; ++y)
-      for (int x = cx - 1; x <= cx + 1; ++x) {
-        if (x < 0 || y < 0 || x >= width_ || y >= height_ || word(x, y) == kInvalid) continue;
-        const float d = (x - t.x) * (x - t.x) + (y - t.y) * (y - t.y);
-        if (d < best) best = d, nearest = decode(word(x, y));
-      }
-    return nearest;
+    return readBilinearOverValid(width_, height_, t, [&](int x, int y, glm::vec3& v) {
+      const uint32_t w = word(x, y);
+      if (w == kInvalid) return false;
+      v = decode(w);
+      return true;
+    });
   }
 
  private:
