@@ -135,8 +135,6 @@ class PackedLightmap {
   }
   PackedLightmap(const Lightmap& m, const std::vector<glm::vec3>& values)
       : PackedLightmap(m, [&](size_t i) { return values[i]; }) {}
-  int width() const { return width_; }
-  int height() const { return height_; }
   bool valid(int x, int y) const { return word(x, y) != kInvalid; }
   glm::vec3 at(int x, int y) const { return decode(word(x, y)); }  // x, y inside; a valid texel
 
@@ -173,7 +171,6 @@ class PackedLightmap {
     int e = 0;
     std::frexp(peak, &e);  // peak in [2^(e-1), 2^e)
     int exponent = std::max(e, -kBias + 1) + kBias;  // stored exponent: unit 2^(exponent - kBias - 9)
-    if (exponent < 0) return 0u;
     float unit = std::ldexp(1.0f, exponent - kBias - kMantissaBits);
     if (std::lround(peak / unit) > 511) unit *= 2.0f, ++exponent;  // rounding carried into the next power
     uint32_t w = static_cast<uint32_t>(exponent) << 27;
@@ -187,12 +184,12 @@ class PackedLightmap {
   float unit_[32] = {};  // value of one mantissa step per stored exponent, the page's scale included
 };
 
-// Every map packed (see PackedLightmap), values from maps[p].texels or, where given, values[p].
+// Every map packed (see PackedLightmap) with the values values[p] (one per texel of maps[p]).
 inline std::vector<PackedLightmap> packLightmaps(const std::vector<Lightmap>& maps,
-                                                 const std::vector<std::vector<glm::vec3>>* values = nullptr) {
+                                                 const std::vector<std::vector<glm::vec3>>& values) {
   std::vector<PackedLightmap> packed;
   packed.reserve(maps.size());
-  for (size_t p = 0; p < maps.size(); ++p) packed.emplace_back(maps[p], values ? (*values)[p] : maps[p].texels);
+  for (size_t p = 0; p < maps.size(); ++p) packed.emplace_back(maps[p], values[p]);
   return packed;
 }
 

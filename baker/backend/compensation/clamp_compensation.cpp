@@ -308,11 +308,9 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   // shared with the bake's other filters: the page's plan in SurfaceFilterCache.
   std::vector<TexelFilterOptions> filterOptions(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) filterOptions[p].radius = radii[p];
-  // Filtered once after the last sweep instead of in each (linear: the same in expectation, noisier between sweeps).
-  const bool endFilter = !options.filterEachSweep;
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
-    const std::vector<PackedLightmap> packed = packLightmaps(maps, &current);  // the hits' reads (lightmap_read.h)
+    const std::vector<PackedLightmap> packed = packLightmaps(maps, current);  // the hits' reads (lightmap_read.h)
     tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
       const Tile& tile = tiles[ti];
       auto& res = slotResidual[tile.page];
@@ -340,7 +338,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
       std::vector<glm::vec3> filtered;
-      const bool filterNow = radii[p] > 0 && !endFilter;
+      const bool filterNow = radii[p] > 0 && options.filterEachSweep;
       if (filterNow) filtered = g.filters()->apply(ts, residual, m.valid, filterOptions[p]);
       const std::vector<glm::vec3>& residualUsed = filterNow ? filtered : residual;
       const std::vector<glm::vec3>& baseMap = base(p);
@@ -387,7 +385,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     if (converged) break;
   }
 
-  if (endFilter)
+  // Or once, after the last sweep (linear: the same in expectation, noisier between sweeps).
+  if (!options.filterEachSweep)
     for (size_t p = 0; p < maps.size(); ++p) {
       if (radii[p] <= 0) continue;
       std::vector<glm::vec3> r(maps[p].size(), glm::vec3(0.0f));

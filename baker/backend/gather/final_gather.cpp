@@ -130,9 +130,11 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
 namespace {
 
 // One gather: maps ← D + gather(source) at valid texels, the lattice rotations from stream.
+// albedo: texelAlbedo(in), made once for both passes.
 void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const std::vector<Lightmap>& source,
-                const std::vector<std::vector<glm::vec3>>& albedo, std::vector<Lightmap>& maps, const FinalGatherOptions& options, uint64_t stream,
-                FinalGatherStats& stats, const L1Pages* directL1, L1Pages* l1) {
+                const std::vector<std::vector<glm::vec3>>& albedo, std::vector<Lightmap>& maps,
+                const FinalGatherOptions& options, uint64_t stream, FinalGatherStats& stats, const L1Pages* directL1,
+                L1Pages* l1) {
   const std::vector<int32_t> mapOfPage = mapIndexOfPages(in.texels);
   const size_t samples = weightedSampleCount(in.texels);
   int rays = std::max(1, options.rays);

@@ -79,8 +79,9 @@ void finalGather(const BakeInputs& in, const std::vector<Lightmap>& direct, std:
 
 // The gathered term at one point (x on a surface with normal n), `rays` cosine rays with lattice rotation
 // (r1, r2), reading maps; a ray that misses brings missRadiance (for tests and tools).
-// With tangential, also the rays' tangential irradiance vector (finalGather's t). The hits' base colour is
-// in.albedoAtHit's (at one map texel's footprint where the pipeline gives one).
+// With tangential, also the rays' tangential irradiance vector (finalGather's t). A hit reads ρ M bilinearly from
+// the maps packed with each texel's base colour (in.albedoAtHit's mean over the texel's samples), as the stage
+// does; each call packs every map again, so it suits tests and tools, not loops.
 glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, const std::vector<int32_t>& mapOfPage,
                    const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
                    const glm::vec3& missRadiance = glm::vec3(0.0f), L1Vectors* tangential = nullptr);
