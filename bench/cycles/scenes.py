@@ -4,6 +4,7 @@
 usage (from the repository root):
   /usr/bin/python3 bench/cycles/scenes.py mcguire OUTDIR   -> OUTDIR/mcguire_cornell.gltf + .bin
   /usr/bin/python3 bench/cycles/scenes.py sponza  OUTDIR   -> OUTDIR/sponza_sun.glb (+ OUTDIR/textures link)
+                                                           and OUTDIR/sponza_sun_x4.glb (+ OUTDIR/textures_x4/)
   /usr/bin/python3 bench/cycles/scenes.py sibenik OUTDIR   -> OUTDIR/sibenik/sibenik_lamp.glb (+ its textures link)
   /usr/bin/python3 bench/cycles/scenes.py all     OUTDIR
 
@@ -23,12 +24,20 @@ sponza: dabrovic_sponza/sponza.glb with KHR_materials_pbrSpecularGlossiness stri
   (= irradiance 5 W/m^2, as `irbake bake --sun 0.35,-1,0.2,5`), and four cameras (SPONZA_CAMERAS). The
   binary chunk is reused byte for byte; the images stay external: OUTDIR/textures links to the shared
   textures folder.
+sponza_sun_x4.glb: the same scene whose images are OUTDIR/textures_x4/NAME.png, each shared texture upsampled
+  4x by nearest neighbour (oiiotool --resample:interp=0, lossless PNG): the same texel values and means, so
+  the same scene for irbake, but Cycles filters base-colour textures in sRGB space *before* decoding (a
+  black/white checker renders 0.247 against glTF's linear mean 0.5; docs/accuracy.md), which darkens its
+  albedo by 0.04-0.67% per Sponza texture; on the upsampled images that filtering acts only on the borders of
+  4x4 blocks of equal texels. The accuracy figures against Cycles use this scene.
 """
 import argparse
 import json
 import math
 import os
+import shutil
 import struct
+import subprocess
 import sys
 
 SUN_DIR = (0.35, -1.0, 0.2)
@@ -289,6 +298,27 @@ def write_level(src, out, name, doc, binchunk, generated):
     return path
 
 
+def upsample_textures(src, out, doc, scale, folder):
+    """Point the images at OUT/folder/NAME.png, each the level's texture upsampled `scale` x by nearest neighbour."""
+    oiiotool = shutil.which("oiiotool")
+    if not oiiotool:
+        fail("oiiotool not found (Debian package openimageio-tools)")
+    os.makedirs(os.path.join(out, folder), exist_ok=True)
+    for img in doc.get("images", []):
+        uri = img.get("uri", "")
+        if not uri or uri.startswith("data:"):
+            fail("image without an external uri: %s" % img)
+        name = os.path.splitext(os.path.basename(uri.replace("%20", " ")))[0] + ".png"
+        dst = os.path.join(out, folder, name)
+        if not os.path.isfile(dst):
+            tmp = dst + ".tmp.png"
+            subprocess.run([oiiotool, os.path.join(src, uri.replace("%20", " ")), "--resample:interp=0",
+                            "%d%%" % (100 * scale), "-o", tmp], check=True)
+            os.replace(tmp, dst)
+        img["uri"] = folder + "/" + name
+        img.pop("mimeType", None)
+
+
 def build_sponza(shared, out):
     src, doc, binchunk, root = read_level(shared, "dabrovic_sponza", "sponza.glb")
     add_light(doc, root, {"type": "directional", "name": "sun", "intensity": SUN_IRRADIANCE, "color": [1.0, 1.0, 1.0]},
@@ -296,6 +326,10 @@ def build_sponza(shared, out):
     add_cameras(doc, root, SPONZA_CAMERAS)
     path = write_level(src, out, "sponza_sun.glb", doc, binchunk, "sun, cameras")
     print("wrote", path, "(%d cameras, sun along %s, E = %g W/m^2)" % (len(SPONZA_CAMERAS), SUN_DIR, SUN_IRRADIANCE))
+    upsample_textures(src, out, doc, 4, "textures_x4")
+    x4 = os.path.join(out, "sponza_sun_x4.glb")
+    write_glb(x4, doc, binchunk)
+    print("wrote", x4, "(the same, textures upsampled 4x by nearest neighbour into textures_x4/)")
     return path
 
 
