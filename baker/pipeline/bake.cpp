@@ -432,6 +432,14 @@ struct StagedBake::State {
     if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
       throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
                                                                 " pages for " + std::to_string(texels.size()));
+    if (eval.includeDirect && !scene.lights.empty() && options.shadowEdges.subSamples > 1) {
+      // On the punctual lights alone, before D is kept for the final gather: its sources see the same edges.
+      // The L1 pages keep the centre's direction (a texel's light comes from one side of an edge either way).
+      const ShadowEdgeStats st = refineShadowEdges(*wholeInputs, maps, options.shadowEdges);
+      seconds["shadowEdges"] = st.seconds;
+      report["shadowEdges"] = {{"subSamples", options.shadowEdges.subSamples}, {"edgeTexels", st.edgeTexels},
+                               {"subPoints", st.subPoints}, {"droppedInside", st.droppedInside}};
+    }
     if (finalGatherOn) {
       directMaps = maps;
       for (size_t p = 0; p < directMaps.size(); ++p)

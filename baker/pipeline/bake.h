@@ -15,6 +15,7 @@
 #include "backend/compensation/clamp_compensation.h"
 #include "backend/gather/final_gather.h"
 #include "backend/gl/gl_backend.h"
+#include "backend/shadow_edges/shadow_edges.h"
 #include "backend/sky/sky_light.h"
 #include "backend/lightmap.h"
 #include "scene/scene.h"
@@ -70,6 +71,7 @@ struct BakeOptions {
                                             // (the bake sets it from clamp)
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
+  ShadowEdgeOptions shadowEdges;          // punctual lights' shadow edges area-averaged (subSamples ≤ 1: off)
   FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (backend/gather)
   FinalGatherOptions gather;              // its rays and filter
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
