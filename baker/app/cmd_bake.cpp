@@ -164,7 +164,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "gather counts a uniform sky itself)")
       ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
-                  "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 4; 0 or 1: the centre alone)")
+                  "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 8; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
   app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up, centre\ntowards −Z) instead of --sky")
       ->type_name("FILE");

@@ -104,25 +104,27 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
             const glm::vec3 xs = rt.insetPoint(pi, tri, (1.0f - b1 - b2) * p0 + b1 * p1 + b2 * p2);
             const glm::vec3 origin = xs + n * eps;
             ++points;
-            // Reachable from the centre along the surface: a wall standing on the triangle (a box resting on
-            // the floor) cuts off the part of the square behind it, which is covered, not shadowed.
-            const glm::vec3 step = origin - centre;
-            const float reach = glm::length(step);
-            if (reach > eps && rt.occluded(centre, step / reach, 0.0f, reach)) {
-              ++dropped;
-              continue;
-            }
             glm::vec3 value(0.0f);
+            bool anyLit = false;
             for (const Light& l : in.scene.lights) {
               const PunctualContribution c = punctualDirect(l, xs, n);
               if (c.mapValue == glm::vec3(0.0f)) continue;
               const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-              if (!(tmax > 0.0f)) {
-                value += c.mapValue;
+              if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
+              anyLit = true;
+              value += tmax > 0.0f && rt.hasTransmission() ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax)
+                                                           : c.mapValue;
+            }
+            // Dark: shadowed, or cut off from the centre by a surface standing on the triangle (the floor under
+            // a box resting on it), which is covered, not shadowed, and no part of what a viewer sees. A lit
+            // sub-point cannot be under a closed box, so only the dark ones need the ray along the surface.
+            if (!anyLit) {
+              const glm::vec3 step = origin - centre;
+              const float reach = glm::length(step);
+              if (reach > eps && rt.occluded(centre, step / reach, 0.0f, reach)) {
+                ++dropped;
                 continue;
               }
-              if (rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-              value += rt.hasTransmission() ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
             }
             sum += glm::dvec3(value);
             ++kept;

@@ -17,7 +17,7 @@
 namespace irbake {
 
 struct ShadowEdgeOptions {
-  int subSamples = 4;           // S: S×S sub-points per edge texel (0 or 1: the stage is off)
+  int subSamples = 8;           // S: S×S sub-points per edge texel (0 or 1: the stage is off)
   float jump = 0.1f;            // an edge: the share of the lights' unshadowed value that arrives differs from a
                                 // valid neighbour's by more (smooth falloff leaves the share at 1)
 };
