@@ -434,8 +434,19 @@ struct StagedBake::State {
                                                                 " pages for " + std::to_string(texels.size()));
     if (eval.includeDirect && !scene.lights.empty() && options.shadowEdges.subSamples > 1) {
       // On the punctual lights alone, before D is kept for the final gather: its sources see the same edges.
-      // The L1 pages keep the centre's direction (a texel's light comes from one side of an edge either way).
+      // The L1 pages keep the centre's direction, scaled with the value per channel so that |L1| stays within
+      // what L0 allows (a refined texel's light comes from the same lights; where the centre was dark, L1 is 0).
+      std::vector<Lightmap> before;
+      if (l1) before = maps;
       const ShadowEdgeStats st = refineShadowEdges(*wholeInputs, maps, options.shadowEdges);
+      for (size_t p = 0; l1 && p < maps.size(); ++p)
+        for (size_t t = 0; t < maps[p].size(); ++t) {
+          const glm::vec3 &was = before[p].texels[t], &now = maps[p].texels[t];
+          if (was == now) continue;
+          const glm::vec3 scale(was.x > 0.0f ? now.x / was.x : 0.0f, was.y > 0.0f ? now.y / was.y : 0.0f,
+                                was.z > 0.0f ? now.z / was.z : 0.0f);
+          for (int k = 0; k < 3; ++k) (*l1)[k][p].texels[t] *= scale;
+        }
       seconds["shadowEdges"] = st.seconds;
       report["shadowEdges"] = {{"subSamples", options.shadowEdges.subSamples}, {"edgeTexels", st.edgeTexels},
                                {"subPoints", st.subPoints}, {"droppedInside", st.droppedInside}};
