@@ -265,6 +265,8 @@ def map_mode(args, out, rep, row, rows):
     w, h = pages[0]["width"], pages[0]["height"]
     scene = os.path.join(out, "scene.gltf")
     base = ["--uv", "UVMap.001", "--width", str(w), "--height", str(h), "--max-bounces", str(args.max_bounces)]
+    if args.bake_lights:
+        base += ["--cycles-dir", args.cycles_dir]
     half = max(1, args.map_spp // 2)
     kf = [export_key_file(scene, out)]
     refs = [cycles_cached(args, args.bake_script, scene, base + ["--spp", str(half), "--seed", str(s)], "map.exr", kf)
@@ -381,6 +383,8 @@ def main():
     ap.add_argument("--cache", default=os.path.join(REPO, "build", "cycles-cache"))
     ap.add_argument("--maps", action="store_true")
     ap.add_argument("--map-spp", type=int, default=1024, help="reference samples per texel (two halves)")
+    ap.add_argument("--bake-lights", action="store_true",
+                    help="maps: bake through cycles_bake_lights.py, which keeps the punctual lights (a sun-lit level)")
     ap.add_argument("--map-ladder", default="", help="Cycles bakes scored against the reference, e.g. 4,16,64,256")
     ap.add_argument("--views", default="", help="glTF camera indices, e.g. 0,1,2")
     ap.add_argument("--view-size", default="128x128")
@@ -402,6 +406,8 @@ def main():
             fail("%s not found: %s" % (what, p))
     args.render_script = os.path.join(args.cycles_dir, "cycles_render.py")
     args.bake_script = os.path.join(args.cycles_dir, "cycles_bake.py")
+    if args.bake_lights:
+        args.bake_script = os.path.join(REPO, "bench", "cycles", "cycles_bake_lights.py")
     if not os.path.isfile(args.render_script):
         fail("Cycles scripts not found in %s (--cycles-dir)" % args.cycles_dir)
     if shutil.which(args.blender) is None:
