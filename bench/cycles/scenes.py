@@ -9,7 +9,7 @@ usage (from the repository root):
   /usr/bin/python3 bench/cycles/scenes.py all     OUTDIR
 
 Inputs are read from ../shared/scenes (relative to the repository root; --shared overrides) and never copied
-into git: write OUTDIR under build/. Standard library only.
+into git: write OUTDIR under build/. Standard library only, but for coplanar.py (numpy) on Sibenik.
 
 mcguire: CornellBox-Original.obj/.mtl (McGuire archive) -> one glTF material per MTL material, base colour
   from Kd. The two blocks have Kd = 0 and Ks = 0.725 0.71 0.68 (a glossy white) in the MTL: irbake and our
@@ -30,6 +30,9 @@ sponza_sun_x4.glb: the same scene whose images are OUTDIR/textures_x4/NAME.png, 
   black/white checker renders 0.247 against glTF's linear mean 0.5; docs/accuracy.md), which darkens its
   albedo by 0.04-0.67% per Sponza texture; on the upsampled images that filtering acts only on the borders of
   4x4 blocks of equal texels. The accuracy figures against Cycles use this scene.
+sibenik: sibenik/sibenik.glb, its BLEND glass made opaque, one 2000 cd point lamp in the nave, six cameras,
+  and the 205 triangles (12.3 m^2: the pulpit's carpet, gallery floors) that a coincident triangle of the same
+  plane already covers dropped (coplanar.py: Cycles renders such overlaps black).
 """
 import argparse
 import json
@@ -39,6 +42,8 @@ import shutil
 import struct
 import subprocess
 import sys
+
+import coplanar  # numpy: only the Sibenik scene uses it
 
 SUN_DIR = (0.35, -1.0, 0.2)
 SUN_IRRADIANCE = 5.0
@@ -60,6 +65,10 @@ SIBENIK_CAMERAS = [
     ("choir", (14.0, -12.5, 0.0), (-6.0, -15.3, 0.0), 60.0),
     ("aisle", (-14.0, -12.0, 5.0), (6.0, -14.0, -4.0), 60.0),
     ("across", (0.0, -14.0, 6.5), (0.0, -10.0, -8.0), 60.0),
+    # The pulpit's landing and parapet, where the coincident carpet triangles were (coplanar.py, session 19).
+    ("landing", (4.6, -12.2, 0.3), (4.1, -14.16, -0.35), 60.0),
+    ("parapet", (4.6, -13.6, 0.85), (4.2, -13.95, -0.69), 60.0),
+    ("pulpit", (8.0, -11.0, 3.0), (4.2, -14.0, -0.5), 60.0),
 ]
 
 
@@ -339,6 +348,11 @@ def build_sibenik(shared, out):
         if m.get("alphaMode") == "BLEND":
             del m["alphaMode"]
             m.setdefault("pbrMetallicRoughness", {}).setdefault("baseColorFactor", [1.0, 1.0, 1.0, 1.0])[3] = 1.0
+    # Coincident triangles (the pulpit's carpet, gallery floors) render black in Cycles (coplanar.py): drop
+    # those that earlier ones of the same plane cover whole; partial overlaps stay.
+    binchunk, dropped, dropped_m2, partial_m2 = coplanar.drop_covered(doc, binchunk)
+    print("sibenik: dropped %d coincident triangles (%.2f m^2) covered by others; partial overlaps left %.2f m^2"
+          % (dropped, dropped_m2, partial_m2))
     pos, cd = SIBENIK_LAMP
     add_light(doc, root, {"type": "point", "name": "interior lamp", "intensity": cd, "color": [1.0, 1.0, 1.0]},
               {"name": "interior lamp", "translation": list(pos)})
