@@ -3,7 +3,7 @@
 # From the repository root, after a Release build:  bash bench/cycles/run_all.sh [IRBAKE [IRVIEW]]
 # Cycles results are cached under build/cycles-cache (by input checksum): a re-run after a baker change
 # re-runs our bakes and re-bakes Cycles' maps only if our atlas changed. Rows are appended to
-# bench/results/cycles_<scene>.csv. Cost on the shared 2-core machine, cold cache: about two hours (Sponza's four views at 8192 spp: ~40 min).
+# bench/results/cycles_<scene>.csv. Cost on the shared 2-core machine, cold cache: about three hours (Sponza's four views at 8192 spp: ~40 min; its map and Cycles' ladder: ~50 min).
 set -euo pipefail
 IRBAKE=${1:-build/baker/irbake}
 IRVIEW=${2:-build/runtime/irview}
@@ -20,7 +20,9 @@ SPONZA=$S/sponza_sun_x4.glb  # textures upsampled 4x: Cycles filters them in sRG
     --views 0 --view-size 128x128 --view-spp 2048 --save-diff
 "${C[@]}" $SPONZA --name sponza_sun_x4 --opts "" --opts "--seed 1" --opts "--seed 2" --views 3,0,1,2 --view-size 160x100 \
     --view-spp 8192 --save-diff
+# Sponza's map against Cycles' own bake (the sun kept: cycles_bake_lights.py), its ladder up to our error (~50 min).
+"${C[@]}" $SPONZA --name sponza_sun_x4 --opts "" --maps --bake-lights --map-spp 256 --map-ladder 4,16,64,96 --save-diff
 # Sibenik lit by its interior lamp alone (glass made opaque: scenes.py); no emitters, so no emitter cut.
-"${C[@]}" $S/sibenik/sibenik_lamp.glb --name sibenik_lamp --opts "" --views 0,1,2 --view-size 160x100 --view-spp 1024 \
+"${C[@]}" $S/sibenik/sibenik_lamp.glb --name sibenik_lamp --opts "" --views 0,1,2,3,4,5 --view-size 160x100 --view-spp 1024 \
     --emitter-cut 1e30 --save-diff
 /usr/bin/python3 bench/cycles/table.py bench/results/cycles_*.csv
