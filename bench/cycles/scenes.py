@@ -43,8 +43,6 @@ import struct
 import subprocess
 import sys
 
-import coplanar  # numpy: only the Sibenik scene uses it
-
 SUN_DIR = (0.35, -1.0, 0.2)
 SUN_IRRADIANCE = 5.0
 
@@ -350,6 +348,7 @@ def build_sibenik(shared, out):
             m.setdefault("pbrMetallicRoughness", {}).setdefault("baseColorFactor", [1.0, 1.0, 1.0, 1.0])[3] = 1.0
     # Coincident triangles (the pulpit's carpet, gallery floors) render black in Cycles (coplanar.py): drop
     # those that earlier ones of the same plane cover whole; partial overlaps stay.
+    import coplanar  # numpy, so imported here: the other scenes need the standard library only
     binchunk, dropped, dropped_m2, partial_m2 = coplanar.drop_covered(doc, binchunk)
     print("sibenik: dropped %d coincident triangles (%.2f m^2) covered by others; partial overlaps left %.2f m^2"
           % (dropped, dropped_m2, partial_m2))
