@@ -6,9 +6,10 @@ carpet and gallery floors, about 21 m^2), Cycles shades the overlap black. Every
 hits its twin at distance ~0 (Cycles skips only the primitive it starts on), so the direct light is shadowed and
 each bounce lands on the twin again. irbake offsets its rays and sees one lit surface, which is what a level
 artist means by it. A reference that renders the overlap black is wrong there, and the light that should
-bounce off it is missing around it (docs/accuracy.md, session 19). The bench scenes drop, from each plane, the
-triangles whose whole area earlier triangles of the same plane already cover: the surface stays where it was,
-once. Partial overlaps are kept and counted.
+bounce off it is missing around it (docs/accuracy.md, session 19). The bench scenes keep, in each plane, the
+first triangle over any spot: later triangles that earlier ones cover are dropped, those partly covered are cut
+to their uncovered rest (convex pieces, fan-triangulated, new vertices interpolated). The surface stays where it
+was, once.
 
 Used by scenes.py (numpy; the rest of scenes.py is standard library). Also a tool:
   /usr/bin/python3 bench/cycles/coplanar.py SCENE.glb|.gltf     -> prints the coincident area, changes nothing
@@ -23,8 +24,7 @@ import numpy as np
 COMPONENT = {5126: np.float32, 5125: np.uint32, 5123: np.uint16, 5121: np.uint8}
 WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
 PLANE_TOL = 1e-5   # metres and normal components: planes that agree to this are one (a 0.1 mm gap is not)
-COVERED = 0.98     # a triangle is dropped when this share of its sample points lies inside earlier ones
-LATTICE = 8        # sample points: the centres of an 8x8 barycentric lattice (36 points), no randomness
+COVERED = 0.98     # a triangle is dropped when earlier ones cover this share of its area
 
 
 def read_accessor(doc, binchunk, i):
@@ -88,16 +88,53 @@ def world_triangles(doc, binchunk):
     return out
 
 
-def lattice():
-    k = LATTICE
-    pts = [((i + 1.0 / 3) / k, (j + 1.0 / 3) / k) for i in range(k) for j in range(k - i)]
-    pts += [((i + 2.0 / 3) / k, (j + 2.0 / 3) / k) for i in range(k) for j in range(k - i - 1)]
-    return np.array(pts)
+def _clip(poly, a, b, keep_left):
+    """The part of a convex 2D polygon (list of points) left (or right) of the line a->b."""
+    out = []
+    d = [((b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])) * (1 if keep_left else -1) for q in poly]
+    for i, q in enumerate(poly):
+        r, dq, dr = poly[(i + 1) % len(poly)], d[i], d[(i + 1) % len(poly)]
+        if dq >= 0:
+            out.append(q)
+        if (dq >= 0) != (dr >= 0):
+            t = dq / (dq - dr)
+            out.append((q[0] + t * (r[0] - q[0]), q[1] + t * (r[1] - q[1])))
+    return out
+
+
+def _area(poly):
+    n = len(poly)
+    return 0.5 * abs(sum(poly[i][0] * poly[(i + 1) % n][1] - poly[(i + 1) % n][0] * poly[i][1]
+                         for i in range(n))) if n > 2 else 0.0
+
+
+def _subtract(poly, tri, tol):
+    """Convex polygon minus a triangle (both 2D): the polygon itself where they share less than tol of area
+    (neighbours that only touch must not cut it up), else up to three convex pieces, one per edge."""
+    ccw = (tri[1][0] - tri[0][0]) * (tri[2][1] - tri[0][1]) - (tri[1][1] - tri[0][1]) * (tri[2][0] - tri[0][0]) > 0
+    inside = poly
+    for v in range(3):
+        inside = _clip(inside, tri[v], tri[(v + 1) % 3], ccw)
+        if len(inside) < 3:
+            return [poly]
+    if _area(inside) <= tol:
+        return [poly]
+    pieces, rest = [], poly
+    for v in range(3):
+        a, b = tri[v], tri[(v + 1) % 3]
+        outside = _clip(rest, a, b, not ccw)
+        if _area(outside) > tol:
+            pieces.append(outside)
+        rest = _clip(rest, a, b, ccw)
+        if _area(rest) <= tol:
+            break
+    return pieces
 
 
 def coincident(tris):
-    """For triangles (n,3,3): a drop flag per triangle (covered by earlier ones in its plane) and the area of
-    the partial overlaps that stay (m^2, estimated on the sample points)."""
+    """For triangles (n,3,3) in world space, earlier ones first: which to drop (earlier triangles of the same
+    plane, facing the same way, cover it) and, for those partly covered, the uncovered rest as triangles in
+    barycentric coordinates of the original (a dict index -> (k,3,3) weights). Returns (drop, rest, area)."""
     e1, e2 = tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]
     nrm = np.cross(e1, e2)
     area = 0.5 * np.linalg.norm(nrm, axis=1)
@@ -106,66 +143,115 @@ def coincident(tris):
     off = (nrm * tris[:, 0]).sum(axis=1)
     key = np.round(np.column_stack([nrm, off]) / PLANE_TOL).astype(np.int64)
     drop = np.zeros(len(tris), bool)
-    partial = 0.0
-    uv = lattice()
+    rest = {}
     order = np.lexsort(key.T[::-1])
     ks = key[order]
     starts = np.flatnonzero(np.r_[True, np.any(ks[1:] != ks[:-1], axis=1)])
     ends = np.r_[starts[1:], len(order)]
     for s, e in zip(starts, ends):
-        if e - s < 2:
-            continue
         ids = np.sort(order[s:e])
         ids = ids[ok[ids]]
         if len(ids) < 2:
             continue
-        lo, hi = tris[ids].min(axis=1) - PLANE_TOL, tris[ids].max(axis=1) + PLANE_TOL
-        n = nrm[ids[0]]
-        kept = []
+        ax = [k for k in range(3) if k != int(np.argmax(np.abs(nrm[ids[0]])))]  # the plane seen along its normal
+        t2 = tris[ids][:, :, ax]                                                    # (m,3,2)
+        lo, hi = t2.min(axis=1) - PLANE_TOL, t2.max(axis=1) + PLANE_TOL
+        kept = []                                                                   # 2D triangles already there
+        klo, khi = np.empty((0, 2)), np.empty((0, 2))
         for a, j in enumerate(ids):
-            cand = [b for b in kept if np.all(lo[b] <= hi[a]) and np.all(hi[b] >= lo[a])]
-            if cand:
-                pts = tris[j, 0] + uv[:, :1] * e1[j] + uv[:, 1:] * e2[j]
-                c = tris[ids[cand]]                                             # (k,3,3)
-                inside = np.ones((len(cand), len(pts)), bool)
-                for v in range(3):
-                    edge = c[:, (v + 1) % 3] - c[:, v]                          # (k,3)
-                    rel = pts[None, :, :] - c[:, v][:, None, :]                 # (k,p,3)
-                    inside &= (np.cross(edge[:, None, :], rel) @ n) >= -1e-9
-                share = inside.any(axis=0).mean()
-                if share >= COVERED:
-                    drop[j] = True
-                    continue
-                partial += share * area[j]
-            kept.append(a)
-    return drop, partial, area
+            if len(kept) != len(klo):                                               # bounds of the new ones
+                new = np.array(kept[len(klo):])
+                klo, khi = np.vstack([klo, new.min(axis=1)]), np.vstack([khi, new.max(axis=1)])
+            tri = [tuple(v) for v in t2[a]]
+            whole = _area(tri)
+            tol = 1e-6 * whole
+            polys = [tri]
+            for q in np.flatnonzero(np.all(klo <= hi[a], axis=1) & np.all(khi >= lo[a], axis=1)):
+                polys = [piece for poly in polys for piece in _subtract(poly, [tuple(v) for v in kept[q]], tol)]
+                if not polys:
+                    break
+            left = sum(_area(poly) for poly in polys) / max(whole, 1e-30)
+            if left <= 1.0 - COVERED:
+                drop[j] = True
+                continue
+            if left >= 1.0 - 1e-4:
+                kept.append(t2[a])
+                continue
+            # Partly covered: keep the uncovered pieces, fan-triangulated, in barycentrics of the original.
+            m = np.column_stack([t2[a][1] - t2[a][0], t2[a][2] - t2[a][0]])
+            bary = []
+            for poly in polys:
+                uv = np.linalg.solve(m, (np.array(poly) - t2[a][0]).T).T               # (p,2)
+                w = np.column_stack([1 - uv.sum(axis=1), uv])
+                for k in range(1, len(poly) - 1):
+                    if _area([poly[0], poly[k], poly[k + 1]]) > tol:
+                        bary.append(np.stack([w[0], w[k], w[k + 1]]))
+                        kept.append(np.array([poly[0], poly[k], poly[k + 1]]))
+            rest[j] = np.array(bary).reshape(-1, 3, 3)
+    return drop, rest, area
+
+
+def _append(out, doc, data, ctype, typ, target):
+    out += b"\0" * ((4 - len(out) % 4) % 4)
+    doc["bufferViews"].append({"buffer": 0, "byteOffset": len(out), "byteLength": data.nbytes, "target": target})
+    out += data.tobytes()
+    acc = {"bufferView": len(doc["bufferViews"]) - 1, "componentType": ctype, "count": int(data.shape[0]),
+           "type": typ}
+    if typ == "VEC3" and data.dtype == np.float32:
+        acc["min"], acc["max"] = data.min(axis=0).tolist(), data.max(axis=0).tolist()
+    doc["accessors"].append(acc)
+    return len(doc["accessors"]) - 1
 
 
 def drop_covered(doc, binchunk):
-    """Rewrite the index buffers without the covered triangles; returns (binchunk, dropped, dropped m^2,
-    partial overlap m^2 left)."""
+    """Rewrite the primitives without what earlier coincident triangles cover: whole triangles dropped, partly
+    covered ones cut to their uncovered rest (new vertices interpolated; primitives with non-float attributes
+    only lose whole triangles). Returns (binchunk, dropped, dropped m^2, cut, cut-away m^2)."""
     prims = world_triangles(doc, binchunk)
     if not prims:
-        return binchunk, 0, 0.0, 0.0
+        return binchunk, 0, 0.0, 0, 0.0
     tris = np.concatenate([t for _, _, _, t in prims])
-    drop, partial, area = coincident(tris)
+    drop, rest, area = coincident(tris)
     out = bytearray(binchunk)
-    first = 0
+    first, cut, cut_m2 = 0, 0, 0.0
     for mesh, p, idx, t in prims:
-        d = drop[first:first + len(idx)]
-        first += len(idx)
-        if not d.any():
+        n = len(idx)
+        d = drop[first:first + n]
+        r = {j - first: w for j, w in rest.items() if first <= j < first + n}
+        base = first
+        first += n
+        if not d.any() and not r:
             continue
-        keep = idx[~d].astype(np.uint32).ravel()
-        out += b"\0" * ((4 - len(out) % 4) % 4)
-        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(out), "byteLength": keep.nbytes,
-                                   "target": 34963})
-        out += keep.tobytes()
-        doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5125,
-                                 "count": int(keep.size), "type": "SCALAR"})
-        doc["meshes"][mesh]["primitives"][p]["indices"] = len(doc["accessors"]) - 1
+        prim = doc["meshes"][mesh]["primitives"][p]
+        attrs = {name: read_accessor(doc, binchunk, i) for name, i in prim["attributes"].items()}
+        if any(a.dtype != np.float32 for a in attrs.values()):
+            r = {}
+        nvert = len(next(iter(attrs.values())))
+        keep = ~d
+        keep[list(r)] = False
+        tri_idx = [idx[keep]]
+        if r:
+            new = {name: [] for name in attrs}
+            for j, w in r.items():
+                flat = w.reshape(-1, 3)                                              # (3k,3) weights
+                for name, a in attrs.items():
+                    v = flat @ a[idx[j]].astype(np.float64)
+                    if name == "NORMAL":
+                        v /= np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-20)
+                    new[name].append(v)
+                tri_idx.append((nvert + np.arange(len(flat))).reshape(-1, 3))
+                nvert += len(flat)
+                uv = w[:, :, 1:]
+                e, f = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+                cut += 1
+                cut_m2 += area[base + j] * (1.0 - np.abs(e[:, 0] * f[:, 1] - e[:, 1] * f[:, 0]).sum())
+            for name, a in attrs.items():
+                full = np.concatenate([a.astype(np.float32)] + [np.asarray(x, np.float32) for x in new[name]])
+                typ = doc["accessors"][prim["attributes"][name]]["type"]
+                prim["attributes"][name] = _append(out, doc, full, 5126, typ, 34962)
+        prim["indices"] = _append(out, doc, np.concatenate(tri_idx).astype(np.uint32).ravel(), 5125, "SCALAR", 34963)
     doc["buffers"][0]["byteLength"] = len(out)
-    return bytes(out), int(drop.sum()), float(area[drop].sum()), partial
+    return bytes(out), int(drop.sum()), float(area[drop].sum()), cut, cut_m2
 
 
 def main():
@@ -182,9 +268,9 @@ def main():
         binchunk = open(os.path.join(os.path.dirname(path), doc["buffers"][0]["uri"]), "rb").read()
     prims = world_triangles(doc, binchunk)
     tris = np.concatenate([t for _, _, _, t in prims])
-    drop, partial, area = coincident(tris)
-    print("%s: %d triangles, %d covered by earlier coincident ones (%.2f m^2), partial overlaps %.2f m^2"
-          % (path, len(tris), drop.sum(), area[drop].sum(), partial))
+    drop, rest, area = coincident(tris)
+    print("%s: %d triangles, %d covered by earlier coincident ones (%.2f m^2), %d partly covered (%.2f m^2)"
+          % (path, len(tris), drop.sum(), area[drop].sum(), len(rest), sum(area[j] for j in rest)))
 
 
 if __name__ == "__main__":
