@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Coincident triangles in a level: find them, and drop those another triangle already covers.
+"""Coincident triangles in a level: find them; drop those earlier ones cover, cut those partly covered.
 
 Why: where two triangles lie in the same plane, facing the same way, one on top of the other (Sibenik's pulpit
 carpet and gallery floors, about 21 m^2), Cycles shades the overlap black. Every ray that leaves one triangle
@@ -16,7 +16,6 @@ Used by scenes.py (numpy; the rest of scenes.py is standard library). Also a too
 """
 import json
 import os
-import struct
 import sys
 
 import numpy as np
@@ -259,17 +258,15 @@ def main():
         sys.exit(__doc__)
     path = sys.argv[1]
     if path.endswith(".glb"):
-        data = open(path, "rb").read()
-        jl = struct.unpack("<I", data[12:16])[0]
-        doc = json.loads(data[20:20 + jl])
-        binchunk = data[20 + jl + 8:]
+        from scenes import read_glb  # scenes.py imports this module only inside build_sibenik
+        doc, binchunk = read_glb(path)
     else:
         doc = json.load(open(path))
         binchunk = open(os.path.join(os.path.dirname(path), doc["buffers"][0]["uri"]), "rb").read()
     prims = world_triangles(doc, binchunk)
     tris = np.concatenate([t for _, _, _, t in prims])
     drop, rest, area = coincident(tris)
-    print("%s: %d triangles, %d covered by earlier coincident ones (%.2f m^2), %d partly covered (%.2f m^2)"
+    print("%s: %d triangles, %d covered by earlier coincident ones (%.2f m^2), %d partly covered (their area %.2f m^2)"
           % (path, len(tris), drop.sum(), area[drop].sum(), len(rest), sum(area[j] for j in rest)))
 
 
