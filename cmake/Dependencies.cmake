@@ -12,6 +12,7 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 pkg_check_modules(GLFW REQUIRED IMPORTED_TARGET glfw3)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # checksums of partials, checkpoints, scene files
 
 # OpenMesh's CMake package has no version file: find it without a version and use OpenMeshCore.
 find_package(OpenMesh REQUIRED)

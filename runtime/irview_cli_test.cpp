@@ -11,6 +11,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "samples/sample_scenes.h"
 
@@ -155,4 +156,28 @@ TEST(IrviewCli, OptionRangesHelpAndVersion) {
   RunResult version = run("--version");
   EXPECT_EQ(version.status, 0);
   EXPECT_EQ(version.output.rfind("irview 0.", 0), 0u) << version.output;
+}
+
+// A view that cannot show anything is an error, never a black image with exit 0: --eye equal to
+// --target, or a glTF camera whose yfov is π or more.
+TEST(IrviewCli, DegenerateViewsAreRefused) {
+  const std::string scene = sampleFile("furnace").string();
+  const fs::path shot = workDir() / "degenerate.png";
+  fs::remove(shot);
+  RunResult same = run(scene + " --eye 0.1,0.2,0.3 --target 0.1,0.2,0.3 --screenshot " + shot.string());
+  EXPECT_EQ(same.status, 2) << same.output;
+  EXPECT_NE(same.output.find("--eye and --target are the same point"), std::string::npos) << same.output;
+  for (double yfov : {M_PI, 4.0}) {
+    // The sample with one camera node added at its centre (the furnace has none): yfov as given.
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(scene));
+    doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", 0.01}}}}};
+    doc["nodes"].push_back({{"camera", 0}, {"translation", {0.1, 0.2, 0.3}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+    const fs::path wide = fs::path(scene).parent_path() / "furnace_wide.gltf";  // beside its .bin
+    std::ofstream(wide) << doc.dump();
+    RunResult r = run(wide.string() + " --camera 0 --width 32 --height 32 --screenshot " + shot.string());
+    EXPECT_EQ(r.status, 5) << yfov << ": " << r.output;
+    EXPECT_NE(r.output.find("yfov"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(shot));
+  }
 }

@@ -1,5 +1,8 @@
 #include "viewer_options.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "common/command_line.h"
 #include "common/error.h"
 #include "common/version.h"
@@ -71,6 +74,9 @@ std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& 
     auto e = cli::parseNumberList(raw.eye), t = cli::parseNumberList(raw.target);
     o.eye = glm::vec3(e[0], e[1], e[2]);
     o.target = glm::vec3(t[0], t[1], t[2]);
+    const glm::dvec3 gap = glm::dvec3(t[0] - e[0], t[1] - e[1], t[2] - e[2]);
+    if (!(glm::length(gap) > 1e-6 * std::max({1.0, std::abs(e[0]), std::abs(e[1]), std::abs(e[2])})))
+      throw Error(ErrorCode::Usage, "", "--eye and --target are the same point: the view has no direction");
   }
   if (o.walkthrough > 0 && o.screenshot.empty())
     throw Error(ErrorCode::Usage, "", "--walkthrough needs --screenshot OUT.png|OUT.exr (frames are OUT_0000...)");
@@ -78,6 +84,18 @@ std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& 
   if (!raw.lightmapMode.empty()) o.lightmapMode = parseLightmapMode(raw.lightmapMode);
   return o;
 }
+
+namespace {
+// A glTF camera the viewer can draw from: yfov in (0, π) (glTF: > 0, and a projection needs < π).
+ViewCamera usableCamera(const ViewerOptions& o, const Scene& scene, int index, const Bounds3& b) {
+  const float yfov = scene.cameras[index].yfov;
+  if (!(yfov > 0.0f && yfov < 3.14159f))
+    throw Error(ErrorCode::InvalidData, o.scene.string(),
+                "camera " + std::to_string(index) + " has yfov " + std::to_string(yfov) +
+                    " rad: a perspective view needs 0 < yfov < π (use --eye/--target or another --camera)");
+  return fromGltfCamera(scene.cameras[index], b);
+}
+}  // namespace
 
 ViewCamera startCamera(const ViewerOptions& o, const Scene& scene) {
   const Bounds3 b = scene.bounds();
@@ -87,9 +105,9 @@ ViewCamera startCamera(const ViewerOptions& o, const Scene& scene) {
       throw Error(ErrorCode::Usage, o.scene.string(),
                   "camera " + std::to_string(o.camera) + " does not exist: the scene has " +
                       std::to_string(scene.cameras.size()) + " camera(s)");
-    return fromGltfCamera(scene.cameras[o.camera], b);
+    return usableCamera(o, scene, o.camera, b);
   }
-  if (!scene.cameras.empty()) return fromGltfCamera(scene.cameras[0], b);
+  if (!scene.cameras.empty()) return usableCamera(o, scene, 0, b);
   return overview(b);
 }
 

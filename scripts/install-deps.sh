@@ -19,6 +19,7 @@ packages=(
   libbenchmark-dev         # Google Benchmark
   nlohmann-json3-dev       # JSON reports
   libcli11-dev             # CLI11: command-line options of irbake and irview
+  libxxhash-dev            # xxHash: checksums of partials and checkpoints, hashes of scene files
   clang libclang-rt-14-dev # clang + libFuzzer runtime: the glTF loader's fuzz harness (tests/fuzz)
   xvfb xauth               # windowed viewer test without a display
   chromium                 # runtime/web: the three.js viewer test in headless Chromium

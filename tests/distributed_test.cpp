@@ -17,6 +17,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/atomic_file.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -64,7 +66,7 @@ struct Finished {
   int code;
   std::string output;
 };
-Finished irbake(const std::vector<std::string>& args, const fs::path& log) {
+Finished runIrbake(const std::vector<std::string>& args, const fs::path& log) {
   const int code = waitFor(startIrbake(args, log));
   return {code, fileText(log)};
 }
@@ -73,7 +75,7 @@ const fs::path& cornellBox() {
   static const fs::path scene = [] {
     const fs::path dir = fs::current_path() / "test_scratch" / "distributed" / "samples";
     fs::create_directories(dir);
-    irbake({"samples", dir.string(), "--quiet"}, dir.parent_path() / "samples_log.txt");
+    runIrbake({"samples", dir.string(), "--quiet"}, dir.parent_path() / "samples_log.txt");
     return dir / "cornell_box.gltf";
   }();
   return scene;
@@ -102,7 +104,7 @@ Finished bakeCornell(const std::vector<std::string>& options, const fs::path& ou
   std::vector<std::string> args{"bake", cornellBox().string(), "-o", out.string()};
   args.insert(args.end(), options.begin(), options.end());
   args.insert(args.end(), extra.begin(), extra.end());
-  return irbake(args, out.string() + "_log.txt");
+  return runIrbake(args, out.string() + "_log.txt");
 }
 
 }  // namespace
@@ -128,7 +130,7 @@ TEST(Distributed, ShardsMergeToTheBytesOfOneMachine) {
       }
       const fs::path merged = dir / ("merged_" + std::to_string(n));
       merge.insert(merge.end(), {"-o", merged.string(), "--quiet"});
-      Finished m = irbake(merge, merged.string() + "_log.txt");
+      Finished m = runIrbake(merge, merged.string() + "_log.txt");
       ASSERT_EQ(m.code, 0) << m.output;
       expectSameOutputs(dir / "one", merged);
     }
@@ -141,7 +143,7 @@ TEST(Distributed, MergeRefusesPartialsOfOtherBakesAndMissingOrDoubledShares) {
   auto shard = [&](const std::string& name, const std::string& share, const std::string& extra) {
     std::vector<std::string> args{"bake", cornellBox().string(), "-o", (dir / name).string(), "--backend", "embree", "--shard", share};
     for (const auto& a : split(kOptions + " " + extra)) args.push_back(a);
-    Finished r = irbake(args, dir / (name + "_log.txt"));
+    Finished r = runIrbake(args, dir / (name + "_log.txt"));
     EXPECT_EQ(r.code, 0) << r.output;
   };
   shard("a1", "1/2", kWalk);
@@ -156,7 +158,7 @@ TEST(Distributed, MergeRefusesPartialsOfOtherBakesAndMissingOrDoubledShares) {
   {
     std::vector<std::string> args{"bake", edited.string(), "-o", (dir / "scene").string(), "--backend", "embree", "--shard", "2/2"};
     for (const auto& a : split(kOptions + kWalk)) args.push_back(a);
-    ASSERT_EQ(irbake(args, dir / "scene_log.txt").code, 0);
+    ASSERT_EQ(runIrbake(args, dir / "scene_log.txt").code, 0);
   }
   struct Case {
     std::vector<std::string> inputs;
@@ -176,14 +178,14 @@ TEST(Distributed, MergeRefusesPartialsOfOtherBakesAndMissingOrDoubledShares) {
     std::vector<std::string> args{"merge"};
     for (const auto& in : c.inputs) args.push_back((dir / in).string());
     args.insert(args.end(), {"-o", (dir / "out").string()});
-    Finished r = irbake(args, dir / "merge_log.txt");
+    Finished r = runIrbake(args, dir / "merge_log.txt");
     EXPECT_EQ(r.code, c.code) << r.output;
     EXPECT_NE(r.output.find(c.names), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(c.says), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "out" / "lightmap_0.exr"));
   }
   // And the right two, in any order, merge.
-  Finished ok = irbake({"merge", (dir / "a2").string(), (dir / "a1").string(), "-o", (dir / "out").string(), "--quiet"},
+  Finished ok = runIrbake({"merge", (dir / "a2").string(), (dir / "a1").string(), "-o", (dir / "out").string(), "--quiet"},
                   dir / "merge_log.txt");
   EXPECT_EQ(ok.code, 0) << ok.output;
 }
@@ -202,7 +204,7 @@ TEST(Distributed, ResumeAfterSigkillGivesTheBytesOfAnUninterruptedBake) {
     return a;
   };
   const auto t0 = std::chrono::steady_clock::now();
-  Finished whole = irbake(into(dir / "whole", false), dir / "whole_log.txt");
+  Finished whole = runIrbake(into(dir / "whole", false), dir / "whole_log.txt");
   ASSERT_EQ(whole.code, 0) << whole.output;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -216,12 +218,12 @@ TEST(Distributed, ResumeAfterSigkillGivesTheBytesOfAnUninterruptedBake) {
     killedWhileRunning += kill(pid, SIGKILL) == 0 && waitFor(pid) == 128 + SIGKILL;
   }
   EXPECT_GE(killedWhileRunning, 1);
-  Finished last = irbake(into(out, true), dir / "resumed_log.txt");
+  Finished last = runIrbake(into(out, true), dir / "resumed_log.txt");
   ASSERT_EQ(last.code, 0) << last.output;
   expectSameOutputs(dir / "whole", out);
   EXPECT_FALSE(fs::exists(out / ".irbake.checkpoint"));
   for (const auto& entry : fs::directory_iterator(out))
-    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+    EXPECT_FALSE(irbake::isIrbakeTempName(entry.path().filename().string())) << entry.path();
 }
 
 TEST(Distributed, ResumeRefusesTheCheckpointOfAnotherBake) {
@@ -240,7 +242,7 @@ TEST(Distributed, ResumeRefusesTheCheckpointOfAnotherBake) {
   ASSERT_TRUE(fs::exists(checkpoint)) << fileText(dir / "first_log.txt");
   std::vector<std::string> other = args;
   other.insert(other.end(), {"--resume", "--seed", "6"});
-  Finished refused = irbake(other, dir / "refused_log.txt");
+  Finished refused = runIrbake(other, dir / "refused_log.txt");
   EXPECT_EQ(refused.code, 2) << refused.output;
   EXPECT_NE(refused.output.find(".irbake.checkpoint"), std::string::npos) << refused.output;
   EXPECT_NE(refused.output.find("different seed"), std::string::npos) << refused.output;
@@ -271,7 +273,7 @@ TEST(Distributed, DirectionalShardsAndResumeGiveTheBytesOfOneMachine) {
       merge.push_back(out.string());
     }
     merge.insert(merge.end(), {"-o", (dir / "merged").string(), "--quiet"});
-    Finished m = irbake(merge, dir / "merged_log.txt");
+    Finished m = runIrbake(merge, dir / "merged_log.txt");
     ASSERT_EQ(m.code, 0) << m.output;
     expectSameOutputs(dir / "one", dir / "merged", true);
 
@@ -282,7 +284,7 @@ TEST(Distributed, DirectionalShardsAndResumeGiveTheBytesOfOneMachine) {
       std::vector<std::string> plain{"bake", cornellBox().string(), "-o", resumed.string(), "--resume"};
       for (const std::string& a : options)
         if (a != "--directional") plain.push_back(a);
-      Finished refused = irbake(plain, dir / "refused_log.txt");
+      Finished refused = runIrbake(plain, dir / "refused_log.txt");
       EXPECT_EQ(refused.code, 2) << refused.output;
       EXPECT_NE(refused.output.find("different options"), std::string::npos) << refused.output;
       ASSERT_TRUE(fs::exists(resumed / ".irbake.checkpoint"));

@@ -2,10 +2,14 @@
 // arguments a shard stored in its partial, so both rebuild the same bake.
 #pragma once
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
+#include "common/output_lock.h"
 #include "common/progress.h"
 #include "pipeline/bake.h"
 #include "scene/scene.h"
@@ -28,7 +32,8 @@ struct BakeCommand {
   int shardCount = 0;              // N
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
   double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
-  std::string optionsHash;         // hash of every option that changes the result (not -o, --threads, ...)
+  nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
+  std::string optionsHash;         // hash of resultOptions (not -o, --threads, ...)
 };
 
 // Parses the arguments after "bake"; nullopt when --help was printed. Throws Error(Usage).
@@ -39,6 +44,13 @@ Scene loadBakeScene(const BakeCommand& command);
 
 // The scene's identity for partials and checkpoints: hashes of its files (and of --env's map).
 std::string bakeSceneIdentity(const BakeCommand& command);
+
+// Refuses (Error(Usage), exit 2) outputs that would overwrite an input (the scene, its .bin and textures,
+// --env) or each other (--report naming the glTF or a page), and a --report that is a folder.
+void checkOutputPaths(const BakeCommand& command);
+// Locks --report's folder when it is not OUTDIR, so a report never lands in another bake's folder while
+// that bake runs (nullptr when no second lock is needed). Throws Error(Io) when that folder is busy.
+std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& command);
 
 // Writes a finished bake's outputs where the command says (the all-or-nothing set) and lists them.
 void writeFinishedBake(const BakeCommand& command, const BakeResult& result, TerminalProgress& progress);

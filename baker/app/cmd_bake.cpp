@@ -1,6 +1,9 @@
 // irbake bake SCENE -o OUTDIR [options]: the whole bake, outputs in OUTDIR; or one shard of it (--shard),
 // or the rest of one that was killed (--resume).
 #include <algorithm>
+#include <cmath>
+#include <cctype>
+#include <cstdlib>
 #include <cstdio>
 #include <sstream>
 #include <memory>
@@ -18,7 +21,9 @@
 #include "export/gltf_export.h"
 #include "pipeline/bake.h"
 #include "pipeline/vpl_sum_file.h"
+#include "common/atomic_file.h"
 #include "scene/gltf_loader.h"
+#include "scene/scene_files.h"
 
 namespace irbake::app {
 
@@ -37,13 +42,36 @@ constexpr int kDefaultPathsUnderGather = 3072;  // --vpls auto where the final g
 struct BakeArguments {
   std::vector<std::string> scenes;
   std::string backend = "auto", shard, finalGather = "auto";
+  CLI::Option* shardOption = nullptr;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
   int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0, paths = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
   bool noLeakControl = false, noDilate = false, noSeams = false;
   bool noBiasCompensation = false, biasCompensation = false;
   CLI::Option* clampOption = nullptr;
+  std::string clampText() const { return clampOption && !clampOption->results().empty() ? clampOption->results()[0] : ""; }
 };
+
+// The smallest --clamp bound: below it the bound is 0 in single precision.
+constexpr double kSmallestClamp = 1e-30;
+// Light from the command line: at most this much (W/m², W/(m² sr)), so sums over the bake stay finite in float.
+constexpr double kLargestLight = 1e20;
+
+// --sun and --sky as numbers a bake can use: a direction that is not zero (any length), and amounts in
+// [0, kLargestLight]. Throws Error(Usage) naming the option.
+void checkLightArguments(const BakeCommand& c) {
+  if (!c.sun.empty()) {
+    const std::vector<double> d = cli::parseNumberList(c.sun);
+    const double longest = std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+    if (!(longest > 0.0)) throw Error(ErrorCode::Usage, "", "--sun needs a non-zero direction DX,DY,DZ (got '" + c.sun + "')");
+    if (!(d[3] > 0.0) || d[3] > kLargestLight)
+      throw Error(ErrorCode::Usage, "", "--sun needs an irradiance E in (0, 1e20] W/m² (got '" + c.sun + "')");
+  }
+  if (!c.sky.empty())
+    for (double v : cli::parseNumberList(c.sky))
+      if (!(v >= 0.0) || v > kLargestLight)
+        throw Error(ErrorCode::Usage, "", "--sky needs three radiances in [0, 1e20] W/(m² sr) (got '" + c.sky + "')");
+}
 
 // Every option of `irbake bake`, with its range and help.
 std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
@@ -183,7 +211,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
   app->add_flag("--verbose", verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
-  app->add_option("--shard", shard,
+  a.shardOption = app->add_option("--shard", shard,
                   "evaluate share K of N of the VPL blocks and write the exact partial\n"
                   "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
       ->type_name("K/N");
@@ -199,33 +227,62 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   return app;
 }
 
-// The options that change the result, as CLI11 parsed them (so "--vpls=96" and "--vpls 96" agree):
-// partials and checkpoints carry their hash. Not the scene (hashed from its files) nor what only says
-// where and how fast to write.
-std::string resultOptionsHash(const CLI::App& app) {
-  std::istringstream config(app.config_to_str(true, false));
-  std::string line, kept;
-  const std::vector<std::string> notResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
-                                              "shard", "resume", "checkpoint-seconds"};
-  while (std::getline(config, line)) {
-    const std::string key = line.substr(0, line.find('='));
-    if (std::find(notResult.begin(), notResult.end(), key) == notResult.end()) kept += line + "\n";
+// Options that only say where and how fast to write: not part of the result.
+const std::vector<std::string> kNotResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
+                                             "shard", "resume", "checkpoint-seconds", "help"};
+// Options whose presence changes the result even at the default value (--clamp 0: no clamp; none: derived).
+const std::vector<std::string> kPresenceMatters = {"clamp"};
+
+bool sameValue(const std::string& a, const std::string& b) {
+  if (a == b) return true;
+  char* endA = nullptr;
+  char* endB = nullptr;
+  const double x = std::strtod(a.c_str(), &endA), y = std::strtod(b.c_str(), &endB);
+  return !a.empty() && !b.empty() && *endA == 0 && *endB == 0 && x == y;
+}
+
+// The options that change the result, as name -> value: what CLI11 parsed (the validators write numbers
+// canonically), less any option given at its default, so "--seed 0" or "--vpls auto" is the bake without
+// it. Partials and checkpoints carry it and its hash; a refused resume names the options that differ.
+nlohmann::json resultOptions(const CLI::App& app) {
+  BakeCommand freshCommand;
+  BakeArguments freshArguments;
+  const std::unique_ptr<CLI::App> defaults = bakeApp(freshCommand, freshArguments);
+  nlohmann::json options = nlohmann::json::object();
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_single_name();
+    if (option->count() == 0 || std::find(kNotResult.begin(), kNotResult.end(), name) != kNotResult.end()) continue;
+    std::string value;
+    if (option->get_expected_min() == 0) {
+      value = "true";  // a flag
+    } else {
+      for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
+    }
+    const CLI::Option* plain = defaults->get_option_no_throw(option->get_name());
+    const std::string fallback = plain ? const_cast<CLI::Option*>(plain)->capture_default_str()->get_default_str() : "";
+    const bool presence = std::find(kPresenceMatters.begin(), kPresenceMatters.end(), name) != kPresenceMatters.end();
+    if (!presence && option->get_expected_min() != 0 && sameValue(value, fallback)) continue;
+    options[name] = value;
   }
-  return hashText(kept);
+  return options;
 }
 
 // The parsed arguments as options; throws Error(Usage) for combinations CLI11 cannot check.
 void applyArguments(BakeCommand& command, const BakeArguments& a) {
   BakeOptions& o = command.options;
-  if (!a.shard.empty()) {
-    int k = 0, n = 0;
-    char tail = 0;
-    if (std::sscanf(a.shard.c_str(), "%d/%d%c", &k, &n, &tail) != 2 || n < 1 || n > 1000000 || k < 1 || k > n)
+  if (a.shardOption->count() > 0) {
+    long long k = 0, n = 0;
+    const size_t slash = a.shard.find('/');
+    const bool parsed = slash != std::string::npos && cli::parseWholeNumber(a.shard.substr(0, slash), k) &&
+                        cli::parseWholeNumber(a.shard.substr(slash + 1), n);
+    if (!parsed || n < 1 || n > 1000000 || k < 1 || k > n)
       throw Error(ErrorCode::Usage, "", "--shard needs K/N with 1 ≤ K ≤ N ≤ 1000000 (got '" + a.shard + "')");
-    command.shardIndex = k;
-    command.shardCount = n;
+    command.shardIndex = static_cast<int>(k);
+    command.shardCount = static_cast<int>(n);
   }
-
+  if (a.clampOption->count() > 0 && a.clamp > 0.0 && a.clamp < kSmallestClamp)
+    throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
+  checkLightArguments(command);
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
@@ -272,7 +329,8 @@ std::optional<BakeCommand> parseBakeCommand(const Args& args) {
   BakeArguments arguments;
   const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
   if (!cli::parse(*app, args)) return std::nullopt;
-  command.optionsHash = resultOptionsHash(*app);
+  command.resultOptions = resultOptions(*app);
+  command.optionsHash = hashText(command.resultOptions.dump());
   applyArguments(command, arguments);
   return command;
 }
@@ -282,12 +340,12 @@ Scene loadBakeScene(const BakeCommand& command) {
   Scene scene = loadScene(scenePath);
   if (!command.sun.empty()) {
     const std::vector<double> d = cli::parseNumberList(command.sun);
-    scene.lights.push_back(sunLight(glm::vec3(d[0], d[1], d[2]), static_cast<float>(d[3])));
+    const glm::dvec3 direction = glm::normalize(glm::dvec3(d[0], d[1], d[2]) /
+                                                std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])}));
+    scene.lights.push_back(sunLight(glm::vec3(direction), static_cast<float>(d[3])));
   }
   if (!command.sky.empty()) {
     const std::vector<double> L = cli::parseNumberList(command.sky);
-    for (double v : L)
-      if (!(v >= 0.0)) throw Error(ErrorCode::Usage, "", "--sky needs three radiances ≥ 0 (R,G,B)");
     scene.environment = Environment::uniform(glm::vec3(L[0], L[1], L[2]));
   }
   if (!command.env.empty()) {
@@ -309,20 +367,6 @@ std::string partialName(int k, int n) {
   return "partial_" + std::to_string(k) + "_of_" + std::to_string(n) + ".vplsum";
 }
 
-// Temp files a killed bake left mid-write in this folder: we hold its lock, so no writer is alive.
-void removeStaleTemps(const fs::path& dir) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    const size_t at = name.rfind(".tmp");
-    if (at == std::string::npos || at + 4 >= name.size() ||
-        name.find_first_not_of("0123456789_", at + 4) != std::string::npos)
-      continue;
-    std::error_code removeError;
-    fs::remove(entry.path(), removeError);
-  }
-}
-
 // The scene's identity: its files, and the environment map's when --env names one.
 std::string sceneIdentity(const BakeCommand& c) {
   std::string hash = hashSceneFiles(c.scene);
@@ -333,6 +377,81 @@ std::string sceneIdentity(const BakeCommand& c) {
 }  // namespace
 
 std::string bakeSceneIdentity(const BakeCommand& c) { return sceneIdentity(c); }
+
+namespace {
+
+// One path's identity for comparison: absolute and normal, links resolved where they exist.
+fs::path canonicalPath(const fs::path& p) {
+  std::error_code ec;
+  fs::path c = fs::weakly_canonical(fs::absolute(p), ec);
+  return ec ? fs::absolute(p).lexically_normal() : c;
+}
+
+bool samePath(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
+  return canonicalPath(a) == canonicalPath(b);
+}
+
+// lightmap_<page>.exr/.png and the directional lightmap_<page>_l1x|y|z.exr: names a bake writes.
+bool isPageName(const std::string& name) {
+  const std::string prefix = "lightmap_";
+  if (name.rfind(prefix, 0) != 0) return false;
+  size_t at = prefix.size(), digits = 0;
+  while (at < name.size() && std::isdigit(static_cast<unsigned char>(name[at]))) ++at, ++digits;
+  if (digits == 0) return false;
+  const std::string rest = name.substr(at);
+  return rest == ".exr" || rest == ".png" || rest == "_l1x.exr" || rest == "_l1y.exr" || rest == "_l1z.exr";
+}
+
+}  // namespace
+
+void checkOutputPaths(const BakeCommand& c) {
+  const fs::path outDir = outputFolderOf(c.out);
+  const bool gltfNamed = namesGltfFile(c.out);
+  const fs::path gltf = gltfNamed ? fs::path(c.out) : outDir / "scene.gltf";
+  std::vector<std::pair<fs::path, std::string>> outputs;  // path, what it is
+  if (!c.noGltf) {
+    outputs.push_back({gltf, "the glTF output"});
+    std::string extension = gltf.extension().string();
+    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (extension != ".glb") outputs.push_back({outDir / (gltf.stem().string() + ".bin"), "the glTF's .bin output"});
+  }
+  const fs::path report = c.report.empty() ? outDir / "report.json" : fs::path(c.report);
+  std::error_code ec;
+  if (!c.report.empty() && fs::is_directory(report, ec))
+    throw Error(ErrorCode::Usage, c.report, "--report names a folder: give the report's file name (R.json)");
+  if (!c.report.empty()) {
+    for (const auto& [path, what] : outputs)
+      if (samePath(report, path)) throw Error(ErrorCode::Usage, c.report, "--report would overwrite " + what + ": choose another name");
+    if (samePath(report.parent_path().empty() ? fs::path(".") : report.parent_path(), outDir) &&
+        (isPageName(report.filename().string()) || isIrbakeTempName(report.filename().string())))
+      throw Error(ErrorCode::Usage, c.report, "--report would overwrite a light-map page of this bake: choose another name");
+  }
+  outputs.push_back({report, "the report"});
+  // Inputs: the scene and its files, and --env's map.
+  std::vector<fs::path> inputs = sceneInputFiles(c.scene);
+  if (!c.env.empty()) inputs.push_back(c.env);
+  for (const fs::path& input : inputs) {
+    for (const auto& [path, what] : outputs)
+      if (samePath(input, path))
+        throw Error(ErrorCode::Usage, input.string(),
+                    "is an input of this bake and would be overwritten by " + what + ": choose another -o" +
+                        (what == "the report" ? " or --report" : ""));
+    if (samePath(input.parent_path().empty() ? fs::path(".") : input.parent_path(), outDir) &&
+        isPageName(input.filename().string()))
+      throw Error(ErrorCode::Usage, input.string(),
+                  "is an input of this bake and would be overwritten by a light-map page: choose another -o");
+  }
+}
+
+std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& c) {
+  if (c.report.empty()) return nullptr;
+  fs::path folder = fs::path(c.report).parent_path();
+  if (folder.empty()) folder = ".";
+  if (samePath(folder, outputFolderOf(c.out))) return nullptr;
+  return std::make_unique<OutputFolderLock>(folder);
+}
 
 int runBake(const Args& args) {
   std::optional<BakeCommand> parsed = parseBakeCommand(args);
@@ -345,7 +464,9 @@ int runBake(const Args& args) {
     threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);
 
   const fs::path outDir = outputFolderOf(c.out);
+  checkOutputPaths(c);
   const OutputFolderLock lock(outDir);  // before any work: a second bake into OUTDIR fails at once
+  const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
   removeStaleTemps(outDir);
   Stopwatch loadTime;
   Scene scene = loadBakeScene(c);
@@ -362,6 +483,7 @@ int runBake(const Args& args) {
   VplSumHeader header;
   header.sceneHash = sceneIdentity(c);
   header.optionsHash = c.optionsHash;
+  header.options = c.resultOptions;
   header.seed = c.options.walk.seed;
   header.backend = toString(staged.backend());
   header.blockCount = blocks;
@@ -439,6 +561,8 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   outputOptions.outDir = c.out;
   outputOptions.reportPath = c.report;
   outputOptions.writeGltf = !c.noGltf;
+  outputOptions.inputs = sceneInputFiles(c.scene);
+  if (!c.env.empty()) outputOptions.inputs.push_back(c.env);
   Stopwatch writeTime;
   c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
   auto files = writeBakeOutputs(result, outputOptions);

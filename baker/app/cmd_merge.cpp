@@ -12,6 +12,7 @@
 #include "app/bake_command.h"
 #include "app/commands.h"
 #include "common/command_line.h"
+#include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/output_lock.h"
@@ -131,7 +132,10 @@ int runMerge(const Args& args) {
   if (c.optionsHash != first.optionsHash)
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");
 
+  checkOutputPaths(c);
   const OutputFolderLock lock(outputFolderOf(out));
+  const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
+  removeStaleTemps(outputFolderOf(out));
   Scene scene = loadBakeScene(c);  // first: the loader refuses what the hash's JSON parse should not see
   if (bakeSceneIdentity(c) != first.sceneHash)
     throw Error(ErrorCode::InvalidData, c.scene, "the scene changed since the shards baked it (" + files[0].string() + ")");

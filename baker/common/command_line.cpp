@@ -34,11 +34,20 @@ std::string formatNumber(double v) {
   return buf;
 }
 
+// The shortest text that reads back as exactly v ("50", "0.1", "1e-300").
+std::string canonicalNumber(double v) {
+  char buf[64];
+  const auto result = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, result.ptr);
+}
+
 std::string integerRange(long long lo, long long hi) {
   return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
 }
 
 }  // namespace
+
+bool parseWholeNumber(const std::string& text, long long& value) { return parseInteger(text, value); }
 
 std::unique_ptr<CLI::App> makeApp(const std::string& name, const std::string& description) {
   auto app = std::make_unique<CLI::App>(description, name);
@@ -100,6 +109,7 @@ CLI::Validator numberIn(double lo, double hi) {
         double v = 0.0;
         if (!parseFinite(text, v) || v < lo || v > hi)
           return "must be a finite number in " + range + ", got '" + text + "'";
+        text = canonicalNumber(v);
         return {};
       },
       "in " + range);
@@ -116,6 +126,7 @@ CLI::Validator numberOrAuto(double lo, double hi, double autoValue) {
         double v = 0.0;
         if (!parseFinite(text, v) || v < lo || v > hi)
           return "must be 'auto' or a finite number in " + range + ", got '" + text + "'";
+        text = canonicalNumber(v);
         return {};
       },
       "auto or " + range);
@@ -125,15 +136,17 @@ CLI::Validator numberList(size_t count) {
   return CLI::Validator(
       [count](std::string& text) -> std::string {
         std::stringstream ss(text);
-        std::string item;
+        std::string item, canonical;
         size_t n = 0;
         while (std::getline(ss, item, ',')) {
           double v = 0.0;
           if (!parseFinite(item, v)) return "'" + item + "' is not a finite number";
+          canonical += (n ? "," : "") + canonicalNumber(v);
           ++n;
         }
         if (n != count || (!text.empty() && text.back() == ','))
           return "needs " + std::to_string(count) + " comma-separated numbers, got '" + text + "'";
+        text = canonical;
         return {};
       },
       std::to_string(count) + " numbers a,b,..");

@@ -19,13 +19,17 @@ std::unique_ptr<CLI::App> makeApp(const std::string& name, const std::string& de
 bool parse(CLI::App& app, const std::vector<std::string>& args);
 
 // Validators, to be added with ->transform() (->check() would drop their rewrite). Each checks the
-// text before conversion and rewrites it to plain decimal, so CLI11's own conversion (which reads
-// "010" as octal) never sees anything but a checked number.
+// text before conversion and rewrites it to plain decimal (numbers to the shortest text that reads back
+// the same double, so "100.0" and "100" are one value), so CLI11's own conversion (which reads "010" as
+// octal) never sees anything but a checked number.
 CLI::Validator integerIn(long long lo, long long hi);                      // an integer in [lo, hi]
 CLI::Validator integerOrAuto(long long lo, long long hi, long long autoValue);  // or "auto" → autoValue
 CLI::Validator numberIn(double lo, double hi);                             // a finite number in [lo, hi]
 CLI::Validator numberOrAuto(double lo, double hi, double autoValue);      // or "auto" → autoValue
 CLI::Validator numberList(size_t count);                                  // "x,y,z": count finite numbers
+
+// A plain decimal integer (optional '+'), nothing else; false when it is not one or does not fit.
+bool parseWholeNumber(const std::string& text, long long& value);
 
 // The numbers of a list that numberList(count) accepted.
 std::vector<double> parseNumberList(const std::string& text);

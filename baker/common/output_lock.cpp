@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "common/error.h"
+#include "common/signal_cleanup.h"
 
 namespace irbake {
 namespace fs = std::filesystem;
@@ -54,6 +55,8 @@ OutputFolderLock::OutputFolderLock(const fs::path& folder) : folder_(folder), fi
       if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
         // The pid is only for the message of a second bake: a lock without it is still a lock.
       }
+      installSignalCleanup();
+      signalSlot_ = removeOnSignal(fs::absolute(file_));
       return;
     }
     ::close(fd_);
@@ -65,6 +68,7 @@ OutputFolderLock::OutputFolderLock(const fs::path& folder) : folder_(folder), fi
 OutputFolderLock::~OutputFolderLock() {
   if (fd_ < 0) return;
   std::error_code ec;
+  forgetPath(signalSlot_);
   fs::remove(file_, ec);  // unlinked while still held: a waiting bake re-checks the inode
   ::close(fd_);
   if (createdFolder_ && fs::is_empty(folder_, ec)) fs::remove(folder_, ec);

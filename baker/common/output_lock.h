@@ -1,5 +1,6 @@
 // One bake per output folder at a time: an exclusive flock on OUTDIR/.irbake.lock, held from before
 // the scene is loaded until the outputs are written. A second bake into the same folder fails at once.
+// A bake killed by a signal removes the lock file on its way out (common/signal_cleanup.h).
 #pragma once
 #include <filesystem>
 
@@ -22,6 +23,7 @@ class OutputFolderLock {
   std::filesystem::path folder_, file_;
   bool createdFolder_ = false;
   int fd_ = -1;
+  int signalSlot_ = -1;  // the lock file is removed when a signal kills the bake
 };
 
 }  // namespace irbake

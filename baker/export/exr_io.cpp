@@ -12,21 +12,23 @@
 
 namespace irbake {
 
-void writeExr(const Lightmap& map, const std::filesystem::path& path) {
+void writeExrFile(const Lightmap& map, const std::filesystem::path& file, const std::filesystem::path& finalPath) {
   if (map.width <= 0 || map.height <= 0 || map.texels.size() != map.size())
-    throw Error(ErrorCode::InvalidData, path.string(),
+    throw Error(ErrorCode::InvalidData, finalPath.string(),
                 "light map page " + std::to_string(map.page) + " has no texels or a size mismatch");
   for (const glm::vec3& t : map.texels)
     if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
-      throw Error(ErrorCode::NumericError, path.string(), "light map page " + std::to_string(map.page) + " holds NaN/Inf");
-  writeAtomically(path, [&](const std::filesystem::path& temp) {
-    imageio::Pixels px;
-    px.width = map.width;
-    px.height = map.height;
-    px.channels = 3;
-    px.f32.assign(&map.texels[0].x, &map.texels[0].x + map.texels.size() * 3);
-    imageio::api().writeFile(temp.string(), "openexr", px, map.page, path.string());
-  });
+      throw Error(ErrorCode::NumericError, finalPath.string(), "light map page " + std::to_string(map.page) + " holds NaN/Inf");
+  imageio::Pixels px;
+  px.width = map.width;
+  px.height = map.height;
+  px.channels = 3;
+  px.f32.assign(&map.texels[0].x, &map.texels[0].x + map.texels.size() * 3);
+  imageio::api().writeFile(file.string(), "openexr", px, map.page, finalPath.string());
+}
+
+void writeExr(const Lightmap& map, const std::filesystem::path& path) {
+  writeAtomically(path, [&](const std::filesystem::path& temp) { writeExrFile(map, temp, path); });
 }
 
 Lightmap readExr(const std::filesystem::path& path) {

@@ -478,6 +478,16 @@ std::filesystem::path outputFolderOf(const std::filesystem::path& output) {
   return output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
 }
 
+namespace {
+// True when a and b name the same file or folder (links and relative names resolved).
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
+  return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
+         std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
+}
+}  // namespace
+
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options) {
   const std::string file = options.output.string();
   if (options.output.empty()) throw Error(ErrorCode::Usage, "", "export needs an output path");
@@ -508,6 +518,10 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
     // A folder output: images as files beside the .gltf (a GLB keeps them embedded).
     std::vector<std::string> taken = {options.output.filename().string(), options.output.stem().string() + ".bin"};
     taken.insert(taken.end(), pageUris.begin(), pageUris.end());
+    for (const auto& input : options.inputs)
+      if (sameFile(input.parent_path().empty() ? std::filesystem::path(".") : input.parent_path(),
+                   folder.empty() ? std::filesystem::path(".") : folder))
+        taken.push_back(input.filename().string());
     auto images = externalizeImages(doc, taken);
     compactDocument(doc);
     for (auto& [name, bytes] : images) {
@@ -529,18 +543,27 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   if (options.writeExrPages) {
     for (size_t i = 0; i < maps.size(); ++i) {
       const Lightmap* map = &maps[i];
-      files.push_back({folder / pageUris[i], [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});
+      const std::filesystem::path finalPath = folder / pageUris[i];
+      files.push_back({finalPath, [map, finalPath](const std::filesystem::path& temp) { writeExrFile(*map, temp, finalPath); }});
     }
     if (directional)
       for (int k = 0; k < 3; ++k)
         for (const Lightmap& m : (*options.directional)[k]) {
           const Lightmap* map = &m;
-          files.push_back({folder / directionalPageUri(options.exrPrefix, m.page, k),
-                           [map](const std::filesystem::path& temp) { writeExr(*map, temp); }});
+          const std::filesystem::path finalPath = folder / directionalPageUri(options.exrPrefix, m.page, k);
+          files.push_back({finalPath, [map, finalPath](const std::filesystem::path& temp) { writeExrFile(*map, temp, finalPath); }});
         }
   }
   files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
+  refuseOverwritingInputs(files, options.inputs);
   writeAllAtomically(files);
+}
+
+void refuseOverwritingInputs(const std::vector<PendingFile>& outputs, const std::vector<std::filesystem::path>& inputs) {
+  for (const PendingFile& out : outputs)
+    for (const auto& input : inputs)
+      if (sameFile(out.finalPath, input))
+        throw Error(ErrorCode::Usage, out.finalPath.string(), "is an input of this bake: refusing to overwrite it (choose another -o)");
 }
 
 nlohmann::json skyJson(const Environment& sky) {

@@ -24,7 +24,13 @@ struct ExportOptions {
   std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
   // Directional maps' L1 pages (x, y, z; export/directional_export.h), or null: no extension, no files.
   const std::array<std::vector<Lightmap>, 3>* directional = nullptr;
+  // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
+  // any other output that would land on one is refused with Error(Usage).
+  std::vector<std::filesystem::path> inputs;
 };
+
+// Throws Error(Usage) naming the file when one of `outputs` is one of `inputs` (same file, however named).
+void refuseOverwritingInputs(const std::vector<PendingFile>& outputs, const std::vector<std::filesystem::path>& inputs);
 
 // True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.
 bool namesGltfFile(const std::filesystem::path& output);

@@ -150,6 +150,7 @@ struct OutputOptions {
   std::filesystem::path outDir;      // OUTDIR: lightmap_<page>.exr, scene.gltf
   std::filesystem::path reportPath;  // report JSON; empty = OUTDIR/report.json
   bool writeGltf = true;             // export scene.gltf (+ .bin, PNG maps) beside the EXR pages
+  std::vector<std::filesystem::path> inputs;  // the bake's input files: never overwritten (Error(Usage))
 };
 
 // Writes the EXR pages, the glTF (through exportGltf) and the report, each atomically. Returns the

@@ -60,12 +60,27 @@ MapDifference compareMaps(const std::vector<Lightmap>& a, const std::vector<Ligh
   return d;
 }
 
+namespace {
+// A page with NaN or Inf texels scores nothing (every comparison with NaN is false): refuse it.
+Lightmap readFinitePage(const std::filesystem::path& file) {
+  Lightmap page = readExr(file);
+  size_t bad = 0;
+  for (const glm::vec3& t : page.texels)
+    if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z)) ++bad;
+  if (bad > 0)
+    throw Error(ErrorCode::InvalidData, file.string(),
+                std::to_string(bad) + " of " + std::to_string(page.texels.size()) +
+                    " texels are NaN or Inf: not a light map that can be compared");
+  return page;
+}
+}  // namespace
+
 BakeOnDisk readBakeFromDisk(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   BakeOnDisk bake;
   if (!fs::exists(path)) throw Error(ErrorCode::Io, path.string(), "no such file or folder");
   if (!fs::is_directory(path)) {
-    bake.pages.push_back(readExr(path));
+    bake.pages.push_back(readFinitePage(path));
     bake.pages.back().page = 0;
     return bake;
   }
@@ -82,7 +97,7 @@ BakeOnDisk readBakeFromDisk(const std::filesystem::path& path) {
   for (size_t i = 0; i < found.size(); ++i) {
     if (found[i].first != int(i))
       throw Error(ErrorCode::InvalidData, path.string(), "page " + std::to_string(i) + " is missing");
-    bake.pages.push_back(readExr(found[i].second));
+    bake.pages.push_back(readFinitePage(found[i].second));
     bake.pages.back().page = int(i);
   }
   for (const char* gltfName : {"scene.gltf", "scene.glb"}) {

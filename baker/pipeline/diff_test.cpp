@@ -5,6 +5,7 @@
 
 #include "common/error.h"
 #include "export/exr_io.h"
+#include "imageio/image_io.h"
 #include "pipeline/diff.h"
 
 namespace fs = std::filesystem;
@@ -72,4 +73,30 @@ TEST(Diff, ReadsBakeFoldersAndSingleExrs) {
   fs::remove(dir / "lightmap_0.exr");
   EXPECT_THROW(readBakeFromDisk(dir), Error);  // page 0 missing
   EXPECT_THROW(readBakeFromDisk(dir / "nothing"), Error);
+}
+
+// An all-NaN page would score relativeRmse 0 (NaN compares false everywhere): it is refused, naming it.
+TEST(Diff, RefusesPagesWithNaNOrInf) {
+  fs::path dir = fs::current_path() / "test_scratch" / "diff" / "nan";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  writeExr(constant(2, 2, glm::vec3(0.5f), 0), dir / "good.exr");
+  for (float bad : {NAN, INFINITY}) {
+    imageio::Pixels px;
+    px.width = 2;
+    px.height = 2;
+    px.channels = 3;
+    px.f32.assign(12, 0.5f);
+    px.f32[4] = bad;
+    imageio::api().writeFile((dir / "bad.exr").string(), "openexr", px, 0, "bad.exr");
+    try {
+      readBakeFromDisk(dir / "bad.exr");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+      EXPECT_NE(std::string(e.what()).find("bad.exr"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("1 of 4 texels are NaN or Inf"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(readBakeFromDisk(dir / "good.exr").pages.size(), 1u);
 }

@@ -55,19 +55,23 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.writeExrPages = true;
     ex.exrPrefix = "lightmap";
     ex.alsoWrite = {reportFile};
+    ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;
     for (size_t i = 0; i < result.maps.size(); ++i) {
       const Lightmap* map = &result.maps[i];
-      files.push_back({exrs[i], [map](const fs::path& temp) { writeExr(*map, temp); }});
+      const fs::path finalPath = exrs[i];
+      files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
     }
     for (const auto& [path, m] : l1Exrs) {
       const Lightmap* map = m;
-      files.push_back({path, [map](const fs::path& temp) { writeExr(*map, temp); }});
+      const fs::path finalPath = path;
+      files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
     }
     files.push_back(reportFile);
+    refuseOverwritingInputs(files, options.inputs);
     writeAllAtomically(files);
   }
 

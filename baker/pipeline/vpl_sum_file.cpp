@@ -6,28 +6,20 @@
 #include <iterator>
 
 #include "common/atomic_file.h"
+#include "common/checksum.h"
+#include "common/checksum.h"
 #include "common/error.h"
+#include "scene/scene_files.h"
 
 namespace irbake {
 
 namespace {
 
-// Version 2 (issue 15) adds the coefficient count (1: the map; 4: with the directional L1 pages) after the
-// page count; version 1 files, written before, hold one coefficient and are read as such.
-constexpr char kMagic[16] = "IRBAKE-VPLSUM-2";    // 15 characters + NUL
-constexpr char kMagicV1[16] = "IRBAKE-VPLSUM-1";  // no coefficient count: one
-constexpr char kEnd[8] = "VPLSEND";             // after the last page: a truncated file is refused
-
-constexpr uint64_t kFnvOffset = 1469598103934665603ull, kFnvPrime = 1099511628211ull;
-uint64_t fnv1a(const char* data, size_t size, uint64_t h = kFnvOffset) {
-  for (size_t i = 0; i < size; ++i) h = (h ^ static_cast<unsigned char>(data[i])) * kFnvPrime;
-  return h;
-}
-std::string hex(uint64_t v) {
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(v));
-  return text;
-}
+// Version 3: an XXH3-64 checksum of every byte before it closes the file, so a flipped bit or an edited
+// header is refused. Versions 1 and 2 had none and are refused as such.
+constexpr char kMagic[16] = "IRBAKE-VPLSUM-3";   // 15 characters + NUL
+constexpr char kMagicFamily[] = "IRBAKE-VPLSUM-";  // any version
+constexpr char kEnd[8] = "VPLSEND";             // after the last page, before the checksum
 
 bool readFile(const std::filesystem::path& path, std::string& bytes) {
   std::ifstream in(path, std::ios::binary);
@@ -36,10 +28,19 @@ bool readFile(const std::filesystem::path& path, std::string& bytes) {
   return !in.bad();
 }
 
-template <class T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof v);
-}
+// Writes bytes and checksums them on the way.
+struct ChecksummedWriter {
+  std::ofstream& out;
+  Checksum64 sum;
+  void write(const void* data, size_t size) {
+    sum.add(data, size);
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  template <class T>
+  void put(const T& v) {
+    write(&v, sizeof v);
+  }
+};
 
 // Reads from a byte string; every short read is the same error, naming the file.
 struct Reader {
@@ -64,7 +65,21 @@ struct Reader {
 std::string VplSumHeader::mismatch(const VplSumHeader& o) const {
   if (sceneHash != o.sceneHash) return "scene";
   if (seed != o.seed) return "seed";
-  if (optionsHash != o.optionsHash) return "options";
+  if (optionsHash != o.optionsHash) {
+    // Name the options that differ: "options --seed (3 here, 0 there)".
+    std::string which;
+    nlohmann::json all = options.is_object() ? options : nlohmann::json::object();
+    if (o.options.is_object()) all.update(o.options);
+    auto valueIn = [](const nlohmann::json& set, const std::string& key) {
+      if (!set.is_object() || !set.contains(key)) return std::string("default");
+      return set[key].is_string() ? set[key].get<std::string>() : set[key].dump();
+    };
+    for (const auto& [key, unused] : all.items()) {
+      const std::string mine = valueIn(options, key), theirs = valueIn(o.options, key);
+      if (mine != theirs) which += (which.empty() ? " --" : ", --") + key + " (" + mine + " vs " + theirs + ")";
+    }
+    return "options" + which;
+  }
   if (backend != o.backend) return "backend (" + backend + " vs " + o.backend + ")";
   if (blockCount != o.blockCount) return "VPL block count";
   return {};
@@ -74,6 +89,7 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
   const nlohmann::json h = {{"kind", header.kind},
                             {"sceneHash", header.sceneHash},
                             {"optionsHash", header.optionsHash},
+                            {"options", header.options},
                             {"seed", header.seed},
                             {"backend", header.backend},
                             {"blockCount", header.blockCount},
@@ -85,40 +101,49 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
                             {"backendCounts", header.backendCounts}};
   const std::string text = h.dump();
   writeAtomically(path, [&](const std::filesystem::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
+    std::ofstream file(temp, std::ios::binary);
+    ChecksummedWriter out{file, {}};
     out.write(kMagic, sizeof kMagic);
-    put(out, static_cast<uint64_t>(text.size()));
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    put(out, static_cast<uint64_t>(sums.pages.size()));
-    put(out, static_cast<uint64_t>(sums.coefficients));
+    out.put(static_cast<uint64_t>(text.size()));
+    out.write(text.data(), text.size());
+    out.put(static_cast<uint64_t>(sums.pages.size()));
+    out.put(static_cast<uint64_t>(sums.coefficients));
     // Per page: texel count, then per texel 0 (no sums), 1 (receiver, no block found it valid: zero sums
     // not written) or 2 (valid: its 3 · coefficients sums follow at the end of the page, in texel order).
     for (const ExactVplSums::Page& page : sums.pages) {
-      put(out, static_cast<uint64_t>(page.slot.size()));
+      out.put(static_cast<uint64_t>(page.slot.size()));
       std::vector<uint8_t> state(page.slot.size(), 0);
       for (size_t t = 0; t < state.size(); ++t)
         state[t] = page.slot[t] == ExactVplSums::kNoSum ? 0 : page.valid[t] ? 2 : 1;
-      out.write(reinterpret_cast<const char*>(state.data()), static_cast<std::streamsize>(state.size()));
+      out.write(state.data(), state.size());
       for (size_t t = 0; t < state.size(); ++t)
-        if (state[t] == 2)
-          out.write(reinterpret_cast<const char*>(&page.values[sums.channels() * page.slot[t]]),
-                    static_cast<std::streamsize>(sums.channels() * sizeof(ExactInt)));
+        if (state[t] == 2) out.write(&page.values[sums.channels() * page.slot[t]], sums.channels() * sizeof(ExactInt));
     }
     out.write(kEnd, sizeof kEnd);
-    out.close();
-    if (!out) throw Error(ErrorCode::Io, path.string(), "cannot write the VPL sums");
+    const uint64_t checksum = out.sum.digest();
+    file.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+    file.close();
+    if (!file) throw Error(ErrorCode::Io, path.string(), "cannot write the VPL sums: " + writeFailureReason(temp, "write failed"));
   });
 }
 
 VplSumFile readVplSumFile(const std::filesystem::path& path) {
   std::string bytes;
   if (!readFile(path, bytes)) throw Error(ErrorCode::Io, path.string(), "cannot read the VPL sum file");
+  if (bytes.size() < sizeof kMagic || bytes.compare(0, sizeof kMagicFamily - 1, kMagicFamily) != 0)
+    throw Error(ErrorCode::Parse, path.string(), "not an irbake VPL sum file (a partial of 'bake --shard' or a checkpoint)");
+  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw Error(ErrorCode::Parse, path.string(),
+                "VPL sum file of another irbake version (" + std::string(bytes.data(), sizeof kMagic - 1) +
+                    ", this one reads " + kMagic + "): bake it again");
+  uint64_t stored = 0;
+  if (bytes.size() < sizeof kMagic + sizeof stored) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
+  std::memcpy(&stored, bytes.data() + bytes.size() - sizeof stored, sizeof stored);
+  if (checksum64(bytes.data(), bytes.size() - sizeof stored) != stored)
+    throw Error(ErrorCode::Parse, path.string(), "VPL sum file is damaged or truncated (checksum mismatch): bake it again");
+  bytes.resize(bytes.size() - sizeof stored);
   Reader in{bytes, path};
-  char magic[sizeof kMagic];
-  in.take(magic, sizeof magic);
-  const bool version1 = std::memcmp(magic, kMagicV1, sizeof kMagicV1) == 0;
-  if (!version1 && std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw Error(ErrorCode::Parse, path.string(), "not an irbake VPL sum file (partial or checkpoint) of this version");
+  in.at = sizeof kMagic;
   const uint64_t textSize = in.get<uint64_t>();
   if (textSize > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
   std::string text(textSize, '\0');
@@ -130,6 +155,7 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
     hd.kind = h.at("kind").get<std::string>();
     hd.sceneHash = h.at("sceneHash").get<std::string>();
     hd.optionsHash = h.at("optionsHash").get<std::string>();
+    hd.options = h.value("options", nlohmann::json::object());
     hd.seed = h.at("seed").get<uint32_t>();
     hd.backend = h.at("backend").get<std::string>();
     hd.blockCount = h.at("blockCount").get<uint64_t>();
@@ -144,7 +170,7 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   }
   const uint64_t pageCount = in.get<uint64_t>();
   if (pageCount > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
-  const uint64_t coefficients = version1 ? 1 : in.get<uint64_t>();
+  const uint64_t coefficients = in.get<uint64_t>();
   if (coefficients != 1 && coefficients != uint64_t(ExactVplSums::kMaxCoefficients))
     throw Error(ErrorCode::Parse, path.string(),
                 "VPL sum file is damaged (" + std::to_string(coefficients) + " coefficients per texel)");
@@ -175,29 +201,34 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   return file;
 }
 
-std::string hashText(const std::string& text) { return hex(fnv1a(text.data(), text.size())); }
+std::string hashText(const std::string& text) {
+  Checksum64 h;
+  h.add(text);
+  return h.hex();
+}
 
 std::string hashSceneFiles(const std::filesystem::path& scene) {
-  std::string bytes;
-  if (!readFile(scene, bytes)) throw Error(ErrorCode::Io, scene.string(), "cannot read the scene to hash it");
-  uint64_t h = fnv1a(bytes.data(), bytes.size());
-  // A .gltf names its buffers and images by URI: hash the local files too (data: URIs are in the bytes).
-  const nlohmann::json doc = nlohmann::json::parse(bytes, nullptr, false);
-  if (doc.is_object()) {
-    for (const char* list : {"buffers", "images"}) {
-      if (!doc.contains(list) || !doc[list].is_array()) continue;
-      for (const auto& item : doc[list]) {
-        if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
-        const std::string uri = item["uri"].get<std::string>();
-        if (uri.rfind("data:", 0) == 0) continue;
-        std::string file;
-        // A file that cannot be read hashes as its name: the loader has already refused it if it mattered.
-        if (readFile(scene.parent_path() / uri, file)) h = fnv1a(file.data(), file.size(), h);
-        else h = fnv1a(uri.data(), uri.size(), h);
-      }
+  // What the loader reads: the scene's bytes and each local file its buffers and images name, by the
+  // decoded URI (a .gltf's .bin and textures; a GLB's external images), each with its name.
+  Checksum64 h;
+  const bool gltf = std::filesystem::path(scene).extension() == ".gltf" || std::filesystem::path(scene).extension() == ".glb";
+  std::vector<std::filesystem::path> files = {scene};
+  if (gltf) files = sceneInputFiles(scene);
+  for (size_t i = 0; i < files.size(); ++i) {
+    std::string bytes;
+    const std::string name = i == 0 ? std::string() : files[i].lexically_relative(scene.parent_path()).string();
+    h.add(name);
+    h.add("\0", 1);
+    // A file that cannot be read hashes as its name: the loader has already refused it if it mattered.
+    if (!readFile(files[i], bytes)) {
+      if (i == 0) throw Error(ErrorCode::Io, scene.string(), "cannot read the scene to hash it");
+      continue;
     }
+    const uint64_t size = bytes.size();
+    h.add(&size, sizeof size);
+    h.add(bytes);
   }
-  return hex(h);
+  return h.hex();
 }
 
 }  // namespace irbake

@@ -20,6 +20,7 @@ struct VplSumHeader {
   std::string kind;            // "partial" (a shard's share) or "checkpoint" (a bake under way)
   std::string sceneHash;       // hashSceneFiles of the scene (hex)
   std::string optionsHash;     // hash of every option that changes the result (hex)
+  nlohmann::json options;      // those options as name -> value (what a refusal names)
   uint32_t seed = 0;           // the walk seed
   std::string backend;         // the backend that evaluated the blocks (auto resolved)
   uint64_t blockCount = 0;     // VPL blocks of the whole bake
@@ -41,14 +42,14 @@ struct VplSumFile {
 // Writes header + sums to path atomically (only texels some block found valid carry sums).
 void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& header, const ExactVplSums& sums);
 // Reads a file written by writeVplSumFile. Throws Error(Io) when unreadable, Error(Parse) when it is not
-// such a file or is truncated, both naming the file.
+// such a file, is of another version, or fails its checksum (damaged, edited, truncated), naming the file.
 VplSumFile readVplSumFile(const std::filesystem::path& path);
 
-// 64-bit FNV-1a of the scene file and of every local file its buffers and images name (a .gltf's .bin
-// and textures), as 16 hex digits: a scene edited between shards, or between a checkpoint and its resume,
-// is caught. Throws Error(Io) when the scene cannot be read.
+// XXH3-64 of the scene file and of every local file its buffers and images name (URIs decoded: a .gltf's
+// .bin and textures, a GLB's external images), as 16 hex digits: a scene edited between shards, or between
+// a checkpoint and its resume, is caught. Throws Error(Io) when the scene cannot be read.
 std::string hashSceneFiles(const std::filesystem::path& scene);
-// 64-bit FNV-1a of a string, as 16 hex digits.
+// XXH3-64 of a string, as 16 hex digits.
 std::string hashText(const std::string& text);
 
 }  // namespace irbake

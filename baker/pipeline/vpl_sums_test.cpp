@@ -180,10 +180,10 @@ VplSumHeader someHeader() {
 }
 }  // namespace
 
-// Version 2 files carry the coefficient count: four round-trip bit for bit; a version-1 file (written
-// before, one coefficient, no count) still reads as one; a count other than 1 or 4 is damage.
-TEST(VplSumFile, FourCoefficientsRoundTripAndVersionOneStillReads) {
-  const fs::path dir = fs::current_path() / "test_scratch" / "vpl_sum_file_v2";
+// Four coefficients round-trip bit for bit; files of earlier versions (no checksum) are refused as
+// such; a count other than 1 or 4 is damage, caught by the checksum before anything else reads it.
+TEST(VplSumFile, FourCoefficientsRoundTripAndOtherVersionsAreRefused) {
+  const fs::path dir = fs::current_path() / "test_scratch" / "vpl_sum_file_v3";
   fs::remove_all(dir);
   fs::create_directories(dir);
   ExactVplSums sums = ExactVplSums::zeros({{1, 1, 0, 1}}, 4);
@@ -198,36 +198,57 @@ TEST(VplSumFile, FourCoefficientsRoundTripAndVersionOneStillReads) {
   EXPECT_TRUE(back.sums.pages[0].values == sums.pages[0].values);
   EXPECT_EQ(back.sums.pages[0].valid, sums.pages[0].valid);
 
-  // A version-1 file: the same bytes as a version-2 file of one coefficient, less the count after the
-  // page count, under the old magic.
-  ExactVplSums one = ExactVplSums::zeros({{1, 1, 0, 1}});
-  ASSERT_TRUE(one.add(0, 1, values[2]));
-  writeVplSumFile(dir / "one.vplsum", someHeader(), one);
-  std::string bytes = fileBytes(dir / "one.vplsum");
-  ASSERT_EQ(bytes.substr(0, 15), "IRBAKE-VPLSUM-2");
-  uint64_t textSize = 0;
-  std::memcpy(&textSize, bytes.data() + 16, 8);
-  const size_t countAt = 16 + 8 + textSize + 8;
-  uint64_t count = 0;
-  std::memcpy(&count, bytes.data() + countAt, 8);
-  ASSERT_EQ(count, 1u);
-  std::string v1 = bytes;
-  v1.replace(0, 15, "IRBAKE-VPLSUM-1");
-  v1.erase(countAt, 8);
-  std::ofstream(dir / "v1.vplsum", std::ios::binary) << v1;
-  const VplSumFile old = readVplSumFile(dir / "v1.vplsum");
-  EXPECT_EQ(old.sums.coefficients, 1);
-  EXPECT_TRUE(old.sums.pages[0].values == one.pages[0].values);
+  const std::string bytes = fileBytes(file);
+  ASSERT_EQ(bytes.substr(0, 15), "IRBAKE-VPLSUM-3");
+  for (const char* old : {"IRBAKE-VPLSUM-1", "IRBAKE-VPLSUM-2"}) {
+    std::string older = bytes;
+    older.replace(0, 15, old);
+    older.resize(older.size() - 8);  // no checksum then
+    std::ofstream(dir / "old.vplsum", std::ios::binary | std::ios::trunc) << older;
+    try {
+      readVplSumFile(dir / "old.vplsum");
+      ADD_FAILURE() << old << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Parse);
+      EXPECT_NE(std::string(e.what()).find(old), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("old.vplsum"), std::string::npos) << e.what();
+    }
+  }
+}
 
-  std::string three = bytes;
-  const uint64_t bad = 3;
-  std::memcpy(three.data() + countAt, &bad, 8);
-  std::ofstream(dir / "three.vplsum", std::ios::binary) << three;
+// Every byte is covered: flipping any one bit of a file (header, sums, end marker, checksum) is refused
+// naming the file, and so is a header edited to claim more blocks.
+TEST(VplSumFile, ChecksumCoversEveryByte) {
+  const fs::path dir = fs::current_path() / "test_scratch" / "vpl_sum_checksum";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ExactVplSums sums = ExactVplSums::zeros({{1, 1, 0, 1}}, 1);
+  const std::vector<glm::vec3> values = blockValues(3, 7);
+  ASSERT_TRUE(sums.add(0, 0, values[0]));
+  ASSERT_TRUE(sums.add(0, 3, values[1]));
+  writeVplSumFile(dir / "good.vplsum", someHeader(), sums);
+  const std::string good = fileBytes(dir / "good.vplsum");
+  size_t refused = 0;
+  for (size_t at = 15; at < good.size(); ++at) {  // past the magic, which says "not ours" instead
+    std::string bad = good;
+    bad[at] = static_cast<char>(bad[at] ^ (1 << (at % 8)));
+    std::ofstream(dir / "bad.vplsum", std::ios::binary | std::ios::trunc) << bad;
+    try {
+      readVplSumFile(dir / "bad.vplsum");
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::Parse && std::string(e.what()).find("bad.vplsum") != std::string::npos) ++refused;
+    }
+  }
+  EXPECT_EQ(refused, good.size() - 15);
+  std::string edited = good;
+  const size_t at = edited.find("\"endBlock\":2");
+  ASSERT_NE(at, std::string::npos);
+  edited[at + 11] = '4';
+  std::ofstream(dir / "edited.vplsum", std::ios::binary | std::ios::trunc) << edited;
   try {
-    readVplSumFile(dir / "three.vplsum");
-    ADD_FAILURE() << "3 coefficients accepted";
+    readVplSumFile(dir / "edited.vplsum");
+    ADD_FAILURE() << "edited header accepted";
   } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::Parse);
-    EXPECT_NE(std::string(e.what()).find("3 coefficients"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
   }
 }

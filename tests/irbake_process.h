@@ -1,0 +1,53 @@
+// Runs the irbake executable as a user would (fork + exec, output into a log file) for the command-line
+// tests: exit code or 128 + signal, and everything it printed.
+#pragma once
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace irbake::testing {
+
+inline std::string fileText(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Starts irbake with these arguments (stdout and stderr into log); returns its pid.
+inline pid_t startIrbake(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    FILE* out = std::freopen(log.c_str(), "w", stdout);
+    if (!out || dup2(fileno(stdout), 2) < 0) _exit(127);
+    std::vector<char*> argv{const_cast<char*>(IRBAKE_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(IRBAKE_EXE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Exit code, or 128 + signal.
+inline int waitForIrbake(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+struct IrbakeRun {
+  int code;
+  std::string output;
+};
+inline IrbakeRun runIrbakeLogged(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  const int code = waitForIrbake(startIrbake(args, log));
+  return {code, fileText(log)};
+}
+
+}  // namespace irbake::testing
