@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include "common/error.h"
@@ -47,9 +48,17 @@ double componentValue(const uint8_t* p, int componentType) {
   }
 }
 
+// root[key], or an empty array when absent, by reference: json::value() returns a copy, so each read
+// would cost the whole array and the export would grow with the square of the mesh count.
+const json& arrayOrEmpty(const json& root, const char* key) {
+  static const json empty = json::array();
+  const auto it = root.find(key);
+  return it != root.end() ? *it : empty;
+}
+
 // Bytes [offset, offset + size) of buffer view `view` (all views live in buffer 0 here).
 const uint8_t* viewBytes(const GltfDocument& doc, int view, size_t& length, size_t& stride, const std::string& file) {
-  const json& views = doc.root.value("bufferViews", json::array());
+  const json& views = arrayOrEmpty(doc.root, "bufferViews");
   if (view < 0 || view >= static_cast<int>(views.size())) throw Error(ErrorCode::InvalidData, file, "accessor names a missing buffer view");
   const json& v = views[view];
   const size_t offset = v.value("byteOffset", size_t(0));
@@ -204,7 +213,7 @@ std::string safeFileName(std::string name) {
 }  // namespace
 
 AccessorBytes readAccessor(const GltfDocument& doc, int index, const std::string& file) {
-  const json& accessors = doc.root.value("accessors", json::array());
+  const json& accessors = arrayOrEmpty(doc.root, "accessors");
   if (index < 0 || index >= static_cast<int>(accessors.size())) throw Error(ErrorCode::InvalidData, file, "missing accessor " + std::to_string(index));
   const json& a = accessors[index];
   const std::string what = "accessor " + std::to_string(index);
@@ -336,19 +345,21 @@ void compactDocument(GltfDocument& doc) {
   else doc.bin = std::move(fresh);
 }
 
-std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(GltfDocument& doc, std::vector<std::string> taken) {
+std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(GltfDocument& doc, const std::vector<std::string>& taken) {
   std::vector<std::pair<std::string, std::vector<uint8_t>>> files;
   if (!doc.root.contains("images")) return files;
-  auto isTaken = [&](const std::string& n) {
-    std::string lower = n;
-    for (auto& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    for (const auto& t : taken) {
-      std::string tl = t;
-      for (auto& c : tl) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      if (tl == lower) return true;
-    }
-    return false;
+  // Names compare case-insensitively (names differing only in case collide on case-insensitive file
+  // systems); sets keep the check cheap when a scene has thousands of images.
+  auto lower = [](std::string n) {
+    for (auto& c : n) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return n;
   };
+  std::set<std::string> takenLower;
+  for (const auto& t : taken) takenLower.insert(lower(t));
+  auto isTaken = [&](const std::string& n) { return takenLower.count(lower(n)) > 0; };
+  // First suffix still worth trying per stem and extension: names are only ever added, so the first free
+  // suffix never goes down, and many images sharing one stem do not retry every earlier suffix.
+  std::map<std::string, int> nextSuffix;
   for (size_t i = 0; i < doc.root["images"].size(); ++i) {
     json& image = doc.root["images"][i];
     if (!image.contains("bufferView")) continue;
@@ -367,8 +378,11 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(Gltf
     if (stem.size() > 4 && (stem.substr(stem.size() - 4) == ".png" || stem.substr(stem.size() - 4) == ".jpg")) stem.resize(stem.size() - 4);
     if (stem.empty() || stem[0] == '.') stem = "image" + std::to_string(i);
     std::string name = stem + ext;
-    for (int k = 1; isTaken(name); ++k) name = stem + "_" + std::to_string(k) + ext;
-    taken.push_back(name);
+    if (isTaken(name)) {
+      int& k = nextSuffix.try_emplace(lower(stem) + '/' + ext, 1).first->second;
+      for (name = stem + "_" + std::to_string(k) + ext; isTaken(name); name = stem + "_" + std::to_string(++k) + ext) {}
+    }
+    takenLower.insert(lower(name));
     image.erase("bufferView");
     image["uri"] = name;
     files.emplace_back(name, std::move(data));

@@ -42,6 +42,6 @@ inline constexpr const char* kSourceUriKey = "__irbakeSourceUri";
 // Moves every image stored in a buffer view out to its own file beside the glTF (named after its
 // source URI, else its name, else its index; made unique against `takenNames`), setting its uri. Returns the files (name
 // relative to the glTF's folder, bytes). Run compactDocument afterwards to drop the freed views.
-std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(GltfDocument& doc, std::vector<std::string> takenNames);
+std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(GltfDocument& doc, const std::vector<std::string>& takenNames);
 
 }  // namespace irbake

@@ -129,3 +129,28 @@ TEST(GltfCompact, DropsWhatNothingUsesAndRenumbersTheRest) {
   EXPECT_EQ(xyz[3], 1.0f);
   EXPECT_EQ(xyz[7], 1.0f);
 }
+
+TEST(GltfCompact, ExternalizedImagesGetUniqueNamesWhateverTheirCase) {
+  // Five images from "tex.png" files in different folders, one named "Tex" (no source URI), one with
+  // neither: against the taken "TEX_2.png" (another case) the suffixes go 1, 3, 4, 5, 6.
+  GltfDocument doc;
+  const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+  for (int i = 0; i < 5; ++i) {
+    const int image = doc.addPngImage(std::vector<uint8_t>(png, png + 8), "");
+    doc.root["images"][image][kSourceUriKey] = "folder" + std::to_string(i) + "/tex.png";
+  }
+  doc.addPngImage(std::vector<uint8_t>(png, png + 8), "Tex");
+  doc.addPngImage(std::vector<uint8_t>(png, png + 8), "");
+  const auto files = externalizeImages(doc, {"baked.gltf", "TEX_2.png"});
+  std::vector<std::string> names;
+  for (const auto& [name, bytes] : files) {
+    names.push_back(name);
+    EXPECT_EQ(bytes, std::vector<uint8_t>(png, png + 8)) << name;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"tex.png", "tex_1.png", "tex_3.png", "tex_4.png", "tex_5.png", "Tex_6.png", "image6.png"}));
+  for (size_t i = 0; i < names.size(); ++i) {
+    EXPECT_EQ(doc.root["images"][i]["uri"], names[i]);
+    EXPECT_FALSE(doc.root["images"][i].contains("bufferView"));
+    EXPECT_FALSE(doc.root["images"][i].contains(kSourceUriKey));
+  }
+}

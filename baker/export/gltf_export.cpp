@@ -440,21 +440,27 @@ GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& 
   wo.lightmapPages = pageUris;
   GltfDocument doc = gltfFromScene(copy, wo);
   // gltfFromScene encodes light-map textures linearly: put the sRGB-encoded PNGs and their marker in.
-  if (doc.root.contains("materials"))
+  // Each page's PNG goes into buffer 0 once (not once per material), at the last material on that page,
+  // which fixes the order the pages' PNGs are packed in.
+  if (doc.root.contains("materials")) {
+    std::map<int, int> pageOfTexture;
+    for (const auto& [page, t] : pageTexture) pageOfTexture[t] = page;
+    std::map<int, size_t> lastMaterialOfTexture;
+    for (size_t i = 0; i < copy.materials.size(); ++i)
+      if (copy.materials[i].lightmapTexture >= 0) lastMaterialOfTexture[copy.materials[i].lightmapTexture] = i;
     for (size_t i = 0; i < copy.materials.size(); ++i) {
       const Material& m = copy.materials[i];
       if (m.lightmapTexture < 0) continue;
       json& moz = doc.root["materials"][i]["extensions"]["MOZ_lightmap"];
       const int tex = moz["index"].get<int>();
-      const int image = doc.root["textures"][tex]["source"].get<int>();
-      for (const auto& [page, t] : pageTexture)
-        if (t == m.lightmapTexture) {
-          const LightmapPng& png = pngs[pngOfPage.at(page)];
-          const int view = doc.addBufferView(png.png.data(), png.png.size());
-          doc.root["images"][image]["bufferView"] = view;
-          moz = mozLightmap(tex, png);
-        }
+      const LightmapPng& png = pngs[pngOfPage.at(pageOfTexture.at(m.lightmapTexture))];
+      if (lastMaterialOfTexture.at(m.lightmapTexture) == i) {
+        const int image = doc.root["textures"][tex]["source"].get<int>();
+        doc.root["images"][image]["bufferView"] = doc.addBufferView(png.png.data(), png.png.size());
+      }
+      moz = mozLightmap(tex, png);
     }
+  }
   compactDocument(doc);
   return doc;
 }

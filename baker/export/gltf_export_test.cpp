@@ -490,3 +490,92 @@ TEST(GltfExport, PrimitiveWithoutTexcoord0AndEmissiveAboveOneStayValid) {
   Scene r = loadScene(o.output);
   EXPECT_EQ(r.materials[r.primitives[0].material].emission(), glm::vec3(8.0f, 4.0f, 2.0f));
 }
+
+namespace {
+
+// n unit quads in a row, each its own mesh ("quad<i>": POSITION, NORMAL, indices) on its own node, all
+// with material 0.
+GltfDocument separateQuads(int n) {
+  GltfDocument doc;
+  doc.append("materials", {{"name", "grey"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}}}}});
+  const std::vector<glm::vec3> normals(4, glm::vec3(0, 1, 0));
+  json roots = json::array();
+  for (int i = 0; i < n; ++i) {
+    const float x = 2.0f * static_cast<float>(i);
+    const std::vector<glm::vec3> pos = {{x, 0, 0}, {x + 1, 0, 0}, {x + 1, 0, -1}, {x, 0, -1}};
+    json attributes = {{"POSITION", doc.addPositions(pos)}, {"NORMAL", doc.addVec3(normals)}};
+    json prim = {{"attributes", attributes}, {"indices", doc.addIndices({0, 1, 2, 0, 2, 3})}, {"material", 0}};
+    doc.append("meshes", {{"name", "quad" + std::to_string(i)}, {"primitives", json::array({prim})}});
+    roots.push_back(doc.append("nodes", {{"mesh", i}}));
+  }
+  doc.root["scenes"] = json::array({{{"nodes", roots}}});
+  doc.root["scene"] = 0;
+  return doc;
+}
+
+// Quad i's light-map UVs: corner k of a cell that depends on i (so a mix-up between meshes shows).
+glm::vec2 cellCorner(int i, int k) {
+  const glm::vec2 corner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const float cell = 1.0f / 128.0f;
+  return cell * (glm::vec2(static_cast<float>(i % 128), static_cast<float>((i / 128) % 128)) + 0.1f + 0.8f * corner[k]);
+}
+
+}  // namespace
+
+// A source of 10,000 separate meshes (the export once took time quadratic in their number): every
+// mesh is written back with its TEXCOORD_1 (4 elements, the values given) and its page's MOZ_lightmap
+// material, and the file reloads with all 10,000.
+TEST(GltfExport, TenThousandSeparateMeshesEachGetTexcoord1AndTheirPageMaterial) {
+  constexpr int kMeshes = 10000;
+  auto dir = irbake::testing::testFolder("export_separate_meshes");
+  std::filesystem::create_directories(dir / "in");
+  irbake::testing::writeDocument(separateQuads(kMeshes), dir / "in" / "source.gltf");
+  LoadOptions lo;
+  lo.decodeImages = false;
+  Scene loaded = loadScene(dir / "in" / "source.gltf", lo);
+  ASSERT_EQ(loaded.primitives.size(), size_t(kMeshes));
+  for (Primitive& p : loaded.primitives) {
+    ASSERT_EQ(p.positions.size(), 4u);
+    p.uv1.resize(4);
+    for (int k = 0; k < 4; ++k) p.uv1[k] = cellCorner(p.gltfMesh, k);
+    p.lightmap = {p.gltfMesh % 2, 8, 4};  // even meshes on page 0, odd on page 1
+  }
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  exportGltf(loaded, ramps(), o);
+
+  const json j = readJson(o.output);
+  EXPECT_NE(std::find(j["extensionsUsed"].begin(), j["extensionsUsed"].end(), "MOZ_lightmap"), j["extensionsUsed"].end());
+  // "grey" carries page 0 in place, its copy page 1: each with its page's texture and intensity.
+  ASSERT_EQ(j["materials"].size(), 2u);
+  ASSERT_EQ(j["meshes"].size(), size_t(kMeshes));
+  ASSERT_EQ(j["nodes"].size(), size_t(kMeshes));
+  int wrong = 0;
+  for (int i = 0; i < kMeshes; ++i) {
+    const json& mesh = j["meshes"][j["nodes"][i]["mesh"].get<int>()];
+    const json& prims = mesh["primitives"];
+    const json& prim = prims[0];
+    const json& attributes = prim["attributes"];
+    const json& moz = j["materials"][prim.value("material", -1)]["extensions"]["MOZ_lightmap"];
+    const bool ok = mesh["name"] == "quad" + std::to_string(i) && prims.size() == 1 && attributes.contains("TEXCOORD_1") &&
+                    j["accessors"][attributes["TEXCOORD_1"].get<int>()]["count"] == 4 &&
+                    j["accessors"][attributes["TEXCOORD_1"].get<int>()]["type"] == "VEC2" &&
+                    j["accessors"][attributes["POSITION"].get<int>()]["count"] == 4 && prim["extras"]["lightmap"]["page"] == i % 2 &&
+                    moz["texCoord"] == 1 && std::abs(moz["intensity"].get<double>() - 2.5 * (i % 2 + 1)) < 1e-5;
+    if (!ok && ++wrong <= 3) ADD_FAILURE() << "mesh " << i << ": " << mesh.dump();
+  }
+  EXPECT_EQ(wrong, 0);
+
+  Scene r = loadScene(o.output);
+  ASSERT_EQ(r.primitives.size(), size_t(kMeshes));
+  ASSERT_EQ(r.lightmapExrPaths.size(), 2u);
+  wrong = 0;
+  for (const Primitive& p : r.primitives) {
+    bool ok = p.gltfMesh >= 0 && p.uv1.size() == 4 && p.lightmap.page == p.gltfMesh % 2 &&
+              r.materials[p.material].lightmapTexture >= 0 &&
+              std::abs(r.materials[p.material].lightmapIntensity - 2.5f * (p.gltfMesh % 2 + 1)) < 1e-5f;
+    for (int k = 0; ok && k < 4; ++k) ok = p.uv1[k] == cellCorner(p.gltfMesh, k) && p.positions[k] == loaded.primitives[p.gltfMesh].positions[k];
+    if (!ok && ++wrong <= 3) ADD_FAILURE() << "reloaded primitive of mesh " << p.gltfMesh;
+  }
+  EXPECT_EQ(wrong, 0);
+}
