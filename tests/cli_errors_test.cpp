@@ -203,6 +203,23 @@ TEST(CliErrors, OnlyDegenerateTriangles) {
   expectError(file, ErrorCode::EmptyScene, "2 degenerate triangles dropped");
 }
 
+// Scale outside 1e-4 … 1e9 m: refused at load with the class's exit code, never an Embree abort or an all-zero map.
+TEST(CliErrors, SceneScaleOutsideTheSupportedRange) {
+  auto huge = validScene("scale_huge", [](GltfDocument& doc) { doc.root["nodes"][0]["scale"] = {1e10, 1e10, 1e10}; });
+  expectError(huge, ErrorCode::InvalidData, "at a coordinate of 1e10 m, beyond the supported 1e9 m: rescale the scene");
+  auto tiny = validScene("scale_tiny", [](GltfDocument& doc) { doc.root["nodes"][0]["scale"] = {1e-8, 1e-8, 1e-8}; });
+  expectError(tiny, ErrorCode::InvalidData, "scene extent 1e-8 m (largest side of its bounding box) is outside the supported 1e-4 … 1e9 m");
+}
+
+TEST(CliErrors, NegativeLightColourAndUnsupportedRequiredExtension) {
+  auto colour = validScene("negative_colour", [](GltfDocument& doc) {
+    doc.root["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {-1, -1, -1};
+  });
+  expectError(colour, ErrorCode::InvalidData, "light 0 has a negative or non-finite colour (-1, -1, -1)");
+  auto required = validScene("required_draco", [](GltfDocument& doc) { doc.root["extensionsRequired"] = {"KHR_draco_mesh_compression"}; });
+  expectError(required, ErrorCode::InvalidData, "requires extension KHR_draco_mesh_compression");
+}
+
 // 200,000 nested arrays in extras overflowed tinygltf's recursive parser (SIGSEGV). The depth scan
 // refuses them first; brackets inside strings (with escaped quotes) do not count.
 TEST(CliErrors, DeeplyNestedExtras) {

@@ -506,9 +506,14 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
 
   const bool fromSource = !scene.sourcePath.empty() && std::filesystem::exists(scene.sourcePath);
   GltfDocument doc = fromSource ? SourceExport(scene, maps, pngs, file).run() : documentFromScene(scene, maps, pngs, pageUris);
-  if (fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
+  // glTF allows extras of any type: a source's non-object root extras is kept as it is, without our records.
+  const bool rootExtrasIsObject = !doc.root.contains("extras") || doc.root["extras"].is_object();
+  if (!rootExtrasIsObject && ((fromSource && !pageUris.empty()) || scene.environment.present()))
+    log::warn(file + ": the source's root extras is a " + std::string(doc.root["extras"].type_name()) +
+              ", not an object: kept, so the export does not record its EXR pages or sky there");
+  if (rootExtrasIsObject && fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
   // The sky the bake used, for viewers (irview draws it behind the scene) and for a bake of this export.
-  if (scene.environment.present()) doc.root["extras"]["irbakeSky"] = skyJson(scene.environment);
+  if (rootExtrasIsObject && scene.environment.present()) doc.root["extras"]["irbakeSky"] = skyJson(scene.environment);
   const bool directional = options.directional && !(*options.directional)[0].empty();
   if (directional) {
     for (const auto& axis : *options.directional) checkMaps(axis, file);

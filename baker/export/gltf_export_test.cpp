@@ -578,4 +578,54 @@ TEST(GltfExport, TenThousandSeparateMeshesEachGetTexcoord1AndTheirPageMaterial) 
     if (!ok && ++wrong <= 3) ADD_FAILURE() << "reloaded primitive of mesh " << p.gltfMesh;
   }
   EXPECT_EQ(wrong, 0);
+
+// glTF allows extras of any JSON type: a source whose root extras is a string (and whose node, mesh and material
+// extras are a number, an array and a string) exports and reloads; the root value is kept as it was, without the
+// EXR page list and sky that an object would carry. It was a raw JSON type error at the end of the bake.
+TEST(GltfExport, NonObjectExtrasAreKept) {
+  auto dir = irbake::testing::testFolder("export_extras");
+  Scene src = twoQuadScene();
+  for (auto& p : src.primitives) {
+    p.uv1.clear();
+    p.lightmap = {};
+  }
+  std::filesystem::create_directories(dir / "in");
+  writeGltf(src, dir / "in" / "source.gltf");
+  json source = readJson(dir / "in" / "source.gltf");
+  source["nodes"][0]["extras"] = 42;
+  source["meshes"][0]["extras"] = json::array({1, 2});
+  source["materials"][0]["extras"] = "note";
+
+  for (const json& root : {json("hello"), json::object({{"tag", "kept"}})}) {
+    source["extras"] = root;
+    std::ofstream(dir / "in" / "source.gltf") << source.dump();
+    Scene loaded = loadScene(dir / "in" / "source.gltf");
+    ASSERT_EQ(loaded.primitives.size(), 2u);
+    for (int i = 0; i < 2; ++i) {
+      loaded.primitives[i].uv1 = {{0.1f, 0.1f}, {0.9f, 0.1f}, {0.9f, 0.9f}, {0.1f, 0.9f}};
+      loaded.primitives[i].lightmap = {i, 8, 4};
+    }
+    loaded.environment = Environment::uniform(glm::vec3(0.25f, 0.5f, 1.0f));  // the export records a sky
+    ExportOptions o;
+    o.output = dir / "out" / "baked.gltf";
+    ASSERT_NO_THROW(exportGltf(loaded, ramps(), o)) << root.dump();
+    const json j = readJson(o.output);
+    EXPECT_EQ(j["nodes"][0]["extras"], 42);
+    EXPECT_EQ(j["meshes"][0]["extras"], json::array({1, 2}));
+    EXPECT_EQ(j["materials"][0]["extras"], "note");
+    const Scene r = loadScene(o.output);
+    ASSERT_EQ(r.primitives.size(), 2u);
+    EXPECT_EQ(r.primitives[1].lightmap.page, 1);
+    EXPECT_NEAR(r.materials[r.primitives[1].material].lightmapIntensity, 5.0f, 1e-5f);
+    if (root.is_string()) {
+      EXPECT_EQ(j["extras"], "hello");
+      EXPECT_TRUE(r.lightmapExrPaths.empty());
+      EXPECT_FALSE(r.environment.present());
+    } else {
+      EXPECT_EQ(j["extras"]["tag"], "kept");
+      EXPECT_EQ(j["extras"]["lightmapPages"], json::array({"lightmap_0.exr", "lightmap_1.exr"}));
+      EXPECT_EQ(r.lightmapExrPaths.size(), 2u);
+      EXPECT_FLOAT_EQ(r.environment.uniformRadiance().z, 1.0f);
+    }
+  }
 }

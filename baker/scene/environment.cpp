@@ -121,7 +121,9 @@ Environment loadEnvironment(const std::filesystem::path& file, float intensity, 
   } catch (const Error& e) {
     throw Error(ErrorCode::InvalidData, name, std::string("cannot read the environment image (") + e.what() + ")");
   }
-  if (px.width < 2 || px.height < 1 || px.channels < 1) throw Error(ErrorCode::InvalidData, name, "environment image is empty");
+  if (px.width < 1 || px.height < 1 || px.channels < 1)
+    throw Error(ErrorCode::InvalidData, name, "environment image has no pixels (" + std::to_string(px.width) + "×" +
+                                                  std::to_string(px.height) + ", " + std::to_string(px.channels) + " channels)");
   std::vector<glm::vec3> texels(static_cast<size_t>(px.width) * px.height);
   for (size_t i = 0; i < texels.size(); ++i) {
     const float* p = &px.f32[i * px.channels];
@@ -131,6 +133,8 @@ Environment loadEnvironment(const std::filesystem::path& file, float intensity, 
         throw Error(ErrorCode::InvalidData, name, "environment pixel " + std::to_string(i % px.width) + "," +
                                                       std::to_string(i / px.width) + " is negative or not finite");
   }
+  // One pixel is a constant sky: exactly uniform (an equirect of one row would integrate sinθ at θ = π/2 only).
+  if (texels.size() == 1) return Environment::uniform(texels[0] * intensity);
   return Environment::fromEquirect(px.width, px.height, std::move(texels), intensity,
                                    static_cast<float>(rotationDegrees * kPi / 180.0), name);
 }

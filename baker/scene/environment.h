@@ -60,7 +60,7 @@ class Environment {
   glm::dvec3 integral_{0.0};
 };
 
-// Reads an equirectangular EXR/HDR (any size ≥ 2×1, RGB or more channels) with OpenImageIO. Throws
+// Reads an equirectangular EXR/HDR (any size; 1×1 is a uniform sky; one channel is grey) with OpenImageIO. Throws
 // Error(Io/InvalidData) naming the file (missing, unreadable, negative or non-finite radiance).
 Environment loadEnvironment(const std::filesystem::path& file, float intensity = 1.0f, float rotationDegrees = 0.0f);
 

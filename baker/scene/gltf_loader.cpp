@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <functional>
@@ -34,6 +35,25 @@ using json = nlohmann::json;
 constexpr double kAbsurdFactor = 64.0;
 constexpr int kMaxNodeDepth = 1024;
 constexpr size_t kMaxNodeInstances = 1000000;
+
+// The scene sizes a bake handles (docs/refusals.md), in metres after node transforms. Below 1e-4 m the ray
+// tracer's smallest offset (1e-8 m) becomes a visible part of the scene and brightens it.
+constexpr double kMinSceneExtent = 1e-4;
+// Above 1e9 m a triangle's squared cross product can pass float's 3.4e38: its normal vanishes and Embree
+// aborts on the rays built from it. The same bound holds for every vertex and punctual light coordinate.
+constexpr double kMaxSceneExtent = 1e9;
+constexpr double kMaxCoordinate = 1e9;
+// A scene farther from the origin than this many times its size gets a warning: float spacing there
+// (and the ray tracer's offsets, which follow it) reaches a visible fraction of the scene.
+constexpr double kFarFromOriginRatio = 1e4;
+// Relative slack on those bounds, so that a scale of exactly 1e-4 or 1e9 (rounded to float) is inside.
+constexpr double kBoundSlack = 1e-6;
+
+// glTF extensions this loader reads (or, for KHR_mesh_quantization, whose accessor types it reads like
+// any other): the only ones a file may list in extensionsRequired.
+const char* const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                            "KHR_materials_transmission", "KHR_mesh_quantization", "MOZ_lightmap",
+                                            "IRBAKE_lightmap_directional"};
 
 // tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
 // material uses). EXR and unknown formats load too; they are simply recorded.
@@ -148,6 +168,37 @@ WrapMode wrapFromGl(int mode) {
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+// Every component finite and ≥ 0 (colours, factors).
+bool finiteNonNegative(const glm::vec4& v) {
+  for (int c = 0; c < 4; ++c)
+    if (!std::isfinite(v[c]) || v[c] < 0.0f) return false;
+  return true;
+}
+
+// A length in short scientific notation for messages: "3.2e-8", "1e9".
+std::string scientific(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1e", x);
+  std::string s(text);
+  const size_t e = s.find('e');
+  if (e == std::string::npos) return s;  // inf or nan
+  std::string mantissa = s.substr(0, e);
+  if (mantissa.size() >= 2 && mantissa.compare(mantissa.size() - 2, 2, ".0") == 0) mantissa.resize(mantissa.size() - 2);
+  return mantissa + "e" + std::to_string(std::stoi(s.substr(e + 1)));
+}
+
+std::string number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
+std::string rgb(const glm::vec3& c) {
+  std::string text = "(";
+  text += number(c.x) + ", " + number(c.y) + ", " + number(c.z) + ")";
+  return text;
+}
+
 // A primitive's data in mesh space, read once per (mesh, primitive) however many nodes instance it.
 struct LocalPrimitive {
   std::vector<glm::vec3> positions, normals;
@@ -167,6 +218,7 @@ class Loader {
   Scene load() {
     parseWithTinygltf();
     scene_.sourcePath = file_;
+    checkRequiredExtensions();
     materialMap_.assign(model_.materials.size(), -1);
     // Scene material i is glTF material i (the default material, when needed, comes after them).
     for (size_t i = 0; i < model_.materials.size(); ++i) materialIndex(static_cast<int>(i), "scene");
@@ -179,6 +231,11 @@ class Loader {
                         std::to_string(scene_.stats.trianglesDropped) + " degenerate triangles dropped";
       throw Error(ErrorCode::EmptyScene, file_, "no triangles to bake (" + why + ")");
     }
+    checkSceneExtent();
+    // Not through warn(): this count must survive its cap on repeated warnings.
+    if (scene_.stats.trianglesDropped > 0)
+      scene_.stats.warnings.push_back(std::to_string(scene_.stats.trianglesDropped) +
+                                      " degenerate triangles (zero area or a repeated corner) dropped");
     decodeTextures();
     readLightmapPages();
     readSky();
@@ -188,6 +245,35 @@ class Loader {
 
  private:
   [[noreturn]] void invalid(const std::string& message) const { throw Error(ErrorCode::InvalidData, file_, message); }
+
+  // glTF 2.0 (3.12): a loader must refuse a file that requires an extension it does not support.
+  void checkRequiredExtensions() const {
+    const json* required = child(src_.json, "extensionsRequired");
+    if (!required) return;
+    if (!required->is_array()) invalid("extensionsRequired is not an array");
+    for (const json& e : *required) {
+      if (!e.is_string()) invalid("extensionsRequired holds a non-string entry " + e.dump());
+      const std::string name = e.get<std::string>();
+      if (std::find(std::begin(kSupportedExtensions), std::end(kSupportedExtensions), name) == std::end(kSupportedExtensions))
+        invalid("the file requires extension " + name + ", which irbake does not support (extensionsRequired)");
+    }
+  }
+
+  // The flattened scene's size must lie in [kMinSceneExtent, kMaxSceneExtent] (vertex coordinates were
+  // checked against kMaxCoordinate as they were transformed).
+  void checkSceneExtent() {
+    const Bounds3 b = scene_.bounds();
+    const glm::vec3 e = b.extent();
+    const double extent = std::max({e.x, e.y, e.z});
+    if (!(extent >= kMinSceneExtent * (1.0 - kBoundSlack)) || !(extent <= kMaxSceneExtent * (1.0 + kBoundSlack)))
+      invalid("scene extent " + scientific(extent) + " m (largest side of its bounding box) is outside the supported " +
+              scientific(kMinSceneExtent) + " … " + scientific(kMaxSceneExtent) + " m: rescale the scene (node scale)");
+    const double magnitude = std::max(glm::length(b.min), glm::length(b.max));
+    if (magnitude > kFarFromOriginRatio * extent)
+      warn("the scene lies " + scientific(magnitude) + " m from the origin, " + scientific(magnitude / extent) +
+           " times its size: float spacing there is about " + scientific(magnitude * 1.2e-7) +
+           " m; move it nearer the origin (node translation)");
+  }
 
   void warn(const std::string& message) {
     // Many identical warnings (one per primitive) are summarised by the count in LoadStats.
@@ -380,9 +466,22 @@ class Loader {
     light.range = static_cast<float>(l.range);
     light.innerConeAngle = static_cast<float>(l.spot.innerConeAngle);
     light.outerConeAngle = static_cast<float>(l.spot.outerConeAngle);
-    if (!finite(light.color) || !std::isfinite(light.intensity) || light.intensity < 0.0f || !(light.range >= 0.0f))
-      invalid("light " + std::to_string(li) + " has a negative or non-finite colour, intensity or range");
+    const std::string what = "light " + std::to_string(li) + (l.name.empty() ? "" : " ('" + l.name + "')");
+    // Each colour component on its own must be ≥ 0: light is never negative.
+    if (!finiteNonNegative(glm::vec4(light.color, 0.0f)))
+      invalid(what + " has a negative or non-finite colour " + rgb(light.color));
+    if (!std::isfinite(light.intensity) || light.intensity < 0.0f || !(light.range >= 0.0f))
+      invalid(what + " has a negative or non-finite intensity or range");
+    // KHR_lights_punctual: 0 ≤ innerConeAngle < outerConeAngle ≤ π/2 (a little slack above π/2 for a float π/2).
+    if (light.type == LightType::Spot &&
+        !(l.spot.innerConeAngle >= 0.0 && l.spot.innerConeAngle < l.spot.outerConeAngle && l.spot.outerConeAngle <= kPi / 2.0 + 1e-6))
+      invalid(what + " has spot cone angles inner " + number(l.spot.innerConeAngle) + ", outer " +
+              number(l.spot.outerConeAngle) + ": KHR_lights_punctual needs 0 ≤ innerConeAngle < outerConeAngle ≤ π/2");
     light.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
+    const float far = glm::max(glm::abs(light.position.x), glm::max(glm::abs(light.position.y), glm::abs(light.position.z)));
+    if (light.type != LightType::Directional && !(far <= kMaxCoordinate * (1.0 + kBoundSlack)))
+      invalid(what + " on node " + std::to_string(n) + nodeName(n) + " is at a coordinate of " + scientific(far) +
+              " m, beyond the supported " + scientific(kMaxCoordinate) + " m: rescale the scene (node scale)");
     glm::vec3 dir = glm::vec3(world * glm::vec4(0, 0, -1, 0));
     float len = glm::length(dir);
     light.direction = len > 0.0f ? dir / len : glm::vec3(0, 0, -1);
@@ -618,10 +717,18 @@ class Loader {
       out.uv0 = lp.uv0;
       out.uv1 = lp.uv1;
       out.positions.resize(lp.positions.size());
+      const std::string meshLabel = mesh.name.empty() ? std::string() : " ('" + mesh.name + "')";
       for (size_t i = 0; i < lp.positions.size(); ++i) {
         out.positions[i] = glm::vec3(world * glm::vec4(lp.positions[i], 1.0f));
+        const glm::vec3 a = glm::abs(out.positions[i]);
+        const float far = glm::max(a.x, glm::max(a.y, a.z));
         if (!finite(out.positions[i]))
-          invalid("node " + std::to_string(nodeIndex) + nodeName(nodeIndex) + " puts a vertex at NaN/Inf in world space");
+          invalid("node " + std::to_string(nodeIndex) + nodeName(nodeIndex) + " puts a vertex of mesh " + std::to_string(meshIndex) +
+                  meshLabel + " at NaN/Inf in world space");
+        if (far > kMaxCoordinate * (1.0 + kBoundSlack))
+          invalid("node " + std::to_string(nodeIndex) + nodeName(nodeIndex) + " puts a vertex of mesh " + std::to_string(meshIndex) +
+                  meshLabel + " at a coordinate of " + scientific(far) + " m, beyond the supported " +
+                  scientific(kMaxCoordinate) + " m: rescale the scene (node scale)");
       }
       // A mirroring transform (det < 0) turns counter-clockwise into clockwise: swap two corners.
       const bool mirrored = det < 0.0f;
@@ -798,10 +905,17 @@ class Loader {
     else if (g.alphaMode == "BLEND") m.alphaMode = AlphaMode::Blend;
     m.alphaCutoff = static_cast<float>(g.alphaCutoff);
     m.doubleSided = g.doubleSided;
-    for (int c = 0; c < 4; ++c)
-      if (!std::isfinite(m.baseColorFactor[c])) invalid("material " + std::to_string(index) + " has a NaN/Inf baseColorFactor");
-    if (!finite(m.emissiveFactor) || !std::isfinite(m.emissiveStrength) || !std::isfinite(m.lightmapIntensity))
-      invalid("material " + std::to_string(index) + " has a NaN/Inf emissive factor, strength or lightmap intensity");
+    const std::string what = "material " + std::to_string(index) + (g.name.empty() ? "" : " ('" + g.name + "')");
+    if (!finiteNonNegative(m.baseColorFactor))
+      invalid(what + " has a negative or non-finite baseColorFactor " + rgb(glm::vec3(m.baseColorFactor)) +
+              " alpha " + number(m.baseColorFactor.a));
+    if (!finiteNonNegative(glm::vec4(m.emissiveFactor, 0.0f)))
+      invalid(what + " has a negative or non-finite emissiveFactor " + rgb(m.emissiveFactor));
+    if (!std::isfinite(m.emissiveStrength) || m.emissiveStrength < 0.0f)
+      invalid(what + ": KHR_materials_emissive_strength emissiveStrength must be ≥ 0 and finite (it is " +
+              number(m.emissiveStrength) + ")");
+    if (!std::isfinite(m.lightmapIntensity))
+      invalid(what + " has a NaN/Inf MOZ_lightmap intensity");
     return m;
   }
 

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
+#include "export/exr_io.h"
+#include "scene/environment.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_codec.h"
 #include "scene/test_gltf_builder.h"
@@ -30,6 +32,47 @@ void expectNear(const glm::vec3& a, const glm::vec3& b, float tol = 1e-5f) {
   EXPECT_NEAR(a.x, b.x, tol);
   EXPECT_NEAR(a.y, b.y, tol);
   EXPECT_NEAR(a.z, b.z, tol);
+}
+
+// Writes doc as <folder>/<name>.gltf and expects the load to throw `code` with a message naming the file
+// and holding every one of `parts`.
+void expectRefused(const GltfDocument& doc, const std::string& folder, const std::vector<std::string>& parts,
+                   ErrorCode code = ErrorCode::InvalidData) {
+  const auto file = testFolder(folder) / (folder + ".gltf");
+  writeDocument(doc, file);
+  try {
+    loadScene(file);
+    ADD_FAILURE() << folder << ": loaded, expected a refusal";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+    for (const auto& p : parts) EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+  }
+}
+
+Scene loadDocument(const GltfDocument& doc, const std::string& folder) {
+  const auto file = testFolder(folder) / (folder + ".gltf");
+  writeDocument(doc, file);
+  return loadScene(file);
+}
+
+// The triangle with one material (0) and one light (0) of the given JSON on node 1.
+GltfDocument litDocument(const json& light, const json& material) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+  doc.append("materials", material);
+  doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array({light});
+  doc.root["nodes"].push_back({{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  doc.root["scenes"][0]["nodes"] = {0, 1};
+  return doc;
+}
+
+// The triangle on a node with a uniform scale.
+GltfDocument scaledDocument(double scale) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["nodes"][0]["scale"] = {scale, scale, scale};
+  return doc;
 }
 
 }  // namespace
@@ -168,6 +211,9 @@ TEST(GltfLoader, DegenerateTrianglesAreDroppedAndCounted) {
   EXPECT_EQ(s.stats.trianglesKept, 2u);
   EXPECT_EQ(s.stats.trianglesDropped, 2u);
   EXPECT_EQ(s.triangleCount(), 2u);
+  // Never silently: the count is a warning.
+  ASSERT_EQ(s.stats.warnings.size(), 1u);
+  EXPECT_EQ(s.stats.warnings[0], "2 degenerate triangles (zero area or a repeated corner) dropped");
 }
 
 TEST(GltfLoader, MaterialsTexturesAndEmissiveStrength) {
@@ -440,4 +486,164 @@ TEST(GltfLoader, SharedChildLatticeIsCappedNotExpanded) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidData);
     EXPECT_NE(std::string(e.what()).find("absurd size"), std::string::npos) << e.what();
   }
+}
+
+// Colours are checked per component: (−1, −1, −1) was accepted (only NaN/Inf were caught) and gave a negative map.
+TEST(GltfLoader, NegativeOrNonFiniteColoursAreRefused) {
+  const json light = {{"type", "point"}, {"intensity", 5}, {"color", {0.5, 1, 0.25}}};
+  const json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}}, {"emissiveFactor", {1, 0.5, 0}}};
+  const Scene ok = loadDocument(litDocument(light, material), "loader_colours_ok");
+  ASSERT_EQ(ok.lights.size(), 1u);
+  expectNear(ok.lights[0].color, {0.5f, 1.0f, 0.25f});
+  expectNear(ok.materials[0].emission(), {1.0f, 0.5f, 0.0f});
+
+  json badLight = light;
+  badLight["color"] = {-1, -1, -1};
+  expectRefused(litDocument(badLight, material), "loader_light_negative", {"light 0", "negative or non-finite colour (-1, -1, -1)"});
+  badLight["color"] = {1, -0.001, 1};
+  expectRefused(litDocument(badLight, material), "loader_light_negative_one", {"light 0", "colour (1, -0.001, 1)"});
+  badLight["color"] = {1, 1e39, 1};  // a double beyond float: Inf once read
+  expectRefused(litDocument(badLight, material), "loader_light_inf", {"light 0", "non-finite colour"});
+
+  json badBase = material;
+  badBase["pbrMetallicRoughness"]["baseColorFactor"] = {-0.5, 0.5, 0.5, 1};
+  expectRefused(litDocument(light, badBase), "loader_base_negative", {"material 0", "baseColorFactor (-0.5, 0.5, 0.5)"});
+  badBase["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.5, 0.5, -1};
+  expectRefused(litDocument(light, badBase), "loader_alpha_negative", {"material 0", "baseColorFactor", "alpha -1"});
+  json badEmissive = material;
+  badEmissive["emissiveFactor"] = {-1, -1, -1};
+  badEmissive["name"] = "lamp";
+  expectRefused(litDocument(light, badEmissive), "loader_emissive_negative", {"material 0 ('lamp')", "emissiveFactor (-1, -1, -1)"});
+}
+
+// A negative strength made the scene look unlit ("no light"): it is refused at load, naming the material.
+TEST(GltfLoader, NegativeEmissiveStrengthIsRefused) {
+  const json light = {{"type", "point"}, {"intensity", 5}};
+  json material = {{"name", "glow"}, {"emissiveFactor", {1, 1, 1}},
+                   {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 0}}}}}};
+  const Scene zero = loadDocument(litDocument(light, material), "loader_strength_zero");
+  EXPECT_FALSE(zero.materials[0].isEmissive());  // 0 is allowed: no emission
+  material["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] = -2;
+  expectRefused(litDocument(light, material), "loader_strength_negative",
+                {"material 0 ('glow')", "emissiveStrength must be ≥ 0", "-2"});
+}
+
+// KHR_lights_punctual: 0 ≤ innerConeAngle < outerConeAngle ≤ π/2.
+TEST(GltfLoader, SpotConeAnglesOutsideTheSpecAreRefused) {
+  auto spot = [](double inner, double outer) {
+    return json{{"type", "spot"}, {"name", "beam"}, {"intensity", 3}, {"spot", {{"innerConeAngle", inner}, {"outerConeAngle", outer}}}};
+  };
+  const json material = json::object();
+  const Scene ok = loadDocument(litDocument(spot(0.0, static_cast<float>(M_PI / 2)), material), "loader_spot_ok");
+  EXPECT_FLOAT_EQ(ok.lights[0].outerConeAngle, static_cast<float>(M_PI / 2));  // π/2 written as a float is accepted
+  const std::string rule = "0 ≤ innerConeAngle < outerConeAngle ≤ π/2";
+  expectRefused(litDocument(spot(0.6, 0.3), material), "loader_spot_inverted", {"light 0 ('beam')", "inner 0.6, outer 0.3", rule});
+  expectRefused(litDocument(spot(0.4, 0.4), material), "loader_spot_equal", {"light 0", rule});
+  expectRefused(litDocument(spot(-0.1, 0.3), material), "loader_spot_negative", {"light 0", "inner -0.1", rule});
+  expectRefused(litDocument(spot(0.2, 2.0), material), "loader_spot_wide", {"light 0", "outer 2", rule});
+}
+
+// glTF 2.0: a loader must refuse a file whose extensionsRequired it does not support.
+TEST(GltfLoader, UnsupportedRequiredExtensionIsRefused) {
+  GltfDocument doc = litDocument({{"type", "point"}, {"intensity", 5}},
+                                 {{"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 2}}}}}});
+  doc.root["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+  doc.root["extensionsRequired"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+  EXPECT_EQ(loadDocument(doc, "loader_required_ok").lights.size(), 1u);
+  for (const char* name : {"KHR_draco_mesh_compression", "KHR_texture_transform", "EXT_meshopt_compression"}) {
+    doc.root["extensionsRequired"] = {"KHR_lights_punctual", name};
+    expectRefused(doc, std::string("loader_required_") + name, {std::string("requires extension ") + name, "extensionsRequired"});
+  }
+}
+
+// Quantised positions (KHR_mesh_quantization, normalised shorts) read like any accessor: that extension may be required.
+TEST(GltfLoader, RequiredMeshQuantizationLoads) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  const int16_t q[12] = {0, 0, 0, 0, 32767, 0, 0, 0, 0, 16384, 0, 0};  // 3 × (x, y, z, pad): 4-byte aligned elements
+  const int view = doc.addBufferView(q, sizeof q, 34962);
+  doc.root["bufferViews"][view]["byteStride"] = 8;
+  doc.append("accessors", {{"bufferView", view}, {"componentType", 5122}, {"normalized", true}, {"count", 3}, {"type", "VEC3"},
+                           {"min", {0, 0, 0}}, {"max", {1, 0.5, 0}}});
+  doc.root["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = doc.root["accessors"].size() - 1;
+  doc.root["extensionsUsed"] = {"KHR_mesh_quantization"};
+  doc.root["extensionsRequired"] = {"KHR_mesh_quantization"};
+  const Scene s = loadDocument(doc, "loader_quantized");
+  ASSERT_EQ(s.triangleCount(), 1u);
+  expectNear(s.primitives[0].positions[1], {1, 0, 0});
+  expectNear(s.primitives[0].positions[2], {0, 16384 / 32767.0f, 0});
+}
+
+// extras may be any JSON value (glTF 2.0): strings, numbers and arrays on the root, nodes, meshes and materials load.
+TEST(GltfLoader, ExtrasOfAnyTypeLoad) {
+  GltfDocument doc = litDocument({{"type", "point"}, {"intensity", 5}}, {{"extras", "material note"}});
+  doc.root["extras"] = "hello";
+  doc.root["nodes"][0]["extras"] = 42;
+  doc.root["nodes"][1]["extras"] = json::array({1, "two", nullptr});
+  doc.root["meshes"][0]["extras"] = json::array({1, 2});
+  doc.root["meshes"][0]["primitives"][0]["extras"] = 3.5;
+  const Scene s = loadDocument(doc, "loader_extras");
+  EXPECT_EQ(s.triangleCount(), 1u);
+  EXPECT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.primitives[0].lightmap.page, -1);
+  EXPECT_TRUE(s.lightmapExrPaths.empty());
+  EXPECT_FALSE(s.environment.present());
+  for (const json& root : {json(7), json::array({"a"}), json(nullptr), json(true)}) {
+    doc.root["extras"] = root;
+    EXPECT_EQ(loadDocument(doc, "loader_extras_root").triangleCount(), 1u) << root.dump();
+  }
+}
+
+// A 1×1 equirectangular map is a constant sky: loaded as uniform, its integral exactly 4π L.
+TEST(GltfLoader, OnePixelEnvironmentIsUniform) {
+  const auto dir = testFolder("loader_env_1x1");
+  Lightmap px;
+  px.width = px.height = 1;
+  px.texels = {glm::vec3(0.5f, 1.0f, 2.0f)};
+  px.valid = {1};
+  writeExr(px, dir / "sky.exr");
+  const Environment env = loadEnvironment(dir / "sky.exr", 3.0f, 45.0f);
+  ASSERT_TRUE(env.present());
+  EXPECT_TRUE(env.isUniform());
+  expectNear(env.uniformRadiance(), {1.5f, 3.0f, 6.0f});
+  expectNear(env.radiance(glm::normalize(glm::vec3(1, 2, 3))), {1.5f, 3.0f, 6.0f});
+  EXPECT_NEAR(env.integral().z, 4.0 * M_PI * 6.0, 1e-9);
+}
+
+// Scale: refused outside 1e-4 … 1e9 m (extent) and beyond 1e9 m (any coordinate), never dropped silently.
+TEST(GltfLoader, ScenesOutsideTheSupportedScaleAreRefused) {
+  const std::string rescale = "rescale the scene (node scale)";
+  expectRefused(scaledDocument(1e10), "loader_scale_1e10", {"node 0", "mesh 0", "coordinate of 1e10 m", "supported 1e9 m", rescale});
+  expectRefused(scaledDocument(1e30), "loader_scale_1e30", {"node 0", "mesh 0", "coordinate of 1e30 m", rescale});
+  expectRefused(scaledDocument(1e-8), "loader_scale_1e-8",
+                {"scene extent 1e-8 m", "outside the supported 1e-4 … 1e9 m", rescale});
+  expectRefused(meshDocument({{0, 0, 0}, {1e38f, 0, 0}, {0, 1e38f, 0}}, {0, 1, 2}), "loader_position_1e38",
+                {"node 0", "mesh 0", "coordinate of 1e38 m", rescale});
+  // A scale that overflows float on a large position: non-finite, refused naming node and mesh.
+  GltfDocument overflow = meshDocument({{0, 0, 0}, {1e20f, 0, 0}, {0, 1, 0}}, {0, 1, 2});
+  overflow.root["nodes"][0]["scale"] = {1e20, 1, 1};
+  expectRefused(overflow, "loader_scale_overflow", {"node 0", "mesh 0", "NaN/Inf in world space"});
+  // Every coordinate within 1e9 m, but 2e9 m wide.
+  GltfDocument wide = meshDocument({{-1e9f, 0, 0}, {1e9f, 0, 0}, {0, 1e9f, 0}}, {0, 1, 2});
+  expectRefused(wide, "loader_extent_2e9", {"scene extent 2e9 m", "outside the supported 1e-4 … 1e9 m"});
+  // A point light beyond the range: its walk would start at an unusable coordinate.
+  GltfDocument farLight = litDocument({{"type", "point"}, {"intensity", 5}}, json::object());
+  farLight.root["nodes"][1]["translation"] = {0, 5e12, 0};
+  expectRefused(farLight, "loader_light_far", {"light 0", "node 1", "coordinate of 5e12 m", rescale});
+}
+
+TEST(GltfLoader, ScenesInsideTheSupportedScaleLoad) {
+  for (double scale : {1e-4, 1e-3, 1.0, 1e8, 1e9}) {
+    const Scene s = loadDocument(scaledDocument(scale), "loader_scale_ok");
+    ASSERT_EQ(s.triangleCount(), 1u) << scale;
+    EXPECT_EQ(s.stats.trianglesDropped, 0u) << scale;
+    EXPECT_FLOAT_EQ(s.primitives[0].positions[1].x, static_cast<float>(scale));
+    EXPECT_FLOAT_EQ(s.primitives[0].positions[2].y, static_cast<float>(scale));
+    EXPECT_TRUE(s.stats.warnings.empty()) << scale;
+  }
+  // Far from the origin for its size: loads, with a warning about float precision there.
+  GltfDocument far = meshDocument(kTriangle, {0, 1, 2});
+  far.root["nodes"][0]["translation"] = {1e5, 0, 0};
+  const Scene s = loadDocument(far, "loader_far_from_origin");
+  ASSERT_EQ(s.stats.warnings.size(), 1u);
+  EXPECT_NE(s.stats.warnings[0].find("move it nearer the origin"), std::string::npos) << s.stats.warnings[0];
 }
