@@ -194,8 +194,9 @@ TEST(OutputSafety, KilledBakeLeavesNoLock) {
                                   "--texels-per-unit", "40", "--vpls", "4096", "--backend", "embree", "--quiet"};
     const pid_t pid = irbake::testing::startIrbake(args, dir / "log.txt");
     const fs::path lock = out / irbake::OutputFolderLock::kFileName;
-    for (int i = 0; i < 4000 && !fs::exists(lock); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    ASSERT_TRUE(fs::exists(lock)) << fileText(dir / "log.txt");
+    // Held once the bake's pid is in it.
+    for (int i = 0; i < 4000 && fileText(lock).empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ASSERT_FALSE(fileText(lock).empty()) << fileText(dir / "log.txt");
     kill(pid, sig);
     EXPECT_EQ(irbake::testing::waitForIrbake(pid), 128 + sig);
     EXPECT_FALSE(fs::exists(lock)) << "signal " << sig;

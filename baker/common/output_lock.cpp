@@ -51,12 +51,14 @@ OutputFolderLock::OutputFolderLock(const fs::path& folder) : folder_(folder), fi
     struct stat held {}, atPath {};
     if (::fstat(fd_, &held) == 0 && ::stat(file_.c_str(), &atPath) == 0 && held.st_ino == atPath.st_ino &&
         held.st_dev == atPath.st_dev) {
+      // Ours now: removed if a signal kills us (registered before the pid is written, so a file with a pid
+      // in it is always one a signal cleans up).
+      installSignalCleanup();
+      signalSlot_ = removeOnSignal(fs::absolute(file_));
       const std::string pid = std::to_string(::getpid()) + "\n";
       if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
         // The pid is only for the message of a second bake: a lock without it is still a lock.
       }
-      installSignalCleanup();
-      signalSlot_ = removeOnSignal(fs::absolute(file_));
       return;
     }
     ::close(fd_);

@@ -578,6 +578,7 @@ TEST(GltfExport, TenThousandSeparateMeshesEachGetTexcoord1AndTheirPageMaterial) 
     if (!ok && ++wrong <= 3) ADD_FAILURE() << "reloaded primitive of mesh " << p.gltfMesh;
   }
   EXPECT_EQ(wrong, 0);
+}
 
 // glTF allows extras of any JSON type: a source whose root extras is a string (and whose node, mesh and material
 // extras are a number, an array and a string) exports and reloads; the root value is kept as it was, without the

@@ -444,3 +444,57 @@ TEST(Walk, AutoSplitInAnOpenCourtMatchesAPlainWalkOfManyPaths) {
   std::printf("[ figure ] bounce 3 seed-to-seed spread: split %.2f%%\n", 100 * splitRms);
   EXPECT_LT(splitRms, 0.06);
 }
+
+// Budgets follow the light that reaches the scene: a sun 10^4 times the lamp's power that only meets the
+// outside of a closed room (the backs of its inward walls) reaches nothing, takes about 1% of the paths,
+// and the room's VPLs keep the lamp's exact energy per bounce; a sky over an open floor reaches it fully.
+TEST(Walk, LightThatNeverEntersTakesNoBudget) {
+  Scene s;
+  int wall = addMaterial(s, glm::vec3(0.6f));
+  int lamp = addMaterial(s, glm::vec3(0.6f), glm::vec3(3.0f));
+  addBox(s, wall, glm::vec3(0), glm::vec3(2, 1.5f, 1), true, 2);
+  addQuad(s, lamp, glm::vec3(0.8f, 0.6f, 0.999f), glm::vec3(0.4f, 0, 0), glm::vec3(0, 0.3f, 0));
+  s.primitives.back().indices = {0, 2, 1, 0, 3, 2};  // facing down into the room
+  WalkOptions o;
+  o.paths = 1000;
+  o.geometricTail = false;
+  const VplSet alone = generateVpls(s, RayTracer(s), o);
+  s.lights.push_back(directionalLight(glm::vec3(0.2f, -0.3f, -1.0f), 1e4f));
+  const VplSet withSun = generateVpls(s, RayTracer(s), o);
+  ASSERT_EQ(withSun.lightReach.size(), 1u);
+  EXPECT_EQ(withSun.lightReach[0], 0.0);
+  const double Phi = kPi * 3.0 * 0.4 * 0.3, rho = 0.6;
+  ASSERT_GE(withSun.bounces, 5);
+  EXPECT_EQ(withSun.bounces, alone.bounces);
+  // Inside the room (VPLs facing into it), bounce by bounce: the lamp's energy, as without the sun, within
+  // the paths the sun took (≈ 1%) and their share of the lamp's Halton points. All of it: the room is closed.
+  // A VPL lights the room when a step along its normal stays in the box (the lamp's back is 1 mm under
+  // the ceiling: the step is shorter).
+  auto facesIn = [](const Vpl& v) {
+    const glm::vec3 q = v.position + 5e-4f * v.normal;
+    return q.x > 0.0f && q.y > 0.0f && q.z > 0.0f && q.x < 2.0f && q.y < 1.5f && q.z < 1.0f;
+  };
+  auto inside = [&](const VplSet& set, int j) {
+    double sum = 0.0;
+    for (const Vpl& v : set.vpls)
+      if (v.bounce == j && facesIn(v)) sum += v.power.x;
+    return sum;
+  };
+  for (int j = 1; j <= 5; ++j) {
+    EXPECT_NEAR(inside(alone, j), Phi * std::pow(rho, j), 1e-5 * Phi) << "bounce " << j;
+    EXPECT_NEAR(inside(withSun, j), Phi * std::pow(rho, j), 0.03 * Phi * std::pow(rho, j)) << "bounce " << j;
+  }
+  size_t outside = 0;  // the sun's: on the walls' backs, facing away from the room
+  for (const Vpl& v : withSun.vpls) outside += v.bounce == 1 && !facesIn(v);
+  EXPECT_GE(outside, 1u);
+  EXPECT_LE(outside, 25u);  // ≈ 1% of 1000 paths start on the sun
+
+  Scene open;
+  addQuad(open, addMaterial(open, glm::vec3(0.5f)), glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
+  open.environment = Environment::uniform(glm::vec3(1.0f));
+  const VplSet sky = generateVpls(open, RayTracer(open), o);
+  ASSERT_EQ(sky.lightReach.size(), 1u);
+  // A uniform sky through a disc covering the bounding sphere (radius √2·1.001): the one-sided floor (area
+  // 4) receives from the upper half of the directions, with mean cosine 1/2 there: 1/2 · 4 · 1/2 / (π R²).
+  EXPECT_NEAR(sky.lightReach[0], 0.5 * 4.0 * 0.5 / (kPi * 2.0 * 1.001 * 1.001), 0.04);
+}

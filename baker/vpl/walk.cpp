@@ -97,6 +97,45 @@ struct PathStart {
   bool onSurface = false;  // starts on a surface (origin inset): rays leave along the normal
 };
 
+// Where a ray leaves punctual light l for the random numbers (u0..u3): its origin and direction. A
+// directional light's rays start on a disc covering the scene's bounding sphere, upstream of it.
+void lightRay(const Light& l, const LightSources& sources, double u0, double u1, double u2, double u3, glm::vec3& origin,
+              glm::vec3& dir) {
+  switch (l.type) {
+    case LightType::Point:
+      origin = l.position;
+      dir = uniformSphere(u2, u3);
+      break;
+    case LightType::Spot:
+      origin = l.position;
+      dir = spotDirection(l, u2, u3);
+      break;
+    case LightType::Directional: {
+      dir = glm::normalize(l.direction);
+      glm::vec3 t, b;
+      orthonormalBasis(dir, t, b);
+      const double r = sources.sceneRadius * std::sqrt(u0), phi = 2.0 * kPi * u1;
+      origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+               b * float(r * std::sin(phi));
+      break;
+    }
+  }
+}
+
+// The sky's ray: a direction towards the sky by radiance (u2, u3; its density in `pdf`) and a point on a
+// disc covering the bounding sphere upstream (u0, u1). Returns the direction towards the sky.
+glm::vec3 skyRay(const Scene& scene, const LightSources& sources, double u0, double u1, double u2, double u3,
+                 glm::vec3& origin, glm::vec3& dir, double& pdf) {
+  const glm::vec3 toSky = scene.environment.sample(u2, u3, pdf);
+  dir = -toSky;
+  glm::vec3 t, b;
+  orthonormalBasis(dir, t, b);
+  const double r = sources.sceneRadius * std::sqrt(u0), phi = 2.0 * kPi * u1;
+  origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
+           b * float(r * std::sin(phi));
+  return toSky;
+}
+
 PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources& sources, const Halton& halton,
                     uint64_t i, uint64_t N, std::vector<Vpl>& vpls) {
   const size_t numTriangles = sources.triangles.size();
@@ -127,41 +166,73 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
     // The sky: a direction towards it by luminance, a point on a disc covering the bounding sphere
     // upstream; the path carries L(ω)/p(ω) · π R² / N (its colour included).
     double pdf = 0.0;
-    const glm::vec3 toSky = scene.environment.sample(halton.sample(2, i), halton.sample(3, i), pdf);
-    dir = -toSky;
-    glm::vec3 t, b;
-    orthonormalBasis(dir, t, b);
-    const double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
-    origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
-             b * float(r * std::sin(phi));
+    const glm::vec3 toSky = skyRay(scene, sources, residual, u1, halton.sample(2, i), halton.sample(3, i), origin, dir, pdf);
     const double R = sources.sceneRadius;
     pathPower = pdf > 0.0 ? glm::dvec3(scene.environment.radiance(toSky)) * (kPi * R * R / (pdf * p * static_cast<double>(N)))
                           : glm::dvec3(0.0);
   } else {
     const Light& l = scene.lights[s - numTriangles];
     pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
-    switch (l.type) {
-      case LightType::Point:
-        origin = l.position;
-        dir = uniformSphere(halton.sample(2, i), halton.sample(3, i));
-        break;
-      case LightType::Spot:
-        origin = l.position;
-        dir = spotDirection(l, halton.sample(2, i), halton.sample(3, i));
-        break;
-      case LightType::Directional: {
-        // Uniform point on a disc covering the scene's bounding sphere, upstream of it.
-        dir = glm::normalize(l.direction);
-        glm::vec3 t, b;
-        orthonormalBasis(dir, t, b);
-        double r = sources.sceneRadius * std::sqrt(residual), phi = 2.0 * kPi * u1;
-        origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
-                 b * float(r * std::sin(phi));
-        break;
-      }
-    }
+    lightRay(l, sources, residual, u1, halton.sample(2, i), halton.sample(3, i), origin, dir);
   }
   return path;
+}
+
+// Budgets follow the light that reaches the scene. A punctual light or sky whose rays land on the outside of
+// a closed room (the backs of its one-sided walls) or miss everything would otherwise take the paths the
+// light inside needs (the sample box under a sun it never lets in: every path, and a third of the map's
+// light lost). So each such source's weight in the start table is its power times its reach: the share of
+// kReachPilots rays whose first hit is a side that receives light (a front face, or either face of a
+// double-sided material). Sources no pilot ray reached keep a small weight, together at most
+// kUnreachedShare of the rest, so every source can still start paths and the walk stays unbiased.
+constexpr int kReachPilots = 1024;
+constexpr double kUnreachedShare = 0.01;
+
+// Returns the reach of each punctual light, then the sky's when there is one, and rebuilds `sources.all`.
+std::vector<double> weighByReach(const Scene& scene, const RayTracer& rt, LightSources& sources, uint32_t seed) {
+  std::vector<double> reach;
+  const size_t lights = scene.lights.size() + (sources.hasSky ? 1 : 0);
+  if (lights == 0) return reach;
+  reach.assign(lights, 0.0);
+  tbb::parallel_for(size_t(0), lights, [&](size_t k) {
+    Rng rng(hashSeed(seed, 0x72656163680000ull, k));  // "reach"
+    int received = 0;
+    for (int n = 0; n < kReachPilots; ++n) {
+      const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+      glm::vec3 origin, dir;
+      double pdf = 0.0;
+      if (k < scene.lights.size()) lightRay(scene.lights[k], sources, u0, u1, u2, u3, origin, dir);
+      else skyRay(scene, sources, u0, u1, u2, u3, origin, dir, pdf);
+      const RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
+      if (!hit.hit) continue;
+      const Primitive& prim = scene.primitives[hit.primitive];
+      const bool doubleSided = prim.material >= 0 && prim.material < static_cast<int>(scene.materials.size()) &&
+                               scene.materials[prim.material].doubleSided;
+      if (!hit.backFace || doubleSided) ++received;
+    }
+    reach[k] = static_cast<double>(received) / kReachPilots;
+  });
+  std::vector<double> weights;
+  double reached = 0.0, unreached = 0.0;
+  for (const EmitterTriangle& e : sources.triangles) {
+    weights.push_back(channelMean(e.power));
+    reached += weights.back();
+  }
+  for (size_t k = 0; k < lights; ++k) {
+    const double power = channelMean(k < scene.lights.size() ? sources.lightPower[k] : sources.skyPower);
+    weights.push_back(power * reach[k]);
+    if (reach[k] > 0.0) reached += weights.back();
+    else unreached += power;
+  }
+  // Unreached sources: their power in proportion, scaled to kUnreachedShare of the reached weight (or
+  // their plain power when nothing was reached at all).
+  const double scale = reached > 0.0 ? kUnreachedShare * reached / std::max(unreached, 1e-300) : 1.0;
+  for (size_t k = 0; k < lights; ++k)
+    if (reach[k] <= 0.0)
+      weights[sources.triangles.size() + k] =
+          scale * channelMean(k < scene.lights.size() ? sources.lightPower[k] : sources.skyPower);
+  sources.all = AliasTable(weights);
+  return reach;
 }
 
 // From `start` along `dir` to the next surface the path bounces on: see-through surfaces let it go straight
@@ -294,6 +365,7 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   VplSet out;
   if (options.paths <= 0) throw Error(ErrorCode::Usage, "", "the walk needs at least one path (--vpls)");
   LightSources sources = collectLightSources(scene);
+  out.lightReach = weighByReach(scene, rt, sources, options.seed);
   out.emittedPower = sources.totalPower;
   const double rho = meanReflectivity(scene);
   out.meanReflectivity = rho;
