@@ -23,12 +23,7 @@ using irbake::testing::IrbakeRun;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::current_path() / "test_scratch" / "cli_fuzz" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return irbake::testing::scratchFolder("cli_fuzz", name); }
 
 int runsScale() {
   const char* s = std::getenv("IRBAKE_FUZZ_RUNS");
@@ -55,7 +50,9 @@ IrbakeRun runIrbake(std::vector<std::string> args, const fs::path& log) {
 void expectContract(const IrbakeRun& run, const std::string& what) {
   static const std::set<int> documented = {0, 2, 3, 4, 5, 6, 7, 8, 9};
   EXPECT_TRUE(documented.count(run.code)) << what << " exited " << run.code << ":\n" << run.output;
-  if (run.code != 0) EXPECT_NE(run.output.find("irbake: error: "), std::string::npos) << what << ":\n" << run.output;
+  if (run.code != 0) {
+    EXPECT_NE(run.output.find("irbake: error: "), std::string::npos) << what << ":\n" << run.output;
+  }
 }
 
 void expectFiniteExrs(const fs::path& dir, const std::string& what) {
@@ -68,15 +65,7 @@ void expectFiniteExrs(const fs::path& dir, const std::string& what) {
   }
 }
 
-const fs::path& samples() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::current_path() / "test_scratch" / "cli_fuzz" / "samples";
-    fs::create_directories(d);
-    runIrbake({"samples", d.string(), "--quiet"}, d.parent_path() / "samples_log.txt");
-    return d;
-  }();
-  return dir;
-}
+fs::path samples() { return irbake::testing::sampleScenes("cli_fuzz"); }
 
 // Values a hostile user (or a broken script) puts where a value goes.
 const std::vector<std::string> kHostileValues = {

@@ -18,49 +18,22 @@
 #include <gtest/gtest.h>
 
 #include "common/atomic_file.h"
+#include "irbake_process.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratchFolder(const std::string& name) {
-  const fs::path d = fs::current_path() / "test_scratch" / "distributed" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratchFolder(const std::string& name) { return irbake::testing::scratchFolder("distributed", name); }
 
 std::vector<std::string> split(const std::string& words) {
   std::istringstream in(words);
   return {std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
 }
 
-// Starts irbake with these arguments (stdout and stderr into log); returns its pid.
-pid_t startIrbake(const std::vector<std::string>& args, const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    FILE* out = std::freopen(log.c_str(), "w", stdout);
-    if (!out || dup2(fileno(stdout), 2) < 0) _exit(127);
-    std::vector<char*> argv{const_cast<char*>(IRBAKE_EXE)};
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(IRBAKE_EXE, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-// Exit code, or 128 + signal.
-int waitFor(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-std::string fileText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using irbake::testing::fileText;
+using irbake::testing::startIrbake;
+int waitFor(pid_t pid) { return irbake::testing::waitForIrbake(pid); }
 
 struct Finished {
   int code;

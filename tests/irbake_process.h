@@ -50,4 +50,22 @@ inline IrbakeRun runIrbakeLogged(const std::vector<std::string>& args, const std
   return {code, fileText(log)};
 }
 
+// An empty folder test_scratch/<group>/<name> in the working directory (the build folder).
+inline std::filesystem::path scratchFolder(const std::string& group, const std::string& name) {
+  const std::filesystem::path d = std::filesystem::current_path() / "test_scratch" / group / name;
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// The sample scenes (`irbake samples`), written once per process into test_scratch/<group>/samples.
+inline std::filesystem::path sampleScenes(const std::string& group) {
+  const std::filesystem::path d = std::filesystem::current_path() / "test_scratch" / group / "samples";
+  if (!std::filesystem::exists(d / "cornell_box.gltf")) {
+    std::filesystem::create_directories(d);
+    runIrbakeLogged({"samples", d.string(), "--quiet"}, d.parent_path() / "samples_log.txt");
+  }
+  return d;
+}
+
 }  // namespace irbake::testing

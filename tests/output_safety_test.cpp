@@ -25,25 +25,11 @@ using irbake::testing::IrbakeRun;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::current_path() / "test_scratch" / "output_safety" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return irbake::testing::scratchFolder("output_safety", name); }
 
 IrbakeRun runIrbake(const std::vector<std::string>& args, const fs::path& log) { return irbake::testing::runIrbakeLogged(args, log); }
 
-// The sample scenes, written once per test process.
-const fs::path& samples() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::current_path() / "test_scratch" / "output_safety" / "samples";
-    fs::create_directories(d);
-    runIrbake({"samples", d.string(), "--quiet"}, d.parent_path() / "samples_log.txt");
-    return d;
-  }();
-  return dir;
-}
+fs::path samples() { return irbake::testing::sampleScenes("output_safety"); }
 
 // A small, fast bake of the sample Cornell box.
 const std::vector<std::string> kSmall = {"--texels-per-unit", "12", "--vpls", "64", "--backend", "embree", "--quiet"};
@@ -189,7 +175,7 @@ TEST(OutputSafety, OutputOntoTheInputIsRefused) {
 TEST(OutputSafety, KilledBakeLeavesNoLock) {
   const fs::path dir = scratch("killed");
   for (int sig : {SIGTERM, SIGINT, SIGABRT}) {
-    const fs::path out = dir / ("o" + std::to_string(sig));
+    const fs::path out = dir / std::string("o").append(std::to_string(sig));  // append: GCC 12 warns falsely on "o" + string
     std::vector<std::string> args{"bake", (samples() / "cornell_box.gltf").string(), "-o", out.string(),
                                   "--texels-per-unit", "40", "--vpls", "4096", "--backend", "embree", "--quiet"};
     const pid_t pid = irbake::testing::startIrbake(args, dir / "log.txt");

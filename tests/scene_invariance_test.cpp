@@ -18,26 +18,13 @@ using irbake::testing::IrbakeRun;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::current_path() / "test_scratch" / "scene_invariance" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return irbake::testing::scratchFolder("scene_invariance", name); }
 
 IrbakeRun runIrbake(const std::vector<std::string>& args, const fs::path& log) {
   return irbake::testing::runIrbakeLogged(args, log);
 }
 
-const fs::path& samples() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::current_path() / "test_scratch" / "scene_invariance" / "samples";
-    fs::create_directories(d);
-    runIrbake({"samples", d.string(), "--quiet"}, d.parent_path() / "samples_log.txt");
-    return d;
-  }();
-  return dir;
-}
+fs::path samples() { return irbake::testing::sampleScenes("scene_invariance"); }
 
 // Mean of every valid texel of every page (R, G, B averaged).
 double mapMean(const fs::path& out) {
