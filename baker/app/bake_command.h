@@ -32,6 +32,7 @@ struct BakeCommand {
   int shardCount = 0;              // N
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
   double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
+  Args arguments;                  // the arguments parsed: the command line after --config's entries
   nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
   std::string optionsHash;         // hash of resultOptions (not -o, --threads, ...)
 };

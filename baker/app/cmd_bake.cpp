@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <memory>
 #include <string>
@@ -12,6 +13,8 @@
 #include <tbb/global_control.h>
 
 #include "app/bake_command.h"
+#include "app/bake_config.h"
+#include "app/quality.h"
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/error.h"
@@ -29,19 +32,12 @@ namespace irbake::app {
 
 namespace {
 
-// The command's default light paths (--vpls auto): 4096. Against Blender Cycles in our own atlas (docs/accuracy.md) the
-// sample Cornell box is 4.0% at 1024 paths (3.9 s), 2.0% at 4096 (4×4 interleave classes) and 1.6% at
-// 6144 with 6×6 classes, which costs less than 4096 with 4×4 (each texel meets 1/36 of the VPLs). Session 12:
-// 4096 paths now get 6×6 classes too (the automatic interleave), 2.07% against 6144's 2.02% on the sample box
-// and 1.75% against 1.60% on McGuire's, in 7.9–8.9 s end to end instead of 11.4–11.9 s on the 2-core machine
-// (issue 11's ≤ 2.5% in ≤ 10 s). The library's 1024 stays for callers that choose their own budget.
-constexpr int kDefaultPaths = 4096;
-constexpr int kDefaultPathsUnderGather = 3072;  // --vpls auto where the final gather runs
-
 // What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
 struct BakeArguments {
   std::vector<std::string> scenes;
-  std::string backend = "auto", shard, finalGather = "auto";
+  std::string backend = "auto", shard, finalGather = "auto", quality = "default";
+  std::string config, dumpConfig;  // --config FILE (read before parsing), --dump-config FILE
+  bool helpAll = false;
   CLI::Option* shardOption = nullptr;
   long long seed = 0;
   double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
@@ -73,6 +69,36 @@ void checkLightArguments(const BakeCommand& c) {
         throw Error(ErrorCode::Usage, "", "--sky needs three radiances in [0, 1e20] W/(m² sr) (got '" + c.sky + "')");
 }
 
+// The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
+const std::vector<std::string> kCommonOptions = {"SCENE", "output", "quality", "config", "sun", "sky", "env",
+                                                 "texels-per-unit", "directional", "seed", "threads", "report",
+                                                 "quiet", "help", "help-all"};
+const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroups = {
+    {"Light paths and VPLs", {"paths", "bounces", "walk-split", "vpl-importance", "vpl-probes", "vpl-keep", "vpl-block"}},
+    {"Texels", {"max-texels", "supersample", "interleave"}},
+    {"Clamp and its compensation", {"clamp", "clamp-k", "no-bias-compensation", "bias-compensation", "comp-rays",
+                                    "comp-refine", "comp-ray-budget", "comp-filter"}},
+    {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
+    {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
+                                              "shadow-edge-samples"}},
+    {"Backends", {"backend", "cube-face", "spp"}},
+    {"Outputs", {"no-gltf", "dump-config", "verbose"}},
+    {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
+    {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams"}},
+};
+
+void groupOptions(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_single_name();
+    if (std::find(kCommonOptions.begin(), kCommonOptions.end(), name) != kCommonOptions.end()) {
+      option->group("Options");
+      continue;
+    }
+    for (const auto& [group, names] : kOptionGroups)
+      if (std::find(names.begin(), names.end(), name) != names.end()) option->group(group);
+  }
+}
+
 // Every option of `irbake bake`, with its range and help.
 std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
@@ -96,9 +122,9 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
-  app->add_option("--vpls", a.paths,
-                  "light paths of the quasi-random walk (default auto: 4096; 3072 where the\n"
-                  "final gather runs, which reads their map averaged)")
+  app->add_option("--paths,--vpls", a.paths,
+                  "light paths of the quasi-random walk (default auto: by --quality;\n"
+                  "4096, or 3072 where the final gather runs, which reads their map averaged)")
       ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
@@ -119,7 +145,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--vpl-keep", o.vplImportance.keepShare,
                   "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default 0.5)")
       ->transform(cli::numberIn(0.05, 4.0))->type_name("S");
-  app->add_option("--texels-per-unit", tpu, "texels per metre (default: fit about one 1024 page, or\n64 texels per triangle where that is more, at most 4M)")
+  app->add_option("--texels-per-unit", tpu, "texels per metre (default: about one 1024² page, ≥ 64 per triangle)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
                   "texel budget of all pages together (default 16777216 = 16M);\n"
@@ -182,7 +208,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
   app->add_option("--sun", sun, "add a directional light travelling along D with irradiance E (W/m²)")
       ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
-  app->add_option("--sky", sky, "a uniform sky of that radiance (W/(m² sr)): direct light\ntraced, bounces as VPLs")
+  app->add_option("--sky", sky, "a uniform sky of that radiance (W/(m² sr))")
       ->transform(cli::numberList(3))->type_name("R,G,B");
   app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default 64)")
       ->transform(cli::integerIn(8, 4096))->type_name("N");
@@ -194,20 +220,19 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
                   "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 8; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
-  app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up, centre\ntowards −Z) instead of --sky")
+  app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
   app->add_option("--env-intensity", envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
   app->add_option("--env-rotation", envRotation, "turns --env about +Y (degrees, default 0)")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--directional", o.directional,
-                "also bake directional maps (L1: lightmap_<page>_l1x/y/z.exr and the glTF\n"
-                "extension IRBAKE_lightmap_directional; docs/export.md)");
+                "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
   app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
-  app->add_option("--threads", threads, "worker threads (default 0: every core); the outputs are\nbyte-identical for any count")
+  app->add_option("--threads", threads, "worker threads (default 0: every core; same bytes for any count)")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
   app->add_flag("--verbose", verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
@@ -224,12 +249,21 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--vpl-block", o.vplBlock,
                   "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default 512)")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
+  app->add_option("--quality", a.quality,
+                  "paths and rays together (default: default; docs/validation.md)")
+      ->check(CLI::IsMember({"preview", "default", "high", "production"}))->type_name("Q");
+  app->add_option("--config", a.config, "options from a TOML file (key = value); the command line wins")
+      ->type_name("FILE");
+  app->add_option("--dump-config", a.dumpConfig, "write every option of this bake as such a file")->type_name("FILE");
+  app->add_flag("--help-all", a.helpAll, "every option, grouped by stage");
+  groupOptions(*app);
   return app;
 }
 
 // Options that only say where and how fast to write: not part of the result.
 const std::vector<std::string> kNotResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
-                                             "shard", "resume", "checkpoint-seconds", "help"};
+                                             "shard", "resume", "checkpoint-seconds", "help", "help-all",
+                                             "config", "dump-config"};
 // Options whose presence changes the result even at the default value (--clamp 0: no clamp; none: derived).
 const std::vector<std::string> kPresenceMatters = {"clamp"};
 
@@ -305,8 +339,9 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   // Where the final gather runs, half the default paths: it reads the VPLs' map averaged over each texel's
   // hemisphere (Sponza sun + sky, views 2 / 3 against Cycles: 3072 paths 2.01-2.05 / 4.07-4.24%, 6144
   // 1.96-2.11 / 3.97-4.13%, 1536 one seed 4.62%; docs/accuracy.md, session 12).
-  o.walk.paths = a.paths > 0 ? a.paths : kDefaultPaths;
-  if (a.paths == 0) o.finalGatherPaths = kDefaultPathsUnderGather;
+  const QualityPreset& preset = *findQualityPreset(a.quality);
+  o.walk.paths = a.paths > 0 ? a.paths : preset.paths;
+  if (a.paths == 0) o.finalGatherPaths = preset.pathsUnderGather;
   if (a.clampOption->count() > 0) {  // --clamp 0: no clamp; none given: derived
     o.clamp = a.clamp > 0.0 ? ClampMode::Fixed : ClampMode::Off;
     o.clampBound = static_cast<float>(a.clamp);
@@ -324,14 +359,167 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
 
 }  // namespace
 
-std::optional<BakeCommand> parseBakeCommand(const Args& args) {
+namespace {
+
+// "--name value" or "--name=value" in args: the value ("" when absent).
+std::string argumentValue(const Args& args, const std::string& name) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == name && i + 1 < args.size()) return args[i + 1];
+    if (args[i].rfind(name + "=", 0) == 0) return args[i].substr(name.size() + 1);
+  }
+  return {};
+}
+
+// The knobs a --quality preset sets, where their own option is not given.
+void applyQuality(const CLI::App& app, const BakeArguments& a, BakeOptions& o) {
+  const QualityPreset& p = *findQualityPreset(a.quality);
+  auto unset = [&](const char* name) { return app.get_option(name)->count() == 0; };
+  if (unset("--gather-rays")) o.gather.rays = p.gatherRays;
+  if (unset("--gather-ray-budget")) o.gather.rayBudget = p.gatherRayBudget;
+  if (unset("--comp-rays")) o.compensation.rays = p.compensationRays;
+  if (unset("--comp-refine")) o.compensation.refineRays = p.compensationRefine;
+  if (unset("--comp-ray-budget")) o.compensation.rayBudget = p.compensationBudget;
+  if (unset("--sky-rays")) o.sky.raysPerSample = p.skyRays;
+  if (unset("--sky-ray-budget")) o.sky.maxRays = p.skyRayBudget;
+  if (unset("--shadow-edge-samples")) o.shadowEdges.subSamples = p.shadowEdgeSamples;
+}
+
+// Arguments for a config file's entries, each checked alone against the options (unknown keys, wrong types
+// and out-of-range values name the file, the line and the key); entries the command line also sets are left
+// out (the command line wins).
+Args configArguments(const std::filesystem::path& file, const Args& commandLine) {
+  const std::vector<ConfigEntry> entries = readConfigFile(file);
+  BakeCommand probeCommand;
+  BakeArguments probeArguments;
+  std::unique_ptr<CLI::App> given = bakeApp(probeCommand, probeArguments);
+  cli::parse(*given, commandLine);
+  const std::filesystem::path folder = file.parent_path();
+  Args out;
+  for (const ConfigEntry& e : entries) {
+    auto fail = [&](const std::string& what) {
+      throw Error(ErrorCode::Usage, file.string(), "line " + std::to_string(e.line) + ": key '" + e.key + "': " + what);
+    };
+    const bool positional = e.key == "scene";
+    const std::string name = positional ? "SCENE" : "--" + e.key;
+    const CLI::Option* option = given->get_option_no_throw(name);
+    if (!option || e.key == "config" || e.key == "help" || e.key == "help-all")
+      fail("not an option of 'irbake bake' (see 'irbake bake --help-all')");
+    if (option->count() > 0) continue;
+    Args words;
+    std::string value = e.value;
+    if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config")
+      if (!value.empty() && std::filesystem::path(value).is_relative()) value = (folder / value).lexically_normal().string();
+    if (option->get_expected_min() == 0) {  // a flag
+      if (value != "true" && value != "false") fail("a flag takes true or false, got '" + value + "'");
+      if (value == "true") words = {name};
+    } else {
+      words = positional ? Args{value} : Args{name, value};
+    }
+    BakeCommand checkCommand;
+    BakeArguments checkArguments;
+    std::unique_ptr<CLI::App> check = bakeApp(checkCommand, checkArguments);
+    try {
+      cli::parse(*check, words);
+    } catch (const Error& error) {
+      fail(error.what());
+    }
+    out.insert(out.end(), words.begin(), words.end());
+  }
+  return out;
+}
+
+// Every option of the parsed bake as config entries: the given ones as entries (paths absolute), the rest
+// as comments with the value the bake uses ("auto" where it decides, the --quality preset's knobs), so the
+// file reads back to the same bake and still shows every knob.
+std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArguments& a, const BakeOptions& o) {
+  BakeCommand freshCommand;
+  BakeArguments freshArguments;
+  const std::unique_ptr<CLI::App> defaults = bakeApp(freshCommand, freshArguments);
+  const QualityPreset& preset = *findQualityPreset(a.quality);
+  const std::vector<std::pair<std::string, std::string>> fromPreset = {
+      {"gather-rays", std::to_string(o.gather.rays)},          {"gather-ray-budget", std::to_string(o.gather.rayBudget)},
+      {"comp-rays", std::to_string(o.compensation.rays)},     {"comp-refine", std::to_string(o.compensation.refineRays)},
+      {"comp-ray-budget", std::to_string(o.compensation.rayBudget)}, {"sky-rays", std::to_string(o.sky.raysPerSample)},
+      {"sky-ray-budget", std::to_string(o.sky.maxRays)},     {"shadow-edge-samples", std::to_string(o.shadowEdges.subSamples)}};
+  std::vector<ConfigEntry> entries;
+  for (const CLI::Option* option : app.get_options()) {
+    std::string name = option->get_single_name();
+    if (name == "help" || name == "help-all" || name == "config" || name == "dump-config") continue;
+    const bool flag = option->get_expected_min() == 0;
+    std::string value;
+    if (option->count() > 0) {
+      if (flag) value = "true";
+      else
+        for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
+      if (name == "SCENE" || name == "output" || name == "report" || name == "env")
+        value = std::filesystem::absolute(value).lexically_normal().string();
+      entries.push_back({name == "SCENE" ? "scene" : name, value, 0});
+      continue;
+    }
+    CLI::Option* plain = defaults->get_option_no_throw(option->get_name());
+    value = plain ? plain->capture_default_str()->get_default_str() : "";
+    if (flag) value = "false";
+    if (option->get_type_name().find("auto") != std::string::npos) value = "auto";
+    if (name == "paths") value = "auto (" + std::to_string(preset.paths) + ", or " + std::to_string(preset.pathsUnderGather) +
+                                 " under the final gather)";
+    if (name == "clamp") value = "derived from the scene (0: no clamp)";
+    for (const auto& [knob, v] : fromPreset)
+      if (knob == name) value = v + " (--quality " + preset.name + ")";
+    if (value.empty()) value = "none";
+    entries.push_back({"# " + name, value, 0});
+  }
+  return entries;
+}
+
+}  // namespace
+
+std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
+  Args args = givenArgs;
+  // --help shows the common options; --help-all every one, grouped by stage.
+  const bool helpAll = std::find(args.begin(), args.end(), "--help-all") != args.end();
+  const bool help = helpAll || std::find(args.begin(), args.end(), "--help") != args.end() ||
+                    std::find(args.begin(), args.end(), "-h") != args.end();
+  const std::string config = argumentValue(args, "--config");
+  if (!config.empty() && !help) {
+    Args fromFile = configArguments(config, args);
+    fromFile.insert(fromFile.end(), args.begin(), args.end());
+    args = fromFile;
+  }
   BakeCommand command;
   BakeArguments arguments;
   const std::unique_ptr<CLI::App> app = bakeApp(command, arguments);
+  if (help) {
+    if (!helpAll)
+      for (CLI::Option* option : app->get_options())
+        if (option->get_group() != "Options") option->group("");
+    std::fputs(app->help().c_str(), stdout);
+    if (!helpAll) std::fputs("every option, grouped by stage: irbake bake --help-all\n", stdout);
+    return std::nullopt;
+  }
   if (!cli::parse(*app, args)) return std::nullopt;
   command.resultOptions = resultOptions(*app);
   command.optionsHash = hashText(command.resultOptions.dump());
+  // What a merge or resume re-parses: the config's entries are in `args` already, so the file is not needed.
+  for (size_t i = 0; i < args.size(); ++i) {
+    if ((args[i] == "--config" || args[i] == "--dump-config") && i + 1 < args.size()) {
+      ++i;
+      continue;
+    }
+    if (args[i].rfind("--config=", 0) == 0 || args[i].rfind("--dump-config=", 0) == 0) continue;
+    command.arguments.push_back(args[i]);
+  }
   applyArguments(command, arguments);
+  applyQuality(*app, arguments, command.options);
+  if (!arguments.dumpConfig.empty()) {
+    const std::string text = configText(effectiveOptions(*app, arguments, command.options),
+                                        "irbake bake options (read back with --config FILE)");
+    writeAtomically(arguments.dumpConfig, [&](const std::filesystem::path& temp) {
+      std::ofstream out(temp, std::ios::binary);
+      out << text;
+      out.close();
+      if (!out) throw Error(ErrorCode::Io, arguments.dumpConfig, "cannot write the config");
+    });
+  }
   return command;
 }
 
@@ -492,7 +680,7 @@ int runBake(const Args& args) {
   header.shardCount = c.shardCount;
   header.command = {{"scene", fs::absolute(c.scene).string()},
                     {"env", c.env.empty() ? std::string() : fs::absolute(c.env).string()},
-                    {"args", args}};
+                    {"args", c.arguments}};
 
   ExactVplSums sums = staged.emptySums();
   size_t next = begin;
@@ -551,6 +739,7 @@ int runBake(const Args& args) {
 
   BakeResult result = staged.finish(std::move(sums));
   result.report["timings"]["seconds"]["load"] = loadSeconds;
+  result.report["options"] = c.resultOptions;
   writeFinishedBake(c, result, progress);
   fs::remove(checkpoint, ec);
   return 0;

@@ -161,6 +161,7 @@ int runMerge(const Args& args) {
   partials.clear();
   BakeResult result = staged.finish(std::move(sums));
   result.report["shards"] = first.shardCount;
+  result.report["options"] = c.resultOptions;
   writeFinishedBake(c, result, progress);
   return 0;
 }
