@@ -23,6 +23,7 @@ packages=(
   clang libclang-rt-14-dev # clang + libFuzzer runtime: the glTF loader's fuzz harness (tests/fuzz)
   xvfb xauth               # windowed viewer test without a display
   chromium                 # runtime/web: the three.js viewer test in headless Chromium
+  blender python3-numpy    # runtime/blender: the light-map add-on test (Blender 3.4's glTF importer needs numpy)
   slurm-wlm munge          # tests/slurm: a single-node Slurm on localhost bakes in shards (scripts/slurm)
 )
 # node + npm for runtime/web's tests (npm modules: scripts/install-web-deps.sh). Debian's nodejs and
@@ -30,7 +31,7 @@ packages=(
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-matplotlib python3-numpy python3-openimageio)   # openimageio: bench/cycles reads EXRs
+  packages+=(python3-matplotlib python3-openimageio)   # openimageio: bench/cycles reads EXRs
 fi
 
 missing=()
