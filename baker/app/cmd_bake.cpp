@@ -204,6 +204,14 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                 "also bake directional maps (L1: lightmap_<page>_l1x/y/z.exr and the glTF\n"
                 "extension IRBAKE_lightmap_directional; docs/export.md)");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
+  app->add_option("--portable", command.portable,
+                  "also write FILE.glb for viewers without MOZ_lightmap: base colour × light\n"
+                  "map + emission baked into unlit textures (KHR_materials_unlit; docs/export.md)")
+      ->type_name("FILE.glb");
+  app->add_option("--portable-exposure", command.portableExposure,
+                  "--portable: scale on the shown values before the 8-bit sRGB encode\n"
+                  "(default 1: the map as it is; values above 1 clip)")
+      ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
   app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
@@ -229,7 +237,8 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
 
 // Options that only say where and how fast to write: not part of the result.
 const std::vector<std::string> kNotResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
-                                             "shard", "resume", "checkpoint-seconds", "help"};
+                                             "portable", "portable-exposure", "shard", "resume", "checkpoint-seconds",
+                                             "help"};
 // Options whose presence changes the result even at the default value (--clamp 0: no clamp; none: derived).
 const std::vector<std::string> kPresenceMatters = {"clamp"};
 
@@ -314,6 +323,8 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.eval.biasCompensation = !a.noBiasCompensation;  // on by default; --bias-compensation kept
   o.postDilate = !a.noDilate;
   o.postSeams = !a.noSeams;
+  if (command.shardIndex > 0 && !command.portable.empty())
+    throw Error(ErrorCode::Usage, "", "--shard writes only a partial: give --portable to 'irbake merge'");
   if (command.shardIndex > 0 && namesGltfFile(command.out))
     throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
   if (o.directional && o.backend == BackendKind::Reference)
@@ -429,6 +440,20 @@ void checkOutputPaths(const BakeCommand& c) {
       throw Error(ErrorCode::Usage, c.report, "--report would overwrite a light-map page of this bake: choose another name");
   }
   outputs.push_back({report, "the report"});
+  if (!c.portable.empty()) {
+    const fs::path portable = c.portable;
+    if (fs::is_directory(portable, ec))
+      throw Error(ErrorCode::Usage, c.portable, "--portable names a folder: give the portable file's name (P.glb)");
+    std::string extension = portable.extension().string();
+    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (extension != ".glb") throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
+    for (const auto& [path, what] : outputs)
+      if (samePath(portable, path)) throw Error(ErrorCode::Usage, c.portable, "--portable would overwrite " + what + ": choose another name");
+    if (samePath(portable.parent_path().empty() ? fs::path(".") : portable.parent_path(), outDir) &&
+        isIrbakeTempName(portable.filename().string()))
+      throw Error(ErrorCode::Usage, c.portable, "--portable names a temporary file of this bake: choose another name");
+    outputs.push_back({portable, "the portable GLB"});
+  }
   // Inputs: the scene and its files, and --env's map.
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.env.empty()) inputs.push_back(c.env);
@@ -437,7 +462,7 @@ void checkOutputPaths(const BakeCommand& c) {
       if (samePath(input, path))
         throw Error(ErrorCode::Usage, input.string(),
                     "is an input of this bake and would be overwritten by " + what + ": choose another -o" +
-                        (what == "the report" ? " or --report" : ""));
+                        (what == "the report" ? " or --report" : what == "the portable GLB" ? " or --portable" : ""));
     if (samePath(input.parent_path().empty() ? fs::path(".") : input.parent_path(), outDir) &&
         isPageName(input.filename().string()))
       throw Error(ErrorCode::Usage, input.string(),
@@ -561,6 +586,8 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   outputOptions.outDir = c.out;
   outputOptions.reportPath = c.report;
   outputOptions.writeGltf = !c.noGltf;
+  outputOptions.portablePath = c.portable;
+  outputOptions.portable.exposure = c.portableExposure;
   outputOptions.inputs = sceneInputFiles(c.scene);
   if (!c.env.empty()) outputOptions.inputs.push_back(c.env);
   Stopwatch writeTime;
