@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs the npm packages of runtime/web (three, puppeteer-core, gltf-validator; versions pinned in
-# runtime/web/package.json) into BUILD_DIR/web/node_modules, where the web tests look for them.
+# Installs the npm packages of runtime/web (three, puppeteer-core, gltf-validator, gltfpack, @babylonjs/core and
+# @babylonjs/loaders; versions pinned in runtime/web/package.json) into BUILD_DIR/web/node_modules, where the web tests look for them.
 # Idempotent: does nothing when the installed versions already match. Needs Debian nodejs + npm
 # (scripts/install-deps.sh). Usage: scripts/install-web-deps.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
@@ -12,8 +12,12 @@ if ! command -v npm >/dev/null 2>&1; then
   echo "install-web-deps: npm not found (scripts/install-deps.sh installs it); the web tests will be skipped" >&2
   exit 0
 fi
-if [[ -f "$dest/package.json" ]] && cmp -s runtime/web/package.json "$dest/package.json" && [[ -d "$dest/node_modules/three" ]] &&
-   [[ -d "$dest/node_modules/puppeteer-core" ]] && [[ -d "$dest/node_modules/gltf-validator" ]]; then
+installed() {
+  for m in three puppeteer-core gltf-validator gltfpack @babylonjs/core @babylonjs/loaders; do
+    [[ -d "$dest/node_modules/$m" ]] || return 1
+  done
+}
+if [[ -f "$dest/package.json" ]] && cmp -s runtime/web/package.json "$dest/package.json" && installed; then
   echo "install-web-deps: node modules present in $dest, nothing to install"
   exit 0
 fi

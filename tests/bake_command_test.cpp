@@ -20,6 +20,7 @@
 #include "export/exr_io.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"
+#include "scene/image_codec.h"
 #include "texels/texel_samples.h"
 
 namespace fs = std::filesystem;
@@ -170,6 +171,53 @@ TEST(BakeCommand, GlbOutputEmbedsTheLightMap) {
   }
   EXPECT_GT(sumExr, 0.0);
   EXPECT_NEAR(sumPng / sumExr, 1.0, 0.01);
+}
+
+// --portable: a GLB whose unlit base-colour texture, on the atlas UVs, is the plane's base colour 0.5 × the
+// baked map (sRGB 8-bit), listed in the report with its page scale; the main export keeps MOZ_lightmap.
+TEST(BakeCommand, PortableGlbHoldsBaseColourTimesTheMapUnlit) {
+  ASSERT_FALSE(samplesDir().empty());
+  fs::path out = scratch("portable");
+  std::string log;
+  ASSERT_EQ(runIrbake("bake " + q(samplesDir() / "point_over_plane.gltf") + " -o " + q(out / "bake") + " --portable " +
+                          q(out / "plane.glb") + " --backend embree --texels-per-unit 4 --vpls 64 --quiet",
+                      &log),
+            0)
+      << log;
+  Lightmap map = readExr(out / "bake" / "lightmap_0.exr");
+  Scene portable = loadScene(out / "plane.glb");
+  ASSERT_FALSE(portable.primitives.empty());
+  const Material& m = portable.materials.at(portable.primitives[0].material);
+  ASSERT_GE(m.baseColorTexture, 0);
+  EXPECT_EQ(m.lightmapTexture, -1);
+  EXPECT_EQ(m.baseColorFactor, glm::vec4(1.0f));
+  const Texture& tex = portable.textures.at(m.baseColorTexture);
+  ASSERT_EQ(tex.width, map.width);
+  ASSERT_EQ(tex.height, map.height);
+  // Valid texels: 0.5 × map, clipped at 1, rounded to the nearest 8-bit sRGB code (half a code apart); a
+  // texel whose centre lies just outside the chart takes its covered neighbours' mean (within one code).
+  size_t compared = 0, rounded = 0;
+  for (size_t i = 0; i < map.texels.size(); ++i) {
+    if (!map.valid[i]) continue;
+    const float want = std::min(1.0f, 0.5f * map.texels[i].r);
+    const float codes = std::abs(linearToSrgb(tex.texels[i].r) - linearToSrgb(want)) * 255.0f;
+    EXPECT_LE(codes, 1.0f) << "texel " << i;
+    rounded += codes <= 0.5f + 1e-3f;
+    ++compared;
+  }
+  EXPECT_GT(compared, map.texels.size() / 4);
+  EXPECT_GE(static_cast<double>(rounded) / compared, 0.98) << rounded << " of " << compared;
+  std::ifstream portableFile(out / "plane.glb", std::ios::binary);
+  std::string glb((std::istreambuf_iterator<char>(portableFile)), std::istreambuf_iterator<char>());
+  EXPECT_NE(glb.find("\"extensionsUsed\":[\"KHR_materials_unlit\"]"), std::string::npos);
+  EXPECT_EQ(glb.find("MOZ_lightmap"), std::string::npos);
+  EXPECT_EQ(glb.find("KHR_lights_punctual"), std::string::npos);
+  const auto report = nlohmann::json::parse(std::ifstream(out / "bake" / "report.json"));
+  EXPECT_EQ(report["portable"]["pages"][0]["scale"], 1);
+  EXPECT_EQ(report["portable"]["exposure"], 1.0);
+  EXPECT_NE(std::find(report["outputs"].begin(), report["outputs"].end(), (out / "plane.glb").string()), report["outputs"].end());
+  Scene baked = loadScene(out / "bake" / "scene.gltf");
+  EXPECT_GE(baked.materials.at(baked.primitives[0].material).lightmapTexture, 0);
 }
 
 TEST(BakeCommand, SunFromTheCommandLineLightsAnUnlitScene) {

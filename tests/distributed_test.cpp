@@ -268,3 +268,31 @@ TEST(Distributed, DirectionalShardsAndResumeGiveTheBytesOfOneMachine) {
     EXPECT_FALSE(fs::exists(resumed / ".irbake.checkpoint"));
   }
 }
+
+// --portable is where the finished bake writes: refused on a shard (which writes only its partial), given to
+// merge instead, whose portable GLB is the bytes of the one-machine bake's.
+TEST(Distributed, MergeWritesThePortableGlbOfOneMachine) {
+  ASSERT_TRUE(fs::exists(cornellBox()));
+  const fs::path dir = scratchFolder("portable");
+  const std::vector<std::string> options = split(kOptions + kWalk + " --backend embree");
+  Finished one = bakeCornell(options, dir / "one", {"--portable", (dir / "one.glb").string()});
+  ASSERT_EQ(one.code, 0) << one.output;
+  Finished refused = bakeCornell(options, dir / "refused", {"--shard", "1/2", "--portable", (dir / "x.glb").string()});
+  EXPECT_EQ(refused.code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("--portable"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  std::vector<std::string> merge{"merge"};
+  for (int k = 1; k <= 2; ++k) {
+    const fs::path out = dir / ("shard_" + std::to_string(k));
+    Finished shard = bakeCornell(options, out, {"--shard", std::to_string(k) + "/2"});
+    ASSERT_EQ(shard.code, 0) << shard.output;
+    merge.push_back(out.string());
+  }
+  merge.insert(merge.end(), {"-o", (dir / "merged").string(), "--portable", (dir / "merged.glb").string(), "--quiet"});
+  Finished m = runIrbake(merge, dir / "merge_log.txt");
+  ASSERT_EQ(m.code, 0) << m.output;
+  const std::string want = fileText(dir / "one.glb");
+  ASSERT_GT(want.size(), 1000u);
+  EXPECT_TRUE(fileText(dir / "merged.glb") == want);
+  expectSameOutputs(dir / "one", dir / "merged");
+}

@@ -171,6 +171,35 @@ TEST(OutputSafety, OutputOntoTheInputIsRefused) {
   EXPECT_EQ(fileText(dir / "a" / "cornell_box.bin"), aBefore.at("cornell_box.bin"));
 }
 
+// --portable is one more output: refused when it names an input, another output, a folder or a non-GLB name,
+// before any work, leaving the previous bake and the inputs as they were.
+TEST(OutputSafety, PortableNamingAnOutputOrAnInputIsRefused) {
+  const fs::path dir = scratch("portable_clash");
+  const fs::path scene = copyOfCornell(dir / "in", "box");
+  const fs::path out = dir / "o";
+  ASSERT_EQ(bake(scene, out, {"--portable", (dir / "p.glb").string()}, dir / "first.txt").code, 0);
+  ASSERT_TRUE(fs::exists(dir / "p.glb"));
+  const auto outBefore = snapshot(out), inBefore = snapshot(dir / "in");
+  const std::string portableBefore = fileText(dir / "p.glb");
+  const std::vector<fs::path> clashes = {out / "scene.gltf", out / "scene.bin", out / "report.json", scene,
+                                         dir / "in" / "cornell_box.bin", out, dir / "p.gltf"};
+  for (const fs::path& portable : clashes) {
+    IrbakeRun run = bake(scene, out, {"--portable", portable.string()}, dir / "clash.txt");
+    EXPECT_EQ(run.code, 2) << portable << ": " << run.output;
+    EXPECT_NE(run.output.find(portable.filename().string()), std::string::npos) << run.output;
+  }
+  IrbakeRun glb = bake(scene, dir / "x.glb", {"--portable", (dir / "x.glb").string()}, dir / "glb.txt");
+  EXPECT_EQ(glb.code, 2) << glb.output;
+  EXPECT_FALSE(fs::exists(dir / "x.glb"));
+  IrbakeRun report = bake(scene, out, {"--portable", (dir / "r.glb").string(), "--report", (dir / "r.glb").string()},
+                          dir / "report.txt");
+  EXPECT_EQ(report.code, 2) << report.output;
+  EXPECT_FALSE(fs::exists(dir / "r.glb"));
+  EXPECT_TRUE(snapshot(out) == outBefore);
+  EXPECT_TRUE(snapshot(dir / "in") == inBefore);
+  EXPECT_EQ(fileText(dir / "p.glb"), portableBefore);
+}
+
 // A bake killed by SIGTERM, SIGINT or SIGABRT takes its lock file with it.
 TEST(OutputSafety, KilledBakeLeavesNoLock) {
   const fs::path dir = scratch("killed");

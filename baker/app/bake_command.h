@@ -28,6 +28,8 @@ struct BakeCommand {
   bool quiet = false;              // --quiet
   bool verbose = false;            // --verbose
   bool noGltf = false;             // --no-gltf
+  std::string portable;            // --portable FILE.glb: also the unlit core-glTF bake (empty: none)
+  double portableExposure = 1.0;   // --portable-exposure: scale on the portable file's shown values
   int shardIndex = 0;              // --shard K/N: K (1-based), 0 without --shard
   int shardCount = 0;              // N
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
@@ -47,7 +49,8 @@ Scene loadBakeScene(const BakeCommand& command);
 std::string bakeSceneIdentity(const BakeCommand& command);
 
 // Refuses (Error(Usage), exit 2) outputs that would overwrite an input (the scene, its .bin and textures,
-// --env) or each other (--report naming the glTF or a page), and a --report that is a folder.
+// --env) or each other (--report or --portable naming the glTF, a page or each other), and a --report or
+// --portable that is a folder.
 void checkOutputPaths(const BakeCommand& command);
 // Locks --report's folder when it is not OUTDIR, so a report never lands in another bake's folder while
 // that bake runs (nullptr when no second lock is needed). Throws Error(Io) when that folder is busy.

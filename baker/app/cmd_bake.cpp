@@ -72,7 +72,7 @@ void checkLightArguments(const BakeCommand& c) {
 // The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
 const std::vector<std::string> kCommonOptions = {"SCENE", "output", "quality", "config", "sun", "sky", "env",
                                                  "texels-per-unit", "directional", "seed", "threads", "report",
-                                                 "quiet", "help", "help-all"};
+                                                 "quiet", "portable", "help", "help-all"};
 const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroups = {
     {"Light paths and VPLs", {"paths", "bounces", "walk-split", "vpl-importance", "vpl-probes", "vpl-keep", "vpl-block"}},
     {"Texels", {"max-texels", "supersample", "interleave"}},
@@ -82,7 +82,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples"}},
     {"Backends", {"backend", "cube-face", "spp"}},
-    {"Outputs", {"no-gltf", "dump-config", "verbose"}},
+    {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
     {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams"}},
 };
@@ -229,6 +229,14 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
+  app->add_option("--portable", command.portable,
+                  "also write FILE.glb for viewers without MOZ_lightmap: base colour × light\n"
+                  "map + emission baked into unlit textures (KHR_materials_unlit; docs/export.md)")
+      ->type_name("FILE.glb");
+  app->add_option("--portable-exposure", command.portableExposure,
+                  "--portable: scale on the shown values before the 8-bit sRGB encode\n"
+                  "(default 1: the map as it is; values above 1 clip)")
+      ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
   app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
@@ -262,8 +270,8 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
 
 // Options that only say where and how fast to write: not part of the result.
 const std::vector<std::string> kNotResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
-                                             "shard", "resume", "checkpoint-seconds", "help", "help-all",
-                                             "config", "dump-config"};
+                                             "portable", "portable-exposure", "shard", "resume", "checkpoint-seconds",
+                                             "help", "help-all", "config", "dump-config"};
 // Options whose presence changes the result even at the default value (--clamp 0: no clamp; none: derived).
 const std::vector<std::string> kPresenceMatters = {"clamp"};
 
@@ -349,6 +357,8 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   o.eval.biasCompensation = !a.noBiasCompensation;  // on by default; --bias-compensation kept
   o.postDilate = !a.noDilate;
   o.postSeams = !a.noSeams;
+  if (command.shardIndex > 0 && !command.portable.empty())
+    throw Error(ErrorCode::Usage, "", "--shard writes only a partial: give --portable to 'irbake merge'");
   if (command.shardIndex > 0 && namesGltfFile(command.out))
     throw Error(ErrorCode::Usage, "", "--shard writes a partial into a folder: give -o OUTDIR, not a glTF name");
   if (o.directional && o.backend == BackendKind::Reference)
@@ -407,7 +417,8 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine)
     if (option->count() > 0) continue;
     Args words;
     std::string value = e.value;
-    if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config")
+    if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config" ||
+        e.key == "portable")
       if (!value.empty() && std::filesystem::path(value).is_relative()) value = (folder / value).lexically_normal().string();
     if (option->get_expected_min() == 0) {  // a flag
       if (value != "true" && value != "false") fail("a flag takes true or false, got '" + value + "'");
@@ -451,7 +462,7 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
       if (flag) value = "true";
       else
         for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
-      if (name == "SCENE" || name == "output" || name == "report" || name == "env")
+      if (name == "SCENE" || name == "output" || name == "report" || name == "env" || name == "portable")
         value = std::filesystem::absolute(value).lexically_normal().string();
       entries.push_back({name == "SCENE" ? "scene" : name, value, 0});
       continue;
@@ -617,6 +628,20 @@ void checkOutputPaths(const BakeCommand& c) {
       throw Error(ErrorCode::Usage, c.report, "--report would overwrite a light-map page of this bake: choose another name");
   }
   outputs.push_back({report, "the report"});
+  if (!c.portable.empty()) {
+    const fs::path portable = c.portable;
+    if (fs::is_directory(portable, ec))
+      throw Error(ErrorCode::Usage, c.portable, "--portable names a folder: give the portable file's name (P.glb)");
+    std::string extension = portable.extension().string();
+    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (extension != ".glb") throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
+    for (const auto& [path, what] : outputs)
+      if (samePath(portable, path)) throw Error(ErrorCode::Usage, c.portable, "--portable would overwrite " + what + ": choose another name");
+    if (samePath(portable.parent_path().empty() ? fs::path(".") : portable.parent_path(), outDir) &&
+        isIrbakeTempName(portable.filename().string()))
+      throw Error(ErrorCode::Usage, c.portable, "--portable names a temporary file of this bake: choose another name");
+    outputs.push_back({portable, "the portable GLB"});
+  }
   // Inputs: the scene and its files, and --env's map.
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.env.empty()) inputs.push_back(c.env);
@@ -625,7 +650,7 @@ void checkOutputPaths(const BakeCommand& c) {
       if (samePath(input, path))
         throw Error(ErrorCode::Usage, input.string(),
                     "is an input of this bake and would be overwritten by " + what + ": choose another -o" +
-                        (what == "the report" ? " or --report" : ""));
+                        (what == "the report" ? " or --report" : what == "the portable GLB" ? " or --portable" : ""));
     if (samePath(input.parent_path().empty() ? fs::path(".") : input.parent_path(), outDir) &&
         isPageName(input.filename().string()))
       throw Error(ErrorCode::Usage, input.string(),
@@ -750,6 +775,8 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   outputOptions.outDir = c.out;
   outputOptions.reportPath = c.report;
   outputOptions.writeGltf = !c.noGltf;
+  outputOptions.portablePath = c.portable;
+  outputOptions.portable.exposure = c.portableExposure;
   outputOptions.inputs = sceneInputFiles(c.scene);
   if (!c.env.empty()) outputOptions.inputs.push_back(c.env);
   Stopwatch writeTime;

@@ -89,6 +89,8 @@ int runMerge(const Args& args) {
   std::string out, report;
   int threads = 0;
   bool quiet = false, noGltf = false;
+  std::string portable;
+  double portableExposure = 1.0;
   auto app = cli::makeApp("irbake merge",
                           "Adds the partial VPL sums of 'irbake bake --shard K/N' (every share once) and\n"
                           "finishes the bake: the same outputs, byte for byte, as the bake on one machine.");
@@ -96,6 +98,10 @@ int runMerge(const Args& args) {
   app->add_option("-o,--output", out, "output folder (OUTDIR), or OUT.glb / OUT.gltf")->type_name("OUTDIR");
   app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
+  app->add_option("--portable", portable, "also write FILE.glb, the unlit core-glTF bake (as irbake bake --portable)")
+      ->type_name("FILE.glb");
+  app->add_option("--portable-exposure", portableExposure, "--portable: scale on the shown values (default 1)")
+      ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
   app->add_option("--threads", threads, "worker threads (default 0: every core)")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
@@ -128,6 +134,8 @@ int runMerge(const Args& args) {
   c.out = out;
   c.report = report;
   c.noGltf = noGltf;
+  c.portable = portable;  // where and how to write, never the shards' own arguments
+  c.portableExposure = portableExposure;
   c.options.backend = parseBackend(first.backend);
   if (c.optionsHash != first.optionsHash)
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");

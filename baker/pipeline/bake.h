@@ -18,6 +18,7 @@
 #include "backend/shadow_edges/shadow_edges.h"
 #include "backend/sky/sky_light.h"
 #include "backend/lightmap.h"
+#include "export/portable_export.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
 #include "pipeline/backend_choice.h"
@@ -151,6 +152,8 @@ struct OutputOptions {
   std::filesystem::path reportPath;  // report JSON; empty = OUTDIR/report.json
   bool writeGltf = true;             // export scene.gltf (+ .bin, PNG maps) beside the EXR pages
   std::vector<std::filesystem::path> inputs;  // the bake's input files: never overwritten (Error(Usage))
+  std::filesystem::path portablePath;  // also the portable GLB here (export/portable_export.h); empty: none
+  PortableOptions portable;            // its exposure and texture limits
 };
 
 // Writes the EXR pages, the glTF (through exportGltf) and the report, each atomically. Returns the

@@ -1,4 +1,4 @@
-// Writing a finished bake: EXR pages, glTF with the maps attached, the JSON report.
+// Writing a finished bake: EXR pages, glTF with the maps attached, the portable GLB when asked, the JSON report.
 #include <fstream>
 #include <string>
 
@@ -9,6 +9,7 @@
 #include "export/directional_export.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
+#include "export/portable_export.h"
 #include "pipeline/bake.h"
 
 namespace irbake {
@@ -34,6 +35,17 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
+  // The portable GLB is built now (its report entry says how), written with the rest.
+  std::vector<PendingFile> portable;
+  nlohmann::json portableSummary;
+  if (!options.portablePath.empty()) {
+    const fs::path folder = options.portablePath.parent_path();
+    if (!folder.empty()) fs::create_directories(folder, ec);
+    if (!folder.empty() && !fs::is_directory(folder))
+      throw Error(ErrorCode::Io, folder.string(), "cannot create the portable GLB's folder");
+    portable.push_back(portableGlbFile(result.scene, result.maps, options.portablePath, options.portable, &portableSummary));
+    written.push_back(options.portablePath);
+  }
 
   // The report names what is written, and is written with it: glTF (+ .bin, PNG), EXR pages and report are
   // one all-or-nothing set, so a failed bake leaves the previous outputs, report included, untouched.
@@ -42,6 +54,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   report["irbakeVersion"] = versionLine("irbake");
   report["outputs"] = nlohmann::json::array();
   for (const auto& p : written) report["outputs"].push_back(p.string());
+  if (!portable.empty()) report["portable"] = portableSummary;
   const std::string text = report.dump(2) + "\n";
   PendingFile reportFile{reportPath, [&text, reportPath](const fs::path& temp) {
                            std::ofstream out(temp, std::ios::binary);
@@ -55,6 +68,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.writeExrPages = true;
     ex.exrPrefix = "lightmap";
     ex.alsoWrite = {reportFile};
+    ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
     ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     exportGltf(result.scene, result.maps, ex);
@@ -71,6 +85,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
       files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
     }
     files.push_back(reportFile);
+    files.insert(files.end(), portable.begin(), portable.end());
     refuseOverwritingInputs(files, options.inputs);
     writeAllAtomically(files);
   }

@@ -1,9 +1,12 @@
-// Renders a baked glTF in headless Chromium (three.js, the MOZ_lightmap plugin) from one of its
-// cameras and compares it with a reference PNG (irview --camera N --screenshot): prints the mean
-// absolute difference over RGB in 8-bit units and exits 1 when it exceeds --max-mean-abs.
+// Renders a baked glTF in headless Chromium (three.js, the MOZ_lightmap plugin; or Babylon.js with
+// --client babylon) from one of its cameras and compares it with a reference PNG (irview --camera N
+// --screenshot): prints the mean absolute difference over RGB in 8-bit units and exits 1 when it exceeds
+// --max-mean-abs.
 // Usage: node render_compare.mjs --modules DIR --scene FILE.gltf --camera N --width W --height H
 //          --reference REF.png --out WEB.png [--max-mean-abs 2] [--chromium /usr/bin/chromium]
 //          [--lightmap sh|l0] [--min-directional N: fail unless N materials were shaded with directional maps]
+//          [--plugin none: the client's glTF loader without our MOZ_lightmap plugin, as any viewer (the portable GLB)]
+//          [--client three|babylon (default three)]
 import fs from 'node:fs';
 import path from 'node:path';
 import { createRequire } from 'node:module';
@@ -15,15 +18,22 @@ const fail = msg => { console.error(`render_compare: ${msg}`); process.exit(2); 
 for (const k of ['modules', 'scene', 'reference', 'out']) if (!args[k]) fail(`--${k} is required`);
 const width = Number(args.width ?? 256), height = Number(args.height ?? 256), camera = Number(args.camera ?? 0);
 const maxMeanAbs = Number(args['max-mean-abs'] ?? 2);
+const client = args.client ?? 'three';
+if (client !== 'three' && client !== 'babylon') fail(`--client ${client}: three or babylon`);
+const page = client === 'babylon' ? { html: 'babylon.html', module: '/web/babylon_viewer.js' }
+                                  : { html: 'index.html', module: '/web/viewer.js' };
 if (!fs.existsSync(args.scene)) fail(`${args.scene}: no such file`);
 if (!fs.existsSync(args.reference)) fail(`${args.reference}: no such file`);
 
 const require = createRequire(path.join(path.resolve(args.modules), 'package.json'));
 const puppeteer = require('puppeteer-core');
 const here = path.dirname(fileURLToPath(import.meta.url));
+const nodeModules = path.join(path.resolve(args.modules), 'node_modules');
 const server = await serve({
   web: here,
-  three: path.join(path.resolve(args.modules), 'node_modules', 'three'),
+  three: path.join(nodeModules, 'three'),
+  'babylon-core': path.join(nodeModules, '@babylonjs', 'core'),
+  'babylon-loaders': path.join(nodeModules, '@babylonjs', 'loaders'),
   scene: path.dirname(path.resolve(args.scene)),
   ref: path.dirname(path.resolve(args.reference)),
 });
@@ -37,20 +47,20 @@ const browser = await puppeteer.launch({
 });
 let code = 0;
 try {
-  const page = await browser.newPage();
+  const tab = await browser.newPage();
   const log = [];
-  page.on('console', m => log.push(`${m.type()}: ${m.text()}`));
-  page.on('pageerror', e => log.push(`pageerror: ${e.message}`));
-  await page.setViewport({ width, height, deviceScaleFactor: 1 });
+  tab.on('console', m => log.push(`${m.type()}: ${m.text()}`));
+  tab.on('pageerror', e => log.push(`pageerror: ${e.message}`));
+  await tab.setViewport({ width, height, deviceScaleFactor: 1 });
   const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height,
-                                  lightmap: args.lightmap ?? 'sh' });
-  await page.goto(`http://127.0.0.1:${port}/web/index.html?${q}`);
-  await page.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
-  const error = await page.evaluate('window.viewerError');
+                                  lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz' });
+  await tab.goto(`http://127.0.0.1:${port}/web/${page.html}?${q}`);
+  await tab.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
+  const error = await tab.evaluate('window.viewerError');
   if (error) throw new Error(`viewer: ${error}\n${log.join('\n')}`);
-  const ready = await page.evaluate('window.viewerReady');
-  const result = await page.evaluate(async (refUrl) => {
-    const { canvasPixels } = await import('/web/viewer.js');
+  const ready = await tab.evaluate('window.viewerReady');
+  const result = await tab.evaluate(async (refUrl, module) => {
+    const { canvasPixels } = await import(module);
     const web = canvasPixels();
     const blob = await (await fetch(refUrl)).blob();
     const bitmap = await createImageBitmap(blob, { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
@@ -73,13 +83,13 @@ try {
     const n = w * h * 3;
     return { meanAbs: sum / n, max: worst, fractionOver8: over8 / n, webMean: webSum / n, refMean: refSum / n,
              png: document.querySelector('canvas').toDataURL('image/png') };
-  }, `/ref/${encodeURIComponent(path.basename(args.reference))}`);
+  }, `/ref/${encodeURIComponent(path.basename(args.reference))}`, page.module);
   if (result.error) throw new Error(result.error);
   fs.writeFileSync(args.out, Buffer.from(result.png.split(',')[1], 'base64'));
   delete result.png;
-  result.lightmapMode = ready.lightmapMode;
-  result.directionalMaterials = ready.directionalMaterials;
-  result.generatedTangents = ready.generatedTangents;
+  result.client = client;
+  Object.assign(result, ready);
+  for (const k of ['width', 'height']) delete result[k];
   console.log(JSON.stringify(result));
   if (!(result.meanAbs <= maxMeanAbs)) {
     console.error(`render_compare: mean absolute difference ${result.meanAbs.toFixed(3)} > ${maxMeanAbs} (web ${args.out}, irview ${args.reference})`);

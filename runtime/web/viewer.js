@@ -4,7 +4,8 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
-export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh' }) {
+// plugin false: plain GLTFLoader without MOZ_lightmap, as a viewer that does not know it (the portable GLB).
+export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
@@ -14,7 +15,7 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
 
   const loader = new GLTFLoader();
   let lightmapExtension = null;
-  loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
+  if (plugin) loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
   const gltf = await loader.loadAsync(scene);
   // The light maps hold the punctual lights' light already: drop the lights GLTFLoader made.
   const lights = [];
@@ -28,18 +29,9 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   cam.updateProjectionMatrix();
   renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);
-  return { width, height, lights: lights.length, lightmapMode, directionalMaterials: lightmapExtension.directionalMaterials,
-           generatedTangents: lightmapExtension.generatedTangents };
+  return { width, height, lights: lights.length, lightmapMode, plugin,
+           directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
+           generatedTangents: lightmapExtension?.generatedTangents ?? 0 };
 }
 
-// RGBA bytes of the canvas, top row first (as a PNG), for comparisons.
-export function canvasPixels() {
-  const canvas = document.querySelector('canvas');
-  const gl = canvas.getContext('webgl2');
-  const w = canvas.width, h = canvas.height;
-  const px = new Uint8Array(w * h * 4);
-  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
-  const flipped = new Uint8Array(px.length);
-  for (let y = 0; y < h; ++y) flipped.set(px.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
-  return flipped;
-}
+export { canvasPixels } from './canvas_pixels.js';
