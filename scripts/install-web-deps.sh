@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the npm packages of runtime/web (three, puppeteer-core, gltf-validator; versions pinned in
-# runtime/web/package.json) into BUILD_DIR/web/node_modules, where the web tests look for them.
+# Installs the npm packages of runtime/web (three, puppeteer-core, gltf-validator, the glTF-Transform CLI and
+# libraries; versions pinned in runtime/web/package.json) into BUILD_DIR/web/node_modules, where the web tests
+# look for them.
 # Idempotent: does nothing when the installed versions already match. Needs Debian nodejs + npm
 # (scripts/install-deps.sh). Usage: scripts/install-web-deps.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
@@ -13,7 +14,9 @@ if ! command -v npm >/dev/null 2>&1; then
   exit 0
 fi
 if [[ -f "$dest/package.json" ]] && cmp -s runtime/web/package.json "$dest/package.json" && [[ -d "$dest/node_modules/three" ]] &&
-   [[ -d "$dest/node_modules/puppeteer-core" ]] && [[ -d "$dest/node_modules/gltf-validator" ]]; then
+   [[ -d "$dest/node_modules/puppeteer-core" ]] && [[ -d "$dest/node_modules/gltf-validator" ]] &&
+   [[ -d "$dest/node_modules/@gltf-transform/core" ]] && [[ -d "$dest/node_modules/@gltf-transform/extensions" ]] &&
+   [[ -d "$dest/node_modules/@gltf-transform/functions" ]] && [[ -x "$dest/node_modules/.bin/gltf-transform" ]]; then
   echo "install-web-deps: node modules present in $dest, nothing to install"
   exit 0
 fi
