@@ -181,3 +181,59 @@ TEST(IrviewCli, DegenerateViewsAreRefused) {
     EXPECT_FALSE(fs::exists(shot));
   }
 }
+
+// A MOZ_lightmap irview cannot show as written is refused with exit 5 and the material named: a texture that
+// does not exist, a texCoord other than 1, an intensity that is negative or not a number (JSON has no NaN:
+// a string or null stands for it). The same extension written well renders.
+TEST(IrviewCli, BadMozLightmapIsRefusedNamingTheMaterial) {
+  const std::string scene = sampleFile("furnace").string();
+  const fs::path png = fs::path(scene).parent_path() / "moz_grey.png";  // beside the scene: URIs stay inside
+  {
+    auto out = OIIO::ImageOutput::create(png.string());
+    ASSERT_TRUE(out);
+    const unsigned char grey[4 * 4 * 3] = {128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128,
+                                           128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128,
+                                           128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128,
+                                           128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128, 128};
+    ASSERT_TRUE(out->open(png.string(), OIIO::ImageSpec(4, 4, 3, OIIO::TypeDesc::UINT8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, grey));
+    out->close();
+  }
+  // The sample with a texture and MOZ_lightmap = moz on material 0, beside its .bin.
+  auto withLightmap = [&](const std::string& name, const nlohmann::json& moz) {
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(scene));
+    doc["images"] = {{{"uri", png.filename().string()}}};
+    doc["textures"] = {{{"source", 0}}};
+    doc["materials"][0]["name"] = "lit_wall";
+    doc["materials"][0]["extensions"]["MOZ_lightmap"] = moz;
+    doc["extensionsUsed"].push_back("MOZ_lightmap");
+    const fs::path file = fs::path(scene).parent_path() / (name + ".gltf");
+    std::ofstream(file) << doc.dump();
+    return file.string();
+  };
+  const fs::path shot = workDir() / "moz_refused.png";
+  struct Case {
+    const char* name;
+    nlohmann::json moz;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"moz_missing_texture", {{"index", 3}, {"texCoord", 1}, {"intensity", 1.0}}, "names texture 3, which does not exist"},
+      {"moz_texcoord_0", {{"index", 0}, {"texCoord", 0}, {"intensity", 1.0}}, "texCoord 0, but light maps use TEXCOORD_1"},
+      {"moz_negative", {{"index", 0}, {"texCoord", 1}, {"intensity", -0.5}}, "intensity -0.5 must be a finite number"},
+      {"moz_nan_string", {{"index", 0}, {"texCoord", 1}, {"intensity", "NaN"}}, "intensity \"NaN\" must be a finite number"},
+      {"moz_null", {{"index", 0}, {"texCoord", 1}, {"intensity", nullptr}}, "intensity null must be a finite number"},
+  };
+  for (const Case& c : cases) {
+    fs::remove(shot);
+    RunResult r = run(withLightmap(c.name, c.moz) + " --width 16 --height 16 --screenshot " + shot.string());
+    EXPECT_EQ(r.status, 5) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find("material 0 ('lit_wall')"), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_FALSE(fs::exists(shot)) << c.name;
+  }
+  RunResult good = run(withLightmap("moz_good", {{"index", 0}, {"texCoord", 1}, {"intensity", 2.0}}) +
+                       " --width 16 --height 16 --screenshot " + shot.string());
+  EXPECT_EQ(good.status, 0) << good.output;
+  EXPECT_TRUE(fs::exists(shot));
+}

@@ -60,6 +60,13 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
   LoadOptions options;
   options.shadingMaps = true;  // the normal maps, tangents and directional maps a bake does not read
   Scene scene = loadScene(path, options);
+  // The viewer reads every light map through TEXCOORD_1 (docs/export.md); a map meant for another set would
+  // show garbage, so it is refused.
+  for (const Material& m : scene.materials)
+    if (m.lightmapTexture >= 0 && m.lightmapTexCoord != 1)
+      throw Error(ErrorCode::InvalidData, path.string(),
+                  "material " + std::to_string(m.gltfMaterial) + " ('" + m.name + "'): MOZ_lightmap texCoord " +
+                      std::to_string(m.lightmapTexCoord) + ", but light maps use TEXCOORD_1");
   std::vector<Lightmap> pages;
   std::vector<std::string> warnings;
   // The float pages carry the full range; if one cannot be read the PNG × intensity still shows.

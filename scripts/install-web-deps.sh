@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the npm packages of runtime/web (three, puppeteer-core, gltf-validator, gltfpack, @babylonjs/core and
-# @babylonjs/loaders; versions pinned in runtime/web/package.json) into BUILD_DIR/web/node_modules, where the web tests look for them.
+# @babylonjs/loaders, the glTF-Transform CLI and libraries; versions pinned in runtime/web/package.json) into
+# BUILD_DIR/web/node_modules, where the web tests look for them.
 # Idempotent: does nothing when the installed versions already match. Needs Debian nodejs + npm
 # (scripts/install-deps.sh). Usage: scripts/install-web-deps.sh [BUILD_DIR]   (default: build)
 set -euo pipefail
@@ -13,9 +14,11 @@ if ! command -v npm >/dev/null 2>&1; then
   exit 0
 fi
 installed() {
-  for m in three puppeteer-core gltf-validator gltfpack @babylonjs/core @babylonjs/loaders; do
+  for m in three puppeteer-core gltf-validator gltfpack @babylonjs/core @babylonjs/loaders @gltf-transform/core \
+           @gltf-transform/extensions @gltf-transform/functions; do
     [[ -d "$dest/node_modules/$m" ]] || return 1
   done
+  [[ -x "$dest/node_modules/.bin/gltf-transform" ]]
 }
 if [[ -f "$dest/package.json" ]] && cmp -s runtime/web/package.json "$dest/package.json" && installed; then
   echo "install-web-deps: node modules present in $dest, nothing to install"

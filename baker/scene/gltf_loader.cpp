@@ -891,14 +891,7 @@ class Loader {
       m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
       m.transmission = static_cast<float>(
           std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
-      if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) {
-        const json* ti = child(*moz, "index");
-        // irbake's PNG is sRGB-encoded and says so in MOZ_lightmap.extras.colorSpace (docs/export.md).
-        const json* cs = path(*moz, {"extras", "colorSpace"});
-        const bool srgb = cs && cs->is_string() && cs->get<std::string>() == "srgb";
-        if (ti && ti->is_number_integer()) m.lightmapTexture = textureIndex(ti->get<int>(), srgb, m.name);
-        m.lightmapIntensity = static_cast<float>(numberOr(child(*moz, "intensity"), 1.0));
-      }
+      if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) readMozLightmap(index, g.name, *moz, m);
       if (options_.shadingMaps) readShadingMaps(g, *mj, m);
     }
     if (g.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
@@ -914,9 +907,36 @@ class Loader {
     if (!std::isfinite(m.emissiveStrength) || m.emissiveStrength < 0.0f)
       invalid(what + ": KHR_materials_emissive_strength emissiveStrength must be ≥ 0 and finite (it is " +
               number(m.emissiveStrength) + ")");
-    if (!std::isfinite(m.lightmapIntensity))
-      invalid(what + " has a NaN/Inf MOZ_lightmap intensity");
     return m;
+  }
+
+  // MOZ_lightmap (docs/export.md). A light map is never dropped silently: a missing texture and an intensity
+  // that is not a number ≥ 0 are refused here; the texCoord is recorded (irview refuses any but 1).
+  void readMozLightmap(int index, const std::string& gltfName, const json& moz, Material& m) {
+    const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')") +
+                             ": MOZ_lightmap";
+    if (!moz.is_object()) invalid(what + " is not an object");
+    const json* ti = child(moz, "index");
+    if (!ti || !ti->is_number_integer()) invalid(what + " has no texture index");
+    const int textures = static_cast<int>(model_.textures.size());
+    if (ti->get<int64_t>() < 0 || ti->get<int64_t>() >= textures)
+      invalid(what + " names texture " + ti->dump() + ", which does not exist (the file has " + std::to_string(textures) +
+              ")");
+    // irbake's PNG is sRGB-encoded and says so in MOZ_lightmap.extras.colorSpace (docs/export.md).
+    const json* cs = path(moz, {"extras", "colorSpace"});
+    const bool srgb = cs && cs->is_string() && cs->get<std::string>() == "srgb";
+    m.lightmapTexture = textureIndex(ti->get<int>(), srgb, m.name);
+    if (const json* tc = child(moz, "texCoord")) {
+      if (!tc->is_number_integer() || tc->get<int64_t>() < 0 || tc->get<int64_t>() > 255)
+        invalid(what + " has texCoord " + tc->dump() + ", not a UV set index");
+      m.lightmapTexCoord = tc->get<int>();
+    }
+    if (const json* in = child(moz, "intensity")) {
+      const double v = in->is_number() ? in->get<double>() : std::nan("");
+      if (!std::isfinite(v) || v < 0.0 || !std::isfinite(static_cast<float>(v)))
+        invalid(what + " intensity " + in->dump() + " must be a finite number ≥ 0");
+      m.lightmapIntensity = static_cast<float>(v);
+    }
   }
 
   // The viewer's maps (LoadOptions::shadingMaps): the normal texture and IRBAKE_lightmap_directional

@@ -50,6 +50,7 @@ struct Material {
   int gltfMaterial = -1;            // source index, -1 for the default material
   int lightmapTexture = -1;         // MOZ_lightmap texture (index into Scene::textures), -1 none
   float lightmapIntensity = 1.0f;   // MOZ_lightmap intensity: map value = PNG value × intensity
+  int lightmapTexCoord = 1;         // MOZ_lightmap texCoord as written (irview reads only TEXCOORD_1 and refuses others)
   // Read only with LoadOptions::shadingMaps (the viewer shades with them; a bake never reads them):
   int normalTexture = -1;           // normalTexture (index into Scene::textures, linear), -1 none
   int normalTexCoord = 0;           // which TEXCOORD set it reads

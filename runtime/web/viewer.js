@@ -1,6 +1,7 @@
 // Loads a baked glTF and renders it once from one of its cameras, the way irview does.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
@@ -14,6 +15,7 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   document.body.appendChild(renderer.domElement);
 
   const loader = new GLTFLoader();
+  loader.setMeshoptDecoder(MeshoptDecoder);  // EXT_meshopt_compression: gltf-transform optimize's default
   let lightmapExtension = null;
   if (plugin) loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
   const gltf = await loader.loadAsync(scene);

@@ -1,0 +1,184 @@
+// Checks for gltf_transform_irbake.mjs (run by web_pipeline_test.sh):
+//   survives --modules DIR --input BAKE.gltf --output OPT.glb [--directional]
+//     every material of the bake that has MOZ_lightmap (and IRBAKE_lightmap_directional) has it in the output
+//     with the same numbers and texCoord 1 on an existing texture; every light-mapped primitive has TEXCOORD_1
+//     with POSITION's vertex count; the light-mapped triangles are as many as in the bake.
+//   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
+//     read → write keeps both extensions' JSON exactly; bad input (missing texture, texCoord ≠ 1, negative or
+//     non-numeric intensity, incomplete directional extension) and bad output (no TEXCOORD_1, fewer triangles)
+//     throw an Error naming the material or mesh.
+// Exit 0 when every check passes, 1 with the failures listed.
+import fs from 'node:fs';
+import path from 'node:path';
+import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHTMAP_DIRECTIONAL, MOZ_LIGHTMAP }
+  from './gltf_transform_irbake.mjs';
+
+const [mode, ...rest] = process.argv.slice(2);
+// --name value, or --name alone (a flag: true).
+const args = Object.fromEntries(rest.reduce((a, v, i, all) =>
+  (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1] === undefined || all[i + 1].startsWith('--') ? true : all[i + 1]]] : a), []));
+if (!['survives', 'refusals'].includes(mode) || !args.modules || !args.input) {
+  console.error('usage: gltf_transform_check.mjs survives|refusals --modules DIR --input FILE [--output FILE] [--directional]');
+  process.exit(2);
+}
+const modules = path.resolve(args.modules);
+const core = await importPackage(modules, '@gltf-transform/core');
+const { ALL_EXTENSIONS } = await importPackage(modules, '@gltf-transform/extensions');
+const functions = await importPackage(modules, '@gltf-transform/functions');
+const { MeshoptDecoder } = await importPackage(modules, 'meshoptimizer');
+await MeshoptDecoder.ready;
+const { MozLightmap, IrbakeLightmapDirectional } = defineIrbakeExtensions(core);
+const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional])
+  .registerDependencies({ 'meshopt.decoder': MeshoptDecoder });
+io.setLogger(new core.Logger(core.Logger.Verbosity.ERROR));
+
+const failures = [];
+const check = (ok, message) => { if (!ok) failures.push(message); };
+// Equal JSON values, whatever the order of object keys.
+const canonical = v => (Array.isArray(v) ? v.map(canonical) : v !== null && typeof v === 'object'
+  ? Object.fromEntries(Object.keys(v).sort().map(k => [k, canonical(v[k])])) : v);
+const same = (a, b) => JSON.stringify(canonical(a)) === JSON.stringify(canonical(b));
+
+// The JSON of a .gltf or .glb.
+function jsonOf(file) {
+  const bytes = fs.readFileSync(file);
+  if (bytes.readUInt32LE(0) !== 0x46546c67) return JSON.parse(bytes.toString('utf8'));
+  return JSON.parse(bytes.subarray(20, 20 + bytes.readUInt32LE(12)).toString('utf8'));
+}
+
+// A texture info that names an existing texture with an image (core or EXT_texture_webp / KHR_texture_basisu).
+function hasImage(json, info) {
+  const t = json.textures?.[info?.index];
+  const source = t?.source ?? Object.values(t?.extensions ?? {}).find(e => Number.isInteger(e?.source))?.source;
+  return t !== undefined && json.images?.[source] !== undefined;
+}
+
+function survives() {
+  const input = jsonOf(args.input), output = jsonOf(args.output);
+  const byName = new Map((output.materials ?? []).map(m => [m.name, m]));
+  let materials = 0, directional = 0, primitives = 0;
+  for (const inMat of input.materials ?? []) {
+    const inMoz = inMat.extensions?.[MOZ_LIGHTMAP];
+    if (!inMoz) continue;
+    ++materials;
+    const outMat = byName.get(inMat.name), outMoz = outMat?.extensions?.[MOZ_LIGHTMAP];
+    check(outMoz, `material '${inMat.name}': ${MOZ_LIGHTMAP} lost`);
+    if (!outMoz) continue;
+    check(outMoz.texCoord === 1, `material '${inMat.name}': texCoord ${outMoz.texCoord}`);
+    check(outMoz.intensity === inMoz.intensity, `material '${inMat.name}': intensity ${outMoz.intensity}, bake ${inMoz.intensity}`);
+    check(same(outMoz.extras, inMoz.extras), `material '${inMat.name}': extras ${JSON.stringify(outMoz.extras)}`);
+    check(hasImage(output, outMoz), `material '${inMat.name}': light-map texture ${outMoz.index} has no image`);
+    if (args.directional) {
+      const inDir = inMat.extensions[IRBAKE_LIGHTMAP_DIRECTIONAL], outDir = outMat.extensions[IRBAKE_LIGHTMAP_DIRECTIONAL];
+      check(inDir, `material '${inMat.name}': the bake has no ${IRBAKE_LIGHTMAP_DIRECTIONAL}`);
+      check(outDir, `material '${inMat.name}': ${IRBAKE_LIGHTMAP_DIRECTIONAL} lost`);
+      if (!inDir || !outDir) continue;
+      ++directional;
+      check(same(outDir.exr, inDir.exr), `material '${inMat.name}': exr ${JSON.stringify(outDir.exr)}`);
+      check(outDir.l1?.length === 3, `material '${inMat.name}': l1 has ${outDir.l1?.length} entries`);
+      (outDir.l1 ?? []).forEach((e, k) => {
+        check(e.texCoord === 1 && e.scale === inDir.l1[k].scale, `material '${inMat.name}': l1[${k}] ${JSON.stringify(e)}`);
+        check(hasImage(output, e), `material '${inMat.name}': l1[${k}] texture ${e.index} has no image`);
+      });
+    }
+  }
+  check(materials > 0, `${args.input}: no material with ${MOZ_LIGHTMAP}`);
+  (output.meshes ?? []).forEach((mesh, m) => mesh.primitives.forEach((prim, p) => {
+    if (!output.materials?.[prim.material]?.extensions?.[MOZ_LIGHTMAP]) return;
+    ++primitives;
+    const uv = output.accessors[prim.attributes.TEXCOORD_1], position = output.accessors[prim.attributes.POSITION];
+    check(uv, `mesh ${m} ('${mesh.name}') primitive ${p}: TEXCOORD_1 lost`);
+    check(!uv || uv.count === position.count, `mesh ${m} primitive ${p}: TEXCOORD_1 count ${uv?.count}, POSITION ${position.count}`);
+  }));
+  return Promise.all([io.read(args.input), io.read(args.output)]).then(([a, b]) => {
+    const total = d => [...countLightmappedTriangles(d).values()].reduce((x, y) => x + y, 0);
+    const before = total(a), after = total(b);
+    check(before === after && before > 0, `light-mapped triangles ${before} → ${after}`);
+    console.log(JSON.stringify({ output: args.output, materials, directional, primitives, triangles: after }));
+  });
+}
+
+// Runs fn and requires an Error whose message has every one of the texts.
+let refused = 0;
+async function throws(label, fn, ...texts) {
+  ++refused;
+  try {
+    await fn();
+    failures.push(`${label}: accepted`);
+  } catch (e) {
+    const missing = texts.filter(t => !String(e.message).includes(t));
+    check(missing.length === 0, `${label}: error "${e.message}" lacks ${JSON.stringify(missing)}`);
+  }
+}
+
+async function refusals() {
+  const original = await io.readAsJSON(args.input);
+  const clone = () => ({ json: structuredClone(original.json), resources: original.resources });
+  // The extensions of each material with texture indices replaced by image URIs: index-free comparison.
+  const normalised = json => (json.materials ?? []).map(m => {
+    const ext = structuredClone({ moz: m.extensions?.[MOZ_LIGHTMAP], dir: m.extensions?.[IRBAKE_LIGHTMAP_DIRECTIONAL] });
+    for (const info of [ext.moz, ...(ext.dir?.l1 ?? [])].filter(Boolean)) info.index = json.images[json.textures[info.index].source].uri;
+    return ext;
+  });
+  const written = await io.writeJSON(await io.readJSON(clone()));
+  check(original.json.materials.some(m => m.extensions?.[IRBAKE_LIGHTMAP_DIRECTIONAL]), `${args.input}: not a --directional bake`);
+  check(same(normalised(written.json), normalised(original.json)),
+        `read → write changed the extensions:\n  ${JSON.stringify(canonical(normalised(written.json)))}\n  ` +
+        JSON.stringify(canonical(normalised(original.json))));
+
+  // Bad input: material 0 with one field changed.
+  const name = original.json.materials[0].name;
+  const label = `material 0 ('${name}')`;
+  const bad = (mutate) => () => { const doc = clone(); mutate(doc.json.materials[0].extensions); return io.readJSON(doc); };
+  await throws('missing texture', bad(e => { e[MOZ_LIGHTMAP].index = 99; }), label, 'texture 99 does not exist');
+  await throws('no texture index', bad(e => { delete e[MOZ_LIGHTMAP].index; }), label, 'no texture index');
+  await throws('texCoord 0', bad(e => { e[MOZ_LIGHTMAP].texCoord = 0; }), label, 'texCoord 0');
+  await throws('texCoord 2', bad(e => { e[MOZ_LIGHTMAP].texCoord = 2; }), label, 'texCoord 2');
+  await throws('negative intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = -1; }), label, 'intensity -1');
+  await throws('NaN intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = 'NaN'; }), label, 'intensity "NaN"');
+  await throws('null intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = null; }), label, 'intensity null');
+  await throws('two L1 pages', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1.pop(); }), label, 'l1 needs 3 entries');
+  await throws('L1 texCoord 0', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[2].texCoord = 0; }), label, 'l1[2]', 'texCoord 0');
+  await throws('L1 missing texture', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[1].index = 42; }), label, 'texture 42 does not exist');
+  await throws('L1 negative scale', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[0].scale = -2; }), label, 'scale -2');
+
+  // Bad output: a light-mapped primitive without TEXCOORD_1; one triangle fewer (what simplification does).
+  const lightmapped = doc => doc.getRoot().listMeshes().flatMap(m => m.listPrimitives().map(p => [m, p]))
+    .find(([, p]) => p.getMaterial()?.getExtension(MOZ_LIGHTMAP) && p.getIndices());
+  {
+    const doc = await io.readJSON(clone());
+    const [mesh, prim] = lightmapped(doc);
+    prim.setAttribute('TEXCOORD_1', null);
+    await throws('no TEXCOORD_1', () => io.writeJSON(doc), `('${mesh.getName()}')`, `('${prim.getMaterial().getName()}')`,
+                 'needs TEXCOORD_1');
+  }
+  {
+    const doc = await io.readJSON(clone());
+    const [, prim] = lightmapped(doc);
+    const indices = prim.getIndices();
+    indices.setArray(indices.getArray().slice(0, indices.getCount() - 3));
+    await throws('one triangle fewer', () => io.writeJSON(doc), `material '${prim.getMaterial().getName()}'`, 'simplified');
+  }
+  {
+    const doc = await io.readJSON(clone());
+    const lightmap = doc.getRoot().listMaterials()[0].getExtension(MOZ_LIGHTMAP);
+    await throws('setIntensity(NaN)', () => lightmap.setIntensity(NaN), 'intensity null');
+  }
+  // prune moves a material's only UV set to TEXCOORD_0; the written file has the light map on TEXCOORD_1 again.
+  {
+    const doc = await io.readJSON(clone());
+    await doc.transform(functions.prune());
+    const shifted = doc.getRoot().listMaterials().filter(m => m.getExtension(MOZ_LIGHTMAP)?.getTextureInfo().getTexCoord() === 0);
+    const json = (await io.writeJSON(doc)).json;
+    const bad = json.meshes.flatMap(m => m.primitives).filter(p => json.materials[p.material].extensions?.[MOZ_LIGHTMAP] &&
+      (p.attributes.TEXCOORD_1 === undefined || json.materials[p.material].extensions[MOZ_LIGHTMAP].texCoord !== 1));
+    check(bad.length === 0, `after prune: ${bad.length} light-mapped primitives without the map on TEXCOORD_1`);
+    console.log(JSON.stringify({ roundTrip: 'exact', refusalsChecked: refused, pruneShiftedMaterials: shifted.length }));
+  }
+}
+
+await (mode === 'survives' ? survives() : refusals());
+if (failures.length) {
+  console.error(`gltf_transform_check ${mode}:\n  ${failures.join('\n  ')}`);
+  process.exit(1);
+}

@@ -1,0 +1,384 @@
+// irbake's light-map extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap and
+// IRBAKE_lightmap_directional as extension properties whose textures are real Texture references
+// (TextureInfo, texCoord 1), so prune, dedup, resize and texture compression treat the maps as used textures and
+// keep TEXCOORD_1. Reading refuses what irbake's viewers would show wrongly (a missing texture, a texCoord other
+// than 1, a negative or non-numeric intensity, an incomplete directional extension) with an Error naming the
+// material. Writing refuses an output on which the bake no longer fits its geometry: a light-mapped primitive
+// without TEXCOORD_1, or fewer light-mapped triangles than were read (simplification).
+//
+// The classes must extend the very @gltf-transform/core the caller (the CLI) uses, so they are made from it:
+//   const core = await importPackage(modulesDir, '@gltf-transform/core');
+//   const { MozLightmap, IrbakeLightmapDirectional } = defineIrbakeExtensions(core);
+//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional]);
+import fs from 'node:fs';
+import path from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+export const MOZ_LIGHTMAP = 'MOZ_lightmap';
+export const IRBAKE_LIGHTMAP_DIRECTIONAL = 'IRBAKE_lightmap_directional';
+// The UV set of every light map (docs/export.md): TEXCOORD_1.
+export const LIGHTMAP_TEXCOORD = 1;
+const AXES = ['x', 'y', 'z'];
+
+// The folder that holds node_modules/@gltf-transform/core: IRBAKE_WEB_MODULES when set (BUILD/web), else the
+// installation the running script comes from (the gltf-transform CLI in BUILD/web/node_modules/.bin).
+export function findModulesDir(start = process.env.IRBAKE_WEB_MODULES ?? process.argv[1]) {
+  if (!start) throw new Error('gltf_transform_irbake: no modules folder (set IRBAKE_WEB_MODULES to BUILD/web)');
+  let dir = fs.existsSync(start) ? fs.realpathSync(start) : path.resolve(start);
+  if (fs.existsSync(dir) && !fs.statSync(dir).isDirectory()) dir = path.dirname(dir);
+  for (;;) {
+    if (fs.existsSync(path.join(dir, 'node_modules', '@gltf-transform', 'core', 'package.json'))) return dir;
+    const up = path.dirname(dir);
+    if (up === dir) throw new Error(`gltf_transform_irbake: no node_modules/@gltf-transform/core above ${start} ` +
+                                    '(scripts/install-web-deps.sh BUILD_DIR installs it; IRBAKE_WEB_MODULES=BUILD/web)');
+    dir = up;
+  }
+}
+
+// Imports a package's ES-module entry from MODULES_DIR/node_modules (the same file the CLI imports, so the same
+// classes).
+export async function importPackage(modulesDir, name) {
+  const root = path.join(modulesDir, 'node_modules', ...name.split('/'));
+  const pkg = JSON.parse(fs.readFileSync(path.join(root, 'package.json'), 'utf8'));
+  const pick = e => (typeof e === 'string' ? e : e && typeof e === 'object' ? pick(e.import ?? e.default ?? e['.']) : undefined);
+  const entry = pick(pkg.exports) ?? pkg.module ?? pkg.main ?? 'index.js';
+  return import(pathToFileURL(path.join(root, entry)).href);
+}
+
+// "material 3 ('white')": how errors name a material.
+function materialLabel(index, def) {
+  return `material ${index}${def?.name ? ` ('${def.name}')` : ''}`;
+}
+function materialName(material, document) {
+  const index = document.getRoot().listMaterials().indexOf(material);
+  return `material ${index}${material.getName() ? ` ('${material.getName()}')` : ''}`;
+}
+
+const isObject = v => v !== null && typeof v === 'object' && !Array.isArray(v);
+
+// The texture a texture-info definition names, or an Error saying why it cannot be used.
+function textureOf(context, def, what) {
+  const textures = context.jsonDoc.json.textures ?? [];
+  if (!isObject(def) || !Number.isInteger(def.index))
+    throw new Error(`${what}: no texture index (${JSON.stringify(def?.index)})`);
+  if (def.index < 0 || def.index >= textures.length)
+    throw new Error(`${what}: texture ${def.index} does not exist (the file has ${textures.length})`);
+  const texture = context.textures[textures[def.index].source];
+  if (!texture) throw new Error(`${what}: texture ${def.index} has no image`);
+  return texture;
+}
+
+function checkTexCoord(def, what) {
+  const texCoord = def.texCoord ?? LIGHTMAP_TEXCOORD;
+  if (texCoord !== LIGHTMAP_TEXCOORD)
+    throw new Error(`${what}: texCoord ${JSON.stringify(def.texCoord)}, but light maps use TEXCOORD_${LIGHTMAP_TEXCOORD}`);
+}
+
+function checkIntensity(value, what) {
+  if (typeof value !== 'number' || !Number.isFinite(value) || value < 0)
+    throw new Error(`${what}: intensity ${JSON.stringify(value)} (NaN when not a number) must be a finite number ≥ 0`);
+}
+
+// Light-mapped triangles per material name, over every node instance of the scenes (GPU instances counted).
+// Optimisers that keep a bake valid (weld, join, dedup, quantise, flatten, texture compression) keep these
+// counts; simplification lowers them.
+export function countLightmappedTriangles(document) {
+  const counts = new Map();
+  const seen = new Set();
+  for (const scene of document.getRoot().listScenes())
+    scene.traverse(node => {
+      const mesh = node.getMesh();
+      if (!mesh || seen.has(node)) return;
+      seen.add(node);
+      const instanced = node.getExtension('EXT_mesh_gpu_instancing');
+      const copies = instanced ? (instanced.listAttributes()[0]?.getCount() ?? 1) : 1;
+      for (const prim of mesh.listPrimitives()) {
+        const material = prim.getMaterial();
+        if (!material?.getExtension(MOZ_LIGHTMAP)) continue;
+        const n = prim.getIndices()?.getCount() ?? prim.getAttribute('POSITION')?.getCount() ?? 0;
+        const mode = prim.getMode();
+        const triangles = mode === 4 ? Math.floor(n / 3) : mode === 5 || mode === 6 ? Math.max(0, n - 2) : 0;
+        const name = material.getName() || '(unnamed)';
+        counts.set(name, (counts.get(name) ?? 0) + triangles * copies);
+      }
+    });
+  return counts;
+}
+
+export function defineIrbakeExtensions(core) {
+  const { Extension, ExtensionProperty, PropertyType, TextureInfo, TextureChannel } = core;
+  const RGB = TextureChannel.R | TextureChannel.G | TextureChannel.B;
+
+  // MOZ_lightmap on a material: the map texture (TEXCOORD_1) and the intensity that scales its decoded value.
+  class Lightmap extends ExtensionProperty {
+    static EXTENSION_NAME = MOZ_LIGHTMAP;
+    init() {
+      this.extensionName = MOZ_LIGHTMAP;
+      this.propertyType = 'Lightmap';
+      this.parentTypes = [PropertyType.MATERIAL];
+    }
+    getDefaults() {
+      return Object.assign(super.getDefaults(), {
+        intensity: 1,
+        lightmapTexture: null,
+        lightmapTextureInfo: new TextureInfo(this.graph, 'lightmapTextureInfo').setTexCoord(LIGHTMAP_TEXCOORD),
+        otherFields: {},  // fields of the definition this class does not model, written back as read
+      });
+    }
+    getIntensity() { return this.get('intensity'); }
+    setIntensity(intensity) {
+      checkIntensity(intensity, MOZ_LIGHTMAP);
+      return this.set('intensity', intensity);
+    }
+    getTexture() { return this.getRef('lightmapTexture'); }
+    getTextureInfo() { return this.getRef('lightmapTexture') ? this.getRef('lightmapTextureInfo') : null; }
+    // isColor: irbake's PNG is sRGB-encoded when extras.colorSpace says so (texture compression then treats
+    // it as colour).
+    setTexture(texture) {
+      const srgb = this.getRef('lightmapTextureInfo').getExtras().colorSpace === 'srgb';
+      return this.setRef('lightmapTexture', texture, { channels: RGB, isColor: srgb });
+    }
+    getOtherFields() { return this.get('otherFields'); }
+    setOtherFields(fields) { return this.set('otherFields', fields); }
+  }
+
+  // IRBAKE_lightmap_directional on a material: three linear L1 pages (x, y, z) with their scales, and the
+  // names of their float EXR copies.
+  class DirectionalLightmap extends ExtensionProperty {
+    static EXTENSION_NAME = IRBAKE_LIGHTMAP_DIRECTIONAL;
+    init() {
+      this.extensionName = IRBAKE_LIGHTMAP_DIRECTIONAL;
+      this.propertyType = 'DirectionalLightmap';
+      this.parentTypes = [PropertyType.MATERIAL];
+    }
+    getDefaults() {
+      const defaults = Object.assign(super.getDefaults(), { scales: [1, 1, 1], exr: null, otherFields: {}, l1OtherFields: [{}, {}, {}] });
+      for (const a of AXES) {
+        defaults[`l1${a}Texture`] = null;
+        defaults[`l1${a}TextureInfo`] = new TextureInfo(this.graph, `l1${a}TextureInfo`).setTexCoord(LIGHTMAP_TEXCOORD);
+      }
+      return defaults;
+    }
+    // axis 0, 1, 2: x, y, z.
+    getL1Texture(axis) { return this.getRef(`l1${AXES[axis]}Texture`); }
+    getL1TextureInfo(axis) { return this.getRef(`l1${AXES[axis]}Texture`) ? this.getRef(`l1${AXES[axis]}TextureInfo`) : null; }
+    setL1Texture(axis, texture) { return this.setRef(`l1${AXES[axis]}Texture`, texture, { channels: RGB, isColor: false }); }
+    getScales() { return this.get('scales').slice(); }
+    setScales(scales) {
+      if (!Array.isArray(scales) || scales.length !== 3 || !scales.every(s => typeof s === 'number' && Number.isFinite(s) && s >= 0))
+        throw new Error(`${IRBAKE_LIGHTMAP_DIRECTIONAL}: scales ${JSON.stringify(scales)} must be 3 finite numbers ≥ 0`);
+      return this.set('scales', scales.slice());
+    }
+    getExr() { return this.get('exr'); }
+    setExr(exr) { return this.set('exr', exr ? exr.slice() : null); }
+    getOtherFields() { return this.get('otherFields'); }
+    setOtherFields(fields) { return this.set('otherFields', fields); }
+    getL1OtherFields() { return this.get('l1OtherFields'); }
+    setL1OtherFields(fields) { return this.set('l1OtherFields', fields); }
+  }
+
+  // Fields a class models; the rest of a definition is kept verbatim.
+  const without = (def, keys) => Object.fromEntries(Object.entries(def).filter(([k]) => !keys.includes(k)));
+
+  class MozLightmap extends Extension {
+    static EXTENSION_NAME = MOZ_LIGHTMAP;
+    extensionName = MOZ_LIGHTMAP;
+    prereadTypes = [PropertyType.MESH];
+    prewriteTypes = [PropertyType.MESH];
+    // Light-mapped triangles per material name as read; the write refuses fewer.
+    readTriangles = null;
+
+    createLightmap() { return new Lightmap(this.document.getGraph()); }
+
+    preread(context) {
+      (context.jsonDoc.json.materials ?? []).forEach((materialDef, index) => {
+        const def = materialDef.extensions?.[MOZ_LIGHTMAP];
+        if (def === undefined) return;
+        const what = `${materialLabel(index, materialDef)}: ${MOZ_LIGHTMAP}`;
+        if (!isObject(def)) throw new Error(`${what} is not an object`);
+        const texture = textureOf(context, def, what);
+        checkTexCoord(def, what);
+        const intensity = 'intensity' in def ? def.intensity : 1;
+        checkIntensity(intensity, what);
+        const lightmap = this.createLightmap().setIntensity(intensity);
+        context.setTextureInfo(lightmap.getRef('lightmapTextureInfo'), def);  // texCoord, extras, sampler
+        lightmap.setTexture(texture).setOtherFields(without(def, ['index', 'texCoord', 'intensity', 'extras']));
+        context.materials[index].setExtension(MOZ_LIGHTMAP, lightmap);
+      });
+      return this;
+    }
+
+    read() {
+      this.readTriangles = countLightmappedTriangles(this.document);
+      return this;
+    }
+
+    prewrite(context) {
+      const materials = this.document.getRoot().listMaterials();
+      for (const material of materials) {
+        const lightmap = material.getExtension(MOZ_LIGHTMAP);
+        if (!lightmap) continue;
+        const texture = lightmap.getTexture();
+        if (!texture) throw new Error(`${materialName(material, this.document)}: ${MOZ_LIGHTMAP} has no texture`);
+        checkIntensity(lightmap.getIntensity(), `${materialName(material, this.document)}: ${MOZ_LIGHTMAP}`);
+        const def = context.createTextureInfoDef(texture, lightmap.getTextureInfo());
+        def.texCoord = lightmap.getTextureInfo().getTexCoord();  // written even when 0 (normalised in write())
+        def.intensity = lightmap.getIntensity();
+        Object.assign(def, lightmap.getOtherFields());
+        const materialDef = context.jsonDoc.json.materials[context.materialIndexMap.get(material)];
+        materialDef.extensions = materialDef.extensions ?? {};
+        materialDef.extensions[MOZ_LIGHTMAP] = def;
+      }
+      return this;
+    }
+
+    // After everything is written: every light-mapped primitive reads its map through TEXCOORD_1, and the
+    // geometry the bake was made for is still there.
+    write(context) {
+      const json = context.jsonDoc.json;
+      const root = this.document.getRoot();
+      const moved = new Map();
+      for (const mesh of root.listMeshes()) {
+        const meshIndex = context.meshIndexMap.get(mesh);
+        if (meshIndex === undefined) continue;
+        mesh.listPrimitives().forEach((prim, p) => {
+          const material = prim.getMaterial();
+          if (!material?.getExtension(MOZ_LIGHTMAP)) return;
+          const materialDef = json.materials[context.materialIndexMap.get(material)];
+          const primDef = json.meshes[meshIndex].primitives[p];
+          const where = `mesh ${meshIndex}${mesh.getName() ? ` ('${mesh.getName()}')` : ''} primitive ${p}, ` +
+                        `${materialName(material, this.document)}`;
+          moveLightmapToSet1(json, materialDef, primDef, where, moved);
+          const uv = primDef.attributes[`TEXCOORD_${LIGHTMAP_TEXCOORD}`], position = primDef.attributes.POSITION;
+          if (uv === undefined) throw new Error(`${where}: ${MOZ_LIGHTMAP} needs TEXCOORD_1, which this primitive lacks`);
+          if (json.accessors[uv].count !== json.accessors[position].count)
+            throw new Error(`${where}: TEXCOORD_1 has ${json.accessors[uv].count} vertices, POSITION ${json.accessors[position].count}`);
+        });
+      }
+      if (this.readTriangles) {
+        const now = countLightmappedTriangles(this.document);
+        const total = m => [...m.values()].reduce((a, b) => a + b, 0);
+        const fewer = [...this.readTriangles].filter(([name, n]) => now.has(name) && now.get(name) < n)
+          .map(([name, n]) => `material '${name}' ${n} → ${now.get(name)}`);
+        if (fewer.length || total(now) < total(this.readTriangles))
+          throw new Error(`${MOZ_LIGHTMAP}: light-mapped triangles ${total(this.readTriangles)} → ${total(now)}` +
+                          `${fewer.length ? ` (${fewer.join(', ')})` : ''}: the geometry was simplified, and the baked ` +
+                          'light maps no longer fit it. Keep the triangles (gltf-transform optimize --simplify false) ' +
+                          'or bake the simplified model.');
+      }
+      return this;
+    }
+  }
+
+  class IrbakeLightmapDirectional extends Extension {
+    static EXTENSION_NAME = IRBAKE_LIGHTMAP_DIRECTIONAL;
+    extensionName = IRBAKE_LIGHTMAP_DIRECTIONAL;
+    prereadTypes = [PropertyType.MESH];
+    prewriteTypes = [PropertyType.MESH];
+
+    createDirectionalLightmap() { return new DirectionalLightmap(this.document.getGraph()); }
+
+    preread(context) {
+      (context.jsonDoc.json.materials ?? []).forEach((materialDef, index) => {
+        const def = materialDef.extensions?.[IRBAKE_LIGHTMAP_DIRECTIONAL];
+        if (def === undefined) return;
+        const what = `${materialLabel(index, materialDef)}: ${IRBAKE_LIGHTMAP_DIRECTIONAL}`;
+        if (!isObject(def) || !Array.isArray(def.l1) || def.l1.length !== 3)
+          throw new Error(`${what}: l1 needs 3 entries (x, y, z)`);
+        if (materialDef.extensions[MOZ_LIGHTMAP] === undefined) throw new Error(`${what} without ${MOZ_LIGHTMAP}`);
+        if (def.exr !== undefined && !(Array.isArray(def.exr) && def.exr.length === 3 && def.exr.every(e => typeof e === 'string')))
+          throw new Error(`${what}: exr needs 3 file names`);
+        const directional = this.createDirectionalLightmap();
+        const scales = [];
+        def.l1.forEach((entry, axis) => {
+          const at = `${what}.l1[${axis}]`;
+          const texture = textureOf(context, entry, at);
+          checkTexCoord(entry, at);
+          const scale = 'scale' in entry ? entry.scale : 1;
+          if (typeof scale !== 'number' || !Number.isFinite(scale) || scale < 0)
+            throw new Error(`${at}: scale ${JSON.stringify(scale)} must be a finite number ≥ 0`);
+          scales.push(scale);
+          context.setTextureInfo(directional.getRef(`l1${AXES[axis]}TextureInfo`), entry);
+          directional.setL1Texture(axis, texture);
+        });
+        directional.setScales(scales).setExr(def.exr ?? null)
+          .setOtherFields(without(def, ['l1', 'exr']))
+          .setL1OtherFields(def.l1.map(e => without(e, ['index', 'texCoord', 'scale', 'extras'])));
+        context.materials[index].setExtension(IRBAKE_LIGHTMAP_DIRECTIONAL, directional);
+      });
+      return this;
+    }
+
+    read() { return this; }
+
+    prewrite(context) {
+      for (const material of this.document.getRoot().listMaterials()) {
+        const directional = material.getExtension(IRBAKE_LIGHTMAP_DIRECTIONAL);
+        if (!directional) continue;
+        const what = `${materialName(material, this.document)}: ${IRBAKE_LIGHTMAP_DIRECTIONAL}`;
+        if (!material.getExtension(MOZ_LIGHTMAP)) throw new Error(`${what} without ${MOZ_LIGHTMAP}`);
+        const scales = directional.getScales(), other = directional.getL1OtherFields();
+        const l1 = [0, 1, 2].map(axis => {
+          const texture = directional.getL1Texture(axis);
+          if (!texture) throw new Error(`${what}: no L1${AXES[axis]} texture`);
+          const def = context.createTextureInfoDef(texture, directional.getL1TextureInfo(axis));
+          def.texCoord = directional.getL1TextureInfo(axis).getTexCoord();
+          def.scale = scales[axis];
+          return Object.assign(def, other[axis]);
+        });
+        const def = { l1, ...directional.getOtherFields() };
+        if (directional.getExr()) def.exr = directional.getExr();
+        const materialDef = context.jsonDoc.json.materials[context.materialIndexMap.get(material)];
+        materialDef.extensions = materialDef.extensions ?? {};
+        materialDef.extensions[IRBAKE_LIGHTMAP_DIRECTIONAL] = def;
+      }
+      return this;
+    }
+
+    write() { return this; }
+  }
+
+  return { MozLightmap, IrbakeLightmapDirectional, Lightmap, DirectionalLightmap };
+}
+
+// Texture infos inside a material definition (every object with an integer 'index': core slots and
+// extensions alike).
+function textureInfoDefs(value, out = []) {
+  if (Array.isArray(value)) value.forEach(v => textureInfoDefs(v, out));
+  else if (isObject(value)) {
+    if (Number.isInteger(value.index)) out.push(value);
+    for (const [k, v] of Object.entries(value)) if (k !== 'extras') textureInfoDefs(v, out);
+  }
+  return out;
+}
+
+// prune renumbers UV sets so that the used ones start at 0: a material whose only texture is its light map
+// comes out with the map on TEXCOORD_0. Light maps live on TEXCOORD_1 (docs/export.md), so the written
+// primitive gets its light-map UVs back there: the same accessor under both names when set 1 is free (as
+// irbake itself writes a primitive without other UVs), else sets k and 1 swap, with every texCoord of the
+// material. Only the JSON changes; the document stays as the transforms left it. `moved` remembers per
+// material definition what was done, so that its further primitives get the same.
+function moveLightmapToSet1(json, materialDef, primDef, where, moved) {
+  const lightmap = materialDef.extensions[MOZ_LIGHTMAP];
+  const done = moved.get(materialDef);
+  const k = done ? done.from : (lightmap.texCoord ?? 0);
+  if (k === LIGHTMAP_TEXCOORD) return;
+  const from = `TEXCOORD_${k}`, to = `TEXCOORD_${LIGHTMAP_TEXCOORD}`;
+  if (primDef.attributes[from] === undefined) throw new Error(`${where}: ${MOZ_LIGHTMAP} reads ${from}, which this primitive lacks`);
+  const mode = primDef.attributes[to] === undefined ? 'alias' : 'swap';
+  if (done && done.mode !== mode)
+    throw new Error(`${where}: the material's primitives disagree on whether TEXCOORD_1 exists; cannot put its light map on TEXCOORD_1`);
+  if (mode === 'alias') primDef.attributes[to] = primDef.attributes[from];
+  else [primDef.attributes[to], primDef.attributes[from]] = [primDef.attributes[from], primDef.attributes[to]];
+  if (done) return;
+  moved.set(materialDef, { from: k, mode });
+  if (mode === 'alias') {
+    const directional = materialDef.extensions[IRBAKE_LIGHTMAP_DIRECTIONAL];
+    for (const info of [lightmap, ...(directional?.l1 ?? [])]) info.texCoord = LIGHTMAP_TEXCOORD;
+  } else {
+    for (const info of textureInfoDefs(materialDef)) {
+      const t = info.texCoord ?? 0;
+      info.texCoord = t === k ? LIGHTMAP_TEXCOORD : t === LIGHTMAP_TEXCOORD ? k : t;
+    }
+  }
+}
