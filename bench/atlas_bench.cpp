@@ -1,4 +1,4 @@
-// Atlas benchmark on the shared scenes against the xatlas targets of issue 3 (same protocol: padding 2,
+// Atlas benchmark on the shared scenes against xatlas's figures (docs/atlas.md; same protocol: padding 2,
 // one page that grows to fit, single thread). Writes bench/results/atlas.csv; quotes medians of --runs.
 //   atlas_bench [--scenes DIR] [--runs N] [--csv PATH] [--threads N]
 #include <algorithm>

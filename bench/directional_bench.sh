@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 15 figures (docs/performance.md "Directional maps"): a plain bake against --directional, alternating,
+# Directional-map figures (docs/validation.md, "Directional maps"): a plain bake against --directional, alternating,
 # RUNS pairs each, on the default Cornell bake (irbake samples) and the DamagedHelmet from ../shared/scenes
 # with --sun (skipped with a message when absent). Per run: wall and CPU seconds (user + system, less
 # sensitive to a shared machine's load), peak memory (/usr/bin/time), the backend and directional stage

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 14 figures (docs/distributed.md), on the default Cornell bake (irbake samples; irbake bake cornell_box.gltf):
+# The distributed-bake figures (docs/validation.md, "Distributed bakes"), on the default Cornell bake (irbake samples; irbake bake cornell_box.gltf):
 #  1. what the exact block sums cost: a baseline irbake (before them) and this one, alternating, 3 pairs,
 #     plus this one checkpointing after every VPL block → bench/results/vpl_blocks.csv
 #  2. scaling on a single-node Slurm on localhost (scripts/slurm/local-cluster.sh, as root): the bake

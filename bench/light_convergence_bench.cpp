@@ -1,4 +1,4 @@
-// Light-transport convergence and speed (issue 4). Writes two CSVs:
+// Light-transport convergence and speed. Writes two CSVs:
 //   convergence: series,n,relative_rmse   (square emitter over a black plane, exact form factor)
 //     vpl_halton     Keller's quasi-random walk, N paths (= N VPLs on the emitter)
 //     vpl_random     the same number of VPLs at independent uniform random points (the −0.5 baseline)

@@ -1,4 +1,4 @@
-// Speed against error (issue 5, item 7): both VPL backends (GL on EGL, Embree) at N = 64 … 4096
+// Speed against error: both VPL backends (GL on EGL, Embree) at N = 64 … 4096
 // light paths on the same atlas, texel samples and VPL sets, scored against a converged reference
 // bake (path tracer) of that atlas; time per stage. Plus the per-VPL cost of the GL backend's two
 // stages (shadow cube, accumulation) on a synthetic ~100k-triangle scene and a 1M-texel page.

@@ -65,7 +65,7 @@ FurnaceView viewBakedFurnace(const BakeOptions& options) {
   return f;
 }
 
-// Issue 6: every pixel 1.0 within 2%. The bake is converged for this purpose: a tight clamp (k = 4096,
+// Every pixel 1.0 within 2%. The bake is converged for this purpose: a tight clamp (k = 4096,
 // clamp radius ≈ the box) leaves nearly all transport to the compensation gather, which in a furnace reads
 // a uniform map and is almost noise-free. Measured: worst pixel 1.39%.
 TEST(BakedView, FurnaceSeenFromInsideIsOne) {
@@ -78,8 +78,7 @@ TEST(BakedView, FurnaceSeenFromInsideIsOne) {
 }
 
 // The same with the default estimator (k = 256 + gather, 4096 paths): VPL noise at the clamp-radius scale
-// remains. Measured: mean |error| 0.55%, p95 1.63%, worst 4.4% (session 1, k = 16 + Kollig–Keller: 0.68%,
-// 2.3%, 6.1%).
+// remains: the mean, the mean |error| and the 95th percentile are held tight, the worst pixel looser.
 TEST(BakedView, FurnaceWithDefaultEstimatorIsOneOnAverage) {
   const FurnaceView f = viewBakedFurnace(smallBake(4096, 4.0f));
   EXPECT_NEAR(f.mean, 1.0, 0.01);  // unbiased: the mean over every view is 1
@@ -161,7 +160,7 @@ TEST(BakedView, ExportedGltfShowsTheSameLightAsTheBake) {
   RecordProperty("pngMaxDifference", std::to_string(pngDiff));
 }
 
-// Issue 15, directional maps end to end: bake with directional maps, export, load as irview does, render.
+// Directional maps end to end: bake with directional maps, export, load as irview does, render.
 // A point light (I = 10 W/sr, 1 m) over a grey plane (ρ = 0.5; a single plane lights nothing of itself) with
 // a constant normal map tilted 35° towards +x (TEXCOORD_0 planar: u along +x, v along +z, tangent generated):
 // one source, so the L1 form is exact and every pixel within 1.5 m should show ρ I max(0, n·ω) / (π r²); the

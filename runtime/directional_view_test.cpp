@@ -1,4 +1,4 @@
-// Directional light maps in the viewer (issue 15, item 3): a floor of four quads, each with a constant
+// Directional light maps in the viewer: a floor of four quads, each with a constant
 // normal map, constant L0 and L1 pages. Every pixel must equal albedo × max(0, L0 (n_g·n) + t·n)
 // (transport/directional.h) for the quad's mapped normal n, which the test derives from the UV layout
 // (tangent = where u grows, bitangent = where v shrinks: glTF's +Y up with UV (0,0) at the image's top left),

@@ -51,7 +51,7 @@ GLuint uploadColorTexture(const Texture& t) {
 }
 
 // Light maps: half float (range to 65504, 11-bit mantissa: 0.05% relative, far below what a display
-// shows) — llvmpipe filters RGBA16F markedly faster than RGB32F (docs/performance.md, "Viewer");
+// shows) — llvmpipe filters RGBA16F markedly faster than RGB32F (docs/validation.md, "Viewer");
 // bilinear, no mipmaps (a coarser level would mix in the padding between charts), clamped at the page edge.
 GLuint uploadLightmap(int width, int height, GLenum format, const void* data) {
   GLuint tex = 0;

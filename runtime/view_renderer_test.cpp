@@ -340,7 +340,7 @@ TEST(ViewRenderer, SceneWithoutLightmapShowsAlbedoAndWarns) {
   EXPECT_EQ(img.at(0, 0), glm::vec4(0, 0, 0, 1));  // background outside the quad
 }
 
-// Issue 12: the sky is drawn behind the scene, as linear radiance (screenshots) and, on screen, exposed and
+// The sky is drawn behind the scene, as linear radiance (screenshots) and, on screen, exposed and
 // sRGB-encoded like the scene's pixels.
 TEST(ViewRenderer, SkyIsTheBackground) {
   GlContext gl;
@@ -361,7 +361,7 @@ TEST(ViewRenderer, SkyIsTheBackground) {
   EXPECT_EQ(skyBackground(Scene{}), glm::vec3(0.0f));  // no sky: black
 }
 
-// Issue 12: an environment map is drawn itself behind the scene. A 16 × 8 map with a distinct radiance per texel,
+// An environment map is drawn itself behind the scene. A 16 × 8 map with a distinct radiance per texel,
 // turned 40° about +Y: every background pixel whose view direction lies inside a texel (not within 2% of a texel
 // edge, where float and double directions may pick different neighbours) shows exactly the texel the baker's
 // Environment::radiance reads for that direction; pixels on the floor quad show the quad. On screen the same

@@ -3,7 +3,7 @@
 // VPL cubes are tiles of one depth atlas: a face is kept inside its tile by clip distances against its
 // rectangle in normalised device coordinates (the whole face, or the upper half of a side face plus a
 // texel), not by a scissor, because on llvmpipe a scissor change per face cost about as much as drawing
-// a small scene's face (docs/performance.md). The viewport still maps the face onto its tile.
+// a small scene's face. The viewport still maps the face onto its tile.
 layout(location = 0) in vec3 position;
 uniform vec4 shadowView[5];  // [0..3]: clip matrix columns; [4]: the face rectangle (x0, x1, y0, y1) in NDC
 void main() {

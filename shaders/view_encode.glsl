@@ -2,7 +2,7 @@
 // The sRGB encode (IEC 61966-2-1) without pow(): above the linear toe, 1.055 c^(1/2.4) − 0.055 is
 // fitted (minimax over [0.0031308, 1]) by a·c^(1/2) + b·c^(1/4) + d·c + e. Max error 3.6e-4, a tenth
 // of an 8-bit step; llvmpipe's pow() is a log2 and an exp2 polynomial each, this is two sqrt and
-// three multiply-adds (frame 100k: 13 ms of CPU for the exact encode, see docs/performance.md).
+// three multiply-adds.
 vec3 encodeSrgb(vec3 c) {
   c = clamp(c, 0.0, 1.0);
   vec3 s1 = sqrt(c), s2 = sqrt(s1);

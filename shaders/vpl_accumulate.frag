@@ -3,8 +3,7 @@
 // one 2D depth atlas (gl_resources.h, DepthAtlas: faces +X −X +Y −Y +Z; −Z is never drawn and reads as lit).
 // Output: the batch's contribution to irradiance/π, summed by additive blending.
 //
-// Cost on llvmpipe (8 fragments per SIMD vector, 2 threads) is everything inside the per-VPL loop, so
-// (docs/performance.md, "What limits the per-VPL cost"):
+// Cost on llvmpipe (8 fragments per SIMD vector, 2 threads) is everything inside the per-VPL loop, so:
 // - SHADOW_COMPARE: hardware depth comparison with bilinear filtering (sampler2DArrayShadow, GL_LINEAR,
 //   GL_GEQUAL) gives the 2×2 percentage-closer filter in one lookup instead of 4 texelFetch + compares.
 // - The lookup point in the cube frame comes from d (receiver → VPL) and cy; no second position.

@@ -492,7 +492,7 @@ TEST(BakeCommand, ProgressBarsOnATerminalNeverGlueLogLinesAndQuietDrawsNone) {
   EXPECT_NE(quiet.find("lightmap_0.exr"), std::string::npos) << quiet;
 }
 
-// Issue 14: the same scene, options and seed give byte-identical EXR pages, glTF, .bin and PNGs on either backend
+// The same scene, options and seed give byte-identical EXR pages, glTF, .bin and PNGs on either backend
 // and any thread count (twice each); the geometry (.bin) does not depend on the backend.
 TEST(BakeCommand, IdenticalBytesForAnyThreadCountAndRun) {
   const fs::path scene = samplesDir() / "cornell_box.gltf";
@@ -538,7 +538,7 @@ TEST(BakeCommand, IdenticalBytesForAnyThreadCountAndRun) {
   EXPECT_TRUE(firstBin["gl"] == firstBin["embree"]);  // the geometry written does not depend on the backend
 }
 
-// Issue 12: --sky lights a bake and travels with the export (root extras "irbakeSky"), so the loader (and
+// --sky lights a bake and travels with the export (root extras "irbakeSky"), so the loader (and
 // irview, which draws it behind the scene) get it back.
 TEST(BakeCommand, SkyTravelsWithTheExport) {
   const fs::path dir = scratch("sky_export");
@@ -556,7 +556,7 @@ TEST(BakeCommand, SkyTravelsWithTheExport) {
       << log;
 }
 
-// Issue 12: an environment map travels as its file, mean radiance and rotation; the loader reads the file back
+// An environment map travels as its file, mean radiance and rotation; the loader reads the file back
 // with the bake's --env-intensity (recovered from the recorded mean) and rotation, so irview draws the sky the bake
 // saw: every texel centre's direction returns intensity × the file's texel.
 TEST(BakeCommand, EnvironmentMapTravelsWithTheExport) {
@@ -588,7 +588,7 @@ TEST(BakeCommand, EnvironmentMapTravelsWithTheExport) {
     }
 }
 
-// Issue 14: the report is part of the all-or-nothing set: when it cannot be written, neither are the glTF,
+// The report is part of the all-or-nothing set: when it cannot be written, neither are the glTF,
 // its .bin and PNG, nor the EXR pages.
 TEST(BakeCommand, ReportIsWrittenWithTheOutputsOrNotAtAll) {
   const fs::path dir = scratch("report_atomic");

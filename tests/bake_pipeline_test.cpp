@@ -122,9 +122,9 @@ TEST(BakePipeline, DefaultGlBakeOfTheFurnaceIsWithinOnePercent) {
   }
 }
 
-// Issue 11: high albedo with default options (only the texel density lowered to keep the test short:
-// the mean does not depend on it). The walk no longer stops at a fixed 16 bounces (−17% at ρ = 0.9, −84%
-// at ρ = 0.99): it follows the light up to its VPL budget and adds the rest as a geometric tail.
+// High albedo with default options (only the texel density lowered to keep the test short:
+// the mean does not depend on it). The walk follows the light up to its VPL budget and adds the rest as a
+// geometric tail (docs/units.md, "Bounce depth"): a fixed bounce count would lose most of the light at ρ = 0.99.
 TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
   for (float rho : {0.9f, 0.99f})
     for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree}) {
@@ -153,7 +153,7 @@ TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
     }
 }
 
-// Issue 12: a uniform sky over an open plane gives map = L on every backend and with the final gather, which
+// A uniform sky over an open plane gives map = L on every backend and with the final gather, which
 // counts the sky with its own rays (its bounces cannot reach the plane again); a plane under a box's overhang gets less, the same on GL and Embree.
 TEST(BakePipeline, UniformSkyOverAnOpenPlaneOnEveryBackend) {
   for (int run = 0; run < 4; ++run) {  // GL, Embree, reference, and Embree with the final gather (the sky its misses)

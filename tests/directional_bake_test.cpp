@@ -1,4 +1,4 @@
-// Directional maps (issue 15) through the whole pipeline: L0 stays the plain bake's bytes, the L1 pages
+// Directional maps through the whole pipeline: L0 stays the plain bake's bytes, the L1 pages
 // reconstruct the point light's cosine for tilted normals after atlas, texel samples and post, and the
 // export carries them in IRBAKE_lightmap_directional.
 #include <cmath>
@@ -174,7 +174,7 @@ TEST(DirectionalBake, ExportCarriesTheExtension) {
   EXPECT_GE(materials, 1u);
 }
 
-// A uniform sky over an open plane (issue 15, item 4): constant L0 (= L, as without --directional) and zero L1
+// A uniform sky over an open plane: constant L0 (= L, as without --directional) and zero L1
 // (the sky's tangential vector traced with bounded-term rays: |t| < 0.2% of L).
 TEST(DirectionalBake, UniformSkyConstantL0ZeroL1) {
   Scene s = samples::makePointOverPlane();

@@ -1,4 +1,4 @@
-// Issue 14: one bake split over machines and over interruptions gives the bytes of the bake on one
+// One bake split over machines and over interruptions gives the bytes of the bake on one
 // machine: `bake --shard K/N` + `merge`, and `bake --resume` after SIGKILL at random moments.
 #include <signal.h>
 #include <sys/wait.h>
@@ -223,7 +223,7 @@ TEST(Distributed, ResumeRefusesTheCheckpointOfAnotherBake) {
   EXPECT_TRUE(fs::exists(checkpoint));  // refused, not destroyed
 }
 
-// Directional bakes (issue 15) sum their L1 pages in the same exact block sums as the map: shards merged,
+// Directional bakes sum their L1 pages in the same exact block sums as the map: shards merged,
 // and a bake resumed from a checkpoint, give the one-shot bake's bytes, L1 pages included, on both
 // backends. The resume starts from the sums of the first half of the blocks, which is what shard 1/2's
 // partial holds (same header fields as a checkpoint of that bake): deterministic, unlike a SIGKILL.

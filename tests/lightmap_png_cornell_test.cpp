@@ -1,4 +1,4 @@
-// Issue 13 item 2 on the real case: the default sample bake of the Cornell box (README command (a)'s
+// The light-map PNG's encoding on a real case: the default sample bake of the Cornell box (README command (a)'s
 // settings), its 8-bit MOZ_lightmap PNG measured with the old encoding (linear, range = brightest
 // texel) and the new one (sRGB, range = 99.9th percentile). docs/export.md quotes these figures.
 #include <cstdio>
@@ -30,7 +30,7 @@ TEST(LightmapPngCornell, SrgbAtThe999thPercentileKeepsTheShadows) {
     ::testing::Test::RecordProperty(std::string(variants[v].name) + "_zero", std::to_string(e[v].zeroFraction));
     ::testing::Test::RecordProperty(std::string(variants[v].name) + "_p90", std::to_string(e[v].relErrorP90));
   }
-  // The old encoding loses a channel on several percent of the covered texels (issue 13: 8.5%).
+  // The old encoding loses a channel on several percent of the covered texels.
   EXPECT_GT(e[0].zeroFraction, 0.03);
   // The new one (the export's default) loses none of them, and 9 in 10 channels are closer.
   const LightmapPngOptions defaults;

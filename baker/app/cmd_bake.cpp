@@ -344,9 +344,8 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;
-  // Where the final gather runs, half the default paths: it reads the VPLs' map averaged over each texel's
-  // hemisphere (Sponza sun + sky, views 2 / 3 against Cycles: 3072 paths 2.01-2.05 / 4.07-4.24%, 6144
-  // 1.96-2.11 / 3.97-4.13%, 1536 one seed 4.62%; docs/accuracy.md, session 12).
+  // Where the final gather runs, fewer paths (the preset's pathsUnderGather): it reads the VPLs' map averaged
+  // over each texel's hemisphere, so more paths barely lower the error there (docs/validation.md, "Sponza").
   const QualityPreset& preset = *findQualityPreset(a.quality);
   o.walk.paths = a.paths > 0 ? a.paths : preset.paths;
   if (a.paths == 0) o.finalGatherPaths = preset.pathsUnderGather;

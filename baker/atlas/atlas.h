@@ -15,7 +15,7 @@ struct AtlasOptions {
   int targetPageSize = 1024;   // page edge used by the auto-fit when texelsPerUnit is 0
   float texelsPerTriangle = 64.0f;       // auto-fit: at least this many chart texels per triangle, so a
                                          // detailed level gets a finer map than one page (Sponza, 66k
-                                         // triangles: 9.2 → 18 texels/m; docs/accuracy.md)
+                                         // triangles: 18 texels/m instead of 9.2)
   size_t maxAutoTexels = size_t(1) << 22;  // auto-fit: chart texels never above this (4M), whatever the
                                            // triangle count
   int padding = 2;             // empty texels kept around every chart (bilinear-safe)

@@ -20,7 +20,7 @@ struct CellHash {
 
 // Welds the primitive's positions on a grid of `cell`: appends one position per occupied cell to
 // vertexPos and returns the welded vertex of every input vertex. The cell map (~60 bytes per vertex)
-// is gone before the half-edge structure is built, the atlas stage's peak (docs/performance.md, "Memory").
+// is gone before the half-edge structure is built, the atlas stage's peak (docs/validation.md, "Memory").
 std::vector<uint32_t> weldPositions(const Primitive& prim, double cell, std::vector<glm::dvec3>& vertexPos) {
   std::vector<uint32_t> weldOf(prim.positions.size());
   std::unordered_map<std::array<int64_t, 3>, uint32_t, CellHash> cells;

@@ -606,7 +606,7 @@ TEST(Atlas, SharedGazeboSceneIsValid) {
   expectValid(s, r, 2);
   EXPECT_GE(r.stats.areaStretchP5, 0.85);
   EXPECT_LE(r.stats.areaStretchP95, 1.15);
-  EXPECT_GE(r.stats.centreUtilisation, 0.686);  // issue 3 target (xatlas: 68.6%)
+  EXPECT_GE(r.stats.centreUtilisation, 0.686);  // xatlas's utilisation here (docs/atlas.md)
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Directional light maps in the export (issue 15, docs/export.md "IRBAKE_lightmap_directional"): the L1
+// Directional light maps in the export (docs/export.md "IRBAKE_lightmap_directional"): the L1
 // pages as float EXR pages and 8-bit PNGs, referenced from a vendor extension on each light-mapped material.
 // MOZ_lightmap (L0) is unchanged, so clients that know nothing more keep working.
 #pragma once

@@ -310,7 +310,7 @@ std::vector<uint8_t> element(const json& j, const std::vector<uint8_t>& bin, int
 
 }  // namespace
 
-// Issue 13 item 1: the export is the source document with only the light-map data added, nothing
+// The export is the source document with only the light-map data added, nothing
 // unused left behind, and one light-map region per instance of a shared mesh.
 TEST(GltfExport, KeepsTheSourceDocumentAndGivesEachInstanceItsOwnRegion) {
   auto dir = irbake::testing::testFolder("export_keeps_source");

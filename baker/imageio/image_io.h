@@ -4,7 +4,7 @@
 // commands, the dynamic loader spent ~0.3 s of every start resolving their symbols, even for
 // `irbake info` on a missing file. Only this small interface is linked; the OpenImageIO side is a
 // plugin (libirbake_imageio_oiio.so, plugin/oiio_plugin.cpp) opened with dlopen the first time an
-// image is decoded, encoded, read or written. docs/performance.md has the start-up figures.
+// image is decoded, encoded, read or written (docs/validation.md, "Start-up").
 #pragma once
 #include <cstdint>
 #include <filesystem>

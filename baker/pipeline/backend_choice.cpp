@@ -13,7 +13,7 @@ AutoBackendChoice chooseAutoBackend(size_t triangles, const std::string& seeThro
   }
   if (triangles > kGlTriangleHint) {
     c.reason = count + " (> " + hint + "): Embree was as fast as GL or faster, on llvmpipe and on a GPU, and took " +
-               "less memory (docs/performance.md)";
+               "less memory (docs/validation.md)";
     return c;
   }
   const GlProbe gl = probeGl();

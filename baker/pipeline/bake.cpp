@@ -200,8 +200,8 @@ struct StagedBake::State {
       if (backend != BackendKind::Reference && options.eval.includeVpls && !vpls.vpls.empty()) {
         double evenness = 0.0;
         // auto: only under the final gather. Without it the selection thins the VPLs that light bright texels,
-        // which costs a plain bake's close-ups more than it gives (Sponza view 2: +0.3-0.4 points, session 11);
-        // with it view 2 holds (1.96-2.11%) and view 3's swing goes (4.4-5.1% -> 4.0-4.1%, session 12).
+        // which costs a plain bake's close-ups more than it gives; under the final gather the close-ups hold
+        // and the gallery's seed-to-seed swing goes (docs/units.md, "Importance-driven VPL selection").
         const bool pilot = !options.vplImportance.candidateFactor;  // auto; a fixed factor needs none
         if (!pilot || finalGatherOn) {
           if (pilot) {
@@ -292,14 +292,14 @@ struct StagedBake::State {
     if (backend != BackendKind::Gl) return;
     if (!glContext) glContext = std::make_unique<GlContext>();
     log::info("GL backend: " + glContext->description());
-    // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/performance.md).
+    // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/validation.md).
     if (glContext->softwareRenderer() && scene.triangleCount() > kGlTriangleHint && options.eval.includeVpls)
       log::warn("GL backend on a software renderer with " + std::to_string(scene.triangleCount()) +
                 " triangles: its shadow pass draws them for every VPL cube (on the 2-core bench machine the Embree "
                 "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");
     // The compensation's rays read the geometry only, so with the GL backend on a GPU they are traced on the
     // CPU while it bakes. Not on llvmpipe: the trace and the rasteriser threads share the same cores, and
-    // the rasteriser waits for its slowest thread (docs/performance.md).
+    // the rasteriser waits for its slowest thread.
     overlap = compensate && (options.overlapCompensation == OverlapCompensation::Always ||
                              (options.overlapCompensation == OverlapCompensation::Auto &&
                               !glContext->softwareRenderer()));

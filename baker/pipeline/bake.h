@@ -38,7 +38,7 @@ enum class ClampMode {
 
 // Whether the clamp compensation's rays are traced while the GL backend bakes (on the CPU beside the GPU).
 enum class OverlapCompensation {
-  Auto,    // hardware renderers only: on llvmpipe both fight over the cores (docs/performance.md)
+  Auto,    // hardware renderers only: on llvmpipe both fight over the cores
   Never,   // after the VPL blocks
   Always,  // beside the VPL blocks, whatever the renderer
 };
@@ -88,7 +88,7 @@ struct BakeOptions {
   int referenceSpp = 256;                 // reference backend: paths per texel sample
   bool postDilate = true;                 // fill padding from valid texels
   bool postSeams = true;                  // stitch chart seams
-  bool directional = false;               // also bake the L1 pages (BakeResult::directional, issue 15) in the
+  bool directional = false;               // also bake the L1 pages (BakeResult::directional) in the
                                           // backend's passes (4 coefficients in the exact sums); the map's
                                           // bytes are the same. Off: no extra work, the same bytes as before
   ProgressCallback progress;

@@ -153,7 +153,7 @@ std::vector<SeamEdge> findSeams(const Scene& scene, const SeamOptions& options) 
   const double cell = std::max(1e-12, double(options.positionTolerance) * std::max(1e-6f, scene.bounds().diagonal()));
   // Every triangle edge as 8 bytes (its key's hash and where it is), sorted so that the triangles
   // sharing a 3D edge sit side by side. A hash map from key to a vector of sides held ~290 bytes per
-  // triangle (588 MB for a 2M-triangle grid, the bake's peak: docs/performance.md, "Memory").
+  // triangle (the bake's peak on large meshes: docs/validation.md, "Memory").
   std::vector<uint64_t> cornerBase(scene.primitives.size() + 1, 0);  // first global corner of each primitive
   for (size_t p = 0; p < scene.primitives.size(); ++p) {
     const Primitive& prim = scene.primitives[p];

@@ -21,7 +21,7 @@ struct TexelFilterOptions {
   bool symmetric = true;        // a neighbour counts only with its mirror image (−dx, −dy): the window's
                                 // centroid stays on the texel, so a gradient is not biased where the
                                 // window is cut (contact lines, chart borders: a one-sided window read the
-                                // brighter side there; Sponza's column feet +12%, docs/accuracy.md)
+                                // brighter side there: docs/units.md)
   bool tent = false;            // weights (r+1−|dx|)(r+1−|dy|) instead of a box: with r = n−1 every
                                 // texel class (x mod n, y mod n) gets the same total weight
 };

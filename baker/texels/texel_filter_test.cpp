@@ -165,8 +165,8 @@ TEST(SurfaceFilterCache, GivesTheFiltersBitsWithOnePlanPerPage) {
 
 // A light gradient running into a contact line (the texels left of x = 8 invalid, as under a wall standing
 // on the floor): the symmetric window keeps a linear gradient exact up to the line; the one-sided window of
-// the same radius reads the far side only and is biased by radius/2 texels of gradient, as Sponza's column
-// feet were (docs/accuracy.md, "Session 10").
+// the same radius reads the far side only and is biased by radius/2 texels of gradient (what brightened the
+// feet of Sponza's columns).
 TEST(SurfaceFilter, SymmetricWindowKeepsAGradientAtAContactLine) {
   const int size = 24, cut = 8;
   TexelSamples ts = flatPage(size);

@@ -1,4 +1,4 @@
-// Directional light maps (issue 15): the L1 spherical-harmonic part of the irradiance, stored so that the
+// Directional light maps: the L1 spherical-harmonic part of the irradiance, stored so that the
 // L0 page is exactly today's map. Formulas and sources: docs/units.md "Directional maps".
 //
 // Light arriving at x from direction ω with irradiance E (measured facing ω) gives, for a normal n,

@@ -28,7 +28,7 @@ struct VplImportanceOptions {
                                                 // walk; unset: auto (a pilot, chooseCandidateFactor; the bake
                                                 // runs it only under the final gather). Off in the library:
                                                 // without the final gather it trades Sponza's view 2 for
-                                                // view 3 (docs/accuracy.md, sessions 11-12)
+                                                // view 3 (docs/units.md)
   int probes = 1024;             // texel samples the candidates are measured at (uniform over valid samples)
   int pilotProbes = 256;         // auto: the plain walk's VPLs measured at this many probes first, and
   double maxEvenness = 0.3;      // the selection runs only where their evenness (below) is at most this

@@ -14,7 +14,7 @@ namespace irbake {
 // seed gives a low-discrepancy sequence (each prefix of b^m points stays stratified in every dimension)
 // whose every point is uniform over seeds, independently across dimensions. Why not Keller's plain Φ_b:
 // unscrambled low dimensions (light choice, start point) with one shared permutation for the direction
-// dimensions biased the walk in Sponza's upper gallery, 5–8% dark for every seed (docs/accuracy.md).
+// dimensions biased the walk in Sponza's upper gallery, dark for every seed (docs/units.md).
 class Halton {
  public:
   Halton(int dimensions, uint32_t seed);

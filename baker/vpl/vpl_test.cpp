@@ -33,7 +33,7 @@ TEST(Halton, RadicalInversesAreKellersPhi) {
 // other dimensions of the same point, so a walk's expected result over seeds is the exact integral
 // whatever the path's dimensions are used for. (The earlier construction left dimensions 0 and 1 as the
 // plain radical inverses and used one digit permutation per dimension: on Sponza's gallery the walk came
-// out 5–8% dark for every seed; docs/accuracy.md, session 7.)
+// out dark for every seed; docs/units.md.)
 TEST(Halton, EveryPointIsUniformOverSeeds) {
   constexpr int kSeeds = 4000;
   for (uint64_t index : {0ull, 1ull, 5ull, 1000ull}) {

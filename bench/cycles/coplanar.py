@@ -6,7 +6,7 @@ carpet and gallery floors, about 21 m^2), Cycles shades the overlap black. Every
 hits its twin at distance ~0 (Cycles skips only the primitive it starts on), so the direct light is shadowed and
 each bounce lands on the twin again. irbake offsets its rays and sees one lit surface, which is what a level
 artist means by it. A reference that renders the overlap black is wrong there, and the light that should
-bounce off it is missing around it (docs/accuracy.md, session 19). The bench scenes keep, in each plane, the
+bounce off it is missing around it (docs/validation.md, "Sibenik"). The bench scenes keep, in each plane, the
 first triangle over any spot: later triangles that earlier ones cover are dropped, those partly covered are cut
 to their uncovered rest (convex pieces, fan-triangulated, new vertices interpolated). The surface stays where it
 was, once.

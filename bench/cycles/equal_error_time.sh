@@ -2,7 +2,7 @@
 # Our default bake against Cycles' bake at the same error, timed back to back in one run on this machine:
 #   bash bench/cycles/equal_error_time.sh SCENE.gltf CYCLES_SPP [RUNS]
 # CYCLES_SPP: the samples per texel Cycles needs for our error (log-log interpolation of the ladder that
-# compare.py --map-ladder scores; docs/accuracy.md). Prints our median wall time, Cycles' bake-call time
+# compare.py --map-ladder scores; docs/validation.md). Prints our median wall time, Cycles' bake-call time
 # (cycles_bake.py BAKE_TIME_S, Blender start and import excluded) and the ratio; appends to
 # bench/results/equal_error_time.csv.
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The whole comparison against Blender Cycles (docs/accuracy.md, "Against an independent renderer").
+# The whole comparison against Blender Cycles (docs/validation.md, "Accuracy against Cycles").
 # From the repository root, after a Release build:  bash bench/cycles/run_all.sh [IRBAKE [IRVIEW]]
 # Cycles results are cached under build/cycles-cache (by input checksum): a re-run after a baker change
 # re-runs our bakes and re-bakes Cycles' maps only if our atlas changed. Rows are appended to
@@ -13,7 +13,7 @@ S=build/cycles-scenes
 nice -n 15 "$IRBAKE" samples $S/samples
 CORNELL=$S/samples/cornell_box.gltf
 MCGUIRE=$S/mcguire_cornell.gltf
-SPONZA=$S/sponza_sun_x4.glb  # textures upsampled 4x: Cycles filters them in sRGB space (docs/accuracy.md, session 18)
+SPONZA=$S/sponza_sun_x4.glb  # textures upsampled 4x: Cycles filters them in sRGB space (docs/validation.md)
 "${C[@]}" $CORNELL --name cornell_sample --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \
     --views 0 --view-size 128x128 --view-spp 2048 --save-diff
 "${C[@]}" $MCGUIRE --name mcguire_cornell --opts "" --opts "--vpls 4096" --maps --map-spp 256 --map-ladder 4,16,64 \

@@ -27,7 +27,7 @@ sponza: dabrovic_sponza/sponza.glb with KHR_materials_pbrSpecularGlossiness stri
 sponza_sun_x4.glb: the same scene whose images are OUTDIR/textures_x4/NAME.png, each shared texture upsampled
   4x by nearest neighbour (oiiotool --resample:interp=0, lossless PNG): the same texel values and means, so
   the same scene for irbake, but Cycles filters base-colour textures in sRGB space *before* decoding (a
-  black/white checker renders 0.247 against glTF's linear mean 0.5; docs/accuracy.md), which darkens its
+  black/white checker renders 0.247 against glTF's linear mean 0.5; docs/validation.md), which darkens its
   albedo by 0.04-0.67% per Sponza texture; on the upsampled images that filtering acts only on the borders of
   4x4 blocks of equal texels. The accuracy figures against Cycles use this scene.
 sibenik: sibenik/sibenik.glb, its BLEND glass made opaque, one 2000 cd point lamp in the nave, six cameras,
@@ -64,7 +64,7 @@ SIBENIK_CAMERAS = [
     ("choir", (14.0, -12.5, 0.0), (-6.0, -15.3, 0.0), 60.0),
     ("aisle", (-14.0, -12.0, 5.0), (6.0, -14.0, -4.0), 60.0),
     ("across", (0.0, -14.0, 6.5), (0.0, -10.0, -8.0), 60.0),
-    # The pulpit's landing and parapet, where the coincident carpet triangles were (coplanar.py, session 19).
+    # The pulpit's landing and parapet, where the coincident carpet triangles were (coplanar.py).
     ("landing", (4.6, -12.2, 0.3), (4.1, -14.16, -0.35), 60.0),
     ("parapet", (4.6, -13.6, 0.85), (4.2, -13.95, -0.69), 60.0),
     ("pulpit", (8.0, -11.0, 3.0), (4.2, -14.0, -0.5), 60.0),

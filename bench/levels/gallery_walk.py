@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Sponza's upper gallery (camera 3) against our own converged reference, over walk seeds: how the walk's
-random numbers and its split change the light that reaches the gallery (docs/accuracy.md, session 7).
+random numbers and its split change the light that reaches the gallery (docs/units.md). Writes
+bench/results/gallery_walk.csv.
 
 usage (repository root, after a Release build; needs ../shared/scenes and python3-openimageio):
   /usr/bin/python3 bench/levels/gallery_walk.py [--seeds 0,1,2,3,4,5] [--opts "" --opts "--walk-split 1" ...]

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Peak resident memory of `irbake bake` per triangle and per texel (docs/performance.md, "Memory").
+# Peak resident memory of `irbake bake` per triangle and per texel (docs/validation.md, "Memory").
 # Usage: bench/memory/memory_bench.sh IRBAKE WORKDIR CSV [RUNS] [LABEL]
 #   Two series, each varying one size with the other held: a flat grid (grid_scene.py) of 0.5M and
 #   2M triangles at 5 texels/m (254k texels both), and the Cornell box sample (32 triangles) at 800

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 14: a single-node Slurm on localhost (scripts/slurm/local-cluster.sh: munged + slurmctld + slurmd,
+# A single-node Slurm on localhost (scripts/slurm/local-cluster.sh: munged + slurmctld + slurmd,
 # configuration generated into the build folder) bakes the Cornell box in 4 shards with
 # scripts/slurm/bake.sh; the merged outputs must equal the bake on one machine byte for byte.
 # Skips (77) when not root or Slurm/munge are missing. The daemons are stopped on any exit (trap).

@@ -24,8 +24,8 @@ namespace {
 
 // A hit inside the clamp radius, kept for the sweeps: residual(slot) += Le + albedo ⊙ M(page, texel).
 // Le and albedo are already multiplied by w / (rays of the slot). 24 bytes: the kept hits are the
-// compensation's memory (≈ 3.5 per texel in the Cornell box), and few of them see an emitter, so Le
-// lives apart (EmittedHit) instead of 12 zero bytes in every hit (docs/performance.md, "Memory").
+// compensation's memory (a few per texel), and few of them see an emitter, so Le lives apart
+// (EmittedHit) instead of 12 zero bytes in every hit.
 struct KeptHit {
   uint16_t slotInTile = 0;   // slot − Tile::begin (< kTileSlots)
   int16_t map = -1;          // index into maps (< kMaxPages); -1: the hit surface has no light map (Le only)
@@ -114,10 +114,9 @@ void ClampGather::Impl::makeTiles() {
 
 // Auto filter: only where the window stays well inside the clamp radius r_c = 1/√B (the residual varies
 // on the scale of the distance to the nearest edge, so a window of r_c/20 keeps edges sharp) and the
-// per-sample ray count is low. At most 4 texels (9×9; until session 6 at most 2): on Sponza's 2.6M texels
-// the budget leaves 4 rays per sample, and the gather's noise showed in close-ups (view 2 against Cycles
-// 3.09 → 2.77%; Cornell boxes 1.78/1.83 → 1.77/1.81%, where r_c/20 allows 3). Radius and texel geometry
-// per page, once for all sweeps.
+// per-sample ray count is low. At most 4 texels (9×9): on a level's millions of texels the ray budget
+// leaves few rays per sample, and a narrower window let their noise show in close-ups. Radius and texel
+// geometry per page, once for all sweeps.
 void ClampGather::Impl::chooseFilters() {
   const float clampRadius = 1.0f / std::sqrt(bound);
   radii.assign(in.texels.size(), 0);

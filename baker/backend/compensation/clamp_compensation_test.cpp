@@ -1,5 +1,5 @@
 // The clamp residual gathered from the baked map: closed forms (emitter near a receiver), the furnace
-// with both VPL backends (issue 4/5: mean within 1% of Le/(1−ρ)), and that it is a no-op without a clamp.
+// with both VPL backends (mean within 1% of Le/(1−ρ)), and that it is a no-op without a clamp.
 #include "backend/compensation/clamp_compensation.h"
 
 #include <gtest/gtest.h>
@@ -276,7 +276,7 @@ TEST(ClampCompensation, GeometricTailMatchesManySweepsAfterFewer) {
   EXPECT_GT(std::abs(truncated / converged - 1.0), 4 * std::abs(tailed / converged - 1.0));
 }
 
-// Issue 5 item 8: the GL backend's furnace within the same 1% as the Embree backend's.
+// The GL backend's furnace within the same 1% as the Embree backend's.
 TEST(ClampCompensation, FurnaceGlWithinOnePercent) {
   FurnaceBake f(2048, 256.0);
   const BakeInputs in = f.inputs();

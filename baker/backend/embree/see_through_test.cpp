@@ -1,4 +1,4 @@
-// See-through surfaces (issue 12, item 2) against closed forms: a pane of BLEND α = 0.5 halves a point
+// See-through surfaces against closed forms: a pane of BLEND α = 0.5 halves a point
 // light's irradiance behind it, a red pane lets red light through, KHR_materials_transmission passes its
 // factor; MASK holes let the light through where the texture says so. Embree backend and reference.
 #include <gtest/gtest.h>

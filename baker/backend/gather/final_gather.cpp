@@ -153,7 +153,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
     std::vector<L1Vectors> slotVector(directional ? ts.slotCount() : 0, L1Vectors{});
     // Interleaved rotations (sample_lattice.h): every filter window averages one stratified lattice of rays
-    // (Sponza's gallery against Cycles 3.6–3.9% → 3.0–3.3%, docs/accuracy.md session 13).
+    // instead of independent rays per sample, so the filter removes more of their noise.
     const InterleavedRotations interleaved(ts, options.seed, stream, options.interleave ? options.filterRadius : 0, rays);
     forEachSampleLattice(in, ts, options.seed, stream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {

@@ -3,7 +3,7 @@
 //
 // The VPL sum at x estimates the indirect irradiance with the walk's few VPLs near x; where few reach (an
 // open level's upper gallery, lit only through several bounces) each bake's map there is blotchy, and the
-// blotches are 0.5–2 m across, so no texel filter removes them (docs/accuracy.md, session 11). The final
+// blotches are 0.5–2 m across, so no texel filter removes them (docs/units.md, "Final gather"). The final
 // gather writes instead
 //   M'(x) = D(x) + (1/π) ∫_H [Le(y) + ρ(y) M(y)] cosθ dω,
 // with D the exactly computed direct light (punctual lights, sun, sky) and M the full baked map (VPLs, clamp
@@ -44,10 +44,8 @@ struct FinalGatherOptions {
   uint32_t seed = 0;           // rotates the per-sample ray lattices
   int preRays = 2;             // a first, cheaper gather (these rays per sample, preFilterRadius) whose map the
                                // final pass reads instead of M: the walk's blotches averaged once more before the
-                               // final rays see them. Sponza views 2 / 3, seeds 0 / 1 / 2: 1.46 / 1.60 / 1.95% and
-                               // 2.57 / 2.78 / 2.74% against 1.51 / 1.68 / 2.05% and 2.71 / 3.15 / 2.96% without
-                               // (0: off); 1 ray: view 3 2.84 / 2.92 / 3.06%; 2 rays at filter 3: 2.74 / 2.80%
-                               // (seeds 0 / 1). Costs Sponza 5.3M rays, ≈ 2.3 s (docs/performance.md)
+                               // final rays see them; it lowers Sponza's error against Cycles in every view
+                               // tried, for a few seconds of rays (docs/validation.md, "Sponza"). 0: off
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
 };
 

@@ -174,8 +174,7 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
 // per face: a scissor change is llvmpipe's largest fixed cost per face. A glFlush every
 // GlBackendOptions::shadowFlushTriangles submitted triangles hands the scene binned so far to llvmpipe's
 // rasteriser threads while the next faces are binned: one scene per batch is best for small scenes, but
-// at ~100k triangles per cube it serialises binning and rasterising. Both measured in
-// docs/performance.md ("GL against Embree", item 2; "What limits the per-VPL cost").
+// at ~100k triangles per cube it serialises binning and rasterising (docs/validation.md, "GL backend costs").
 void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   drawing_ = geometry_.get();
   renderVplCubes(first, count, atlas, *geometry_);

@@ -110,7 +110,7 @@ struct DepthTargets {
 // 5k + f holds face f (GL order +X −X +Y −Y +Z; the −Z face is never drawn for a hemisphere) of the
 // batch's k-th VPL, at column (5k + f) % cols, row (5k + f) / cols. Cleared once per batch, each face
 // drawn with its own viewport and scissor, so llvmpipe bins a whole batch as one scene instead of
-// paying a framebuffer switch and a scissored clear per face (docs/performance.md).
+// paying a framebuffer switch and a scissored clear per face.
 struct DepthAtlas {
   static constexpr int kTilesPerCube = 5;
   GLuint texture = 0, fbo = 0;

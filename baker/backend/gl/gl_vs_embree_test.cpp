@@ -1,6 +1,5 @@
-// The GL backend against the Embree backend on the same atlas, texel samples and VPL set (issue 5,
-// item 8): relative RMSE < 1% on the Cornell box and the corner scene, and the furnace within the
-// tolerance of the core issue. Small pages (≈ 64² … 128²) keep each test to seconds on llvmpipe.
+// The GL backend against the Embree backend on the same atlas, texel samples and VPL set: relative
+// RMSE < 1% on the Cornell box and the corner scene, and the furnace within the furnace tests' tolerance. Small pages (≈ 64² … 128²) keep each test to seconds on llvmpipe.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -126,7 +125,7 @@ TEST(GlVsEmbree, CornellBoxWithinOnePercent) {
   EXPECT_LT(c.relativeRmse, 0.01);
 }
 
-// Directional maps (issue 15): the GL backend's L1 targets against the Embree backend's L1 on the same
+// Directional maps: the GL backend's L1 targets against the Embree backend's L1 on the same
 // VPLs, and neither backend's map changes by a bit when the L1 pages are asked for. Corner (the spot
 // light's pass and the VPLs, 2×2 samples per texel): 0.04%. Cornell box at this coarse page (128², 14 mm
 // texels): 1.8%, all of it in texels within ~2 cm of the box's inner corners: there L1 is dominated by
@@ -172,7 +171,7 @@ TEST(GlVsEmbree, SharedCornellBoxWithinOnePercent) {
   EXPECT_LT(c.relativeRmse, 0.01);
 }
 
-// Issue 11: contacts a shadow map cannot resolve (a cupboard 1 mm from a wall, a box resting on the
+// Contacts a shadow map cannot resolve (a cupboard 1 mm from a wall, a box resting on the
 // floor, a lamp 0.1 mm under the ceiling). Without resolving contact texels with rays the GL backend lit
 // the texels along every contact; the figures with resolveContacts off are printed for comparison.
 TEST(GlVsEmbree, ContactsSampleWithinOnePercent) {
@@ -208,7 +207,7 @@ TEST(GlVsEmbree, SponzaWithSunWithinOnePercent) {
               c.gl.contactSeconds);
 }
 
-// See-through surfaces (issue 12): a red BLEND pane (α 0.5) and a MASK-free clear transmissive pane
+// See-through surfaces: a red BLEND pane (α 0.5) and a MASK-free clear transmissive pane
 // between a point light and a floor, in a room whose bounces pass them too. GL draws them into shadow maps
 // of their own and sends the texels they shade to the rays: the two backends agree.
 TEST(GlVsEmbree, SeeThroughPanesWithinOnePercent) {

@@ -14,7 +14,7 @@
 
 namespace irbake {
 
-// Distances derived from the scene size (see docs/performance.md, "depth precision and bias").
+// Distances derived from the scene size (docs/units.md, "Shadow maps: depth precision and bias").
 struct ShadowScale {
   float nearPlane = 1e-5f;     // reversed-Z near plane (m)
   float constantBias = 1e-5f;  // constant depth bias (m)
@@ -59,7 +59,7 @@ ShadowView directionalView(const glm::vec3& direction, const Bounds3& bounds, in
 // rounded up to a multiple of 32 and clamped to [minSize, maxSize]. At 1 (the GL backend's default) the
 // 2×2 filter blurs a shadow edge over about ±1 footprint, what the light map blurs anyway (a texel, or ±n
 // texels of the interleaving filter); 0.5 samples visibility at twice the map's rate (Nyquist). The slope
-// bias and the contact leak scale with the footprint too (docs/performance.md has the measured trade).
+// bias and the contact leak scale with the footprint too.
 // r: the contribution-weighted median distance over sampled (VPL, valid texel) pairs that face each other
 // (weight: VPL power × clamped geometry term); h: the median texel spacing over the pages (under
 // interleaved sampling the pages are one class's, so h is n times the full page's spacing).

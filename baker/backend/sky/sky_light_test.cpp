@@ -1,4 +1,4 @@
-// The sky's direct light against closed forms (issue 12): an open plane under a uniform sky gets L
+// The sky's direct light against closed forms: an open plane under a uniform sky gets L
 // exactly, a closed box nothing, a floor beside a long wall the view-factor answer, an environment whose
 // power sits in one texel what a sun of the same irradiance gives; the walk's sky paths carry the
 // sky's power onto the scene.

@@ -1,0 +1,353 @@
+#!/usr/bin/env python3
+"""The tables of docs/validation.md, generated from the CSVs in bench/results/.
+
+Each table sits in the document between `<!-- table:NAME -->` and `<!-- /table:NAME -->`. The rows are the
+current ones: for every case, the latest run that used the default options (or the options the case names).
+
+usage (repository root; standard-library Python 3 only):
+  python3 bench/validation_tables.py --check docs/validation.md   # exit 1 and a diff when a table differs
+  python3 bench/validation_tables.py --write docs/validation.md   # rewrite the tables in place
+  python3 bench/validation_tables.py --print NAME                 # one table on stdout
+  --results DIR: the CSV folder (default: bench/results beside this script)
+"""
+import argparse
+import csv
+import difflib
+import io
+import math
+import os
+import re
+import statistics
+import sys
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def read(name):
+    with open(os.path.join(RESULTS, name), newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(out)
+
+
+def pct(value, digits=2):
+    return "" if value in ("", None) else f"{100.0 * float(value):.{digits}f}%"
+
+
+def num(value, digits=2):
+    return "" if value in ("", None) else f"{float(value):.{digits}f}"
+
+
+def median(values):
+    return statistics.median(float(v) for v in values)
+
+
+# Options that describe the scene or the seed, not the bake's settings: rows with only these are default bakes.
+SCENE_OPTIONS = ("--sky", "--sun", "--seed")
+
+
+def default_options(options):
+    tokens = options.split()
+    return all(tokens[i] in SCENE_OPTIONS for i in range(0, len(tokens), 2))
+
+
+def seed_of(options):
+    tokens = options.split()
+    return tokens[tokens.index("--seed") + 1] if "--seed" in tokens else "0"
+
+
+def latest(rows, key):
+    """The latest row (by date, then by file order) for every key, in the order keys first appear."""
+    best = {}
+    for r in rows:
+        k = key(r)
+        if k not in best or r["date"] >= best[k]["date"]:
+            best[k] = r
+    return list(best.values())
+
+
+SCENES = {
+    "cycles_cornell_sample.csv": "Cornell sample",
+    "cycles_mcguire_cornell.csv": "McGuire Cornell",
+    "cycles_sponza_sun_x4.csv": "Sponza, sun",
+    "cycles_sponza_sun_sky.csv": "Sponza, sun + sky",
+    "cycles_sibenik_lamp.csv": "Sibenik, lamp",
+}
+
+
+def cycles_rows(files, modes=("map", "view")):
+    out = []
+    for name in files:
+        rows = [r for r in read(name) if r["mode"] in modes and default_options(r["our_options"])]
+        current = latest(rows, lambda r: (r["mode"], r["view"], seed_of(r["our_options"])))
+        for r in sorted(current, key=lambda r: (int(seed_of(r["our_options"])), r["mode"], r["view"])):
+            view = "page 0" if r["mode"] == "map" else f"view {r['view']}"
+            size = f"{int(r['texels']) / 1e3:.0f}k texels" if r["mode"] == "map" else f"{r['width']}×{r['height']}"
+            out.append([SCENES[name], f"{r['mode']} ({size})", view, seed_of(r["our_options"]), f"`{r['commit']}`",
+                        num(r["our_wall_s"], 1), num(r["mean_ratio"], 3), pct(r["rel_rmse_4"]),
+                        pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**",
+                        pct(r["rel_rmse_4_with_edges"]), r["ref_spp"]])
+    return table(["scene", "compared", "where", "seed", "baker", "our bake, wall (s)", "mean ours/Cycles",
+                  "rel. RMSE 4×4", "Cycles' noise", "noise removed", "edges kept", "Cycles spp"], out)
+
+
+def t_cycles_cornell():
+    return cycles_rows(["cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv"])
+
+
+def t_cycles_sponza():
+    return cycles_rows(["cycles_sponza_sun_x4.csv", "cycles_sponza_sun_sky.csv"])
+
+
+def t_cycles_sibenik():
+    return cycles_rows(["cycles_sibenik_lamp.csv"])
+
+
+def t_cycles_ladder():
+    out = []
+    for name in ["cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv", "cycles_sponza_sun_x4.csv"]:
+        rows = [r for r in read(name) if r["mode"] == "map-cycles"]
+        for r in sorted(latest(rows, lambda r: r["cycles_spp"]), key=lambda r: int(r["cycles_spp"])):
+            out.append([SCENES[name], f"`{r['commit']}`", r["cycles_spp"], num(r["cycles_s"], 1),
+                        pct(r["rel_rmse_4_corrected"])])
+    return table(["scene (map, our atlas)", "run at", "Cycles samples per texel", "Cycles' bake (s)",
+                  "rel. RMSE 4×4, noise removed"], out)
+
+
+def t_equal_error_time():
+    out = []
+    for r in latest(read("equal_error_time.csv"), lambda r: r["scene"]):
+        out.append([r["scene"], r["date"], f"`{r['commit']}`", num(r["our_wall_s_median"], 2), r["runs"],
+                    r["cycles_spp"], num(r["cycles_bake_s"], 1), f"**{num(r['ratio'], 2)}×**", r["load_avg"]])
+    return table(["scene", "date", "baker", "our bake, median wall (s)", "runs", "Cycles spp at our error",
+                  "Cycles' bake (s)", "Cycles / ours", "load average"], out)
+
+
+def t_speed_error():
+    out = []
+    for r in read("speed_error.csv"):
+        out.append([r["scene"], r["triangles"], r["texels"], r["backend"], r["paths"], r["vpls"],
+                    pct(r["relative_rmse"]), pct(r["relative_rmse_corrected"]), pct(r["relative_bias"]),
+                    num(r["backend_s"], 2), num(r["compensation_s"], 2), r["interleave"]])
+    return table(["scene", "triangles", "texels", "backend", "paths", "VPLs", "rel. RMSE", "noise removed",
+                  "mean bias", "backend (s)", "compensation (s)", "interleave n"], out)
+
+
+def slope(points):
+    xs = [math.log(n) for n, _ in points]
+    ys = [math.log(e) for _, e in points]
+    mx, my = statistics.fmean(xs), statistics.fmean(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+
+
+def t_convergence():
+    series = {}
+    for r in read("light_convergence.csv"):
+        series.setdefault(r["series"], []).append((float(r["n"]), float(r["relative_rmse"])))
+    out = []
+    for name, points in series.items():
+        points.sort()
+        out.append([f"`{name}`", f"{points[0][0]:.0f}…{points[-1][0]:.0f}", pct(points[-1][1]), f"{slope(points):.2f}"])
+    return table(["series", "N", "rel. RMSE at the largest N", "log-log slope"], out)
+
+
+def t_light_timing():
+    out = [[r["case"], r["vpls"], f"{int(r['pairs']) / 1e6:.2f} M", num(r["median_seconds"], 3),
+            f"{float(r['pairs_per_second']) / 1e6:.1f} M"] for r in read("light_timing.csv")]
+    return table(["case", "VPLs", "sample–VPL pairs", "median (s)", "pairs per second"], out)
+
+
+def t_gl_stages():
+    rows = read("gl_stages.csv")
+    last = [r for r in rows if r["variant"] == rows[-1]["variant"] and r["load1"] == rows[-1]["load1"]]
+    groups = {}
+    for r in last:
+        groups.setdefault((r["triangles"], r["texels"], r["vpls"], r["k"], r["face"]), []).append(r)
+    out = []
+    for (tri, texels, vpls, k, face), g in groups.items():
+        out.append([tri, texels, vpls, k, face, len(g), num(median(r["shadow_ms_per_vpl"] for r in g), 1),
+                    num(median(r["accumulate_ms_per_vpl"] for r in g), 1), num(g[0]["load1"], 1)])
+    return table(["triangles", "texels", "VPLs", "VPLs per batch", "cube face", "runs", "shadow (ms per VPL)",
+                  "accumulate (ms per VPL)", "load average"], out)
+
+
+def t_levels():
+    rows = read("levels.csv")
+    last = {}
+    for r in rows:
+        k = r["scene"]
+        if k not in last or (r["date"], rows.index(r)) >= (last[k][0], last[k][1]):
+            last[k] = (r["date"], rows.index(r), r["commit"])
+    out = []
+    for scene, (date, _, commit) in last.items():
+        g = [r for r in rows if r["scene"] == scene and r["commit"] == commit and r["date"] == date]
+        r = g[0]
+        out.append([scene, f"`{r['options']}`", date, f"`{commit}`", r["backend"], len(g),
+                    f"{int(r['texels_valid']) / 1e6:.2f} M", r["vpls"], num(median(x["wall_s"] for x in g), 1),
+                    f"{median(x['peak_mib'] for x in g):.0f}", num(median(x["load_avg"] for x in g), 1)])
+    return table(["scene", "options", "date", "baker", "backend (auto)", "runs", "texels", "VPLs",
+                  "median wall (s)", "peak memory (MiB)", "load average"], out)
+
+
+def t_memory():
+    rows = read("memory.csv")
+    label = rows[-1]["label"]
+    out = [[r["case"], r["triangles"], r["texels"], r["runs"], num(r["peak_rss_mib"], 0), num(r["bake_peak_mib"], 0)]
+           for r in rows if r["label"] == label]
+    return f"Baker: `{label}`.\n\n" + table(["case", "triangles", "texels", "runs", "peak RSS (MiB)",
+                                            "bake's own peak (MiB)"], out)
+
+
+def gpu_table(name):
+    rows = read(name)
+    out = []
+    for r in latest([dict(r, date=f"{int(r['run']):06d}") for r in rows], lambda r: r["tag"]):
+        out.append([r["tag"], r["run"], r["backend"], r["asked"], r["threads"], r["triangles"], r["vpls"],
+                    num(r["bake_s"], 2), num(r["backend_s"], 2), num(r["compensation_s"], 2), r["peak_mib"]])
+    return table(["case", "run", "backend", "asked", "CPU threads", "triangles", "VPLs", "bake (s)", "backend (s)",
+                  "compensation (s)", "peak (MiB)"], out)
+
+
+def t_gpu_h100():
+    return gpu_table("gpu_h100.csv")
+
+
+def t_gpu_h200():
+    return gpu_table("gpu_h200.csv")
+
+
+def t_slurm():
+    rows = read("slurm_scaling.csv")
+    out = []
+    for shards in dict.fromkeys(r["shards"] for r in rows):
+        g = [r for r in rows if r["shards"] == shards]
+        out.append(["one machine" if shards == "0" else shards, len(g), num(median(r["array_wall_s"] for r in g), 1),
+                    num(median(r["merge_wall_s"] for r in g), 1), num(median(r["total_wall_s"] for r in g), 1),
+                    "yes" if all(r["identical_to_one_machine"] == "yes" for r in g) else "**no**",
+                    num(median(r["load1"] for r in g), 1)])
+    return table(["shards", "rounds", "array, median wall (s)", "merge (s)", "total (s)",
+                  "bytes identical to one machine", "load average"], out)
+
+
+def t_vpl_blocks():
+    rows = read("vpl_blocks.csv")
+    out = []
+    for binary in dict.fromkeys(r["binary"] for r in rows):
+        g = [r for r in rows if r["binary"] == binary]
+        out.append([binary, len(g), num(median(r["wall_s"] for r in g), 2), num(median(r["cpu_s"] for r in g), 2),
+                    f"{median(r['peak_mib'] for r in g):.0f}", num(median(r["backend_s"] for r in g), 2)])
+    return table(["irbake", "runs", "median wall (s)", "CPU (s)", "peak (MiB)", "backend (s)"], out)
+
+
+def t_directional():
+    rows = read("directional.csv")
+    out = []
+    for key in dict.fromkeys((r["scene"], r["mode"]) for r in rows):
+        g = [r for r in rows if (r["scene"], r["mode"]) == key]
+        out.append([key[0], key[1], g[0]["backend"], len(g), num(median(r["wall_s"] for r in g), 2),
+                    num(median(r["cpu_s"] for r in g), 2), f"{median(r['peak_mib'] for r in g):.0f}",
+                    num(median(r["backend_s"] for r in g), 2), num(median(r["directional_s"] for r in g), 2),
+                    num(g[0]["exr_mib"], 1)])
+    return table(["scene", "bake", "backend", "runs", "median wall (s)", "CPU (s)", "peak (MiB)", "backend (s)",
+                  "directional stage (s)", "EXR pages (MiB)"], out)
+
+
+def t_export_meshes():
+    out = [[r["meshes"], r["input"], r["materials"], r["runs"], num(r["seconds_median"], 3), num(r["seconds_min"], 3),
+            num(r["seconds_max"], 3)] for r in read("export_meshes.csv")]
+    return table(["meshes", "input document", "materials", "runs", "median (s)", "min (s)", "max (s)"], out)
+
+
+def t_atlas():
+    out = []
+    for r in read("atlas.csv"):
+        out.append([r["scene"], r["triangles"], r["charts"], f"{r['page_w']}×{r['page_h']}", pct(r["centre_util"], 1),
+                    f"{float(r['stretch_p5']):.2f}…{float(r['stretch_p95']):.2f}", r["overlapping_texels"],
+                    r["flipped"], num(r["median_s"], 2), r["xatlas_charts"], pct(r["xatlas_util"], 1),
+                    num(r["xatlas_s"], 2), r["target"]])
+    return table(["scene", "triangles", "charts", "page", "utilisation", "area stretch p5…p95", "overlaps",
+                  "flipped", "median (s)", "xatlas charts", "xatlas utilisation", "xatlas (s)", "target"], out)
+
+
+def t_viewer():
+    with open(os.path.join(RESULTS, "viewer_bench.csv")) as f:
+        lines = f.read().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("name,"))
+    out = []
+    for r in csv.DictReader(io.StringIO("\n".join(lines[start:]))):
+        if r["name"].endswith("_median"):
+            out.append([r["name"].split("/")[0].replace("BM_", ""), r["triangles"], r["fragments"],
+                        num(r["real_time"], 1), num(r["cpu_ms_per_frame"], 1)])
+    return table(["frame", "triangles", "fragments", "median wall (ms)", "CPU (ms per frame)"], out)
+
+
+def t_gallery_walk():
+    rows = read("gallery_walk.csv")
+    last = {}
+    for r in rows:
+        last[(r["options"], r["seed"])] = r
+    out = []
+    for options in dict.fromkeys(k[0] for k in last):
+        g = [r for k, r in last.items() if k[0] == options]
+        ratios = [float(r["mean_ratio"]) for r in g]
+        out.append([f"`{options}`" if options else "default (auto split)", len(g),
+                    f"{min(ratios):.3f}…{max(ratios):.3f}", pct(median(r["rel_rmse_4"] for r in g)),
+                    pct(max(float(r["rel_rmse_4"]) for r in g))])
+    return table(["walk", "seeds", "mean ratio, ours/converged", "rel. RMSE 4×4, median", "worst seed"], out)
+
+
+TABLES = {name[2:]: fn for name, fn in globals().items() if name.startswith("t_")}
+MARKER = re.compile(r"<!-- table:([a-z0-9_]+) -->\n(.*?)<!-- /table:\1 -->", re.S)
+
+
+def render(doc):
+    missing = [name for name in TABLES if f"<!-- table:{name} -->" not in doc]
+    unknown = [m.group(1) for m in MARKER.finditer(doc) if m.group(1) not in TABLES]
+    new = MARKER.sub(lambda m: f"<!-- table:{m.group(1)} -->\n{TABLES[m.group(1)]()}\n<!-- /table:{m.group(1)} -->"
+                     if m.group(1) in TABLES else m.group(0), doc)
+    return new, missing, unknown
+
+
+def main():
+    global RESULTS
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--check", metavar="DOC")
+    g.add_argument("--write", metavar="DOC")
+    g.add_argument("--print", metavar="NAME", choices=sorted(TABLES))
+    p.add_argument("--results", default=RESULTS)
+    a = p.parse_args()
+    RESULTS = a.results
+    if a.print:
+        print(TABLES[a.print]())
+        return 0
+    path = a.check or a.write
+    with open(path, encoding="utf-8") as f:
+        doc = f.read()
+    new, missing, unknown = render(doc)
+    for name in missing:
+        print(f"{path}: no <!-- table:{name} --> block", file=sys.stderr)
+    for name in unknown:
+        print(f"{path}: unknown table '{name}'", file=sys.stderr)
+    if a.write:
+        if new != doc:
+            tmp = path + ".tmp"
+            with open(tmp, "w", encoding="utf-8") as f:
+                f.write(new)
+            os.replace(tmp, path)
+        return 1 if missing or unknown else 0
+    if new != doc:
+        sys.stdout.writelines(difflib.unified_diff(doc.splitlines(True), new.splitlines(True), path,
+                                                   path + " (generated from " + RESULTS + ")"))
+        print(f"{path}: tables differ from the CSVs; run: python3 bench/validation_tables.py --write {path}",
+              file=sys.stderr)
+        return 1
+    return 1 if missing or unknown else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
