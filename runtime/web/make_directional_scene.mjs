@@ -1,4 +1,4 @@
-// Writes a small glTF for the directional-map web test (issue 15): a 4 m × 4 m grey plane (ρ = 0.5) at y = 0,
+// Writes a small glTF for the directional-map web test: a 4 m × 4 m grey plane (ρ = 0.5) at y = 0,
 // TEXCOORD_0 planar (u along +x, v along +z), a constant normal map tilted 35° from the normal towards
 // +u and −v's opposite (the tangent-space normal has x and y components, so both the tangent and the
 // bitangent's sign show), a point light of I candela 1 m above the centre (KHR_lights_punctual) and a camera

@@ -1,7 +1,7 @@
 // A GLTFLoader plugin for MOZ_lightmap as irbake writes it (docs/export.md):
 //   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity, extras: { colorSpace: "srgb" } }
 // A map texel is irradiance/π (linear). The 8-bit PNG is sRGB-encoded when extras.colorSpace says so
-// (irbake ≥ issue 13), linear otherwise; value = decode(PNG) × intensity.
+// (current irbake exports), linear otherwise; value = decode(PNG) × intensity.
 // three.js treats lightMap as irradiance and shades it with BRDF_Lambert = albedo/π, so the
 // lightMapIntensity it needs is intensity × π. Materials with a light map become MeshLambertMaterial
 // (a physical material would add a specular term the bake does not have).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Khronos glTF-Validator on every kind of export (issue 13): the baked Cornell box (.gltf + .bin +
+# Khronos glTF-Validator on every kind of export: the baked Cornell box (.gltf + .bin +
 # images), the same as one GLB, the same with --directional, `irbake unwrap` output, and the DamagedHelmet from ../shared baked with
 # --sun (skipped with a message when absent). Each: 0 errors, no warning its input did not have, no
 # UNUSED_OBJECT for a mesh or an accessor (runtime/web/validate.mjs).
@@ -17,7 +17,7 @@ cornell="$work/samples/cornell_box.gltf"
 validate "$work/cornell/scene.gltf" "$cornell"
 "$irbake" bake "$cornell" -o "$work/glb/cornell.glb" --vpls 128 --texels-per-unit 60 --quiet >> "$work/bake.log" 2>&1
 validate "$work/glb/cornell.glb" "$cornell"
-# Directional maps (issue 15): IRBAKE_lightmap_directional on the materials, in extensionsUsed only.
+# Directional maps: IRBAKE_lightmap_directional on the materials, in extensionsUsed only.
 "$irbake" bake "$cornell" -o "$work/directional" --vpls 128 --texels-per-unit 60 --directional --quiet >> "$work/bake.log" 2>&1
 validate "$work/directional/scene.gltf" "$cornell"
 "$irbake" unwrap "$cornell" -o "$work/unwrap/cornell.gltf" > "$work/unwrap.log" 2>&1

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Real-client test (issue 13): bake the Cornell box, render it from its glTF camera with irview and
+# Real-client test: bake the Cornell box, render it from its glTF camera with irview and
 # with three.js in headless Chromium (runtime/web), and require a mean absolute difference ≤ 2 (8-bit).
 # Usage (from ctest): web_client_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Real-client test of directional light maps (issue 15, item 3): a generated normal-mapped plane under a point light
+# Real-client test of directional light maps: a generated normal-mapped plane under a point light
 # (make_directional_scene.mjs) baked with --directional, rendered with irview and with three.js in headless
 # Chromium (runtime/web, moz_lightmap.js). Mean absolute differences (8-bit sRGB, 256 × 256):
 #   - web SH against irview reading the same 8-bit L1 PNGs (its L1 EXRs removed): ≤ 0.5;
