@@ -93,7 +93,9 @@ TEST(CosineLattice, MatchesCosineHemisphereAtTheLatticePoints) {
         EXPECT_NEAR(glm::length(got), 1.0, 1e-6);
         meanCos += glm::dot(got, n) / count;
       }
-      if (count >= 1000) EXPECT_NEAR(meanCos, 2.0 / 3.0, 1e-4);
+      if (count >= 1000) {
+        EXPECT_NEAR(meanCos, 2.0 / 3.0, 1e-4);
+      }
     }
 }
 
