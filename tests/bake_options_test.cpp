@@ -60,7 +60,7 @@ TEST(BakeOptions, QualityPresetsSetPathsAndRaysAndOwnOptionsWin) {
     std::vector<std::string> extra;
     int paths, compRays;
   };
-  const std::vector<Case> cases = {{{"--quality", "preview"}, 1024, 4},
+  const std::vector<Case> cases = {{{"--quality", "preview"}, 512, 4},
                                    {{}, 4096, 16},
                                    {{"--quality", "high", "--paths", "300", "--comp-rays", "3"}, 300, 3}};
   for (size_t i = 0; i < cases.size(); ++i) {

@@ -391,6 +391,7 @@ void applyQuality(const CLI::App& app, const BakeArguments& a, BakeOptions& o) {
   if (unset("--sky-rays")) o.sky.raysPerSample = p.skyRays;
   if (unset("--sky-ray-budget")) o.sky.maxRays = p.skyRayBudget;
   if (unset("--shadow-edge-samples")) o.shadowEdges.subSamples = p.shadowEdgeSamples;
+  o.atlas.targetPageSize = p.autoPageSize;  // read only where --texels-per-unit is auto
 }
 
 // Arguments for a config file's entries, each checked alone against the options (unknown keys, wrong types

@@ -20,6 +20,7 @@ struct QualityPreset {
   int skyRays;                // --sky-rays
   int skyRayBudget;           // --sky-ray-budget
   int shadowEdgeSamples;      // --shadow-edge-samples
+  int autoPageSize;           // --texels-per-unit auto: the density fills about one page of this edge
 };
 
 // preview, default, high, production (in that order).
