@@ -10,11 +10,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 source "$here/web_tests_common.sh"
 need_node_modules "$modules" @babylonjs/core @babylonjs/loaders
 need_browser_client "$modules" "$work"
-"$irbake" samples "$work/samples" > "$work/samples.log"
-"$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 512 --texels-per-unit 120 --portable "$work/portable.glb" \
-  --quiet > "$work/bake.log" 2>&1
-w=320 h=320
-"$irview" "$work/bake/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/irview.png" > "$work/irview.log" 2>&1
+bake_cornell_and_irview "$irbake" "$irview" "$work" --portable "$work/portable.glb"
 compare() { node "$here/render_compare.mjs" --client babylon --modules "$modules" --camera 0 --width $w --height $h \
               --reference "$work/irview.png" "$@"; }
 compare --scene "$work/bake/scene.gltf" --out "$work/babylon.png" --max-mean-abs 2

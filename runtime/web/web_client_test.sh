@@ -7,9 +7,6 @@ irbake="$1" irview="$2" modules="$3" work="$4"
 here="$(cd "$(dirname "$0")" && pwd)"
 source "$here/web_tests_common.sh"
 need_browser_client "$modules" "$work"
-"$irbake" samples "$work/samples" > "$work/samples.log"
-"$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 512 --texels-per-unit 120 --quiet > "$work/bake.log" 2>&1
-w=320 h=320
-"$irview" "$work/bake/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/irview.png" > "$work/irview.log" 2>&1
+bake_cornell_and_irview "$irbake" "$irview" "$work"
 node "$here/render_compare.mjs" --modules "$modules" --scene "$work/bake/scene.gltf" --camera 0 --width $w --height $h \
   --reference "$work/irview.png" --out "$work/web.png" --max-mean-abs 2

@@ -16,3 +16,13 @@ need_browser_client() {
   [[ -x /usr/bin/chromium ]] || skip "/usr/bin/chromium not found (scripts/install-deps.sh installs Debian chromium)"
   rm -rf "$work" && mkdir -p "$work"
 }
+# The Cornell box sample baked into WORK/bake (more bake options after WORK) and irview's W×H (320×320)
+# screenshot from its camera 0 in WORK/irview.png: what the client tests compare against. Sets w and h.
+bake_cornell_and_irview() {
+  local irbake="$1" irview="$2" work="$3"; shift 3
+  "$irbake" samples "$work/samples" > "$work/samples.log"
+  "$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 512 --texels-per-unit 120 "$@" --quiet \
+    > "$work/bake.log" 2>&1
+  w=320 h=320
+  "$irview" "$work/bake/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/irview.png" > "$work/irview.log" 2>&1
+}
