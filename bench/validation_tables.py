@@ -300,6 +300,28 @@ def t_gallery_walk():
     return table(["walk", "seeds", "mean ratio, ours/converged", "rel. RMSE 4×4, median", "worst seed"], out)
 
 
+def t_quality_presets():
+    """Each --quality preset: time and memory (quality_presets.py) beside its map error against Cycles (compare.py)."""
+    timing = latest(read("quality_presets.csv"), lambda r: (r["scene"], r["options"], r["preset"]))
+    errors = {}
+    for name in ["cycles_cornell_sample.csv"]:
+        for r in read(name):
+            if r["mode"] != "map":
+                continue
+            options = r["our_options"].split()
+            preset = options[1] if options[:1] == ["--quality"] and len(options) == 2 else "default" if not options else None
+            if preset and (preset not in errors or r["date"] >= errors[preset]["date"]):
+                errors[preset] = r
+    out = []
+    for t in timing:
+        e = errors.get(t["preset"]) if t["scene"] == "cornell_sample" and not t["options"] else None
+        out.append([t["scene"], f"`{t['preset']}`", f"`{t['commit']}`", f"{int(t['page_texels']) / 1e3:.0f}k", t["runs"],
+                    t["median_wall_s"], t["peak_memory_mib"], t["load_average"],
+                    f"**{pct(e['rel_rmse_4_corrected'])}**" if e else "", num(e["mean_ratio"], 3) if e else ""])
+    return table(["scene", "preset", "baker", "page texels", "runs", "median wall (s)", "peak memory (MiB)",
+                  "load average", "rel. RMSE 4×4 against Cycles, noise removed", "mean ours/Cycles"], out)
+
+
 TABLES = {name[2:]: fn for name, fn in globals().items() if name.startswith("t_")}
 MARKER = re.compile(r"<!-- table:([a-z0-9_]+) -->\n(.*?)<!-- /table:\1 -->", re.S)
 
