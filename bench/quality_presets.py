@@ -50,7 +50,7 @@ def main():
     path = os.path.join(here, "results", "quality_presets.csv")
     new = not os.path.exists(path)
     with open(path, "a", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()), lineterminator="\n")
         if new:
             writer.writeheader()
         writer.writerows(rows)

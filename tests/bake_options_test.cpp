@@ -99,6 +99,11 @@ TEST(BakeOptions, ConfigFileGivesTheSameBakeAndTheCommandLineWins) {
   EXPECT_EQ(fileText(dir / "level" / "baked" / "lightmap_0.exr"), exr);
   EXPECT_EQ(report(dir / "level" / "baked")["options"]["seed"], "4");
 
+  const std::string dumped = fileText(dir / "dumped.toml");
+  EXPECT_NE(dumped.find("\nseed = 4\n"), std::string::npos) << dumped;
+  EXPECT_NE(dumped.find("# gather-rays = 16 (--quality default)"), std::string::npos) << dumped;
+  EXPECT_NE(dumped.find("#   backend = embree"), std::string::npos) << dumped;  // what the bake decided
+  EXPECT_NE(dumped.find("#   paths = 256"), std::string::npos) << dumped;
   fs::create_directories(dir / "elsewhere");
   fs::copy_file(dir / "dumped.toml", dir / "elsewhere" / "again.toml");
   fs::remove_all(dir / "level" / "baked");

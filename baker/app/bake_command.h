@@ -35,6 +35,8 @@ struct BakeCommand {
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
   double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
   Args arguments;                  // the arguments parsed: the command line after --config's entries
+  std::string dumpConfig;          // --dump-config FILE ("" without it)
+  std::string dumpText;            // that file's text as parsed (what the bake decides is appended after it)
   nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
   std::string optionsHash;         // hash of resultOptions (not -o, --threads, ...)
 };
@@ -55,6 +57,10 @@ void checkOutputPaths(const BakeCommand& command);
 // Locks --report's folder when it is not OUTDIR, so a report never lands in another bake's folder while
 // that bake runs (nullptr when no second lock is needed). Throws Error(Io) when that folder is busy.
 std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& command);
+
+// "# key = value" lines of what the bake decided where its options said auto (backend, paths, bounces,
+// interleave, clamp, final gather), from its report: the tail of a --dump-config file.
+std::string automaticChoices(const nlohmann::json& report);
 
 // Writes a finished bake's outputs where the command says (the all-or-nothing set) and lists them.
 void writeFinishedBake(const BakeCommand& command, const BakeResult& result, TerminalProgress& progress);

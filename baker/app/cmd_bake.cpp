@@ -482,7 +482,41 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
   return entries;
 }
 
+// Writes a --dump-config file atomically.
+void writeDumpedConfig(const std::string& file, const std::string& text) {
+  writeAtomically(file, [&](const std::filesystem::path& temp) {
+    std::ofstream out(temp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw Error(ErrorCode::Io, file, "cannot write the config");
+  });
+}
+
 }  // namespace
+
+std::string automaticChoices(const nlohmann::json& report) {
+  std::string text = "# what this bake decided where an option is auto (the same scene and options decide the same):\n";
+  auto line = [&](const std::string& key, const nlohmann::json& value) {
+    if (!value.is_null()) text += "#   " + key + " = " + (value.is_string() ? value.get<std::string>() : value.dump()) + "\n";
+  };
+  const auto at = [&](std::initializer_list<const char*> path) {
+    const nlohmann::json* j = &report;
+    for (const char* k : path) {
+      if (!j->is_object() || !j->contains(k)) return nlohmann::json();
+      j = &(*j)[k];
+    }
+    return *j;
+  };
+  line("backend", at({"backend"}));
+  line("paths", at({"vpls", "paths"}));
+  line("bounces", at({"vpls", "bounces"}));
+  line("walk-split", at({"vpls", "split"}));
+  line("interleave", at({"interleave", "classes"}));
+  line("clamp (1/m²)", at({"eval", "clampBound"}));
+  line("final-gather", report.contains("finalGather") ? nlohmann::json("on") : nlohmann::json("off"));
+  line("texels-per-unit", at({"atlas", "texelsPerUnit"}));
+  return text;
+}
 
 std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
   Args args = givenArgs;
@@ -522,14 +556,10 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
   applyArguments(command, arguments);
   applyQuality(*app, arguments, command.options);
   if (!arguments.dumpConfig.empty()) {
-    const std::string text = configText(effectiveOptions(*app, arguments, command.options),
-                                        "irbake bake options (read back with --config FILE)");
-    writeAtomically(arguments.dumpConfig, [&](const std::filesystem::path& temp) {
-      std::ofstream out(temp, std::ios::binary);
-      out << text;
-      out.close();
-      if (!out) throw Error(ErrorCode::Io, arguments.dumpConfig, "cannot write the config");
-    });
+    command.dumpConfig = arguments.dumpConfig;
+    command.dumpText = configText(effectiveOptions(*app, arguments, command.options),
+                                  "irbake bake options (read back with --config FILE)");
+    writeDumpedConfig(command.dumpConfig, command.dumpText);
   }
   return command;
 }
@@ -766,6 +796,7 @@ int runBake(const Args& args) {
   result.report["timings"]["seconds"]["load"] = loadSeconds;
   result.report["options"] = c.resultOptions;
   writeFinishedBake(c, result, progress);
+  if (!c.dumpConfig.empty()) writeDumpedConfig(c.dumpConfig, c.dumpText + automaticChoices(result.report));
   fs::remove(checkpoint, ec);
   return 0;
 }
