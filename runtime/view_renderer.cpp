@@ -255,6 +255,39 @@ struct ViewRenderer::Impl {
     return true;
   }
 
+  // The primitive's vertex array: vertices, indices (16-bit where every index fits) and attributes 0-4.
+  static void uploadGeometry(GpuPrimitive& g, const std::vector<Vertex>& verts, const std::vector<uint32_t>& indices) {
+    glGenVertexArrays(1, &g.vao);
+    glBindVertexArray(g.vao);
+    glGenBuffers(1, &g.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
+    glBufferData(GL_ARRAY_BUFFER, verts.size() * sizeof(Vertex), verts.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &g.ebo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
+    if (*std::max_element(indices.begin(), indices.end()) <= 0xffff) {
+      // Half the index bytes for llvmpipe's vertex fetch to read.
+      const std::vector<uint16_t> shortIndices(indices.begin(), indices.end());
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, shortIndices.size() * sizeof(uint16_t), shortIndices.data(),
+                   GL_STATIC_DRAW);
+      g.indexType = GL_UNSIGNED_SHORT;
+    } else {
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, indices.size() * sizeof(uint32_t), indices.data(),
+                   GL_STATIC_DRAW);
+    }
+    const GLsizei stride = sizeof(Vertex);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, position)));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, normal)));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv0)));
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv1)));
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, chart)));
+    glBindVertexArray(0);
+  }
+
   GLuint colorTexture(int index) {
     if (index < 0 || index >= static_cast<int>(scene.textures.size())) return 0;
     const Texture& t = scene.textures[index];
@@ -375,35 +408,7 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     }
     for (uint32_t c : charts) nextChartBase = std::max(nextChartBase, chartBase + c + 1);
     chartBase = nextChartBase;
-    glGenVertexArrays(1, &g.vao);
-    glBindVertexArray(g.vao);
-    glGenBuffers(1, &g.vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
-    glBufferData(GL_ARRAY_BUFFER, verts.size() * sizeof(Vertex), verts.data(), GL_STATIC_DRAW);
-    glGenBuffers(1, &g.ebo);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
-    if (*std::max_element(p.indices.begin(), p.indices.end()) <= 0xffff) {
-      // Half the index bytes for llvmpipe's vertex fetch to read.
-      const std::vector<uint16_t> shortIndices(p.indices.begin(), p.indices.end());
-      glBufferData(GL_ELEMENT_ARRAY_BUFFER, shortIndices.size() * sizeof(uint16_t), shortIndices.data(),
-                   GL_STATIC_DRAW);
-      g.indexType = GL_UNSIGNED_SHORT;
-    } else {
-      glBufferData(GL_ELEMENT_ARRAY_BUFFER, p.indices.size() * sizeof(uint32_t), p.indices.data(),
-                   GL_STATIC_DRAW);
-    }
-    const GLsizei stride = sizeof(Vertex);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, position)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, normal)));
-    glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv0)));
-    glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, uv1)));
-    glEnableVertexAttribArray(4);
-    glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(Vertex, chart)));
-    glBindVertexArray(0);
+    Impl::uploadGeometry(g, verts, p.indices);
     g.indexCount = static_cast<GLsizei>(p.indices.size());
     g.boundsMin = g.boundsMax = p.positions.front();
     for (const glm::vec3& q : p.positions) {

@@ -22,6 +22,7 @@ packages=(
   libxxhash-dev            # xxHash: checksums of partials and checkpoints, hashes of scene files
   clang libclang-rt-14-dev # clang + libFuzzer runtime: the glTF loader's fuzz harness (tests/fuzz)
   xvfb xauth               # windowed viewer test without a display
+  universal-ctags          # the long-function check (scripts/long_functions.py)
   chromium                 # runtime/web: the three.js viewer test in headless Chromium
   blender python3-numpy    # runtime/blender: the light-map add-on test (Blender 3.4's glTF importer needs numpy)
   slurm-wlm munge          # tests/slurm: a single-node Slurm on localhost bakes in shards (scripts/slurm)

@@ -99,26 +99,12 @@ void groupOptions(CLI::App& app) {
   }
 }
 
-// Every option of `irbake bake`, with its range and help.
-std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
+// The scene, the output, the backend, the walk and the texels.
+void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
-  std::vector<std::string>& scenes = a.scenes;
-  std::string &backend = a.backend, &shard = a.shard;
-  std::string &out = command.out, &sun = command.sun, &sky = command.sky, &env = command.env, &report = command.report;
-  double &envIntensity = command.envIntensity, &envRotation = command.envRotation;
-  long long& seed = a.seed;
-  double &tpu = a.tpu, &clamp = a.clamp;
-  int& threads = command.threads;
-  bool &verbose = command.verbose;
-  bool &quiet = command.quiet, &noGltf = command.noGltf;
-  bool &noLeakControl = a.noLeakControl, &noDilate = a.noDilate, &noSeams = a.noSeams;
-  bool &noBiasCompensation = a.noBiasCompensation, &biasCompensation = a.biasCompensation;
-  auto app = cli::makeApp("irbake bake",
-                          "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
-                          "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
-  app->add_option("SCENE", scenes, "the glTF/GLB scene to bake");
-  app->add_option("-o,--output", out, "output folder (OUTDIR), or OUT.glb / OUT.gltf: that glTF, the rest beside it")->type_name("OUTDIR");
-  app->add_option("--backend", backend,
+  app->add_option("SCENE", a.scenes, "the glTF/GLB scene to bake");
+  app->add_option("-o,--output", command.out, "output folder (OUTDIR), or OUT.glb / OUT.gltf: that glTF, the rest beside it")->type_name("OUTDIR");
+  app->add_option("--backend", a.backend,
                   "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
@@ -145,7 +131,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--vpl-keep", o.vplImportance.keepShare,
                   "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default 0.5)")
       ->transform(cli::numberIn(0.05, 4.0))->type_name("S");
-  app->add_option("--texels-per-unit", tpu, "texels per metre (default: about one 1024² page, ≥ 64 per triangle)")
+  app->add_option("--texels-per-unit", a.tpu, "texels per metre (default: about one 1024² page, ≥ 64 per triangle)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
                   "texel budget of all pages together (default 16777216 = 16M);\n"
@@ -153,17 +139,22 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
   app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
       ->transform(cli::integerIn(1, 8))->type_name("S");
+}
+
+// The clamp and its compensation, the final gather, interleaving, the GL backend's cubes.
+void addStageOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
+  BakeOptions& o = command.options;
   a.clampOption =
-      app->add_option("--clamp", clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
+      app->add_option("--clamp", a.clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
           ->transform(cli::numberIn(0.0, 1e30))
           ->type_name("B");
   app->add_option("--clamp-k", o.clampVplsPerMean,
                   "derived clamp: no VPL adds more than 1/K of the mean\n"
                   "(default with bias compensation: 256, or 1024 in a scene\nwithout emissive surfaces; 16 without; 0 = automatic)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
-  app->add_flag("--no-bias-compensation", noBiasCompensation,
+  app->add_flag("--no-bias-compensation", a.noBiasCompensation,
                "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");
-  app->add_flag("--bias-compensation", biasCompensation, "the default (kept for old scripts)");
+  app->add_flag("--bias-compensation", a.biasCompensation, "the default (kept for old scripts)");
   app->add_option("--comp-rays", o.compensation.rays, "bias compensation: rays per texel sample, first round (default 16)")
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
@@ -203,12 +194,17 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "GL backend: VPL depth-cube face size in texels\n"
                   "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, 128..256)")
       ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
-  app->add_option("--seed", seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
+}
+
+// The seed, light from the command line, and what is written.
+void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
+  BakeOptions& o = command.options;
+  app->add_option("--seed", a.seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
   app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default 256)")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
-  app->add_option("--sun", sun, "add a directional light travelling along D with irradiance E (W/m²)")
+  app->add_option("--sun", command.sun, "add a directional light travelling along D with irradiance E (W/m²)")
       ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
-  app->add_option("--sky", sky, "a uniform sky of that radiance (W/(m² sr))")
+  app->add_option("--sky", command.sky, "a uniform sky of that radiance (W/(m² sr))")
       ->transform(cli::numberList(3))->type_name("R,G,B");
   app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default 64)")
       ->transform(cli::integerIn(8, 4096))->type_name("N");
@@ -220,15 +216,15 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
                   "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 8; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
-  app->add_option("--env", env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
+  app->add_option("--env", command.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
-  app->add_option("--env-intensity", envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
-  app->add_option("--env-rotation", envRotation, "turns --env about +Y (degrees, default 0)")
+  app->add_option("--env-intensity", command.envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-rotation", command.envRotation, "turns --env about +Y (degrees, default 0)")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
-  app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
+  app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
-  app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
+  app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");
   app->add_option("--portable", command.portable,
                   "also write FILE.glb for viewers without MOZ_lightmap: base colour × light\n"
                   "map + emission baked into unlit textures (KHR_materials_unlit; docs/export.md)")
@@ -237,14 +233,19 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
                   "--portable: scale on the shown values before the 8-bit sRGB encode\n"
                   "(default 1: the map as it is; values above 1 clip)")
       ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
-  app->add_flag("--no-leak-control", noLeakControl, "diagnostics: texel samples may sit behind walls");
-  app->add_flag("--no-dilate", noDilate, "diagnostics: no dilation into the padding");
-  app->add_flag("--no-seams", noSeams, "diagnostics: no seam stitching");
-  app->add_option("--threads", threads, "worker threads (default 0: every core; same bytes for any count)")
+}
+
+// Diagnostics, threads and logging, distributed and resumable bakes, presets and config files.
+void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
+  BakeOptions& o = command.options;
+  app->add_flag("--no-leak-control", a.noLeakControl, "diagnostics: texel samples may sit behind walls");
+  app->add_flag("--no-dilate", a.noDilate, "diagnostics: no dilation into the padding");
+  app->add_flag("--no-seams", a.noSeams, "diagnostics: no seam stitching");
+  app->add_option("--threads", command.threads, "worker threads (default 0: every core; same bytes for any count)")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
-  app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
-  app->add_flag("--verbose", verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
-  a.shardOption = app->add_option("--shard", shard,
+  app->add_flag("--quiet", command.quiet, "warnings and errors only, no progress bars");
+  app->add_flag("--verbose", command.verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
+  a.shardOption = app->add_option("--shard", a.shard,
                   "evaluate share K of N of the VPL blocks and write the exact partial\n"
                   "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
       ->type_name("K/N");
@@ -264,6 +265,17 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
       ->type_name("FILE");
   app->add_option("--dump-config", a.dumpConfig, "write every option of this bake as such a file")->type_name("FILE");
   app->add_flag("--help-all", a.helpAll, "every option, grouped by stage");
+}
+
+// Every option of `irbake bake`, with its range and help.
+std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
+  auto app = cli::makeApp("irbake bake",
+                          "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
+                          "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
+  addWalkOptions(app.get(), command, a);
+  addStageOptions(app.get(), command, a);
+  addLightAndOutputOptions(app.get(), command, a);
+  addRunOptions(app.get(), command, a);
   groupOptions(*app);
   return app;
 }

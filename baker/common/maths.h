@@ -14,11 +14,6 @@ constexpr float kInvPi2F = 1.0f / (kPiF * kPiF);
 // Mean of the three channels: the scalar that power splits, stopping tests and figures compare. The float
 // channels are summed in float and divided in double, as the loops that wrote it out by hand did.
 inline double channelMean(const glm::vec3& c) { return (c.x + c.y + c.z) / 3.0; }
-// The double version is a template only so that it can stand beside vpl/sampling.h's own plain overload
-// (which wins where both are seen) until that one is removed; the two compute the same.
-template <typename T>
-inline T channelMean(const glm::vec<3, T, glm::defaultp>& c) {
-  return (c.x + c.y + c.z) / T(3);
-}
+inline double channelMean(const glm::dvec3& c) { return (c.x + c.y + c.z) / 3.0; }
 
 }  // namespace irbake

@@ -242,6 +242,29 @@ std::vector<SeamEdge> findSeams(const Scene& scene, const SeamOptions& options) 
   return seams;
 }
 
+namespace {
+
+// 1 / (wd + ws Σ_s (r_s)_i²) for every unknown i, from the rows' transpose (each unknown's taps in row order).
+std::vector<double> jacobiInverseDiagonal(const std::vector<size_t>& columnStart, const std::vector<Tap>& columns,
+                                          double ws, double wd) {
+  const size_t n = columnStart.size() - 1;
+  std::vector<double> inverseDiagonal(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    double diagonal = wd, rowSum = 0.0;
+    for (size_t k = columnStart[i]; k < columnStart[i + 1]; ++k) {
+      rowSum += columns[k].weight;  // an unknown can sit twice in one row (clamped taps at a page's edge)
+      if (k + 1 == columnStart[i + 1] || columns[k + 1].index != columns[k].index) {
+        diagonal += ws * rowSum * rowSum;
+        rowSum = 0.0;
+      }
+    }
+    inverseDiagonal[i] = 1.0 / diagonal;
+  });
+  return inverseDiagonal;
+}
+
+}  // namespace
+
 double seamMismatch(const std::vector<Lightmap>& maps, const std::vector<SeamEdge>& seams, const SeamOptions& options) {
   auto offsets = pageOffsets(maps);
   return rowsMismatch(maps, offsets, buildRows(maps, offsets, seams, options));
@@ -301,18 +324,7 @@ double stitchSeams(std::vector<Lightmap>& maps, const std::vector<SeamEdge>& sea
   // Jacobi preconditioner: the diagonal wd + ws Σ_s (r_s)_i². Unknowns that only a seam sample's far bilinear
   // corner touches have a diagonal near wd, the rest near ws: without it the system's condition number is
   // ~ws/wd and plain CG ran into its 200-iteration cap on Sponza (1.6 s, a tenth of the bake's serial time).
-  std::vector<double> inverseDiagonal(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
-    double diagonal = wd, rowSum = 0.0;
-    for (size_t k = columnStart[i]; k < columnStart[i + 1]; ++k) {
-      rowSum += columns[k].weight;  // an unknown can sit twice in one row (clamped taps at a page's edge)
-      if (k + 1 == columnStart[i + 1] || columns[k + 1].index != columns[k].index) {
-        diagonal += ws * rowSum * rowSum;
-        rowSum = 0.0;
-      }
-    }
-    inverseDiagonal[i] = 1.0 / diagonal;
-  });
+  const std::vector<double> inverseDiagonal = jacobiInverseDiagonal(columnStart, columns, ws, wd);
   std::vector<glm::dvec3> x0(n), x(n), r(n), z(n), p(n), ap(n);
   for (size_t i = 0; i < n; ++i) x[i] = x0[i] = glm::dvec3(texel(globalOf[i]));
   apply(x, ap);

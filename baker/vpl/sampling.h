@@ -6,6 +6,8 @@
 
 #include <glm/glm.hpp>
 
+#include "common/maths.h"  // channelMean: the scalar weight of an RGB power
+
 namespace irbake {
 
 // Halton sequence: dimension d uses the d-th prime b as base (2, 3, 5, ...), randomized by digit
@@ -89,8 +91,5 @@ class Rng {
 };
 // Mixes several integers into one well-spread 64-bit seed.
 uint64_t hashSeed(uint64_t a, uint64_t b = 0, uint64_t c = 0);
-
-// Scalar weight of an RGB power for sampling: the channel mean (grey stays exact).
-inline double channelMean(const glm::dvec3& c) { return (c.x + c.y + c.z) / 3.0; }
 
 }  // namespace irbake

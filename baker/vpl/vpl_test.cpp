@@ -13,7 +13,6 @@ using namespace irbake;
 using namespace irbake::testing;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 double sumPower(const VplSet& set, int fromBounce = 0) {
   double s = 0.0;

@@ -270,6 +270,55 @@ ClampGather::ClampGather(const BakeInputs& in, const ClampCompensationOptions& o
   gather.traceSeconds = clock.seconds();
 }
 
+namespace {
+
+// One sweep's gather: each texel sample's residual, Σ over its kept hits of (emitted + albedo × map read).
+void gatherSlotResiduals(const std::vector<Tile>& tiles, const std::vector<PackedLightmap>& packed,
+                         std::vector<std::vector<glm::vec3>>& slotResidual) {
+  tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
+    const Tile& tile = tiles[ti];
+    auto& res = slotResidual[tile.page];
+    for (size_t s = tile.begin; s < tile.end; ++s) res[s] = glm::vec3(0.0f);
+    size_t e = 0;  // next EmittedHit
+    for (size_t h = 0; h < tile.hits.size(); ++h) {
+      const KeptHit& kept = tile.hits[h];
+      glm::vec3 L(0.0f);
+      if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
+      if (kept.map >= 0) L += kept.albedo * packed[kept.map].read(kept.texel);
+      res[tile.begin + kept.slotInTile] += L;
+    }
+  });
+}
+
+// current = map + filter(current − map) on the valid texels: the residual filtered once, after the sweeps.
+void filterResidual(const Lightmap& map, std::vector<glm::vec3>& current, SurfaceFilterCache& filters,
+                    const TexelSamples& texels, const TexelFilterOptions& options) {
+  std::vector<glm::vec3> r(map.size(), glm::vec3(0.0f));
+  for (size_t t = 0; t < r.size(); ++t)
+    if (map.valid[t]) r[t] = current[t] - map.texels[t];
+  r = filters.apply(texels, r, map.valid, options);
+  for (size_t t = 0; t < r.size(); ++t)
+    if (map.valid[t]) current[t] = map.texels[t] + r[t];
+}
+
+// maps = current on the valid, finite texels (post's finite check reports the others); `before` and `added`
+// sum the channel means of the maps before and of what was added.
+void writeFinite(std::vector<Lightmap>& maps, const std::vector<std::vector<glm::vec3>>& current, double& before,
+                 double& added) {
+  for (size_t p = 0; p < maps.size(); ++p) {
+    for (size_t t = 0; t < maps[p].size(); ++t) {
+      if (!maps[p].valid[t]) continue;
+      const glm::vec3 c = current[p][t];
+      if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;
+      before += channelMean(maps[p].texels[t]);
+      added += channelMean(c - maps[p].texels[t]);
+      maps[p].texels[t] = c;
+    }
+  }
+}
+
+}  // namespace
+
 void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats) const {
   Stopwatch clock;
   const Impl& g = *impl_;
@@ -310,19 +359,7 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
     if (options.extrapolateTail && sweep >= kFirstTailSweep) previous = current;
     const std::vector<PackedLightmap> packed = packLightmaps(maps, current);  // the hits' reads (lightmap_read.h)
-    tbb::parallel_for(size_t(0), tiles.size(), [&](size_t ti) {
-      const Tile& tile = tiles[ti];
-      auto& res = slotResidual[tile.page];
-      for (size_t s = tile.begin; s < tile.end; ++s) res[s] = glm::vec3(0.0f);
-      size_t e = 0;  // next EmittedHit
-      for (size_t h = 0; h < tile.hits.size(); ++h) {
-        const KeptHit& kept = tile.hits[h];
-        glm::vec3 L(0.0f);
-        if (e < tile.emitted.size() && tile.emitted[e].hit == h) L = tile.emitted[e++].emitted;
-        if (kept.map >= 0) L += kept.albedo * packed[kept.map].read(kept.texel);
-        res[tile.begin + kept.slotInTile] += L;
-      }
-    });
+    gatherSlotResiduals(tiles, packed, slotResidual);
     double added = 0.0;  // Σ residual (channel mean) = what this sweep's map adds to the base
     for (size_t p = 0; p < maps.size(); ++p) {
       const TexelSamples& ts = in.texels[p];
@@ -386,26 +423,10 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
 
   // Or once, after the last sweep (linear: the same in expectation, noisier between sweeps).
   if (!options.filterEachSweep)
-    for (size_t p = 0; p < maps.size(); ++p) {
-      if (radii[p] <= 0) continue;
-      std::vector<glm::vec3> r(maps[p].size(), glm::vec3(0.0f));
-      for (size_t t = 0; t < r.size(); ++t)
-        if (maps[p].valid[t]) r[t] = current[p][t] - base(p)[t];
-      r = g.filters()->apply(in.texels[p], r, maps[p].valid, filterOptions[p]);
-      for (size_t t = 0; t < r.size(); ++t)
-        if (maps[p].valid[t]) current[p][t] = base(p)[t] + r[t];
-    }
+    for (size_t p = 0; p < maps.size(); ++p)
+      if (radii[p] > 0) filterResidual(maps[p], current[p], *g.filters(), in.texels[p], filterOptions[p]);
   double before = 0.0, added = 0.0;
-  for (size_t p = 0; p < maps.size(); ++p) {
-    for (size_t t = 0; t < maps[p].size(); ++t) {
-      if (!maps[p].valid[t]) continue;
-      glm::vec3 c = current[p][t];
-      if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;  // post's finite check reports
-      before += channelMean(base(p)[t]);
-      added += channelMean(c - base(p)[t]);
-      maps[p].texels[t] = c;
-    }
-  }
+  writeFinite(maps, current, before, added);
   if (stats) {
     stats->raysTraced = g.rays;
     stats->samplesRefined = g.refined;
