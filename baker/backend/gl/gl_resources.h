@@ -195,7 +195,10 @@ struct GpuPage {
       const uint32_t* idx = &p.indices[3 * size_t(s.triangle[i])];
       const glm::vec3 n = glm::cross(p.positions[idx[1]] - p.positions[idx[0]], p.positions[idx[2]] - p.positions[idx[0]]);
       const float len = glm::length(n);
-      if (len > 0.0f && std::isfinite(len)) faceNormal[i] = glm::vec4(n / len, 0.0f);
+      // On the side the shading normal faces: a triangle wound against its normals is lit on the normals' side,
+      // as the Embree backend and path tracers light it (the raw winding left such a surface black).
+      const float side = glm::dot(n, glm::vec3(s.normal[i])) < 0.0f ? -1.0f : 1.0f;
+      if (len > 0.0f && std::isfinite(len)) faceNormal[i] = glm::vec4(side * n / len, 0.0f);
     }
     glTextureSubImage3D(geomNormal, 0, 0, 0, 0, s.width, s.height, layers, GL_RGBA, GL_FLOAT, faceNormal.data());
     glCreateTextures(GL_TEXTURE_2D, 1, &accum);

@@ -150,6 +150,28 @@ TEST(GlVsEmbree, CornerSceneWithinOnePercent) {
   EXPECT_LT(c.relativeRmse, 0.01);
 }
 
+// Triangles wound against their vertex normals (front faces away from the light, normals towards it) are lit on
+// the normals' side by both backends: GL took the winding's side and left every texel black.
+TEST(GlVsEmbree, TrianglesWoundAgainstTheirNormalsAreLitOnTheNormalsSide) {
+  Scene scene = samples::makeCorner();
+  for (Primitive& p : scene.primitives) {
+    if (p.normals.size() != p.positions.size()) {
+      p.normals.assign(p.positions.size(), glm::vec3(0.0f));
+      for (size_t t = 0; 3 * t + 2 < p.indices.size(); ++t) {
+        const uint32_t* i = &p.indices[3 * t];
+        const glm::vec3 n = glm::normalize(glm::cross(p.positions[i[1]] - p.positions[i[0]], p.positions[i[2]] - p.positions[i[0]]));
+        for (int k = 0; k < 3; ++k) p.normals[i[k]] = n;
+      }
+    }
+    for (size_t t = 0; 3 * t + 2 < p.indices.size(); ++t) std::swap(p.indices[3 * t + 1], p.indices[3 * t + 2]);
+  }
+  const Comparison wound = compareBackends(scene, 128, 256);
+  const Comparison plain = compareBackends(samples::makeCorner(), 128, 256);
+  EXPECT_GT(wound.validTexels, 3000u);
+  EXPECT_LT(wound.relativeRmse, 0.01);
+  EXPECT_NEAR(wound.meanGl / plain.meanGl, 1.0, 0.02);  // lit as the plainly wound corner
+}
+
 TEST(GlVsEmbree, CornerBouncesOnlyWithinOnePercent) {
   // Only the VPLs (no exact direct light), so the comparison is about the VPL cubes alone.
   const Comparison c = compareBackends(samples::makeCorner(), 128, 256, 1, false);
