@@ -22,7 +22,7 @@
 #include "backend/reference/reference_integrator.h"
 #include "common/atomic_file.h"
 #include "raytrace/test_scenes.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 #include "vpl/vpl.h"
 
 using namespace irbake;

@@ -12,7 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "backend/bake_inputs.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 

@@ -7,7 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "transport/geometry_term.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 

@@ -6,7 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 

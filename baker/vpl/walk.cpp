@@ -24,7 +24,7 @@
 #include "common/error.h"
 #include "common/maths.h"
 #include "vpl/light_sources.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 #include "vpl/vpl.h"
 
 namespace irbake {

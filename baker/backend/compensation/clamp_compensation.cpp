@@ -16,7 +16,7 @@
 #include "common/progress.h"
 #include "texels/surface_filter_cache.h"
 #include "transport/geometry_term.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 namespace {

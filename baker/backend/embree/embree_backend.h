@@ -10,7 +10,7 @@
 
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 

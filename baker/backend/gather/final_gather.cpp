@@ -13,7 +13,7 @@
 #include "common/maths.h"
 #include "common/progress.h"
 #include "texels/surface_filter_cache.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 namespace {

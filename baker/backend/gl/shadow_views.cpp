@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "texels/texel_filter.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 

@@ -11,7 +11,7 @@
 #include "backend/bake_inputs.h"
 #include "backend/lightmap.h"
 #include "vpl/light_sources.h"
-#include "vpl/sampling.h"
+#include "sampling/sampling.h"
 
 namespace irbake {
 
