@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "scene/scene.h"
 
 namespace irbake::view {

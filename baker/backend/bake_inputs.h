@@ -2,7 +2,7 @@
 #pragma once
 #include <vector>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "common/progress.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/footprint_albedo.h"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "export/gltf_writer.h"
 #include "scene/scene.h"
 

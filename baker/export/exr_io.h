@@ -2,7 +2,7 @@
 #pragma once
 #include <filesystem>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 
 namespace irbake {
 

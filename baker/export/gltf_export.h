@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "common/atomic_file.h"
 #include "export/lightmap_png.h"
 #include "scene/scene.h"

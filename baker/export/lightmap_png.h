@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "scene/scene.h"
 
 namespace irbake {

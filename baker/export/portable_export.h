@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "common/atomic_file.h"
 #include "export/gltf_writer.h"
 #include "scene/scene.h"

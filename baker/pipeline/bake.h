@@ -17,7 +17,7 @@
 #include "backend/gl/gl_backend.h"
 #include "backend/shadow_edges/shadow_edges.h"
 #include "backend/sky/sky_light.h"
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "export/portable_export.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"

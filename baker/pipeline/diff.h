@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 
 namespace irbake {
 

@@ -8,7 +8,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "scene/scene.h"
 
 namespace irbake {

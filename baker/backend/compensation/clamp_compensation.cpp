@@ -9,7 +9,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "backend/lightmap_read.h"
+#include "lightmap/lightmap_read.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/maths.h"

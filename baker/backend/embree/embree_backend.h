@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "backend/bake_inputs.h"
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "sampling/sampling.h"
 
 namespace irbake {

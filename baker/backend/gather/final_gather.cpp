@@ -7,7 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "backend/lightmap_read.h"
+#include "lightmap/lightmap_read.h"
 #include "backend/sample_lattice.h"
 #include "common/error.h"
 #include "common/maths.h"

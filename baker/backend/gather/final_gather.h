@@ -22,7 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/bake_inputs.h"
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "transport/directional.h"
 
 namespace irbake {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "atlas/atlas.h"
-#include "backend/lightmap_read.h"
+#include "lightmap/lightmap_read.h"
 #include "backend/sample_lattice.h"
 #include "common/maths.h"
 #include "raytrace/test_scenes.h"

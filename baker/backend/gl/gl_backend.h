@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/bake_inputs.h"
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 
 namespace irbake {
 

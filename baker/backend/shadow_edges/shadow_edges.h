@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "backend/bake_inputs.h"
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 
 namespace irbake {
 

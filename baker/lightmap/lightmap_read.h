@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 #include <tbb/parallel_for.h>
 
-#include "backend/lightmap.h"
+#include "lightmap/lightmap.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/scene.h"
 #include "texels/texel_samples.h"
