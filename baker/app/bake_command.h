@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -35,6 +36,7 @@ struct BakeCommand {
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
   double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
   Args arguments;                  // the arguments parsed: the command line after --config's entries
+  std::vector<std::filesystem::path> inputs;  // the scene's files and --env's map (checkOutputPaths)
   std::string dumpConfig;          // --dump-config FILE ("" without it)
   std::string dumpText;            // that file's text as parsed (what the bake decides is appended after it)
   nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
@@ -52,8 +54,8 @@ std::string bakeSceneIdentity(const BakeCommand& command);
 
 // Refuses (Error(Usage), exit 2) outputs that would overwrite an input (the scene, its .bin and textures,
 // --env) or each other (--report or --portable naming the glTF, a page or each other), and a --report or
-// --portable that is a folder.
-void checkOutputPaths(const BakeCommand& command);
+// --portable that is a folder. Returns the inputs (BakeCommand::inputs), which the export never overwrites.
+std::vector<std::filesystem::path> checkOutputPaths(const BakeCommand& command);
 // Locks --report's folder when it is not OUTDIR, so a report never lands in another bake's folder while
 // that bake runs (nullptr when no second lock is needed). Throws Error(Io) when that folder is busy.
 std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& command);

@@ -18,6 +18,7 @@
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/error.h"
+#include "common/file_paths.h"
 #include "common/log.h"
 #include "common/output_lock.h"
 #include "common/progress.h"
@@ -621,19 +622,6 @@ std::string bakeSceneIdentity(const BakeCommand& c) { return sceneIdentity(c); }
 
 namespace {
 
-// One path's identity for comparison: absolute and normal, links resolved where they exist.
-fs::path canonicalPath(const fs::path& p) {
-  std::error_code ec;
-  fs::path c = fs::weakly_canonical(fs::absolute(p), ec);
-  return ec ? fs::absolute(p).lexically_normal() : c;
-}
-
-bool samePath(const fs::path& a, const fs::path& b) {
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
-  return canonicalPath(a) == canonicalPath(b);
-}
-
 // lightmap_<page>.exr/.png and the directional lightmap_<page>_l1x|y|z.exr: names a bake writes.
 bool isPageName(const std::string& name) {
   const std::string prefix = "lightmap_";
@@ -647,16 +635,14 @@ bool isPageName(const std::string& name) {
 
 }  // namespace
 
-void checkOutputPaths(const BakeCommand& c) {
+std::vector<fs::path> checkOutputPaths(const BakeCommand& c) {
   const fs::path outDir = outputFolderOf(c.out);
   const bool gltfNamed = namesGltfFile(c.out);
   const fs::path gltf = gltfNamed ? fs::path(c.out) : outDir / "scene.gltf";
   std::vector<std::pair<fs::path, std::string>> outputs;  // path, what it is
   if (!c.noGltf) {
     outputs.push_back({gltf, "the glTF output"});
-    std::string extension = gltf.extension().string();
-    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (extension != ".glb") outputs.push_back({outDir / (gltf.stem().string() + ".bin"), "the glTF's .bin output"});
+    if (!hasExtension(gltf, ".glb")) outputs.push_back({outDir / (gltf.stem().string() + ".bin"), "the glTF's .bin output"});
   }
   const fs::path report = c.report.empty() ? outDir / "report.json" : fs::path(c.report);
   std::error_code ec;
@@ -664,8 +650,8 @@ void checkOutputPaths(const BakeCommand& c) {
     throw Error(ErrorCode::Usage, c.report, "--report names a folder: give the report's file name (R.json)");
   if (!c.report.empty()) {
     for (const auto& [path, what] : outputs)
-      if (samePath(report, path)) throw Error(ErrorCode::Usage, c.report, "--report would overwrite " + what + ": choose another name");
-    if (samePath(report.parent_path().empty() ? fs::path(".") : report.parent_path(), outDir) &&
+      if (sameFile(report, path)) throw Error(ErrorCode::Usage, c.report, "--report would overwrite " + what + ": choose another name");
+    if (sameFile(folderOf(report), outDir) &&
         (isPageName(report.filename().string()) || isIrbakeTempName(report.filename().string())))
       throw Error(ErrorCode::Usage, c.report, "--report would overwrite a light-map page of this bake: choose another name");
   }
@@ -674,12 +660,10 @@ void checkOutputPaths(const BakeCommand& c) {
     const fs::path portable = c.portable;
     if (fs::is_directory(portable, ec))
       throw Error(ErrorCode::Usage, c.portable, "--portable names a folder: give the portable file's name (P.glb)");
-    std::string extension = portable.extension().string();
-    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (extension != ".glb") throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
+    if (!hasExtension(portable, ".glb")) throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
     for (const auto& [path, what] : outputs)
-      if (samePath(portable, path)) throw Error(ErrorCode::Usage, c.portable, "--portable would overwrite " + what + ": choose another name");
-    if (samePath(portable.parent_path().empty() ? fs::path(".") : portable.parent_path(), outDir) &&
+      if (sameFile(portable, path)) throw Error(ErrorCode::Usage, c.portable, "--portable would overwrite " + what + ": choose another name");
+    if (sameFile(folderOf(portable), outDir) &&
         isIrbakeTempName(portable.filename().string()))
       throw Error(ErrorCode::Usage, c.portable, "--portable names a temporary file of this bake: choose another name");
     outputs.push_back({portable, "the portable GLB"});
@@ -689,22 +673,22 @@ void checkOutputPaths(const BakeCommand& c) {
   if (!c.env.empty()) inputs.push_back(c.env);
   for (const fs::path& input : inputs) {
     for (const auto& [path, what] : outputs)
-      if (samePath(input, path))
+      if (sameFile(input, path))
         throw Error(ErrorCode::Usage, input.string(),
                     "is an input of this bake and would be overwritten by " + what + ": choose another -o" +
                         (what == "the report" ? " or --report" : what == "the portable GLB" ? " or --portable" : ""));
-    if (samePath(input.parent_path().empty() ? fs::path(".") : input.parent_path(), outDir) &&
+    if (sameFile(folderOf(input), outDir) &&
         isPageName(input.filename().string()))
       throw Error(ErrorCode::Usage, input.string(),
                   "is an input of this bake and would be overwritten by a light-map page: choose another -o");
   }
+  return inputs;
 }
 
 std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& c) {
   if (c.report.empty()) return nullptr;
-  fs::path folder = fs::path(c.report).parent_path();
-  if (folder.empty()) folder = ".";
-  if (samePath(folder, outputFolderOf(c.out))) return nullptr;
+  const fs::path folder = folderOf(c.report);
+  if (sameFile(folder, outputFolderOf(c.out))) return nullptr;
   return std::make_unique<OutputFolderLock>(folder);
 }
 
@@ -719,7 +703,7 @@ int runBake(const Args& args) {
     threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);
 
   const fs::path outDir = outputFolderOf(c.out);
-  checkOutputPaths(c);
+  c.inputs = checkOutputPaths(c);
   const OutputFolderLock lock(outDir);  // before any work: a second bake into OUTDIR fails at once
   const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
   removeStaleTemps(outDir);
@@ -820,8 +804,7 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   outputOptions.writeGltf = !c.noGltf;
   outputOptions.portablePath = c.portable;
   outputOptions.portable.exposure = c.portableExposure;
-  outputOptions.inputs = sceneInputFiles(c.scene);
-  if (!c.env.empty()) outputOptions.inputs.push_back(c.env);
+  outputOptions.inputs = c.inputs;
   Stopwatch writeTime;
   c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another
   auto files = writeBakeOutputs(result, outputOptions);

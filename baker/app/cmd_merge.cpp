@@ -140,7 +140,7 @@ int runMerge(const Args& args) {
   if (c.optionsHash != first.optionsHash)
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");
 
-  checkOutputPaths(c);
+  c.inputs = checkOutputPaths(c);
   const OutputFolderLock lock(outputFolderOf(out));
   const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
   removeStaleTemps(outputFolderOf(out));

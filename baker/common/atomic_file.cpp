@@ -152,11 +152,10 @@ void writeAllAtomically(const std::vector<PendingFile>& files) {
     if (ec) {
       // All or nothing: the files already renamed go, and what they replaced comes back.
       std::error_code ignored;
-      for (size_t j = 0; j < i; ++j) {
-        bool hadPrevious = false;
-        for (const auto& r : replaced) hadPrevious = hadPrevious || r.index == j;
-        if (!hadPrevious) fs::remove(files[j].finalPath, ignored);
-      }
+      std::vector<bool> hadPrevious(files.size(), false);
+      for (const auto& r : replaced) hadPrevious[r.index] = true;
+      for (size_t j = 0; j < i; ++j)
+        if (!hadPrevious[j]) fs::remove(files[j].finalPath, ignored);
       dropBackups(true);
       cleanup();
       throw Error(ErrorCode::Io, files[i].finalPath.string(), "cannot rename temp file: " + ec.message());

@@ -22,6 +22,7 @@
 
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_paths.h"
 #include "common/log.h"
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
@@ -465,34 +466,16 @@ GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& 
   return doc;
 }
 
-bool isGlbPath(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb";
-}
-
 }  // namespace
 
 bool namesGltfFile(const std::filesystem::path& output) {
-  std::string ext = output.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb" || ext == ".gltf";
+  return hasExtension(output, ".glb") || hasExtension(output, ".gltf");
 }
 
 std::filesystem::path outputFolderOf(const std::filesystem::path& output) {
   if (!namesGltfFile(output)) return output;
-  return output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
+  return folderOf(output);
 }
-
-namespace {
-// True when a and b name the same file or folder (links and relative names resolved).
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-  std::error_code ec;
-  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec)) return std::filesystem::equivalent(a, b, ec);
-  return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
-         std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
-}
-}  // namespace
 
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options) {
   const std::string file = options.output.string();
@@ -525,13 +508,12 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
 
   std::vector<PendingFile> files;
   const std::filesystem::path folder = options.output.parent_path();
-  if (!isGlbPath(options.output)) {
+  if (!hasExtension(options.output, ".glb")) {
     // A folder output: images as files beside the .gltf (a GLB keeps them embedded).
     std::vector<std::string> taken = {options.output.filename().string(), options.output.stem().string() + ".bin"};
     taken.insert(taken.end(), pageUris.begin(), pageUris.end());
     for (const auto& input : options.inputs)
-      if (sameFile(input.parent_path().empty() ? std::filesystem::path(".") : input.parent_path(),
-                   folder.empty() ? std::filesystem::path(".") : folder))
+      if (sameFile(folderOf(input), folderOf(options.output)))
         taken.push_back(input.filename().string());
     auto images = externalizeImages(doc, taken);
     compactDocument(doc);

@@ -7,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "common/error.h"
+#include "common/file_paths.h"
 #include "scene/image_codec.h"
 
 namespace irbake {
@@ -49,11 +50,6 @@ void writeBytes(const std::filesystem::path& path, const void* data, size_t size
   if (!out) throw Error(ErrorCode::Io, finalName, "write failed (disk full?)");
 }
 
-bool isGlb(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb";
-}
 
 }  // namespace
 
@@ -154,7 +150,7 @@ std::vector<PendingFile> GltfDocument::files(const std::filesystem::path& path) 
   buffer0.erase("uri");
   if (bin.empty() && doc["buffers"].size() == 1) doc.erase("buffers");
   const std::string finalName = path.string();
-  if (isGlb(path)) {
+  if (hasExtension(path, ".glb")) {
     auto text = std::make_shared<std::string>(doc.dump());
     out.push_back({path, [text, this, finalName](const std::filesystem::path& temp) {
                      std::string jsonChunk = *text;

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "common/error.h"
+#include "common/file_paths.h"
 #include "export/gltf_compact.h"
 #include "post/post.h"
 
@@ -20,11 +21,6 @@ namespace {
 
 float cross2(glm::vec2 a, glm::vec2 b) { return a.x * b.y - a.y * b.x; }
 
-bool isGlb(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".glb";
-}
 
 // The base-colour texture of a material when it has texels, else null.
 const Texture* baseColorTextureOf(const Scene& scene, const Material& m) {
@@ -213,7 +209,7 @@ PortableBake buildPortable(const Scene& scene, const std::vector<Lightmap>& maps
 
 PendingFile portableGlbFile(const Scene& scene, const std::vector<Lightmap>& maps, const std::filesystem::path& path,
                             const PortableOptions& options, json* summary) {
-  if (!isGlb(path)) throw Error(ErrorCode::Usage, path.string(), "--portable writes one GLB: give a .glb file name");
+  if (!hasExtension(path, ".glb")) throw Error(ErrorCode::Usage, path.string(), "--portable writes one GLB: give a .glb file name");
   auto bake = std::make_shared<PortableBake>(buildPortable(scene, maps, options));
   if (summary) {
     *summary = {{"file", path.string()}, {"exposure", options.exposure}, {"pages", json::array()}};

@@ -9,6 +9,7 @@
 #include "common/checksum.h"
 #include "common/checksum.h"
 #include "common/error.h"
+#include "common/file_paths.h"
 #include "scene/scene_files.h"
 
 namespace irbake {
@@ -211,7 +212,7 @@ std::string hashSceneFiles(const std::filesystem::path& scene) {
   // What the loader reads: the scene's bytes and each local file its buffers and images name, by the
   // decoded URI (a .gltf's .bin and textures; a GLB's external images), each with its name.
   Checksum64 h;
-  const bool gltf = std::filesystem::path(scene).extension() == ".gltf" || std::filesystem::path(scene).extension() == ".glb";
+  const bool gltf = hasExtension(scene, ".gltf") || hasExtension(scene, ".glb");
   std::vector<std::filesystem::path> files = {scene};
   if (gltf) files = sceneInputFiles(scene);
   for (size_t i = 0; i < files.size(); ++i) {

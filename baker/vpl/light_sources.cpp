@@ -62,6 +62,7 @@ LightSources collectLightSources(const Scene& scene) {
     }
   }
   if (!weights.empty()) out.all = AliasTable(weights);
+  out.startWeights = std::move(weights);
   if (!areaWeights.empty()) out.areaOnly = AliasTable(areaWeights);
   return out;
 }

@@ -22,6 +22,7 @@ struct LightSources {
   std::vector<glm::dvec3> lightPower;      // per Scene::lights (W); directional: I · π R² through its disc
   glm::dvec3 skyPower{0.0};                // Scene::environment: π R² ∫ L dω through the bounding sphere (W)
   bool hasSky = false;                     // the sky is the last entry of `all`
+  std::vector<double> startWeights;  // what `all` samples by: triangles, then lights, then the sky (channel-mean power)
   AliasTable all;       // triangles first, then lights, then the sky, by channel-mean power (the walk's start points)
   AliasTable areaOnly;  // emissive triangles only (next-event estimation in the reference)
   std::vector<int64_t> firstSlot;          // per primitive: slot of its triangle 0 in `triangles`, -1 if not emissive

@@ -212,25 +212,25 @@ std::vector<double> weighByReach(const Scene& scene, const RayTracer& rt, LightS
     }
     reach[k] = static_cast<double>(received) / kReachPilots;
   });
-  std::vector<double> weights;
+  // The lights' and the sky's start weights times their reach; the triangles' (emitters light what faces them)
+  // stay as they are.
+  std::vector<double> weights = sources.startWeights;
+  const size_t first = sources.triangles.size();
   double reached = 0.0, unreached = 0.0;
-  for (const EmitterTriangle& e : sources.triangles) {
-    weights.push_back(channelMean(e.power));
-    reached += weights.back();
-  }
-  for (size_t k = 0; k < lights; ++k) {
-    const double power = channelMean(k < scene.lights.size() ? sources.lightPower[k] : sources.skyPower);
-    weights.push_back(power * reach[k]);
-    if (reach[k] > 0.0) reached += weights.back();
-    else unreached += power;
+  for (size_t i = 0; i < weights.size(); ++i) {
+    const bool light = i >= first;
+    if (light && reach[i - first] <= 0.0) {
+      unreached += weights[i];
+      continue;
+    }
+    if (light) weights[i] *= reach[i - first];
+    reached += weights[i];
   }
   // Unreached sources: their power in proportion, scaled to kUnreachedShare of the reached weight (or
   // their plain power when nothing was reached at all).
   const double scale = reached > 0.0 ? kUnreachedShare * reached / std::max(unreached, 1e-300) : 1.0;
   for (size_t k = 0; k < lights; ++k)
-    if (reach[k] <= 0.0)
-      weights[sources.triangles.size() + k] =
-          scale * channelMean(k < scene.lights.size() ? sources.lightPower[k] : sources.skyPower);
+    if (reach[k] <= 0.0) weights[first + k] *= scale;
   sources.all = AliasTable(weights);
   return reach;
 }
