@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "backend/embree/embree_backend.h"
+#include "evaluators/embree/embree_backend.h"
 #include "transport/geometry_term.h"
-#include "backend/reference/reference_integrator.h"
+#include "evaluators/reference/reference_integrator.h"
 #include "common/atomic_file.h"
 #include "raytrace/test_scenes.h"
 #include "sampling/sampling.h"

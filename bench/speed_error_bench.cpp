@@ -8,7 +8,7 @@
 //                     [--backends gl,embree] [--ref-cache FILE] [--interleave N|auto]
 //   speed_error_bench scene --room DIV [--room-grids] ...   the generated furnished room (atlas, or grids)
 //     --clamp-k: k of deriveClampBound (larger = tighter clamp); --compensate: add the clamp residual
-//     (backend/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
+//     (stages/compensation) after each backend, its time in compensation_s; --ref-cache: keep the
 //     reference maps in FILE (raw floats) and reuse them when FILE matches the texel layout.
 //   speed_error_bench stages [--tris-div 91] [--texels 1024] [--vpls 64] [--k 1,4,16,64]
 //                     [--variants default] [--repeat 1] [--covered 1.0] [--csv OUT.csv]
@@ -26,13 +26,13 @@
 #include <vector>
 
 #include "atlas/atlas.h"
-#include "backend/compensation/clamp_compensation.h"
-#include "backend/embree/embree_backend.h"
-#include "backend/interleave/interleaved_sampling.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "evaluators/embree/embree_backend.h"
+#include "stages/interleave/interleaved_sampling.h"
 #include "transport/geometry_term.h"
-#include "backend/gl/gl_backend.h"
+#include "evaluators/gl/gl_backend.h"
 #include "glcontext/gl_context.h"
-#include "backend/reference/reference_integrator.h"
+#include "evaluators/reference/reference_integrator.h"
 #include "common/error.h"
 #include "common/progress.h"
 #include "pipeline/diff.h"

@@ -1,5 +1,5 @@
 // Reading a baked map at a ray hit: which page the hit surface's light map is on, where on it, and the value
-// there. Shared by the stages that gather from the map (backend/compensation, backend/gather).
+// there. Shared by the stages that gather from the map (stages/compensation, stages/gather).
 #pragma once
 #include <algorithm>
 #include <cmath>

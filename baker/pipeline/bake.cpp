@@ -9,19 +9,19 @@
 
 #include <tbb/parallel_for.h>
 
-#include "backend/compensation/clamp_compensation.h"
-#include "backend/embree/embree_backend.h"
-#include "backend/gather/final_gather.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "evaluators/embree/embree_backend.h"
+#include "stages/gather/final_gather.h"
 #include "transport/geometry_term.h"
 #include "transport/vpl_importance.h"
-#include "backend/gl/gl_backend.h"
-#include "backend/interleave/interleaved_sampling.h"
+#include "evaluators/gl/gl_backend.h"
+#include "stages/interleave/interleaved_sampling.h"
 #include "glcontext/gl_context.h"
-#include "backend/reference/reference_integrator.h"
+#include "evaluators/reference/reference_integrator.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/progress.h"
-#include "backend/gl/shadow_views.h"
+#include "evaluators/gl/shadow_views.h"
 #include "common/maths.h"
 #include "post/post.h"
 #include "raytrace/ray_tracer.h"
@@ -105,7 +105,7 @@ namespace {
 
 // The evaluation flags each backend call gets, decided here once: VPL blocks evaluate the clamped VPL sum
 // only, the direct call the punctual lights only, and no backend compensates the clamp (that is its own
-// stage, backend/compensation, after either backend).
+// stage, stages/compensation, after either backend).
 VplEvalOptions vplBlockEval(const VplEvalOptions& eval) {
   VplEvalOptions e = eval;
   e.includeDirect = false;
@@ -579,7 +579,7 @@ struct StagedBake::State {
     return finalGatherOn && scene.environment.present() && scene.environment.isUniform() && !rayTracer->hasTransmission();
   }
 
-  // Final gather: each texel's bounced light read from the finished map one bounce away (backend/gather).
+  // Final gather: each texel's bounced light read from the finished map one bounce away (stages/gather).
   // With l1 (--directional) the L1 pages become D's plus the same rays' tangential vector.
   void finalGatherStage(std::vector<Lightmap>& maps, L1Pages* l1, nlohmann::json& report) {
     if (!finalGatherOn || directMaps.size() != maps.size()) return;

@@ -11,12 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include "atlas/atlas.h"
-#include "backend/bake_inputs.h"
-#include "backend/compensation/clamp_compensation.h"
-#include "backend/gather/final_gather.h"
-#include "backend/gl/gl_backend.h"
-#include "backend/shadow_edges/shadow_edges.h"
-#include "backend/sky/sky_light.h"
+#include "evaluators/bake_inputs.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "stages/gather/final_gather.h"
+#include "evaluators/gl/gl_backend.h"
+#include "stages/shadow_edges/shadow_edges.h"
+#include "stages/sky/sky_light.h"
 #include "lightmap/lightmap.h"
 #include "export/portable_export.h"
 #include "scene/scene.h"
@@ -44,7 +44,7 @@ enum class OverlapCompensation {
 };
 
 // Whether the bounced light of each texel is gathered from the baked map one bounce away (final gather,
-// backend/gather) instead of read from the VPLs that reach it.
+// stages/gather) instead of read from the VPLs that reach it.
 enum class FinalGatherMode {
   Off,   // the VPL sum (+ clamp compensation) is the map
   On,    // in every scene the VPL backends bake
@@ -73,7 +73,7 @@ struct BakeOptions {
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   ShadowEdgeOptions shadowEdges;          // punctual lights' shadow edges area-averaged (subSamples ≤ 1: off)
-  FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (backend/gather)
+  FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (stages/gather)
   FinalGatherOptions gather;              // its rays and filter
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
   float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)

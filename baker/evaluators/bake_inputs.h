@@ -1,0 +1,54 @@
+// What every backend (embree | gl | reference) receives. Backends return one Lightmap per page.
+#pragma once
+#include <vector>
+
+#include "lightmap/lightmap.h"
+#include "common/progress.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/footprint_albedo.h"
+#include "scene/scene.h"
+#include "texels/surface_filter_cache.h"
+#include "texels/texel_samples.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+struct VplEvalOptions {
+  float clampBound = 0.0f;         // upper bound on the VPL geometry term cosθx cosθy / r² (1/m²); 0 = no clamp
+  bool biasCompensation = false;   // recover the clamped energy: the pipeline's compensation stage
+                                   // (stages/compensation) after the backends; no backend reads it
+  bool includeDirect = true;       // punctual lights evaluated exactly (shadow ray / shadow map)
+  bool includeVpls = true;         // area emitters and bounces through the VPLs
+};
+
+struct BakeInputs {
+  const Scene& scene;
+  const RayTracer& rayTracer;
+  const std::vector<TexelSamples>& texels;  // one per page
+  const VplSet& vpls;
+  VplEvalOptions eval;
+  ProgressCallback progress;
+  // The base colour at the hits of the stages that multiply it by the map read there (the clamp compensation,
+  // the final gather), at one map texel's footprint; the pipeline builds one for both. Null: read at the point.
+  const FootprintAlbedo* footprintAlbedo = nullptr;
+  glm::vec3 albedoAtHit(const RayHit& hit) const {
+    return footprintAlbedo ? footprintAlbedo->at(hit.primitive, hit.triangle, hit.barycentric) : rayTracer.albedoAt(hit);
+  }
+  // The pages' surface filters, each page's neighbour tests made once for every stage that filters it (the
+  // interleave's mix, the sky, the compensation, the final gather); the pipeline makes one per bake. Null: each
+  // filter makes its own (the same bits).
+  SurfaceFilterCache* surfaceFilters = nullptr;
+};
+
+// A page's map with every texel 0 and invalid, sized like its texel samples.
+inline Lightmap blankLightmap(const TexelSamples& ts) {
+  Lightmap map;
+  map.page = ts.page;
+  map.width = ts.width;
+  map.height = ts.height;
+  map.texels.assign(ts.layerSize(), glm::vec3(0.0f));
+  map.valid.assign(ts.layerSize(), 0);
+  return map;
+}
+
+}  // namespace irbake

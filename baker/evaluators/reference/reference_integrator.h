@@ -1,0 +1,34 @@
+// The converged reference: path-traced irradiance / π per texel sample, with a standard error.
+// Independent of the VPLs: cosine-hemisphere paths, next-event estimation on emissive triangles
+// (multiple importance sampling with the hemisphere hits, power heuristic) and on punctual lights
+// (exact, one shadow ray), Russian roulette, seeded per texel sample. The yardstick for every error figure.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "evaluators/bake_inputs.h"
+#include "lightmap/lightmap.h"
+#include "vpl/light_sources.h"
+#include "sampling/sampling.h"
+
+namespace irbake {
+
+struct ReferenceOptions {
+  int spp = 256;           // paths per texel sample
+  uint32_t seed = 0;       // every texel sample gets its own stream derived from (seed, page, slot)
+  int maxDepth = 256;      // hard cap on bounces (roulette ends paths long before in practice)
+  int rouletteStart = 2;   // bounces before Russian roulette may stop a path
+};
+
+// One Lightmap per TexelSamples page (inputs.vpls and inputs.eval are not used: the reference is the
+// full solution). standardError (optional) receives per texel the standard error of the mean, same layout.
+std::vector<Lightmap> bakeReference(const BakeInputs& inputs, const ReferenceOptions& options,
+                                    std::vector<Lightmap>* standardError = nullptr);
+
+// One path's estimate of irradiance / π at surface point (x, n); the mean over paths converges to it.
+glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const LightSources& lights, const glm::vec3& x,
+                              const glm::vec3& n, Rng& rng, const ReferenceOptions& options);
+
+}  // namespace irbake
