@@ -1,4 +1,4 @@
-// What the GL backend (baker/backend/gl/gl_backend.cpp) and its light-map shaders must agree on:
+// What the GL backend (baker/evaluators/gl/gl_backend.cpp) and its light-map shaders must agree on:
 // texture units and the direct-light shader's codes. #define lines only, so the same file is valid
 // C++ (gl_backend.cpp includes it) and GLSL (prepended to direct_light.frag and vpl_accumulate.frag).
 // Texture units: the page's G-buffer (both passes)
