@@ -102,8 +102,11 @@ TEST(BakeOptions, ConfigFileGivesTheSameBakeAndTheCommandLineWins) {
   const std::string dumped = fileText(dir / "dumped.toml");
   EXPECT_NE(dumped.find("\nseed = 4\n"), std::string::npos) << dumped;
   EXPECT_NE(dumped.find("# gather-rays = 16 (--quality default)"), std::string::npos) << dumped;
-  EXPECT_NE(dumped.find("#   backend = embree"), std::string::npos) << dumped;  // what the bake decided
-  EXPECT_NE(dumped.find("#   paths = 256"), std::string::npos) << dumped;
+  // What the bake chose where the options said auto: as entries that replay it, or stay auto with the choice.
+  EXPECT_NE(dumped.find("\ninterleave = "), std::string::npos) << dumped;
+  EXPECT_NE(dumped.find("\nclamp-k = 256\n"), std::string::npos) << dumped;  // the sample box has an emitter
+  EXPECT_NE(dumped.find("\n# bounces = auto (chose "), std::string::npos) << dumped;
+  EXPECT_EQ(dumped.find("\npaths = 256\npaths"), std::string::npos) << dumped;  // given once, not again
   fs::create_directories(dir / "elsewhere");
   fs::copy_file(dir / "dumped.toml", dir / "elsewhere" / "again.toml");
   fs::remove_all(dir / "level" / "baked");

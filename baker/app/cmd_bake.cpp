@@ -348,7 +348,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
                   : a.finalGather == "auto" ? FinalGatherMode::Auto
                                             : FinalGatherMode::Off;
   o.walk.seed = static_cast<uint32_t>(a.seed);
-  o.atlas.texelsPerUnit = static_cast<float>(a.tpu);
+  o.atlas.texelsPerUnit = a.tpu;
   o.texels.leakControl = !a.noLeakControl;
   if (a.bounces >= 0) o.walk.maxBounces = a.bounces;
   if (a.walkSplit > 0) o.walk.split = a.walkSplit;
@@ -508,26 +508,28 @@ void writeDumpedConfig(const std::string& file, const std::string& text) {
 }  // namespace
 
 std::string automaticChoices(const nlohmann::json& report) {
-  std::string text = "# what this bake decided where an option is auto (the same scene and options decide the same):\n";
-  auto line = [&](const std::string& key, const nlohmann::json& value) {
-    if (!value.is_null()) text += "#   " + key + " = " + (value.is_string() ? value.get<std::string>() : value.dump()) + "\n";
-  };
-  const auto at = [&](std::initializer_list<const char*> path) {
-    const nlohmann::json* j = &report;
-    for (const char* k : path) {
-      if (!j->is_object() || !j->contains(k)) return nlohmann::json();
-      j = &(*j)[k];
-    }
-    return *j;
-  };
-  line("backend", at({"backend"}));
-  line("paths", at({"vpls", "paths"}));
-  line("bounces", at({"vpls", "bounces"}));
-  line("walk-split", at({"vpls", "split"}));
-  line("interleave", at({"interleave", "classes"}));
-  line("clamp (1/m²)", at({"eval", "clampBound"}));
-  line("final-gather", report.contains("finalGather") ? nlohmann::json("on") : nlohmann::json("off"));
-  line("texels-per-unit", at({"atlas", "texelsPerUnit"}));
+  // Options whose chosen value, given explicitly, makes the same bake; the other automatic choices (the walk's
+  // depth and split, the compensation's per-page filter) follow the scene and stay auto, with what they chose.
+  static const std::vector<std::string> kReplayable = {"backend",    "final-gather",   "paths",          "interleave",
+                                                       "cube-face",  "clamp-k",        "vpl-importance", "texels-per-unit"};
+  std::vector<ConfigEntry> entries, comments;
+  const nlohmann::json plan = report.value("plan", nlohmann::json::object());
+  for (auto it = plan.begin(); it != plan.end(); ++it) {
+    const std::string& key = it.key();
+    const nlohmann::json& choice = it.value();
+    if (!choice.value("automatic", false)) continue;
+    const nlohmann::json& v = choice["value"];
+    const std::string value = v.is_string() ? v.get<std::string>() : v.is_number_float() ? cli::canonicalNumber(v.get<double>()) : v.dump();
+    if (std::find(kReplayable.begin(), kReplayable.end(), key) != kReplayable.end())
+      entries.push_back({key, value, 0});
+    else
+      comments.push_back({"# " + key, "auto (chose " + value + ": " + choice.value("reason", "") + ")", 0});
+  }
+  std::string text = "# what this bake chose where its options said auto (the same scene and options choose the same):\n";
+  const std::string body = configText(entries, "") + configText(comments, "");
+  std::istringstream lines(body);
+  for (std::string line; std::getline(lines, line);)
+    if (line != "# " && line != "[bake]") text += line + "\n";
   return text;
 }
 

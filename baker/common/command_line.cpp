@@ -34,18 +34,18 @@ std::string formatNumber(double v) {
   return buf;
 }
 
+std::string integerRange(long long lo, long long hi) {
+  return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+}
+
+}  // namespace
+
 // The shortest text that reads back as exactly v ("50", "0.1", "1e-300").
 std::string canonicalNumber(double v) {
   char buf[64];
   const auto result = std::to_chars(buf, buf + sizeof(buf), v);
   return std::string(buf, result.ptr);
 }
-
-std::string integerRange(long long lo, long long hi) {
-  return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-}
-
-}  // namespace
 
 bool parseWholeNumber(const std::string& text, long long& value) { return parseInteger(text, value); }
 

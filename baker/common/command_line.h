@@ -34,4 +34,7 @@ bool parseWholeNumber(const std::string& text, long long& value);
 // The numbers of a list that numberList(count) accepted.
 std::vector<double> parseNumberList(const std::string& text);
 
+// The shortest text that reads back as exactly v ("50", "0.1", "1e-300").
+std::string canonicalNumber(double v);
+
 }  // namespace irbake::cli

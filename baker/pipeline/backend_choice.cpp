@@ -1,5 +1,7 @@
 #include "pipeline/backend_choice.h"
 
+#include "common/error.h"
+
 namespace irbake {
 
 AutoBackendChoice chooseAutoBackend(size_t triangles, const std::string& seeThrough,
@@ -25,6 +27,24 @@ AutoBackendChoice chooseAutoBackend(size_t triangles, const std::string& seeThro
   c.reason = std::string(gl.softwareRenderer ? "software" : "hardware") + " GL renderer, " + count + " (≤ " + hint +
              ": GL as fast as Embree or faster)";
   return c;
+}
+
+BackendKind parseBackend(const std::string& name) {
+  if (name == "auto") return BackendKind::Auto;
+  if (name == "gl") return BackendKind::Gl;
+  if (name == "embree") return BackendKind::Embree;
+  if (name == "reference") return BackendKind::Reference;
+  throw Error(ErrorCode::Usage, "", "unknown backend '" + name + "' (auto, gl, embree or reference)");
+}
+
+const char* toString(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::Auto: return "auto";
+    case BackendKind::Gl: return "gl";
+    case BackendKind::Embree: return "embree";
+    case BackendKind::Reference: return "reference";
+  }
+  return "?";
 }
 
 }  // namespace irbake

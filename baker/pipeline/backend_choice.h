@@ -35,4 +35,8 @@ struct GlProbe {
 AutoBackendChoice chooseAutoBackend(size_t triangles, const std::string& seeThrough,
                                     const std::function<GlProbe()>& probeGl);
 
+// "auto" | "gl" | "embree" | "reference" (throws Error(Usage) otherwise), and back.
+BackendKind parseBackend(const std::string& name);
+const char* toString(BackendKind kind);
+
 }  // namespace irbake

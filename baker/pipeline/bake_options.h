@@ -1,0 +1,86 @@
+// The bake's options: one struct per stage, each with its defaults; BakePlan (pipeline/bake_plan.h) settles
+// what they leave automatic.
+#pragma once
+#include <optional>
+
+#include "atlas/atlas.h"
+#include "common/progress.h"
+#include "evaluators/bake_inputs.h"
+#include "evaluators/gl/gl_backend.h"
+#include "pipeline/backend_choice.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "stages/gather/final_gather.h"
+#include "stages/shadow_edges/shadow_edges.h"
+#include "stages/sky/sky_light.h"
+#include "texels/texel_samples.h"
+#include "transport/vpl_importance.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+// How the bake bounds the VPL geometry term (VplEvalOptions::clampBound of every backend call).
+enum class ClampMode {
+  Derived,  // deriveClampBound from the scene and VPLs (k = BakeOptions::clampVplsPerMean)
+  Off,      // no clamp
+  Fixed,    // BakeOptions::clampBound
+};
+
+// Whether the clamp compensation's rays are traced while the GL backend bakes (on the CPU beside the GPU).
+enum class OverlapCompensation {
+  Auto,    // hardware renderers only: on llvmpipe both fight over the cores
+  Never,   // after the VPL blocks
+  Always,  // beside the VPL blocks, whatever the renderer
+};
+
+// Whether the bounced light of each texel is gathered from the baked map one bounce away (final gather,
+// stages/gather) instead of read from the VPLs that reach it.
+enum class FinalGatherMode {
+  Off,   // the VPL sum (+ clamp compensation) is the map
+  On,    // in every scene the VPL backends bake
+  Auto,  // on where the scene has no emissive surface (the rays would find small emitters by chance) and no
+         // see-through one (the gather reads the glass's own map, not what lies behind it)
+};
+
+// The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
+inline VplEvalOptions compensatedEval() {
+  VplEvalOptions e;
+  e.biasCompensation = true;
+  return e;
+}
+
+struct BakeOptions {
+  BackendKind backend = BackendKind::Auto;  // auto (default), gl, embree, reference
+  AtlasOptions atlas;                     // texel density, padding, page size
+  TexelSampleOptions texels;              // supersampling, leak control
+  WalkOptions walk;                       // VPL paths, bounces, seed
+  std::optional<int> finalGatherPaths;    // the walk's paths where the final gather runs (unset: walk.paths)
+  VplImportanceOptions vplImportance;     // the walk's candidates thinned to where they matter (auto: where the
+                                          // final gather runs, the pilot finds the walk uneven and the probes ×
+                                          // candidates budget allows ≥ 2 candidates per VPL)
+  VplEvalOptions eval = compensatedEval();  // bias compensation (on), direct, VPLs; its clampBound is not read
+                                            // (the bake sets it from clamp)
+  ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
+  SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
+  ShadowEdgeOptions shadowEdges;          // punctual lights' shadow edges area-averaged (subSamples ≤ 1: off)
+  FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (stages/gather)
+  FinalGatherOptions gather;              // its rays and filter
+  ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound
+  float clampBound = 0.0f;                // the bound with ClampMode::Fixed (1/m², > 0)
+  double clampVplsPerMean = 0.0;          // k of deriveClampBound (larger = tighter clamp); 0: with bias
+                                          // compensation 256 (emissive surfaces) or 1024 (none), 16 without
+  std::optional<int> interleave;          // n ≥ 1: VPLs split over n×n texel classes (Keller & Heidrich 2001),
+                                          // 1 = off; unset: automatic (chooseInterleave: 1…6)
+  GlBackendOptions gl;                    // GL backend: cube face size (unset = from the light map), VPLs per pass, biases
+  OverlapCompensation overlapCompensation = OverlapCompensation::Auto;  // compensation rays beside the GL bake
+  int vplBlock = 512;                     // VPLs per block of the exact VPL sum (within one interleave class):
+                                          // the unit of shards and checkpoints, fixed by the options alone
+  int referenceSpp = 256;                 // reference backend: paths per texel sample
+  bool postDilate = true;                 // fill padding from valid texels
+  bool postSeams = true;                  // stitch chart seams
+  bool directional = false;               // also bake the L1 pages (BakeResult::directional) in the
+                                          // backend's passes (4 coefficients in the exact sums); the map's
+                                          // bytes are the same. Off: no extra work, the same bytes as before
+  ProgressCallback progress;
+};
+
+}  // namespace irbake

@@ -1,0 +1,186 @@
+// The bake plan: each automatic choice and cross-stage rule, with its reason.
+#include "pipeline/bake_plan.h"
+
+#include <algorithm>
+
+#include "common/error.h"
+#include "common/log.h"
+#include "evaluators/gl/shadow_views.h"
+#include "stages/interleave/interleaved_sampling.h"
+#include "transport/geometry_term.h"
+
+namespace irbake {
+
+void BakePlan::settle(const std::string& key, nlohmann::json value, const std::string& reason, bool automatic) {
+  if (automatic) log::info("plan: " + key + " = " + (value.is_string() ? value.get<std::string>() : value.dump()) + " (" + reason + ")");
+  choices[key] = PlanChoice{std::move(value), reason, automatic};
+}
+
+nlohmann::json BakePlan::toJson() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [key, c] : choices) j[key] = {{"value", c.value}, {"reason", c.reason}, {"automatic", c.automatic}};
+  return j;
+}
+
+std::string seeThroughMaterials(const Scene& scene) {
+  for (const Primitive& p : scene.primitives) {
+    const Material& m = scene.materials[p.material];
+    if (m.alphaMode == AlphaMode::Mask) return "material '" + m.name + "' is alpha MASK";
+    if (m.alphaMode == AlphaMode::Blend) return "material '" + m.name + "' is alpha BLEND (see-through)";
+    if (m.transmission > 0.0f) return "material '" + m.name + "' is transmissive";
+  }
+  return {};
+}
+
+namespace {
+
+const char* onOff(bool on) { return on ? "on" : "off"; }
+
+// --backend auto: GL where it is both right and fast, Embree otherwise.
+void settleBackend(BakePlan& plan, const Scene& scene, const BakeOptions& options,
+                   const std::function<GlProbe()>& probeGl) {
+  plan.backend = options.backend;
+  if (plan.backend != BackendKind::Auto) {
+    plan.settle("backend", toString(plan.backend), "asked for", false);
+    return;
+  }
+  const AutoBackendChoice choice = chooseAutoBackend(scene.triangleCount(), seeThroughMaterials(scene), probeGl);
+  plan.backend = choice.backend;
+  plan.settle("backend", toString(plan.backend), choice.reason);
+}
+
+// The final gather: on where asked, or (auto) where the scene has no emissive surface (its rays would find
+// small emitters by chance) and no see-through one (the gather reads the glass's own map, not what lies behind).
+void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
+  const bool vplBackend = plan.backend != BackendKind::Reference && options.eval.includeVpls;
+  const std::string seeThrough = seeThroughMaterials(scene);
+  plan.finalGather = vplBackend && (options.finalGather == FinalGatherMode::On ||
+                                    (options.finalGather == FinalGatherMode::Auto && !scene.hasEmissiveSurface() &&
+                                     seeThrough.empty()));
+  std::string reason;
+  if (!vplBackend) reason = "no VPLs to gather from";
+  else if (options.finalGather != FinalGatherMode::Auto) reason = "asked for";
+  else if (scene.hasEmissiveSurface()) reason = "auto: the scene has emissive surfaces";
+  else if (!seeThrough.empty()) reason = "auto: " + seeThrough;
+  else reason = "auto: no emissive or see-through surface";
+  plan.settle("final-gather", onOff(plan.finalGather), reason, options.finalGather == FinalGatherMode::Auto);
+}
+
+// The walk's paths: finalGatherPaths where the final gather runs (it reads their map averaged).
+void settleWalk(BakePlan& plan, const BakeOptions& options) {
+  plan.walk = options.walk;
+  const bool underGather = plan.finalGather && options.finalGatherPaths;
+  if (underGather) plan.walk.paths = *options.finalGatherPaths;
+  // finalGatherPaths is set where the paths were left to the quality preset.
+  const bool automatic = options.finalGatherPaths.has_value();
+  plan.settle("paths", plan.walk.paths,
+              !automatic   ? "asked for"
+              : underGather ? "the preset's paths under the final gather, which reads their map averaged"
+                            : "the preset's paths",
+              automatic);
+}
+
+// The clamp compensation and whether its rays run beside the GL evaluator. With the final gather its
+// refinement is off and its first rays fewer: the gather replaces the residual at the texel and reads it only
+// averaged over its rays one bounce away.
+void settleCompensation(BakePlan& plan, const BakeOptions& options, const std::function<GlProbe()>& probeGl) {
+  plan.compensate = options.eval.biasCompensation && plan.backend != BackendKind::Reference;
+  plan.compensation = options.compensation;
+  plan.compensation.seed = options.walk.seed;
+  plan.compensation.directional = options.directional && !plan.finalGather;  // the gather writes the L1 itself
+  if (plan.finalGather) {
+    plan.compensation.refineRays = 0;
+    plan.compensation.minRays = std::min(plan.compensation.minRays, 2);
+    plan.compensation.filterEachSweep = false;
+  }
+  if (plan.compensate && plan.finalGather)
+    plan.settle("comp-refine", 0, "the final gather replaces the residual at the texel; only the map it reads needs it");
+  // On a GPU the compensation's rays (geometry only) are traced on the CPU while GL bakes; not on a software
+  // renderer, where the trace and the rasteriser share the cores.
+  plan.overlapCompensation = false;
+  if (plan.compensate && plan.backend == BackendKind::Gl) {
+    const bool software = probeGl().softwareRenderer;
+    plan.overlapCompensation = options.overlapCompensation == OverlapCompensation::Always ||
+                               (options.overlapCompensation == OverlapCompensation::Auto && !software);
+    plan.settle("compensation-overlap", onOff(plan.overlapCompensation),
+                options.overlapCompensation != OverlapCompensation::Auto ? "asked for"
+                : software ? "a software renderer shares the cores with the rays"
+                           : "rays on the CPU while the GPU bakes",
+                options.overlapCompensation == OverlapCompensation::Auto);
+  }
+}
+
+// The sky: a uniform sky in a scene without see-through surfaces is counted by the final gather's escaping
+// rays (its cosine rays are the sky stage's own estimator), so the sky stage's light is read only at its hits
+// and half its rays do.
+void settleSky(BakePlan& plan, const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options) {
+  plan.sky = options.sky;
+  plan.sky.seed = options.walk.seed;
+  plan.skyByGather = plan.finalGather && scene.environment.present() && scene.environment.isUniform() &&
+                     !rayTracer.hasTransmission();
+  if (plan.skyByGather) {
+    plan.sky.minRays = std::min(plan.sky.minRays, 4);
+    plan.settle("sky-by-gather", "on", "a uniform sky: the final gather's escaping rays count it");
+  }
+  plan.gather = options.gather;
+  plan.gather.seed = options.walk.seed;
+  if (plan.skyByGather) plan.gather.missRadiance = scene.environment.uniformRadiance();
+}
+
+}  // namespace
+
+BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
+                  const std::function<GlProbe()>& probeGl) {
+  BakePlan plan;
+  plan.directional = options.directional;
+  settleBackend(plan, scene, options, probeGl);
+  settleFinalGather(plan, scene, options);
+  settleWalk(plan, options);
+  settleCompensation(plan, options, probeGl);
+  settleSky(plan, scene, rayTracer, options);
+  plan.shadowEdges = options.shadowEdges;
+  plan.post.dilate = options.postDilate;
+  plan.post.stitchSeams = options.postSeams;
+  plan.eval = options.eval;
+  plan.gl = options.gl;
+  return plan;
+}
+
+void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls) {
+  plan.eval = options.eval;
+  if (options.clamp != ClampMode::Derived) {
+    plan.eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
+    plan.settle("clamp", plan.eval.clampBound, options.clamp == ClampMode::Fixed ? "asked for" : "no clamp asked for", false);
+    return;
+  }
+  const bool given = options.clampVplsPerMean > 0.0;
+  plan.clampK = given                           ? options.clampVplsPerMean
+                : !plan.eval.biasCompensation  ? kClampVplsPerMean
+                : scene.hasEmissiveSurface()   ? kCompensatedClampVplsPerMean
+                                               : kCompensatedClampVplsPerMeanNoEmitters;
+  plan.eval.clampBound = deriveClampBound(scene, vpls, plan.clampK);
+  plan.clampDerived = true;
+  plan.settle("clamp-k", plan.clampK,
+              given                         ? "asked for"
+              : !plan.eval.biasCompensation ? "no bias compensation: a loose clamp keeps the bias small"
+              : scene.hasEmissiveSurface()  ? "compensated, with emissive surfaces"
+                                            : "compensated, no emissive surfaces",
+              !given);
+  plan.settle("clamp", plan.eval.clampBound, "derived: no VPL adds more than 1/k of the mean (1/m²)");
+}
+
+void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,
+                  SurfaceFilterCache* filters, const std::function<const std::vector<TexelSamples>&(int)>& pagesOf,
+                  const VplSet& vpls) {
+  plan.interleave = options.interleave ? *options.interleave : chooseInterleave(texels, plan.eval.clampBound, filters);
+  plan.settle("interleave", plan.interleave,
+              options.interleave ? "asked for" : "from the texel spacing and the clamp radius", !options.interleave);
+  if (plan.backend != BackendKind::Gl || plan.gl.cubeFaceSize) return;
+  // Once for every block, from the first class's pages.
+  plan.gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), plan.eval.clampBound, plan.gl.cubeFootprintPerTexel,
+                                            plan.gl.minCubeFaceSize, plan.gl.maxCubeFaceSize)
+                             .size;
+  plan.settle("cube-face", *plan.gl.cubeFaceSize, "a shadow texel's footprint held to the light-map texel spacing");
+}
+
+}  // namespace irbake

@@ -1,0 +1,82 @@
+// The bake plan: every "auto" of the options and every rule between stages settled in one place, each with
+// its reason. The stages read their options from the plan, never from each other's. The plan goes into the
+// log, into report.json ("plan") and into --dump-config.
+#pragma once
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "evaluators/bake_inputs.h"
+#include "evaluators/gl/gl_backend.h"
+#include "pipeline/backend_choice.h"
+#include "pipeline/bake_options.h"
+#include "post/post.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/scene.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "stages/gather/final_gather.h"
+#include "stages/shadow_edges/shadow_edges.h"
+#include "stages/sky/sky_light.h"
+#include "vpl/vpl.h"
+
+namespace irbake {
+
+// One settled choice: the value as the report shows it and why.
+struct PlanChoice {
+  nlohmann::json value;
+  std::string reason;
+  bool automatic = true;  // the bake chose it (false: an option fixed it)
+};
+
+struct BakePlan {
+  BackendKind backend = BackendKind::Auto;  // never Auto once planned
+  bool finalGather = false;                 // bounced light gathered from the map (stages/gather)
+  bool compensate = false;                  // the clamp compensation stage runs
+  bool overlapCompensation = false;         // its rays traced while the GL evaluator bakes
+  bool skyByGather = false;                 // the final gather's escaping rays count a uniform sky
+  bool directional = false;                 // L1 pages beside the map
+  WalkOptions walk;                         // the light paths as walked (paths settled)
+  ClampCompensationOptions compensation;    // as the compensation stage runs
+  SkyLightOptions sky;                      // as the sky stage runs
+  FinalGatherOptions gather;                // as the final gather runs
+  ShadowEdgeOptions shadowEdges;            // as the shadow-edge stage runs
+  PostOptions post;                         // dilation and seams
+  // Settled once the walk's VPLs are known (settleClamp, settleBlocks):
+  VplEvalOptions eval;                      // with the clamp bound
+  double clampK = 0.0;                      // k of deriveClampBound (0: the clamp was not derived)
+  bool clampDerived = false;
+  double importanceFactor = 1.0;            // candidates per kept VPL (1: the plain walk)
+  int interleave = 1;                       // n×n texel classes
+  GlBackendOptions gl;                      // the GL evaluator's options, cube face size settled
+
+  std::map<std::string, PlanChoice> choices;  // by option name ("backend", "paths", ...) or rule name
+
+  // Records a settled choice and logs it when the bake made it.
+  void settle(const std::string& key, nlohmann::json value, const std::string& reason, bool automatic = true);
+  // {"key": {"value", "reason", "automatic"}, ...}
+  nlohmann::json toJson() const;
+};
+
+// The first see-through material (MASK cut-outs, BLEND, transmission) a primitive uses, as a phrase for the
+// log; empty when there is none.
+std::string seeThroughMaterials(const Scene& scene);
+
+// Settles what the scene, the options and the machine decide before any light is traced: evaluator, final
+// gather, paths, compensation and its overlap, the sky's share, each stage's options. probeGl makes the GL
+// context (the caller keeps it) and is called where the choice depends on it.
+BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
+                  const std::function<GlProbe()>& probeGl);
+
+// The clamp: fixed, off, or derived from the scene and these VPLs (sets plan.eval.clampBound).
+void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls);
+
+// The interleave classes and the GL cube face size, from the texels, the clamp and the VPLs.
+// pagesOf(c): the texel samples of interleave class c as pages of their own.
+void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,
+                  SurfaceFilterCache* filters, const std::function<const std::vector<TexelSamples>&(int)>& pagesOf,
+                  const VplSet& vpls);
+
+}  // namespace irbake

@@ -1,0 +1,120 @@
+// The stages after the evaluators, each reading the plan and writing its own report object.
+#include "pipeline/bake_stages.h"
+
+#include <algorithm>
+
+#include "common/progress.h"
+#include "stages/gather/final_gather.h"
+#include "stages/shadow_edges/shadow_edges.h"
+#include "stages/sky/sky_light.h"
+
+namespace irbake {
+
+void StageContext::timed(const char* name, const std::function<void()>& stage) {
+  Stopwatch watch;
+  stage();
+  seconds[name] = seconds.value(name, 0.0) + watch.seconds();
+}
+
+void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1) {
+  const BakePlan& plan = ctx.plan;
+  if (!plan.eval.includeDirect || ctx.scene.lights.empty() || plan.shadowEdges.subSamples <= 1) return;
+  // The L1 pages keep the centre's direction, scaled with the value per channel so that |L1| stays within
+  // what L0 allows (a refined texel's light comes from the same lights; where the centre was dark, L1 is 0).
+  std::vector<Lightmap> before;
+  if (l1) before = maps;
+  const ShadowEdgeStats st = refineShadowEdges(ctx.inputs, maps, plan.shadowEdges);
+  for (size_t p = 0; l1 && p < maps.size(); ++p)
+    for (size_t t = 0; t < maps[p].size(); ++t) {
+      const glm::vec3 &was = before[p].texels[t], &now = maps[p].texels[t];
+      if (was == now) continue;
+      const glm::vec3 scale(was.x > 0.0f ? now.x / was.x : 0.0f, was.y > 0.0f ? now.y / was.y : 0.0f,
+                            was.z > 0.0f ? now.z / was.z : 0.0f);
+      for (int k = 0; k < 3; ++k) (*l1)[k][p].texels[t] *= scale;
+    }
+  ctx.seconds["shadowEdges"] = st.seconds;
+  ctx.report["shadowEdges"] = {{"subSamples", plan.shadowEdges.subSamples}, {"edgeTexels", st.edgeTexels},
+                               {"subPoints", st.subPoints}, {"droppedInside", st.droppedInside}};
+}
+
+void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct) {
+  const Scene& scene = ctx.scene;
+  const BakePlan& plan = ctx.plan;
+  if (!scene.environment.present() || plan.backend == BackendKind::Reference) return;
+  ctx.timed("sky", [&] {
+    SkyLightStats stats;
+    if (plan.finalGather && direct.size() == maps.size() && !plan.skyByGather) {
+      // An environment map's light goes into D as well (its importance sampling beats the gather's cosine
+      // rays): traced once into blank pages, added to both. A uniform sky stays out of D: the final
+      // gather's rays that leave the scene count it.
+      std::vector<Lightmap> sky = maps;
+      for (Lightmap& m : sky) std::fill(m.texels.begin(), m.texels.end(), glm::vec3(0.0f));
+      addSkyLight(ctx.inputs, sky, plan.sky, &stats);
+      for (size_t p = 0; p < maps.size(); ++p)
+        for (size_t t = 0; t < maps[p].size(); ++t) {
+          maps[p].texels[t] += sky[p].texels[t];
+          direct[p].texels[t] += sky[p].texels[t];
+        }
+    } else {
+      addSkyLight(ctx.inputs, maps, plan.sky, &stats);
+    }
+    nlohmann::json& report = ctx.report["sky"] = stats.toJson();
+    report["uniform"] = scene.environment.isUniform();
+    report["source"] = scene.environment.source();
+    const glm::dvec3 integral = scene.environment.integral();
+    report["integral"] = nlohmann::json::array({integral.x, integral.y, integral.z});
+  });
+}
+
+void compensationStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,
+                       std::unique_ptr<ClampGather> traced) {
+  BakePlan& plan = ctx.plan;
+  if (!plan.compensate) return;
+  ctx.timed("compensation", [&] {  // with an overlapped trace: the sweeps (and any trace not yet done)
+    ClampCompensationStats stats;
+    if (ctx.progress) ctx.progress("compensate", 0.0);  // coarse: start and end of the stage
+    std::unique_ptr<ClampGather> g = traced ? std::move(traced) : std::make_unique<ClampGather>(ctx.inputs, plan.compensation);
+    g->apply(maps, &stats);
+    if (l1 && !plan.finalGather) g->applyDirectional(maps, *l1);  // the final gather writes the L1 itself
+    if (ctx.progress) ctx.progress("compensate", 1.0);
+    ctx.seconds["compensationTrace"] = g->traceSeconds();
+    if (!ctx.askedCompensation.filterRadius)
+      plan.settle("comp-filter", stats.filterRadius, "where the rays per sample are few, within 1/20 of the clamp radius");
+    ctx.report["compensation"] = stats.toJson();
+  });
+}
+
+void finalGatherStage(StageContext& ctx, const std::vector<Lightmap>& direct, const L1Pages* directL1,
+                      std::vector<Lightmap>& maps, L1Pages* l1) {
+  if (!ctx.plan.finalGather || direct.size() != maps.size()) return;
+  ctx.timed("finalGather", [&] {
+    FinalGatherStats stats;
+    if (ctx.progress) ctx.progress("gather", 0.0);
+    finalGather(ctx.inputs, direct, maps, ctx.plan.gather, &stats, l1 ? directL1 : nullptr, l1);
+    if (ctx.progress) ctx.progress("gather", 1.0);
+    ctx.report["finalGather"] = stats.toJson();
+  });
+}
+
+// The evaluators' passes accumulated the L1 pages of the punctual lights and VPLs beside the map, and the
+// clamp compensation added its share (ClampGather::applyDirectional): the sky's part is traced here.
+void directionalStage(StageContext& ctx, L1Pages& axes) {
+  ctx.timed("directional", [&] {
+    if (ctx.scene.environment.present()) addSkyLightDirectional(ctx.inputs, axes, ctx.plan.sky);
+    PostStats stats;
+    for (auto& pages : axes) stats = postProcess(ctx.scene, pages, ctx.plan.post);
+    ctx.report["directional"] = {{"pages", axes[0].size() * 3}, {"seamMismatchAfter", stats.seamMismatchAfter}};
+  });
+}
+
+PostStats postStage(StageContext& ctx, std::vector<Lightmap>& maps) {
+  PostStats stats;
+  ctx.timed("post", [&] {
+    if (ctx.progress) ctx.progress("post", 0.0);
+    stats = postProcess(ctx.scene, maps, ctx.plan.post);
+    if (ctx.progress) ctx.progress("post", 1.0);
+  });
+  return stats;
+}
+
+}  // namespace irbake

@@ -1,0 +1,49 @@
+// The stages after the evaluators, in the order the bake runs them: shadow edges (on the punctual lights'
+// map), sky, clamp compensation, final gather, directional pages, post. Each reads its options from the plan.
+#pragma once
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "evaluators/bake_inputs.h"
+#include "lightmap/lightmap.h"
+#include "pipeline/bake_plan.h"
+#include "post/post.h"
+#include "stages/compensation/clamp_compensation.h"
+
+namespace irbake {
+
+// What the stages share: the scene, every page and VPL (BakeInputs), the plan; each stage adds its wall time
+// to `seconds` and its stats, as its own object, to `report`.
+struct StageContext {
+  const Scene& scene;
+  const BakeInputs& inputs;
+  BakePlan& plan;
+  const ClampCompensationOptions& askedCompensation;  // as given (the plan records what auto chose)
+  const ProgressCallback& progress;
+  nlohmann::json& seconds;
+  nlohmann::json& report;
+
+  void timed(const char* name, const std::function<void()>& stage);
+};
+
+// Punctual lights' shadow edges area-averaged, on their map alone (l1: scaled with it).
+void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1);
+// The sky's direct light, traced (every VPL evaluator; the reference integrator finds the sky itself).
+// Under the final gather an environment map's light goes into its D (direct) as well.
+void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct);
+// The clamp's lost near-field light gathered back from the map; traced: its rays traced beforehand (beside
+// the GL evaluator), or null.
+void compensationStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,
+                       std::unique_ptr<ClampGather> traced);
+// Each texel's bounced light read from the finished map one bounce away; direct: D (and its L1 pages).
+void finalGatherStage(StageContext& ctx, const std::vector<Lightmap>& direct, const L1Pages* directL1,
+                      std::vector<Lightmap>& maps, L1Pages* l1);
+// The L1 pages' sky share, then post per axis.
+void directionalStage(StageContext& ctx, L1Pages& axes);
+// Dilation and seams on the map pages.
+PostStats postStage(StageContext& ctx, std::vector<Lightmap>& maps);
+
+}  // namespace irbake
