@@ -150,3 +150,34 @@ TEST(BakeOptions, BadConfigIsRefusedNamingFileLineAndKey) {
                                       dir / "missing.txt");
   EXPECT_EQ(missing.code, 3) << missing.output;
 }
+
+// Every automatic choice is in the report's plan with its reason, and --dump-config writes each replayable one
+// as an entry: the file reads back to the same bytes with nothing left to choose (the corner: a spot light, no
+// emitter, so the final gather, the VPL importance pilot and the GL cube size are all chosen).
+TEST(BakeOptions, DumpedConfigReplaysEveryAutomaticChoice) {
+  const fs::path dir = scratch("plan");
+  const std::string scene = (samples() / "corner.gltf").string();
+  const IrbakeRun first = runIrbake({"bake", scene, "-o", (dir / "first").string(), "--quality", "preview", "--quiet",
+                                     "--dump-config", (dir / "dumped.toml").string()}, dir / "first.txt");
+  ASSERT_EQ(first.code, 0) << first.output;
+  const nlohmann::json plan = report(dir / "first")["plan"];
+  for (const char* key : {"backend", "final-gather", "paths", "interleave", "clamp-k", "vpl-importance", "texels-per-unit",
+                          "bounces", "walk-split", "comp-refine"}) {
+    ASSERT_TRUE(plan.contains(key)) << key << "\n" << plan.dump(1);
+    EXPECT_TRUE(plan[key]["automatic"].get<bool>()) << key;
+    EXPECT_FALSE(plan[key]["reason"].get<std::string>().empty()) << key;
+  }
+  EXPECT_EQ(plan["final-gather"]["value"], "on");
+  EXPECT_EQ(plan["comp-refine"]["value"], 0);
+  const std::string dumped = fileText(dir / "dumped.toml");
+  for (const char* key : {"\nbackend = ", "\nfinal-gather = \"on\"", "\npaths = ", "\ninterleave = ", "\ntexels-per-unit = "})
+    EXPECT_NE(dumped.find(key), std::string::npos) << key << "\n" << dumped;
+
+  const IrbakeRun again = runIrbake({"bake", "--config", (dir / "dumped.toml").string(), "-o", (dir / "again").string()},
+                                    dir / "again.txt");
+  ASSERT_EQ(again.code, 0) << again.output;
+  EXPECT_EQ(fileText(dir / "again" / "lightmap_0.exr"), fileText(dir / "first" / "lightmap_0.exr"));
+  const nlohmann::json replayed = report(dir / "again")["plan"];
+  for (const char* key : {"backend", "final-gather", "paths", "interleave", "texels-per-unit"})
+    EXPECT_FALSE(replayed[key]["automatic"].get<bool>()) << key << ": given by the file";
+}
