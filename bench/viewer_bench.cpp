@@ -18,6 +18,7 @@
 
 #include "glcontext/gl_context.h"
 #include "pipeline/bake.h"
+#include "scene/light_additions.h"
 #include "samples/sample_scenes.h"
 #include "scene/gltf_loader.h"
 #include "view_renderer.h"
@@ -198,7 +199,7 @@ const ViewerScene* bakedHelmet() {
         LoadOptions load;
         load.shadingMaps = true;
         Scene s = loadScene(gltf, load);
-        s.lights.push_back(sunLight(glm::vec3(0.3f, -1.0f, -0.4f), 3.0f));
+        s.lights.push_back(directionalLight(glm::vec3(0.3f, -1.0f, -0.4f), 3.0f));
         BakeOptions o;
         o.backend = BackendKind::Embree;
         o.directional = true;

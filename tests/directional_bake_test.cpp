@@ -13,6 +13,7 @@
 #include "common/maths.h"
 #include "export/exr_io.h"
 #include "pipeline/bake.h"
+#include "scene/light_additions.h"
 #include "raytrace/ray_tracer.h"
 #include "samples/sample_scenes.h"
 #include "scene/environment.h"
@@ -107,7 +108,7 @@ TEST(DirectionalBake, CornellL0IsThePlainBakesBytesOnBothBackends) {
   };
   auto scene = [] {
     Scene s = samples::makeCornellBox();
-    s.lights.push_back(sunLight(glm::vec3(0.3f, -1.0f, -0.4f), 2.0f));
+    s.lights.push_back(directionalLight(glm::vec3(0.3f, -1.0f, -0.4f), 2.0f));
     return s;
   };
   std::array<L1Pages, 2> l1;

@@ -13,6 +13,7 @@
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "pipeline/bake.h"
+#include "scene/light_additions.h"
 #include "scene/scene.h"
 
 namespace irbake::app {
@@ -22,9 +23,7 @@ struct BakeCommand {
   std::string scene;               // SCENE as given
   std::string out;                 // -o OUTDIR | OUT.glb | OUT.gltf
   std::string report;              // --report (empty: OUTDIR/report.json)
-  std::string sun, sky, env;       // scene additions: --sun, --sky, --env
-  double envIntensity = 1.0;       // --env-intensity
-  double envRotation = 0.0;        // --env-rotation (degrees)
+  LightAdditions lights;           // --sun, --sky, --env (+ --env-intensity, --env-rotation), checked
   int threads = 0;                 // --threads (0: every core)
   bool quiet = false;              // --quiet
   bool verbose = false;            // --verbose
@@ -46,7 +45,7 @@ struct BakeCommand {
 // Parses the arguments after "bake"; nullopt when --help was printed. Throws Error(Usage).
 std::optional<BakeCommand> parseBakeCommand(const Args& args);
 
-// Loads SCENE with the command's additions (--sun, --sky, --env) and checks it has light.
+// Loads SCENE with the command's light additions (--sun, --sky, --env) and checks it has light.
 Scene loadBakeScene(const BakeCommand& command);
 
 // The scene's identity for partials and checkpoints: hashes of its files (and of --env's map).

@@ -38,6 +38,8 @@ struct BakeArguments {
   std::vector<std::string> scenes;
   std::string backend = "auto", shard, finalGather = "auto", quality = "default";
   std::string config, dumpConfig;  // --config FILE (read before parsing), --dump-config FILE
+  std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
+  double envIntensity = 1.0, envRotation = 0.0;
   bool helpAll = false;
   CLI::Option* shardOption = nullptr;
   long long seed = 0;
@@ -54,20 +56,31 @@ constexpr double kSmallestClamp = 1e-30;
 // Light from the command line: at most this much (W/m², W/(m² sr)), so sums over the bake stay finite in float.
 constexpr double kLargestLight = 1e20;
 
-// --sun and --sky as numbers a bake can use: a direction that is not zero (any length), and amounts in
-// [0, kLargestLight]. Throws Error(Usage) naming the option.
-void checkLightArguments(const BakeCommand& c) {
-  if (!c.sun.empty()) {
-    const std::vector<double> d = cli::parseNumberList(c.sun);
+// --sun, --sky and --env as light a bake can use: a direction that is not zero (any length), amounts in
+// [0, kLargestLight], not both a sky and a map. Throws Error(Usage) naming the option.
+LightAdditions lightArguments(const BakeArguments& a) {
+  LightAdditions lights;
+  if (!a.sun.empty()) {
+    const std::vector<double> d = cli::parseNumberList(a.sun);
     const double longest = std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
-    if (!(longest > 0.0)) throw Error(ErrorCode::Usage, "", "--sun needs a non-zero direction DX,DY,DZ (got '" + c.sun + "')");
+    if (!(longest > 0.0)) throw Error(ErrorCode::Usage, "", "--sun needs a non-zero direction DX,DY,DZ (got '" + a.sun + "')");
     if (!(d[3] > 0.0) || d[3] > kLargestLight)
-      throw Error(ErrorCode::Usage, "", "--sun needs an irradiance E in (0, 1e20] W/m² (got '" + c.sun + "')");
+      throw Error(ErrorCode::Usage, "", "--sun needs an irradiance E in (0, 1e20] W/m² (got '" + a.sun + "')");
+    const glm::dvec3 direction = glm::normalize(glm::dvec3(d[0], d[1], d[2]) / longest);
+    lights.sun = directionalLight(glm::vec3(direction), static_cast<float>(d[3]));
   }
-  if (!c.sky.empty())
-    for (double v : cli::parseNumberList(c.sky))
+  if (!a.sky.empty()) {
+    const std::vector<double> L = cli::parseNumberList(a.sky);
+    for (double v : L)
       if (!(v >= 0.0) || v > kLargestLight)
-        throw Error(ErrorCode::Usage, "", "--sky needs three radiances in [0, 1e20] W/(m² sr) (got '" + c.sky + "')");
+        throw Error(ErrorCode::Usage, "", "--sky needs three radiances in [0, 1e20] W/(m² sr) (got '" + a.sky + "')");
+    lights.sky = glm::vec3(L[0], L[1], L[2]);
+  }
+  if (!a.env.empty() && lights.sky) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
+  lights.environment = a.env;
+  lights.environmentIntensity = static_cast<float>(a.envIntensity);
+  lights.environmentRotation = static_cast<float>(a.envRotation);
+  return lights;
 }
 
 // The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
@@ -203,9 +216,9 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
   app->add_option("--seed", a.seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
   app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default 256)")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
-  app->add_option("--sun", command.sun, "add a directional light travelling along D with irradiance E (W/m²)")
+  app->add_option("--sun", a.sun, "add a directional light travelling along D with irradiance E (W/m²)")
       ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
-  app->add_option("--sky", command.sky, "a uniform sky of that radiance (W/(m² sr))")
+  app->add_option("--sky", a.sky, "a uniform sky of that radiance (W/(m² sr))")
       ->transform(cli::numberList(3))->type_name("R,G,B");
   app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default 64)")
       ->transform(cli::integerIn(8, 4096))->type_name("N");
@@ -217,10 +230,10 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
                   "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 8; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
-  app->add_option("--env", command.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
+  app->add_option("--env", a.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
-  app->add_option("--env-intensity", command.envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
-  app->add_option("--env-rotation", command.envRotation, "turns --env about +Y (degrees, default 0)")
+  app->add_option("--env-intensity", a.envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default 0)")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--directional", o.directional,
@@ -337,7 +350,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   }
   if (a.clampOption->count() > 0 && a.clamp > 0.0 && a.clamp < kSmallestClamp)
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
-  checkLightArguments(command);
+  command.lights = lightArguments(a);
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
@@ -582,21 +595,7 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
 Scene loadBakeScene(const BakeCommand& command) {
   const std::filesystem::path scenePath = command.scene;
   Scene scene = loadScene(scenePath);
-  if (!command.sun.empty()) {
-    const std::vector<double> d = cli::parseNumberList(command.sun);
-    const glm::dvec3 direction = glm::normalize(glm::dvec3(d[0], d[1], d[2]) /
-                                                std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])}));
-    scene.lights.push_back(sunLight(glm::vec3(direction), static_cast<float>(d[3])));
-  }
-  if (!command.sky.empty()) {
-    const std::vector<double> L = cli::parseNumberList(command.sky);
-    scene.environment = Environment::uniform(glm::vec3(L[0], L[1], L[2]));
-  }
-  if (!command.env.empty()) {
-    if (!command.sky.empty()) throw Error(ErrorCode::Usage, "", "--sky and --env exclude each other");
-    scene.environment = loadEnvironment(command.env, static_cast<float>(command.envIntensity),
-                                        static_cast<float>(command.envRotation));
-  }
+  addLights(scene, command.lights);
   requireLight(scene, scenePath);
   return scene;
 }
@@ -614,7 +613,7 @@ std::string partialName(int k, int n) {
 // The scene's identity: its files, and the environment map's when --env names one.
 std::string sceneIdentity(const BakeCommand& c) {
   std::string hash = hashSceneFiles(c.scene);
-  if (!c.env.empty()) hash = hashText(hash + hashSceneFiles(c.env));
+  if (!c.lights.environment.empty()) hash = hashText(hash + hashSceneFiles(c.lights.environment));
   return hash;
 }
 
@@ -672,7 +671,7 @@ std::vector<fs::path> checkOutputPaths(const BakeCommand& c) {
   }
   // Inputs: the scene and its files, and --env's map.
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
-  if (!c.env.empty()) inputs.push_back(c.env);
+  if (!c.lights.environment.empty()) inputs.push_back(c.lights.environment);
   for (const fs::path& input : inputs) {
     for (const auto& [path, what] : outputs)
       if (sameFile(input, path))
@@ -732,7 +731,7 @@ int runBake(const Args& args) {
   header.shardIndex = c.shardIndex;
   header.shardCount = c.shardCount;
   header.command = {{"scene", fs::absolute(c.scene).string()},
-                    {"env", c.env.empty() ? std::string() : fs::absolute(c.env).string()},
+                    {"env", c.lights.environment.empty() ? std::string() : fs::absolute(c.lights.environment).string()},
                     {"args", c.arguments}};
 
   ExactVplSums sums = staged.emptySums();

@@ -130,7 +130,8 @@ int runMerge(const Args& args) {
   if (!parsed) throw Error(ErrorCode::InvalidData, files[0].string(), "the partial's bake arguments ask for --help");
   BakeCommand& c = *parsed;
   c.scene = first.command.value("scene", c.scene);
-  if (!c.env.empty()) c.env = first.command.value("env", c.env);
+  if (!c.lights.environment.empty())
+    c.lights.environment = first.command.value("env", c.lights.environment.string());
   c.out = out;
   c.report = report;
   c.noGltf = noGltf;

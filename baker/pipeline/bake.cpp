@@ -52,20 +52,6 @@ void checkOptionRanges(const BakeOptions& o) {
 
 }  // namespace
 
-Light sunLight(const glm::vec3& direction, float irradiance) {
-  float len = glm::length(direction);
-  if (!(len > 0.0f) || !std::isfinite(len))
-    throw Error(ErrorCode::Usage, "", "--sun needs a non-zero direction");
-  if (!(irradiance > 0.0f) || !std::isfinite(irradiance))
-    throw Error(ErrorCode::Usage, "", "--sun needs a positive irradiance");
-  Light sun;
-  sun.name = "sun (command line)";
-  sun.type = LightType::Directional;
-  sun.direction = direction / len;
-  sun.intensity = irradiance;
-  return sun;
-}
-
 double peakMemoryMiB() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);

@@ -67,9 +67,6 @@ class StagedBake {
   std::unique_ptr<State> state_;
 };
 
-// A directional light from the command line (--sun): direction the light travels, irradiance W/m².
-Light sunLight(const glm::vec3& direction, float irradiance);
-
 struct OutputOptions {
   std::filesystem::path outDir;      // OUTDIR: lightmap_<page>.exr, scene.gltf
   std::filesystem::path reportPath;  // report JSON; empty = OUTDIR/report.json
