@@ -308,21 +308,18 @@ int sceneBench(const std::vector<std::string>& args) {
       std::vector<Lightmap> maps;
       if (std::string(backend) == "gl") {
         GlContext context;  // one per bake, as the pipeline does (its programs are reused by every call)
-        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) {
-          GlBakeStats one;
-          GlBackendOptions glOptions;
-          glOptions.context = &context;
-          glOptions.stats = &one;
-          glOptions.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
-          if (const char* e = std::getenv("CUBE_FACE"); e && std::atoi(e) > 0) glOptions.cubeFaceSize = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("VPLS_PER_PASS")) glOptions.vplsPerPass = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("SHADOW_PCF")) glOptions.shadowPcf = std::atoi(e) != 0;  // diagnostics
-          if (const char* e = std::getenv("SLOPE_BIAS")) glOptions.slopeBias = std::atof(e);  // diagnostics
-          if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
-          auto m = bakeGl(i, glOptions);
-          glStats.add(one);
-          return m;
-        });
+        GlBackendOptions glOptions;
+        glOptions.context = &context;
+        glOptions.stats = &glStats;  // every call's figures added
+        glOptions.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
+        if (const char* e = std::getenv("CUBE_FACE"); e && std::atoi(e) > 0) glOptions.cubeFaceSize = std::atoi(e);  // diagnostics
+        if (const char* e = std::getenv("VPLS_PER_PASS")) glOptions.vplsPerPass = std::atoi(e);  // diagnostics
+        if (const char* e = std::getenv("SHADOW_PCF")) glOptions.shadowPcf = std::atoi(e) != 0;  // diagnostics
+        if (const char* e = std::getenv("SLOPE_BIAS")) glOptions.slopeBias = std::atof(e);  // diagnostics
+        if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
+        const EmbreeEvaluator contacts;
+        const GlEvaluator gl(glOptions, &contacts);
+        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) { return gl.evaluate(i); });
       } else {
         maps = bakeInterleaved(in, classes, [](const BakeInputs& i) { return bakeEmbree(i); });
       }
@@ -525,7 +522,8 @@ int stagesBench(const std::vector<std::string>& args) {
         else if (variant == "cluster128") o.clusterTriangles = 128;
         else if (variant != "default") throw Error(ErrorCode::Usage, "", "unknown variant " + variant);
         BakeInputs in{s, rt, pages, vs, {}, {}};
-        bakeGl(in, o);
+        const EmbreeEvaluator contacts;
+        GlEvaluator(o, &contacts).evaluate(in);
         const double sv = 1e3 * glStats.shadowSeconds / nv, av = 1e3 * glStats.accumulateSeconds / nv;
         const double sc = 1e3 * glStats.shadowCpuSeconds / nv, ac = 1e3 * glStats.accumulateCpuSeconds / nv;
         std::printf("%-10s %zu triangles, %zu/%d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate "

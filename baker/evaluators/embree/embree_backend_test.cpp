@@ -331,3 +331,42 @@ TEST(EmbreeBackend, DirectionalAndSpotShadowsAreExact) {
   EXPECT_GT(shadowedSun, 0);
   EXPECT_GT(shadowedSpot, 0);
 }
+
+// A texel subset: its texels get the bits of the whole page's bake, L1 pages included; every other texel
+// comes back invalid and 0.
+TEST(EmbreeEvaluator, TexelSubsetKeepsItsTexelsOnly) {
+  Scene s = samples::makeThinWall();
+  std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-2, 0, -1), glm::vec3(0, 0, 2), glm::vec3(4, 0, 0), 8, 16)};
+  RayTracer rt(s);
+  WalkOptions w;
+  w.paths = 256;
+  const VplSet vpls = generateVpls(s, rt, w);
+  const BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};
+  std::vector<std::vector<uint8_t>> subset(1, std::vector<uint8_t>(texels[0].layerSize(), 0));
+  for (size_t t = 0; t < subset[0].size(); t += 3) subset[0][t] = 1;
+  L1Pages wholeL1, partL1;
+  EvaluationRequest whole, part;
+  whole.directional = &wholeL1;
+  part.directional = &partL1;
+  part.texelSubset = &subset;
+  const EmbreeEvaluator embree;
+  EXPECT_STREQ(embree.name(), "embree");
+  EXPECT_TRUE(embree.stats().empty());
+  const std::vector<Lightmap> a = embree.evaluate(in, whole), b = embree.evaluate(in, part);
+  int inside = 0, lit = 0;
+  for (size_t t = 0; t < a[0].size(); ++t) {
+    if (subset[0][t]) {
+      ++inside;
+      lit += b[0].texels[t].x > 0.0f;
+      EXPECT_EQ(b[0].valid[t], a[0].valid[t]) << t;
+      EXPECT_EQ(b[0].texels[t], a[0].texels[t]) << t;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(partL1[k][0].texels[t], wholeL1[k][0].texels[t]) << t;
+    } else {
+      EXPECT_EQ(b[0].valid[t], 0) << t;
+      EXPECT_EQ(b[0].texels[t], glm::vec3(0.0f)) << t;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(partL1[k][0].valid[t], 0) << t;
+    }
+  }
+  EXPECT_EQ(inside, 43);  // every third of 128 texels
+  EXPECT_GT(lit, 10);
+}

@@ -74,11 +74,12 @@ Comparison compareBackends(Scene scene, int pageSize, int paths, int supersample
   eval.clampBound = deriveClampBound(scene, vpls);
   eval.includeDirect = includeDirect;
   BakeInputs in{scene, rt, texels, vpls, eval, {}};
-  const std::vector<Lightmap> ref = bakeEmbree(in);
+  const EmbreeEvaluator embree;
+  const std::vector<Lightmap> ref = embree.evaluate(in);
   Comparison c;
   GlBackendOptions go;
   go.stats = &c.gl;
-  const std::vector<Lightmap> gl = bakeGl(in, go);
+  const std::vector<Lightmap> gl = GlEvaluator(go, &embree).evaluate(in);
   EXPECT_EQ(gl.size(), ref.size());
   double num = 0, den = 0;
   for (size_t p = 0; p < std::min(gl.size(), ref.size()); ++p) {
@@ -103,12 +104,11 @@ Comparison compareBackends(Scene scene, int pageSize, int paths, int supersample
               100.0 * c.relativeRmse, c.meanEmbree, c.meanGl);
   if (directional) {
     L1Pages refL1, glL1;
-    EmbreeOptions eo;
-    eo.directional = &refL1;
-    c.embreeMapUnchanged = sameBits(bakeEmbree(in, eo), ref);
-    GlBackendOptions gd;
-    gd.directional = &glL1;
-    c.glMapUnchanged = sameBits(bakeGl(in, gd), gl);
+    EvaluationRequest er, gr;
+    er.directional = &refL1;
+    gr.directional = &glL1;
+    c.embreeMapUnchanged = sameBits(embree.evaluate(in, er), ref);
+    c.glMapUnchanged = sameBits(GlEvaluator({}, &embree).evaluate(in, gr), gl);
     double l1Num = 0.0, l1Den = 0.0;
     for (int k = 0; k < 3; ++k) c.l1RelativeRmse = relativeRmse(glL1[k], refL1[k], l1Num, l1Den);
     std::printf("L1 pages: relative RMSE %.4f%% (RMS of the Embree pages %.4g); maps unchanged: gl %d, embree %d\n",
@@ -279,8 +279,9 @@ TEST(GlVsEmbree, FurnaceMatchesClosedForm) {
   GlBackendOptions go;
   go.cubeFaceSize = 64;  // a convex box: nothing to shadow, small cubes keep the test quick
   go.vplsPerPass = 64;
-  const std::vector<Lightmap> gl = bakeGl(in, go);
-  const std::vector<Lightmap> em = bakeEmbree(in);
+  const EmbreeEvaluator embree;
+  const std::vector<Lightmap> gl = GlEvaluator(go, &embree).evaluate(in);
+  const std::vector<Lightmap> em = embree.evaluate(in);
   double sumGl = 0, sumEm = 0;
   size_t n = 0;
   for (size_t p = 0; p < gl.size(); ++p)
