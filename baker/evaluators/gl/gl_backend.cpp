@@ -172,13 +172,9 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
                         static_cast<GLsizei>(drawCounts_.size()));
 }
 
-// The batch's cubes into the atlas: one clear (reversed-Z: 0 = nothing drawn), then each face with the
-// viewport of its tile, kept inside the tile by clip distances against the view's rectangle
-// (shaders/shadow_depth.vert), so nothing can spill into a neighbour. Clip distances instead of a scissor
-// per face: a scissor change is llvmpipe's largest fixed cost per face. A glFlush every
-// GlBackendOptions::shadowFlushTriangles submitted triangles hands the scene binned so far to llvmpipe's
-// rasteriser threads while the next faces are binned: one scene per batch is best for small scenes, but
-// at ~100k triangles per cube it serialises binning and rasterising (docs/validation.md, "GL backend costs").
+// The batch's cubes into the atlas: one clear (reversed-Z: 0 = nothing drawn), then each face in its tile's
+// viewport, kept inside it by clip distances (shaders/shadow_depth.vert): cheaper than a scissor per face on
+// llvmpipe. A glFlush every shadowFlushTriangles lets the rasteriser threads work while later faces are binned.
 void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   drawing_ = geometry_.get();
   renderVplCubes(first, count, atlas, *geometry_);

@@ -83,14 +83,14 @@ struct GlBackendOptions {
   int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
   std::optional<int> cubeFaceSize;  // VPL depth-cube face size (texels, > 0); unset: from the light map (chooseCubeFaceSize)
   float cubeFootprintPerTexel = 1.0f;  // automatic face size: face texel footprint at the median VPL distance, in texel spacings
-  int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see: furnished room, 64: GL vs Embree 1.2%, 128: 0.3%)
+  int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see; docs/validation.md)
   int maxCubeFaceSize = 256;     // automatic face size: upper bound
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
-  int lightMapSize = 4096;      // spot / directional shadow map size (texels; 64 MiB): Sponza's sun at 2048², sub-texel slivers
-                                // the rays hit were missing: GL vs Embree 1.5% → 0.28% at 4096² (0.22% at 8192²)
+  int lightMapSize = 4096;       // spot / directional shadow map size (texels; 64 MiB): smaller maps miss sub-texel
+                                 // slivers of occluders that rays hit (docs/validation.md)
   int shadowFlushTriangles = 32768;  // VPL shadow pass: glFlush after this many triangles drawn into the depth atlas (0: once per batch)
   int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
-  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling; 64: −20% drawn vs 256)
+  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling: smaller clusters cull more)
   float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
   float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
   float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal

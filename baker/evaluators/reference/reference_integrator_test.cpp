@@ -57,7 +57,7 @@ TEST(Reference, PointLightOverBlackPlaneIsExact) {
   }
 }
 
-// Issue item 9: reference against closed forms within 0.5% (quad emitter over a black plane), and its
+// Reference against closed forms within 0.5% (quad emitter over a black plane), and its
 // standard error is honest: errors / standard error have an RMS near 1.
 TEST(Reference, QuadOverPlaneMatchesFormFactorWithHonestErrorBars) {
   Scene s;
@@ -86,7 +86,7 @@ TEST(Reference, QuadOverPlaneMatchesFormFactorWithHonestErrorBars) {
   EXPECT_LT(zRms, 1.4);
 }
 
-// Issue item 9: reference furnace within 0.5% of Le/(1−ρ).
+// Reference furnace within 0.5% of Le/(1−ρ).
 TEST(Reference, FurnaceMatchesClosedForm) {
   for (float rho : {0.5f, 0.9f}) {
     Scene s;
@@ -100,7 +100,7 @@ TEST(Reference, FurnaceMatchesClosedForm) {
   }
 }
 
-// Issue item 9: corner (floor and two walls, a point light). The clamped VPL estimate loses energy
+// Corner (floor and two walls, a point light). The clamped VPL estimate loses energy
 // near the edges; ClampGather's compensation brings the mean within 2% of the reference.
 TEST(Reference, CornerCompensationMatchesReference) {
   Scene s;
