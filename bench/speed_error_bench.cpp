@@ -99,7 +99,7 @@ void addModel(Scene& scene, const std::string& spec) {
 // A furnished room (≥ 50k triangles) built here: 4 × 3 × 4 m room of div×div-cell walls, a
 // checker-textured floor, three boxes as furniture, an emissive ceiling panel and a point light. By
 // default it goes through the atlas like any scene; --room-grids scores hand-made texel grids on the
-// floor and the back wall instead (the session-1 rows).
+// floor and the back wall instead (the earliest rows of the results).
 Scene furnishedRoom(int div, std::vector<TexelSamples>& texels, int grid) {
   using namespace irbake::testing;
   Scene s;
@@ -308,21 +308,18 @@ int sceneBench(const std::vector<std::string>& args) {
       std::vector<Lightmap> maps;
       if (std::string(backend) == "gl") {
         GlContext context;  // one per bake, as the pipeline does (its programs are reused by every call)
-        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) {
-          GlBakeStats one;
-          GlBackendOptions glOptions;
-          glOptions.context = &context;
-          glOptions.stats = &one;
-          glOptions.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
-          if (const char* e = std::getenv("CUBE_FACE"); e && std::atoi(e) > 0) glOptions.cubeFaceSize = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("VPLS_PER_PASS")) glOptions.vplsPerPass = std::atoi(e);  // diagnostics
-          if (const char* e = std::getenv("SHADOW_PCF")) glOptions.shadowPcf = std::atoi(e) != 0;  // diagnostics
-          if (const char* e = std::getenv("SLOPE_BIAS")) glOptions.slopeBias = std::atof(e);  // diagnostics
-          if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
-          auto m = bakeGl(i, glOptions);
-          glStats.add(one);
-          return m;
-        });
+        GlBackendOptions glOptions;
+        glOptions.context = &context;
+        glOptions.stats = &glStats;  // every call's figures added
+        glOptions.stageTimings = !std::getenv("NO_STAGE_TIMINGS");  // diagnostics: glFinish between stages serialises llvmpipe
+        if (const char* e = std::getenv("CUBE_FACE"); e && std::atoi(e) > 0) glOptions.cubeFaceSize = std::atoi(e);  // diagnostics
+        if (const char* e = std::getenv("VPLS_PER_PASS")) glOptions.vplsPerPass = std::atoi(e);  // diagnostics
+        if (const char* e = std::getenv("SHADOW_PCF")) glOptions.shadowPcf = std::atoi(e) != 0;  // diagnostics
+        if (const char* e = std::getenv("SLOPE_BIAS")) glOptions.slopeBias = std::atof(e);  // diagnostics
+        if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
+        const EmbreeEvaluator contacts;
+        const GlEvaluator gl(glOptions, &contacts);
+        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) { return gl.evaluate(i); });
       } else {
         maps = bakeInterleaved(in, classes, [](const BakeInputs& i) { return bakeEmbree(i); });
       }
@@ -525,7 +522,8 @@ int stagesBench(const std::vector<std::string>& args) {
         else if (variant == "cluster128") o.clusterTriangles = 128;
         else if (variant != "default") throw Error(ErrorCode::Usage, "", "unknown variant " + variant);
         BakeInputs in{s, rt, pages, vs, {}, {}};
-        bakeGl(in, o);
+        const EmbreeEvaluator contacts;
+        GlEvaluator(o, &contacts).evaluate(in);
         const double sv = 1e3 * glStats.shadowSeconds / nv, av = 1e3 * glStats.accumulateSeconds / nv;
         const double sc = 1e3 * glStats.shadowCpuSeconds / nv, ac = 1e3 * glStats.accumulateCpuSeconds / nv;
         std::printf("%-10s %zu triangles, %zu/%d texels, K=%d, %d² faces: shadow %.2f ms/VPL (CPU %.2f), accumulate "

@@ -1,4 +1,4 @@
-// What every backend (embree | gl | reference) receives. Backends return one Lightmap per page.
+// What every evaluator (evaluators/evaluator.h: gl, embree, reference) receives; each returns one Lightmap per page.
 #pragma once
 #include <vector>
 

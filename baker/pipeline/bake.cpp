@@ -11,19 +11,18 @@
 #include <tbb/parallel_for.h>
 
 #include "stages/compensation/clamp_compensation.h"
-#include "evaluators/embree/embree_backend.h"
 #include "stages/gather/final_gather.h"
 #include "transport/geometry_term.h"
 #include "transport/vpl_importance.h"
 #include "evaluators/gl/gl_backend.h"
 #include "stages/interleave/interleaved_sampling.h"
 #include "glcontext/gl_context.h"
-#include "evaluators/reference/reference_integrator.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/progress.h"
 #include "evaluators/gl/shadow_views.h"
 #include "common/maths.h"
+#include "pipeline/evaluator_factory.h"
 #include "post/post.h"
 #include "raytrace/ray_tracer.h"
 
@@ -98,7 +97,9 @@ struct StagedBake::State {
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
   std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
-  GlBakeStats glStats;
+  GlBakeStats glStats;        // the GL evaluator adds every call's figures here (and a merge its shards' counts)
+  std::unique_ptr<Evaluator> contactEvaluator;  // Embree: where the GL evaluator sends its contact texels
+  std::unique_ptr<Evaluator> vplEvaluator;      // GL or Embree, made on the first call (after planBlocks)
   InterleaveStats interleaveStats;
   std::unique_ptr<FootprintAlbedo> footprintAlbedo;  // hit albedo for the compensation and the gather (one for both)
   std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
@@ -254,23 +255,21 @@ struct StagedBake::State {
     return classPages;
   }
 
-  // One call of the GL or Embree backend; with l1, the same pass also gives the L1 pages (--directional).
+  // One call of the GL or Embree evaluator; with l1, the same pass also gives the L1 pages (--directional).
   std::vector<Lightmap> runVplBackend(const BakeInputs& in, L1Pages* l1 = nullptr) {
-    if (plan.backend == BackendKind::Gl) {
-      GlBakeStats callStats;
-      GlBackendOptions o = plan.gl;
-      o.stats = &callStats;
-      o.context = glContext.get();
-      o.directional = l1;
-      std::vector<Lightmap> maps = bakeGl(in, o);
-      glStats.add(callStats);
-      ++interleaveStats.backendCalls;
-      return maps;
+    if (!vplEvaluator) {
+      EvaluatorSettings settings;
+      settings.gl = plan.gl;
+      settings.gl.context = glContext.get();
+      settings.gl.stats = &glStats;
+      if (plan.backend == BackendKind::Gl) contactEvaluator = makeEvaluator(BackendKind::Embree);
+      vplEvaluator = makeEvaluator(plan.backend, settings, contactEvaluator.get());
     }
+    EvaluationRequest request;
+    request.directional = l1;
+    std::vector<Lightmap> maps = vplEvaluator->evaluate(in, request);
     ++interleaveStats.backendCalls;
-    EmbreeOptions o;
-    o.directional = l1;
-    return bakeEmbree(in, o);
+    return maps;
   }
 
   // RGB triples per texel in the exact sums: the map, and the three L1 pages with --directional.
@@ -328,20 +327,12 @@ struct StagedBake::State {
   }
 
   std::vector<Lightmap> referenceStage(nlohmann::json& report) {
-    ReferenceOptions ref;
-    ref.spp = options.referenceSpp;
-    ref.seed = options.walk.seed;
-    std::vector<Lightmap> standardError;
-    std::vector<Lightmap> maps = bakeReference(inputs(texels, vpls, plan.eval), ref, &standardError);
-    // The mean standard error over valid texels says how converged the yardstick is.
-    double se = 0.0, value = 0.0;
-    for (size_t p = 0; p < maps.size() && p < standardError.size(); ++p)
-      for (size_t i = 0; i < maps[p].size() && i < standardError[p].size(); ++i) {
-        if (i < maps[p].valid.size() && !maps[p].valid[i]) continue;
-        se += channelMean(standardError[p].texels[i]);
-        value += channelMean(maps[p].texels[i]);
-      }
-    report["reference"] = {{"spp", ref.spp}, {"relativeStandardError", value > 0.0 ? se / value : 0.0}};
+    EvaluatorSettings settings;
+    settings.reference.spp = options.referenceSpp;
+    settings.reference.seed = options.walk.seed;
+    const std::unique_ptr<Evaluator> reference = makeEvaluator(BackendKind::Reference, settings);
+    std::vector<Lightmap> maps = reference->evaluate(inputs(texels, vpls, plan.eval));
+    report["reference"] = reference->stats();  // its paths per sample and how converged it is
     return maps;
   }
 

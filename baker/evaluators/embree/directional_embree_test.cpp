@@ -1,4 +1,4 @@
-// Directional maps from the Embree backend (EmbreeOptions::directional) against closed forms.
+// Directional maps from the Embree evaluator (EvaluationRequest::directional) against closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,9 +26,9 @@ L1Vectors texelL1(const L1Pages& axes, size_t page, size_t t) {
 
 // The maps and their L1 pages from one pass; the maps must be the bits of a pass without L1.
 std::vector<Lightmap> bakeWithL1(const BakeInputs& in, L1Pages& axes) {
-  EmbreeOptions o;
-  o.directional = &axes;
-  std::vector<Lightmap> maps = bakeEmbree(in, o);
+  EvaluationRequest request;
+  request.directional = &axes;
+  std::vector<Lightmap> maps = EmbreeEvaluator().evaluate(in, request);
   const std::vector<Lightmap> plain = bakeEmbree(in);
   EXPECT_EQ(maps.size(), plain.size());
   for (size_t p = 0; p < maps.size() && p < plain.size(); ++p) {

@@ -174,11 +174,16 @@ PointShading shadePointEmbree(const BakeInputs& in, const glm::vec3& x, const gl
   return shadePointEmbree(in, x, n, options);
 }
 
-std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& options) {
+std::vector<Lightmap> bakeEmbree(const BakeInputs& inputs, const EmbreeOptions& options) {
+  return EmbreeEvaluator(options).evaluate(inputs);
+}
+
+std::vector<Lightmap> EmbreeEvaluator::evaluate(const BakeInputs& in, const EvaluationRequest& request) const {
+  const EmbreeOptions& options = options_;
   std::vector<Lightmap> maps;
-  const bool directional = options.directional != nullptr;
+  const bool directional = request.directional != nullptr;
   if (directional)
-    for (auto& axis : *options.directional) axis.clear();
+    for (auto& axis : *request.directional) axis.clear();
   size_t totalSlots = 0, doneSlots = 0;
   for (const auto& t : in.texels) totalSlots += t.slotCount();
   std::atomic<size_t> progressSlots{0};
@@ -194,7 +199,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
     std::vector<glm::vec3> slotValue(slots, glm::vec3(0.0f));
     std::vector<L1Vectors> slotL1(directional ? slots : 0, L1Vectors{});
     const std::vector<uint8_t>* subset =
-        options.texelSubset && page < options.texelSubset->size() ? &(*options.texelSubset)[page] : nullptr;
+        request.texelSubset && page < request.texelSubset->size() ? &(*request.texelSubset)[page] : nullptr;
     auto wanted = [&](size_t t) { return !subset || (t < subset->size() && (*subset)[t] != 0); };
 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, tile), [&](const tbb::blocked_range<size_t>& r) {
@@ -255,7 +260,7 @@ std::vector<Lightmap> bakeEmbree(const BakeInputs& in, const EmbreeOptions& opti
       for (int k = 0; k < 3; ++k) {
         Lightmap axis = blankLightmap(ts);
         resolve(axis, "directional value", [&](size_t s) { return slotL1[s][k]; });
-        (*options.directional)[k].push_back(std::move(axis));
+        (*request.directional)[k].push_back(std::move(axis));
       }
   }
   if (in.progress) in.progress("embree", 1.0);

@@ -1,7 +1,7 @@
-// The Embree backend: every valid texel sample gathers the punctual lights (exact, one shadow ray each)
-// and all VPLs (clamped geometry term, ray-traced visibility). The reference for the GL backend and its
-// fallback. Formulas: transport/geometry_term.h. The energy the clamp removes is given back after any backend
-// by stages/compensation (ClampGather); eval.biasCompensation is not read here.
+// The Embree evaluator: every valid texel sample gathers the punctual lights (exact, one shadow ray each)
+// and all VPLs (clamped geometry term, ray-traced visibility). Formulas: transport/geometry_term.h. The
+// energy the clamp removes is given back after any evaluator by stages/compensation; eval.biasCompensation
+// is not read here.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "evaluators/bake_inputs.h"
+#include "evaluators/evaluator.h"
 #include "lightmap/lightmap.h"
 #include "sampling/sampling.h"
 
@@ -17,18 +18,25 @@ namespace irbake {
 struct EmbreeOptions {
   int vplBlock = 256;            // VPLs per block: a block stays in cache while a tile of samples loops over it
   int tileSlots = 64;            // texel samples per parallel task
-  bool packets = true;           // shadow rays in packets of 8 (rtcOccluded8): faster than one by one (bench: room_floor_occluded8)
-  // Per page, per texel: evaluate only texels marked ≠ 0, the rest come back invalid (null: every texel).
-  // The GL backend resolves its contact texels this way.
-  const std::vector<std::vector<uint8_t>>* texelSubset = nullptr;
-  // Out, optional: the directional maps' L1 pages (transport/directional.h: x, y, z world components of the
-  // tangential irradiance vector t, RGB each) of the same punctual lights and clamped VPLs, gathered in the
-  // same pass (each visible source's direction is at hand there); valid flags as the maps'. The map itself
-  // is the same bits with or without it. The sky and the clamp compensation add none here.
-  L1Pages* directional = nullptr;
+  bool packets = true;           // shadow rays in packets of 8 (rtcOccluded8): faster than one by one, the same maps
 };
 
-// One Lightmap per TexelSamples page; valid = the texel's valid flag. Throws Error(NumericError) on NaN/Inf.
+// Asked for L1 pages (EvaluationRequest::directional), it gathers them in the same pass from the same punctual
+// lights and clamped VPLs (each visible source's direction is at hand there); the map is the same bits with
+// or without them. A texel subset costs only its texels' rays. stats(): an empty object (nothing measured).
+class EmbreeEvaluator final : public Evaluator {
+ public:
+  explicit EmbreeEvaluator(const EmbreeOptions& options = {}) : options_(options) {}
+  // Throws Error(NumericError) on NaN/Inf.
+  std::vector<Lightmap> evaluate(const BakeInputs& inputs, const EvaluationRequest& request = {}) const override;
+  const char* name() const override { return "embree"; }
+  nlohmann::json stats() const override { return nlohmann::json::object(); }
+
+ private:
+  EmbreeOptions options_;
+};
+
+// Every texel, no L1 pages: EmbreeEvaluator(options).evaluate(inputs), for the tests and tools that want a map.
 std::vector<Lightmap> bakeEmbree(const BakeInputs& inputs, const EmbreeOptions& options = {});
 
 // What one texel sample at (x, n) receives, as irradiance / π. For tests and tools.

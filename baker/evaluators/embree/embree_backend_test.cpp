@@ -79,7 +79,7 @@ double quadRelativeRmse(const Lightmap& m, const TexelSamples& t, float h) {
 
 }  // namespace
 
-// Issue item 9: point light over a black plane, every texel within 0.5% of I cosθ / (π r²).
+// Point light over a black plane, every texel within 0.5% of I cosθ / (π r²).
 TEST(EmbreeBackend, PointLightOverPlaneMatchesInverseSquareEverywhere) {
   Scene s;
   addQuad(s, addMaterial(s, glm::vec3(0.0f)), glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
@@ -102,7 +102,7 @@ TEST(EmbreeBackend, PointLightOverPlaneMatchesInverseSquareEverywhere) {
   EXPECT_LT(worst, 0.005);
 }
 
-// Issue item 9: square emitter over a parallel plane. 1024 VPLs: RMSE < 1%; QMC slope ≤ −0.75.
+// Square emitter over a parallel plane. 1024 VPLs: RMSE < 1%; QMC slope ≤ −0.75.
 TEST(EmbreeBackend, QuadOverPlaneConvergesAtQuasiMonteCarloRate) {
   const float h = 0.5f;
   Scene s = quadOverPlane(h);
@@ -173,7 +173,7 @@ void runFurnace(float rho, int paths, int grid, float fixedBound = 0.0f) {
 }
 }  // namespace
 
-// Issue item 9: furnace, mean within 1% of Le/(1−ρ) with the clamp compensation; clamped-only bias printed.
+// Furnace, mean within 1% of Le/(1−ρ) with the clamp compensation; clamped-only bias printed.
 TEST(EmbreeBackend, FurnaceHalfAlbedo) { runFurnace(0.5f, 4096, 16); }
 TEST(EmbreeBackend, FurnaceHighAlbedo) { runFurnace(0.9f, 1024, 12); }
 // A deliberately coarse clamp (B = 25/m², r_c = 0.2 m: a fifth of the room) removes a large part of the
@@ -183,7 +183,7 @@ TEST(EmbreeBackend, FurnaceCoarseClampIsCompensated) {
   runFurnace(0.9f, 4096, 12, 25.0f);
 }
 
-// Issue item 9: thin wall. Light on one side; the floor on the other side, right against the wall,
+// Thin wall. Light on one side; the floor on the other side, right against the wall,
 // stays dark (< 1e-3 of the lit side) with VPL bounces and the clamp compensation on.
 TEST(EmbreeBackend, ThinWallDoesNotLeak) {
   Scene s;
@@ -206,7 +206,7 @@ TEST(EmbreeBackend, ThinWallDoesNotLeak) {
   EXPECT_LT(darkMax, 1e-3 * lit);
 }
 
-// Issue item 9: 1e5 VPLs accumulated in float stay within 1e-5 relative of a double sum.
+// 1e5 VPLs accumulated in float stay within 1e-5 relative of a double sum.
 TEST(EmbreeBackend, HundredThousandVplsSumLikeDouble) {
   Scene s;
   addQuad(s, addMaterial(s, glm::vec3(0.0f)), glm::vec3(-1, -1, 0), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0));
@@ -330,4 +330,43 @@ TEST(EmbreeBackend, DirectionalAndSpotShadowsAreExact) {
   }
   EXPECT_GT(shadowedSun, 0);
   EXPECT_GT(shadowedSpot, 0);
+}
+
+// A texel subset: its texels get the bits of the whole page's bake, L1 pages included; every other texel
+// comes back invalid and 0.
+TEST(EmbreeEvaluator, TexelSubsetKeepsItsTexelsOnly) {
+  Scene s = samples::makeThinWall();
+  std::vector<TexelSamples> texels = {gridSamples(glm::vec3(-2, 0, -1), glm::vec3(0, 0, 2), glm::vec3(4, 0, 0), 8, 16)};
+  RayTracer rt(s);
+  WalkOptions w;
+  w.paths = 256;
+  const VplSet vpls = generateVpls(s, rt, w);
+  const BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};
+  std::vector<std::vector<uint8_t>> subset(1, std::vector<uint8_t>(texels[0].layerSize(), 0));
+  for (size_t t = 0; t < subset[0].size(); t += 3) subset[0][t] = 1;
+  L1Pages wholeL1, partL1;
+  EvaluationRequest whole, part;
+  whole.directional = &wholeL1;
+  part.directional = &partL1;
+  part.texelSubset = &subset;
+  const EmbreeEvaluator embree;
+  EXPECT_STREQ(embree.name(), "embree");
+  EXPECT_TRUE(embree.stats().empty());
+  const std::vector<Lightmap> a = embree.evaluate(in, whole), b = embree.evaluate(in, part);
+  int inside = 0, lit = 0;
+  for (size_t t = 0; t < a[0].size(); ++t) {
+    if (subset[0][t]) {
+      ++inside;
+      lit += b[0].texels[t].x > 0.0f;
+      EXPECT_EQ(b[0].valid[t], a[0].valid[t]) << t;
+      EXPECT_EQ(b[0].texels[t], a[0].texels[t]) << t;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(partL1[k][0].texels[t], wholeL1[k][0].texels[t]) << t;
+    } else {
+      EXPECT_EQ(b[0].valid[t], 0) << t;
+      EXPECT_EQ(b[0].texels[t], glm::vec3(0.0f)) << t;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(partL1[k][0].valid[t], 0) << t;
+    }
+  }
+  EXPECT_EQ(inside, 43);  // every third of 128 texels
+  EXPECT_GT(lit, 10);
 }

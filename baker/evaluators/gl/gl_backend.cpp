@@ -1,7 +1,5 @@
 #include "evaluators/gl/gl_backend.h"
 
-#include "evaluators/embree/embree_backend.h"
-
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -63,10 +61,11 @@ struct StageClock {
 
 class GlBaker {
  public:
-  GlBaker(const BakeInputs& in, const GlBackendOptions& opt, GlBakeStats& stats, GlProgramCache& programs)
-      : in_(in), opt_(opt), stats_(stats), programs_(programs) {}
+  GlBaker(const BakeInputs& in, const GlBackendOptions& opt, const EvaluationRequest& request, GlBakeStats& stats,
+          GlProgramCache& programs)
+      : in_(in), opt_(opt), request_(request), stats_(stats), programs_(programs) {}
 
-  // The maps, and with GlBackendOptions::directional its L1 pages.
+  // The maps, and with EvaluationRequest::directional their L1 pages.
   std::vector<Lightmap> run();
   std::vector<Lightmap> readMaps();
   // Per page, per texel: 1 where the shadow lookups could not tell a contact from the receiver (after run).
@@ -85,11 +84,16 @@ class GlBaker {
   const GlProgram& vplProgram(int layers);
   // The contact check runs on the default lookup (2×2 filter); with the other lookups alpha stays 0.
   bool contactFlags() const { return opt_.resolveContacts && opt_.shadowPcf && opt_.shadowCompare; }
-  bool directional() const { return opt_.directional != nullptr; }
+  bool directional() const { return request_.directional != nullptr; }
+  bool wanted(size_t page, size_t texel) const {
+    const auto* subset = request_.texelSubset;
+    return !subset || (page < subset->size() && texel < (*subset)[page].size() && (*subset)[page][texel] != 0);
+  }
   void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
 
   const BakeInputs& in_;
   const GlBackendOptions& opt_;
+  const EvaluationRequest& request_;
   GlBakeStats& stats_;
   GlProgramCache& programs_;  // the context's: programs outlive this call, so later calls skip compiling
   ShadowScale scale_;
@@ -168,13 +172,9 @@ void GlBaker::drawCulled(const ShadowView& view, int size) {
                         static_cast<GLsizei>(drawCounts_.size()));
 }
 
-// The batch's cubes into the atlas: one clear (reversed-Z: 0 = nothing drawn), then each face with the
-// viewport of its tile, kept inside the tile by clip distances against the view's rectangle
-// (shaders/shadow_depth.vert), so nothing can spill into a neighbour. Clip distances instead of a scissor
-// per face: a scissor change is llvmpipe's largest fixed cost per face. A glFlush every
-// GlBackendOptions::shadowFlushTriangles submitted triangles hands the scene binned so far to llvmpipe's
-// rasteriser threads while the next faces are binned: one scene per batch is best for small scenes, but
-// at ~100k triangles per cube it serialises binning and rasterising (docs/validation.md, "GL backend costs").
+// The batch's cubes into the atlas: one clear (reversed-Z: 0 = nothing drawn), then each face in its tile's
+// viewport, kept inside it by clip distances (shaders/shadow_depth.vert): cheaper than a scissor per face on
+// llvmpipe. A glFlush every shadowFlushTriangles lets the rasteriser threads work while later faces are binned.
 void GlBaker::renderVplBatch(size_t first, size_t count, const DepthAtlas& atlas) {
   drawing_ = geometry_.get();
   renderVplCubes(first, count, atlas, *geometry_);
@@ -366,13 +366,14 @@ void GlBaker::bakeDirect(const Light& light) {
   finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
 }
 
-// The pages' double sums as maps (valid texels only), and the contact texels: those where lookups that
-// could not tell a contact from the receiver carried more than contactLeakFraction of the texel's light.
+// The pages' double sums as maps (valid texels of the subset only), and the contact texels: those where
+// lookups that could not tell a contact from the receiver carried more than contactLeakFraction of the light.
 std::vector<Lightmap> GlBaker::readMaps() {
   std::vector<Lightmap> maps;
   if (directional())
-    for (auto& axis : *opt_.directional) axis.clear();
-  for (const auto& page : pages_) {
+    for (auto& axis : *request_.directional) axis.clear();
+  for (size_t p = 0; p < pages_.size(); ++p) {
+    const auto& page = pages_[p];
     const TexelSamples& s = *page->samples;
     Lightmap m;
     m.page = s.page;
@@ -382,7 +383,7 @@ std::vector<Lightmap> GlBaker::readMaps() {
     m.valid.assign(m.size(), 0);
     std::vector<uint8_t>& contact = contactTexels_.emplace_back(m.size(), 0);
     for (size_t i = 0; i < m.size(); ++i) {
-      const bool valid = i < s.valid.size() && s.valid[i];
+      const bool valid = i < s.valid.size() && s.valid[i] && wanted(p, i);
       m.valid[i] = valid ? 1 : 0;
       stats_.texelsEvaluated += valid;
       if (valid && page->leak[i] > 0.0 &&
@@ -404,7 +405,7 @@ std::vector<Lightmap> GlBaker::readMaps() {
                                                          std::to_string(s.page));
           axis.texels[i] = glm::vec3(v);
         }
-        (*opt_.directional)[k].push_back(std::move(axis));
+        (*request_.directional)[k].push_back(std::move(axis));
       }
     maps.push_back(std::move(m));
   }
@@ -523,21 +524,22 @@ std::vector<Lightmap> GlBaker::run() {
   return maps;
 }
 
-// The contact texels again with rays: the Embree backend on the same VPLs and lights (the clamped sum,
-// as here), over those texels only, replaces what the shadow maps gave them (and their L1 pages, l1 ≠ null).
-void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<uint8_t>>& contact,
-                          std::vector<Lightmap>& maps, L1Pages* l1, GlBakeStats& stats) {
+// The contact texels again by the contact evaluator on the same VPLs and lights (the clamped sum, as here),
+// over those texels only: its values replace what the shadow maps gave them (and their L1 pages, l1 ≠ null).
+void resolveContactTexels(const Evaluator& contacts, const BakeInputs& in,
+                          const std::vector<std::vector<uint8_t>>& contact, std::vector<Lightmap>& maps, L1Pages* l1,
+                          GlBakeStats& stats) {
   size_t count = 0;
   for (const auto& page : contact) count += static_cast<size_t>(std::count(page.begin(), page.end(), uint8_t{1}));
   stats.contactTexels += count;
   if (count == 0) return;
   Stopwatch watch;
-  const BakeInputs rays{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};
-  EmbreeOptions eo;
-  eo.texelSubset = &contact;
+  const BakeInputs quiet{in.scene, in.rayTracer, in.texels, in.vpls, in.eval, {}};  // its progress is this call's
+  EvaluationRequest request;
+  request.texelSubset = &contact;
   L1Pages tracedL1;
-  if (l1) eo.directional = &tracedL1;
-  const std::vector<Lightmap> traced = bakeEmbree(rays, eo);
+  if (l1) request.directional = &tracedL1;
+  const std::vector<Lightmap> traced = contacts.evaluate(quiet, request);
   for (size_t p = 0; p < maps.size() && p < traced.size(); ++p)
     for (size_t i = 0; i < maps[p].size(); ++i) {
       if (!contact[p][i] || !traced[p].valid[i]) continue;
@@ -550,30 +552,38 @@ void resolveContactTexels(const BakeInputs& in, const std::vector<std::vector<ui
 
 }  // namespace
 
-std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& options) {
-  GlBakeStats localStats;
-  GlBakeStats& stats = options.stats ? *options.stats : localStats;
-  stats = GlBakeStats{};
+GlEvaluator::GlEvaluator(const GlBackendOptions& options, const Evaluator* contacts)
+    : options_(options), contacts_(contacts), stats_(options.stats ? options.stats : &ownStats_) {
+  if (!contacts_) options_.resolveContacts = false;
+}
+
+std::vector<Lightmap> GlEvaluator::evaluate(const BakeInputs& inputs, const EvaluationRequest& request) const {
+  GlBakeStats stats;
   Stopwatch contextTime;
   std::unique_ptr<GlContext> owned;
-  const GlContext* ctx = options.context;
+  const GlContext* ctx = options_.context;
   if (ctx)
     ctx->makeCurrent();
   else
     ctx = (owned = std::make_unique<GlContext>()).get();
   const double contextSeconds = contextTime.seconds();
   stats.renderer = ctx->description();
-  if (!options.context) log::info("GL backend: " + stats.renderer);  // a caller passing a context logs it once
+  if (!options_.context) log::info("GL backend: " + stats.renderer);  // a caller passing a context logs it once
   std::vector<Lightmap> maps;
   std::vector<std::vector<uint8_t>> contact;
   {
-    GlBaker baker(inputs, options, stats, ctx->programs());
+    GlBaker baker(inputs, options_, request, stats, ctx->programs());
     maps = baker.run();
     contact = baker.contactTexels();
   }
   stats.setupSeconds += contextSeconds;
-  if (options.resolveContacts) resolveContactTexels(inputs, contact, maps, options.directional, stats);
+  if (options_.resolveContacts) resolveContactTexels(*contacts_, inputs, contact, maps, request.directional, stats);
+  stats_->add(stats);
   return maps;
+}
+
+nlohmann::json GlEvaluator::stats() const {
+  return {{"renderer", stats_->renderer}, {"counts", stats_->toJson()}, {"timings", stats_->timingsJson()}};
 }
 
 }  // namespace irbake

@@ -1,5 +1,6 @@
-// The OpenGL backend: each VPL's shadowed contribution rendered into the light-map pages (EGL,
-// headless) and accumulated in float, folded into double. Same transport as the Embree backend.
+// The OpenGL evaluator: each VPL's shadowed contribution rendered into the light-map pages (EGL,
+// headless) and accumulated in float, folded into double. The same transport maths (transport/) as the
+// other evaluators; the texels its depth tests cannot resolve go to the evaluator its builder hands it.
 #pragma once
 #include <algorithm>
 #include <optional>
@@ -9,13 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include "evaluators/bake_inputs.h"
+#include "evaluators/evaluator.h"
 #include "lightmap/lightmap.h"
 
 namespace irbake {
 
 class GlContext;
 
-// Measured by bakeGl (wall clock with glFinish between stages when GlBackendOptions::stageTimings).
+// Measured by GlEvaluator (wall clock with glFinish between stages when GlBackendOptions::stageTimings).
 struct GlBakeStats {
   std::string renderer;          // GL_RENDERER | GL_VERSION | EGL platform
   double setupSeconds = 0.0;     // context, programs, geometry and G-buffer upload
@@ -30,9 +32,9 @@ struct GlBakeStats {
   size_t facesRendered = 0;      // shadow views drawn (cube faces, spot/directional maps)
   size_t trianglesDrawn = 0;     // triangles submitted to shadow views after CPU culling
   size_t trianglesBeforeCulling = 0;  // triangles that would be submitted without culling
-  size_t contactTexels = 0;      // texels resolved with rays (GlBackendOptions::resolveContacts)
+  size_t contactTexels = 0;      // texels handed to the contact evaluator (GlBackendOptions::resolveContacts)
   size_t texelsEvaluated = 0;    // valid texels of the pages
-  double contactSeconds = 0.0;   // the rays of the contact texels
+  double contactSeconds = 0.0;   // the contact evaluator's time on them
   // The report's "gl" object (counts, the same every run) and its "timings.gl" object (wall clock).
   nlohmann::json toJson() const {
     return {{"passes", passes},
@@ -56,7 +58,7 @@ struct GlBakeStats {
     contactTexels += j.value("contactTexels", size_t{0});
     texelsEvaluated += j.value("texelsEvaluated", size_t{0});
   }
-  // Adds another call's figures (the bake calls the backend once per VPL block).
+  // Adds another call's figures (the bake calls the evaluator once per VPL block).
   void add(const GlBakeStats& o) {
     renderer = o.renderer;
     setupSeconds += o.setupSeconds;
@@ -81,14 +83,14 @@ struct GlBackendOptions {
   int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
   std::optional<int> cubeFaceSize;  // VPL depth-cube face size (texels, > 0); unset: from the light map (chooseCubeFaceSize)
   float cubeFootprintPerTexel = 1.0f;  // automatic face size: face texel footprint at the median VPL distance, in texel spacings
-  int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see: furnished room, 64: GL vs Embree 1.2%, 128: 0.3%)
+  int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see; docs/validation.md)
   int maxCubeFaceSize = 256;     // automatic face size: upper bound
   int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
-  int lightMapSize = 4096;      // spot / directional shadow map size (texels; 64 MiB): Sponza's sun at 2048², sub-texel slivers
-                                // the rays hit were missing: GL vs Embree 1.5% → 0.28% at 4096² (0.22% at 8192²)
+  int lightMapSize = 4096;       // spot / directional shadow map size (texels; 64 MiB): smaller maps miss sub-texel
+                                 // slivers of occluders that rays hit (docs/validation.md)
   int shadowFlushTriangles = 32768;  // VPL shadow pass: glFlush after this many triangles drawn into the depth atlas (0: once per batch)
   int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
-  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling; 64: −20% drawn vs 256)
+  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling: smaller clusters cull more)
   float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
   float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
   float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal
@@ -100,22 +102,35 @@ struct GlBackendOptions {
   // Contact texels: a shadow lookup that the depth bias counts as lit although the stored surface lies in
   // front of the receiver's plane cannot tell a contact (a box on a floor, a lamp 0.1 mm under a ceiling)
   // from the receiver itself. Texels where such lookups carry more than contactLeakFraction of the
-  // texel's light are evaluated again with rays (the Embree backend, same VPLs and lights). At 0.01 an
-  // unresolved texel is off by at most 1% from such lookups (Cornell box at 128² faces: 8.5% of texels
-  // traced, GL vs Embree 0.11%; at 0.001: 21%, 0.09%).
+  // texel's light go to the contact evaluator (same inputs, those texels only), so an unresolved texel is
+  // off by at most that fraction from such lookups. Without a contact evaluator this is off.
   bool resolveContacts = true;
   float contactLeakFraction = 0.01f;
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
-  const GlContext* context = nullptr;  // an existing current context; null: bakeGl creates one
-  GlBakeStats* stats = nullptr;  // out: timings and counts (may be null)
-  // Out, optional: the directional maps' L1 pages (transport/directional.h), accumulated by the same
-  // passes into three more float targets per page (contact texels: from the same rays as the map). Null:
-  // the plain shaders and targets, nothing more is done.
-  L1Pages* directional = nullptr;
+  const GlContext* context = nullptr;  // an existing context, made current per call; null: one made per call
+  GlBakeStats* stats = nullptr;  // where every call's figures are added (null: the evaluator keeps its own)
 };
 
-// One Lightmap per TexelSamples page (irradiance/π). Throws Error(Gl) when no GL 4.5 context can be
-// created (hint: --backend embree) and Error(NumericError) if a non-finite value appears.
-std::vector<Lightmap> bakeGl(const BakeInputs& inputs, const GlBackendOptions& options = {});
+// L1 pages (EvaluationRequest::directional) come from the same passes, three more float targets per page
+// (contact texels: from the contact evaluator's L1 pages). A texel subset is rendered whole and then cut
+// (no time saved). stats(): {"renderer", "counts" (the report's "gl"), "timings" (its "timings.gl")}.
+class GlEvaluator final : public Evaluator {
+ public:
+  // contacts: the evaluator of the contact texels (null: resolveContacts is off); it must outlive this one.
+  explicit GlEvaluator(const GlBackendOptions& options = {}, const Evaluator* contacts = nullptr);
+  GlEvaluator(const GlEvaluator&) = delete;
+  GlEvaluator& operator=(const GlEvaluator&) = delete;
+  // Throws Error(Gl) when no GL 4.5 context can be created (hint: --backend embree) and
+  // Error(NumericError) if a non-finite value appears.
+  std::vector<Lightmap> evaluate(const BakeInputs& inputs, const EvaluationRequest& request = {}) const override;
+  const char* name() const override { return "gl"; }
+  nlohmann::json stats() const override;
+
+ private:
+  GlBackendOptions options_;
+  const Evaluator* contacts_;
+  mutable GlBakeStats ownStats_;  // the figures when options.stats is null
+  GlBakeStats* stats_;
+};
 
 }  // namespace irbake

@@ -106,11 +106,9 @@ struct DepthTargets {
   }
 };
 
-// The VPL depth cubes of one batch as tiles of ONE 2D depth texture behind ONE framebuffer: tile
-// 5k + f holds face f (GL order +X −X +Y −Y +Z; the −Z face is never drawn for a hemisphere) of the
-// batch's k-th VPL, at column (5k + f) % cols, row (5k + f) / cols. Cleared once per batch, each face
-// drawn with its own viewport and scissor, so llvmpipe bins a whole batch as one scene instead of
-// paying a framebuffer switch and a scissored clear per face.
+// The VPL depth cubes of one batch as tiles of one 2D depth texture and framebuffer (one clear and one binned
+// scene per batch, no framebuffer switch per face): tile 5k + f holds face f (GL order +X −X +Y −Y +Z; a
+// hemisphere never needs −Z) of the batch's k-th VPL, at column (5k + f) % cols, row (5k + f) / cols.
 struct DepthAtlas {
   static constexpr int kTilesPerCube = 5;
   GLuint texture = 0, fbo = 0;
@@ -156,11 +154,9 @@ struct DepthAtlas {
   }
 };
 
-// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a
-// validity mask as depth (1 valid, 0 not): the light-map passes draw at depth 0 with GL_LESS, so
-// llvmpipe's early depth test drops invalid texels before shading (whole 8-fragment vectors skipped).
-// With directional maps, three more float targets (colour attachments 1–3) and double accumulators hold
-// the L1 pages (x, y, z; RGB each), written by the same passes; without, the page is as before.
+// One page on the GPU: G-buffer (S×S layers), float accumulation target, double accumulator, and a validity
+// mask as depth (1 valid, 0 not) that the early depth test uses to skip invalid texels before shading. With
+// directional maps, three more float targets (attachments 1–3) and accumulators hold the L1 pages.
 struct GpuPage {
   const TexelSamples* samples = nullptr;
   GLuint positionWeight = 0, normal = 0, geomNormal = 0, accum = 0, validDepth = 0, fbo = 0;

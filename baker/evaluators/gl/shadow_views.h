@@ -54,15 +54,11 @@ ShadowView spotView(const glm::vec3& position, const glm::vec3& direction, float
 ShadowView directionalView(const glm::vec3& direction, const Bounds3& bounds, int size, float& texelSize,
                            float& depthRange);
 
-// VPL cube face size from what the light map can show. A face texel's footprint at the typical VPL →
-// receiver distance r, 2r/F, is held to `footprintPerTexel` texel spacings h: F = 2r / (footprintPerTexel·h),
-// rounded up to a multiple of 32 and clamped to [minSize, maxSize]. At 1 (the GL backend's default) the
-// 2×2 filter blurs a shadow edge over about ±1 footprint, what the light map blurs anyway (a texel, or ±n
-// texels of the interleaving filter); 0.5 samples visibility at twice the map's rate (Nyquist). The slope
-// bias and the contact leak scale with the footprint too.
-// r: the contribution-weighted median distance over sampled (VPL, valid texel) pairs that face each other
-// (weight: VPL power × clamped geometry term); h: the median texel spacing over the pages (under
-// interleaved sampling the pages are one class's, so h is n times the full page's spacing).
+// VPL cube face size from what the light map can show: a face texel's footprint 2r/F at the typical VPL →
+// receiver distance r is held to `footprintPerTexel` texel spacings h, F = 2r / (footprintPerTexel·h), rounded
+// up to a multiple of 32 and clamped to [minSize, maxSize]. At 1 the 2×2 filter blurs an edge about as much as
+// the map does. r: the contribution-weighted median distance of sampled facing (VPL, valid texel) pairs;
+// h: the pages' median texel spacing (one interleave class's pages: n times the full page's).
 struct CubeFaceChoice {
   int size = 0;                // chosen face size (texels)
   float medianDistance = 0.0f; // r (m); 0 when no facing pair was found (size = maxSize)

@@ -119,8 +119,10 @@ glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const Lig
 }
 
 std::vector<Lightmap> bakeReference(const BakeInputs& in, const ReferenceOptions& options,
-                                    std::vector<Lightmap>* standardError) {
+                                    std::vector<Lightmap>* standardError, const EvaluationRequest& request) {
   if (options.spp < 1) throw Error(ErrorCode::Usage, "", "the reference needs at least one path per sample (--spp)");
+  if (request.directional)
+    throw Error(ErrorCode::Usage, "", "the reference makes no L1 pages: directional maps need a VPL evaluator");
   const LightSources lights = collectLightSources(in.scene);
   std::vector<Lightmap> maps;
   if (standardError) standardError->clear();
@@ -128,12 +130,16 @@ std::vector<Lightmap> bakeReference(const BakeInputs& in, const ReferenceOptions
   for (const auto& t : in.texels) totalSlots += t.slotCount();
   std::atomic<size_t> progressSlots{0};
 
-  for (const TexelSamples& ts : in.texels) {
+  for (size_t page = 0; page < in.texels.size(); ++page) {
+    const TexelSamples& ts = in.texels[page];
     const size_t slots = ts.slotCount(), layer = ts.layerSize();
+    const std::vector<uint8_t>* subset =
+        request.texelSubset && page < request.texelSubset->size() ? &(*request.texelSubset)[page] : nullptr;
+    auto wanted = [&](size_t t) { return !subset || (t < subset->size() && (*subset)[t] != 0); };
     std::vector<glm::dvec3> mean(slots, glm::dvec3(0.0)), varianceOfMean(slots, glm::dvec3(0.0));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, 16), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t s = r.begin(); s != r.end(); ++s) {
-        if (!(ts.positionWeight[s].w > 0.0f)) continue;
+        if (!(ts.positionWeight[s].w > 0.0f) || !wanted(s % layer)) continue;
         Rng rng(hashSeed(options.seed, static_cast<uint64_t>(ts.page), s));
         glm::vec3 x(ts.positionWeight[s]), n(ts.normal[s]);
         // Moved ε into its triangle: a sample snapped onto an edge would start paths on the plane of the
@@ -166,6 +172,7 @@ std::vector<Lightmap> bakeReference(const BakeInputs& in, const ReferenceOptions
     map.valid.assign(layer, 0);
     const int layers = ts.supersample * ts.supersample;
     for (size_t t = 0; t < layer; ++t) {
+      if (!wanted(t)) continue;
       glm::dvec3 value(0.0), var(0.0);
       double weight = 0.0;
       for (int l = 0; l < layers; ++l) {
@@ -194,6 +201,24 @@ std::vector<Lightmap> bakeReference(const BakeInputs& in, const ReferenceOptions
   }
   if (in.progress) in.progress("reference", 1.0);
   return maps;
+}
+
+std::vector<Lightmap> ReferenceEvaluator::evaluate(const BakeInputs& inputs, const EvaluationRequest& request) const {
+  std::vector<Lightmap> standardError;
+  std::vector<Lightmap> maps = bakeReference(inputs, options_, &standardError, request);
+  double se = 0.0, value = 0.0;
+  for (size_t p = 0; p < maps.size() && p < standardError.size(); ++p)
+    for (size_t i = 0; i < maps[p].size() && i < standardError[p].size(); ++i) {
+      if (i < maps[p].valid.size() && !maps[p].valid[i]) continue;
+      se += channelMean(standardError[p].texels[i]);
+      value += channelMean(maps[p].texels[i]);
+    }
+  relativeStandardError_ = value > 0.0 ? se / value : 0.0;
+  return maps;
+}
+
+nlohmann::json ReferenceEvaluator::stats() const {
+  return {{"spp", options_.spp}, {"relativeStandardError", relativeStandardError_}};
 }
 
 }  // namespace irbake

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "evaluators/bake_inputs.h"
+#include "evaluators/evaluator.h"
 #include "lightmap/lightmap.h"
 #include "vpl/light_sources.h"
 #include "sampling/sampling.h"
@@ -24,8 +25,24 @@ struct ReferenceOptions {
 
 // One Lightmap per TexelSamples page (inputs.vpls and inputs.eval are not used: the reference is the
 // full solution). standardError (optional) receives per texel the standard error of the mean, same layout.
+// request.texelSubset traces those texels only; it makes no L1 pages (request.directional: Error(Usage)).
 std::vector<Lightmap> bakeReference(const BakeInputs& inputs, const ReferenceOptions& options,
-                                    std::vector<Lightmap>* standardError = nullptr);
+                                    std::vector<Lightmap>* standardError = nullptr,
+                                    const EvaluationRequest& request = {});
+
+// bakeReference behind the evaluator interface. stats(): the last evaluation's {"spp", "relativeStandardError"}
+// (the mean standard error over the mean value of its valid texels: how converged the yardstick is).
+class ReferenceEvaluator final : public Evaluator {
+ public:
+  explicit ReferenceEvaluator(const ReferenceOptions& options) : options_(options) {}
+  std::vector<Lightmap> evaluate(const BakeInputs& inputs, const EvaluationRequest& request = {}) const override;
+  const char* name() const override { return "reference"; }
+  nlohmann::json stats() const override;
+
+ private:
+  ReferenceOptions options_;
+  mutable double relativeStandardError_ = 0.0;  // of the last evaluation
+};
 
 // One path's estimate of irradiance / π at surface point (x, n); the mean over paths converges to it.
 glm::vec3 referencePathSample(const Scene& scene, const RayTracer& rt, const LightSources& lights, const glm::vec3& x,

@@ -7,6 +7,7 @@
 
 #include "stages/compensation/test_probe_bake.h"
 #include "evaluators/embree/embree_backend.h"
+#include "common/error.h"
 #include "common/maths.h"
 #include "raytrace/test_scenes.h"
 #include "transport/geometry_term.h"
@@ -56,7 +57,7 @@ TEST(Reference, PointLightOverBlackPlaneIsExact) {
   }
 }
 
-// Issue item 9: reference against closed forms within 0.5% (quad emitter over a black plane), and its
+// Reference against closed forms within 0.5% (quad emitter over a black plane), and its
 // standard error is honest: errors / standard error have an RMS near 1.
 TEST(Reference, QuadOverPlaneMatchesFormFactorWithHonestErrorBars) {
   Scene s;
@@ -85,7 +86,7 @@ TEST(Reference, QuadOverPlaneMatchesFormFactorWithHonestErrorBars) {
   EXPECT_LT(zRms, 1.4);
 }
 
-// Issue item 9: reference furnace within 0.5% of Le/(1−ρ).
+// Reference furnace within 0.5% of Le/(1−ρ).
 TEST(Reference, FurnaceMatchesClosedForm) {
   for (float rho : {0.5f, 0.9f}) {
     Scene s;
@@ -99,7 +100,7 @@ TEST(Reference, FurnaceMatchesClosedForm) {
   }
 }
 
-// Issue item 9: corner (floor and two walls, a point light). The clamped VPL estimate loses energy
+// Corner (floor and two walls, a point light). The clamped VPL estimate loses energy
 // near the edges; ClampGather's compensation brings the mean within 2% of the reference.
 TEST(Reference, CornerCompensationMatchesReference) {
   Scene s;
@@ -186,4 +187,56 @@ TEST(Reference, SamplesOnAConcaveEdgeStayInside) {
   std::printf("[ figure ] furnace edge samples: with triangle %.4f, without %.4f (exact 2)\n", mean(named.maps[0]),
               mean(plain.maps[0]));
   EXPECT_NEAR(mean(named.maps[0]), 2.0, 0.04);
+}
+
+// The reference behind the evaluator interface: a texel subset traces those texels with the bits of the
+// whole page (each sample's stream is its own), the rest come back invalid and 0; stats() holds the paths
+// per sample and the mean standard error over the mean value; it makes no L1 pages.
+TEST(ReferenceEvaluator, SubsetStatsAndNoDirectionalMaps) {
+  Scene s;
+  addBox(s, addMaterial(s, glm::vec3(0.5f), glm::vec3(1.0f)), glm::vec3(0), glm::vec3(1), true);
+  const std::vector<TexelSamples> t = {gridSamples(glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), 8, 8)};
+  RayTracer rt(s);
+  const VplSet none;
+  const BakeInputs in{s, rt, t, none, VplEvalOptions{}, {}};
+  ReferenceOptions o;
+  o.spp = 16;
+  o.seed = 3;
+  const ReferenceEvaluator reference(o);
+  EXPECT_STREQ(reference.name(), "reference");
+  std::vector<std::vector<uint8_t>> subset(1, std::vector<uint8_t>(64, 0));
+  for (size_t i = 0; i < 64; i += 5) subset[0][i] = 1;
+  EvaluationRequest part;
+  part.texelSubset = &subset;
+  const std::vector<Lightmap> b = reference.evaluate(in, part);
+  const std::vector<Lightmap> a = reference.evaluate(in);
+  std::vector<Lightmap> err;
+  const std::vector<Lightmap> same = bakeReference(in, o, &err);
+  double se = 0.0, value = 0.0;
+  for (size_t i = 0; i < 64; ++i) {
+    ASSERT_EQ(same[0].texels[i], a[0].texels[i]) << i;
+    se += channelMean(err[0].texels[i]);
+    value += channelMean(a[0].texels[i]);
+    if (subset[0][i]) {
+      EXPECT_EQ(b[0].valid[i], 1) << i;
+      EXPECT_EQ(b[0].texels[i], a[0].texels[i]) << i;
+    } else {
+      EXPECT_EQ(b[0].valid[i], 0) << i;
+      EXPECT_EQ(b[0].texels[i], glm::vec3(0.0f)) << i;
+    }
+  }
+  const nlohmann::json stats = reference.stats();  // of the last evaluation, the whole page
+  EXPECT_EQ(stats.at("spp"), 16);
+  EXPECT_DOUBLE_EQ(stats.at("relativeStandardError").get<double>(), se / value);
+  EXPECT_GT(se / value, 0.01);  // 16 paths: a few per cent
+  EXPECT_LT(se / value, 0.2);
+  L1Pages l1;
+  EvaluationRequest directional;
+  directional.directional = &l1;
+  try {
+    reference.evaluate(in, directional);
+    FAIL() << "the reference made L1 pages";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Usage);
+  }
 }

@@ -112,9 +112,9 @@ TEST(ClampCompensation, DirectionalShareRestoresTheIrradianceVector) {
   const std::vector<TexelSamples>& texels = scene.texels;
   const BakeInputs in = scene.inputs();
   L1Pages axes;
-  EmbreeOptions eo;
-  eo.directional = &axes;
-  std::vector<Lightmap> maps = bakeEmbree(in, eo);
+  EvaluationRequest request;
+  request.directional = &axes;
+  std::vector<Lightmap> maps = EmbreeEvaluator().evaluate(in, request);
   const L1Pages clampedAxes = axes;
   ClampCompensationOptions options;
   options.rays = 64;
@@ -283,7 +283,8 @@ TEST(ClampCompensation, FurnaceGlWithinOnePercent) {
   GlBackendOptions glOptions;
   glOptions.cubeFaceSize = 64;  // a convex box: nothing to shadow, small cubes keep the test quick
   glOptions.vplsPerPass = 64;
-  const auto maps = bakeGl(in, glOptions);
+  const EmbreeEvaluator contacts;
+  const auto maps = GlEvaluator(glOptions, &contacts).evaluate(in);
   expectFurnaceCompensated(maps, maps, in, "gl");
 }
 

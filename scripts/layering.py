@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""layering.py [ROOT]: the evaluators are peers. Fails (exit 1, one "file:line: why" per offence) when a
+file under baker/evaluators/X includes "evaluators/Y/..." for another evaluator Y, or a file under
+baker/stages includes an evaluator implementation (evaluators/{gl,embree,reference}/...): both may include
+only the interface (evaluators/evaluator.h, evaluators/bake_inputs.h), and whoever builds the evaluators
+(baker/pipeline) wires them together. Tests (*_test.cpp and the test_*.h helpers they include) may compare
+or combine evaluators and are left out. ROOT: the repository (default: the folder above this script)."""
+import os
+import pathlib
+import re
+import sys
+
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^">]+)[">]')
+SOURCES = {".h", ".hpp", ".cpp", ".cc", ".inl"}
+
+
+def is_test(path):
+    return path.name.endswith("_test.cpp") or path.name.startswith("test_")
+
+
+def evaluator_of(include, path, root, evaluators_dir):
+    """The evaluator folder an include lands in (baker/ is the include root; "../x.h" is relative), or None."""
+    base = root / "baker" if not include.startswith(".") else path.parent
+    target = pathlib.Path(os.path.normpath(base / include))
+    try:
+        parts = target.relative_to(evaluators_dir).parts
+    except ValueError:
+        return None
+    return parts[0] if len(parts) > 1 else None
+
+
+def offences(root):
+    evaluators_dir = root / "baker" / "evaluators"
+    stages_dir = root / "baker" / "stages"
+    evaluators = sorted(p.name for p in evaluators_dir.iterdir() if p.is_dir())
+    found = []
+    for top, owner in [(evaluators_dir, "evaluator"), (stages_dir, "stage")]:
+        for path in sorted(top.rglob("*")):
+            if path.suffix not in SOURCES or not path.is_file() or is_test(path):
+                continue
+            rel = path.relative_to(top)
+            own = rel.parts[0] if owner == "evaluator" and len(rel.parts) > 1 else None
+            for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+                m = INCLUDE.match(line)
+                other = evaluator_of(m.group(1), path, root, evaluators_dir) if m else None
+                if other not in evaluators or other == own:
+                    continue
+                why = (f"the {own} evaluator includes the {other} one" if own
+                       else f"includes the {other} evaluator's implementation")
+                found.append(f"{path.relative_to(root)}:{number}: {why} ({line.strip()}); "
+                             "include evaluators/evaluator.h and be handed the evaluator instead")
+    return found
+
+
+def main():
+    root = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parent.parent
+    found = offences(root)
+    for line in found:
+        print(line)
+    if not found:
+        print("evaluators are peers: no evaluator includes another, no stage includes one")
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
