@@ -1,5 +1,6 @@
 // The bake, stage by stage, with the report the benchmarks and users read.
 #include "pipeline/bake.h"
+#include "pipeline/bake_report.h"
 #include "pipeline/bake_stages.h"
 
 #include <sys/resource.h>
@@ -28,8 +29,6 @@
 
 namespace irbake {
 namespace {
-
-nlohmann::json rgb(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 // The values an option holds when it is set must make sense: unset is "automatic", never a number.
 void checkOptionRanges(const BakeOptions& o) {
@@ -381,49 +380,6 @@ struct StagedBake::State {
   StageContext stageContext(nlohmann::json& report) {
     return StageContext{scene, *wholeInputs, plan, options.compensation, options.progress, seconds, report};
   }
-
-  // What was baked and how: each stage's stats as its own object.
-  void describe(nlohmann::json& report, const PostStats& post) const {
-    size_t texelCount = 0, covered = 0, valid = 0;
-    for (const auto& t : texels) {
-      texelCount += t.layerSize();
-      for (auto c : t.covered) covered += c != 0;
-      for (auto v : t.valid) valid += v != 0;
-    }
-    report["backendChoice"] = {{"asked", toString(options.backend)}, {"used", toString(plan.backend)}, {"reason", plan.choices.at("backend").reason}};
-    report["compensationOverlapped"] = plan.overlapCompensation;
-    report["backend"] = toString(plan.backend);
-    if (plan.backend == BackendKind::Gl) {
-      report["renderer"] = glStats.renderer;
-      report["gl"] = glStats.toJson();
-      report["timings"]["gl"] = glStats.timingsJson();
-    }
-    if (plan.backend != BackendKind::Reference) {
-      report["interleave"] = interleaveStats.toJson();
-      report["interleave"]["vplBlocks"] = blocks.size();
-      report["interleave"]["vplsPerBlock"] = options.vplBlock;
-    }
-    report["scene"] = {{"source", scene.sourcePath},
-                       {"triangles", scene.triangleCount()},
-                       {"primitives", scene.primitives.size()},
-                       {"lights", scene.lights.size()},
-                       {"emitterPower", rgb(glm::dvec3(scene.emitterPower()))}};
-    report["atlas"] = atlas.toJson();
-    report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
-                        {"supersample", std::max(1, options.texels.supersample)},
-                        {"leakControl", options.texels.leakControl}};
-    report["vpls"] = vpls.toJson();
-    report["vpls"]["paths"] = plan.walk.paths;
-    report["vpls"]["seed"] = options.walk.seed;
-    if (plan.importanceFactor > 1.0 || importanceStats.evenness > 0.0) report["vplImportance"] = importanceStats.toJson();
-    report["eval"] = {{"clampBound", plan.eval.clampBound},
-                      {"clampVplsPerMean", plan.clampK},
-                      {"clampDerived", plan.clampDerived},
-                      {"biasCompensation", plan.eval.biasCompensation}};
-    if (plan.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = options.referenceSpp;
-    report["post"] = post.toJson();
-    report["plan"] = plan.toJson();
-  }
 };
 
 StagedBake::StagedBake(Scene scene, const BakeOptions& options) : state_(std::make_unique<State>()) {
@@ -502,7 +458,9 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   if (s.plan.directional) directionalStage(ctx, r.directional);
   const PostStats post = postStage(ctx, r.maps);
   s.seconds["bake"] = s.total.seconds();
-  s.describe(report, post);
+  describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, s.glStats, s.interleaveStats,
+                         s.blocks.size(), s.importanceStats, post},
+               report);
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,
   // the GL stage split, peak memory); the rest of the report is the same bytes every time.
   report["timings"]["seconds"] = s.seconds;

@@ -1,0 +1,53 @@
+// The report's description of a bake: what was baked and how, each stage's stats as its own object.
+#include "pipeline/bake_report.h"
+
+#include <algorithm>
+
+namespace irbake {
+
+void describeBake(const BakeFacts& f, nlohmann::json& report) {
+  size_t texelCount = 0, covered = 0, valid = 0;
+  for (const auto& t : f.texels) {
+    texelCount += t.layerSize();
+    for (auto c : t.covered) covered += c != 0;
+    for (auto v : t.valid) valid += v != 0;
+  }
+  report["backendChoice"] = {{"asked", toString(f.options.backend)},
+                             {"used", toString(f.plan.backend)},
+                             {"reason", f.plan.choices.at("backend").reason}};
+  report["compensationOverlapped"] = f.plan.overlapCompensation;
+  report["backend"] = toString(f.plan.backend);
+  if (f.plan.backend == BackendKind::Gl) {
+    report["renderer"] = f.gl.renderer;
+    report["gl"] = f.gl.toJson();
+    report["timings"]["gl"] = f.gl.timingsJson();
+  }
+  if (f.plan.backend != BackendKind::Reference) {
+    report["interleave"] = f.interleave.toJson();
+    report["interleave"]["vplBlocks"] = f.vplBlocks;
+    report["interleave"]["vplsPerBlock"] = f.options.vplBlock;
+  }
+  const glm::dvec3 emitted(f.scene.emitterPower());
+  report["scene"] = {{"source", f.scene.sourcePath},
+                     {"triangles", f.scene.triangleCount()},
+                     {"primitives", f.scene.primitives.size()},
+                     {"lights", f.scene.lights.size()},
+                     {"emitterPower", nlohmann::json::array({emitted.x, emitted.y, emitted.z})}};
+  report["atlas"] = f.atlas.toJson();
+  report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
+                      {"supersample", std::max(1, f.options.texels.supersample)},
+                      {"leakControl", f.options.texels.leakControl}};
+  report["vpls"] = f.vpls.toJson();
+  report["vpls"]["paths"] = f.plan.walk.paths;
+  report["vpls"]["seed"] = f.options.walk.seed;
+  if (f.plan.importanceFactor > 1.0 || f.importance.evenness > 0.0) report["vplImportance"] = f.importance.toJson();
+  report["eval"] = {{"clampBound", f.plan.eval.clampBound},
+                    {"clampVplsPerMean", f.plan.clampK},
+                    {"clampDerived", f.plan.clampDerived},
+                    {"biasCompensation", f.plan.eval.biasCompensation}};
+  if (f.plan.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = f.options.referenceSpp;
+  report["post"] = f.post.toJson();
+  report["plan"] = f.plan.toJson();
+}
+
+}  // namespace irbake
