@@ -4,7 +4,9 @@ file under baker/evaluators/X includes "evaluators/Y/..." for another evaluator 
 baker/stages includes an evaluator implementation (evaluators/{gl,embree,reference}/...): both may include
 only the interface (evaluators/evaluator.h, evaluators/bake_inputs.h), and whoever builds the evaluators
 (baker/pipeline) wires them together. Tests (*_test.cpp and the test_*.h helpers they include) may compare
-or combine evaluators and are left out. ROOT: the repository (default: the folder above this script)."""
+or combine evaluators and are left out. Also fails when docs/architecture.md does not name a module folder
+(baker/X, baker/stages/X, baker/evaluators/X, written out or as baker/evaluators/{a,b}) or names one that is
+gone. ROOT: the repository (default: the folder above this script)."""
 import os
 import pathlib
 import re
@@ -52,13 +54,43 @@ def offences(root):
     return found
 
 
+def module_folders(root):
+    """baker/X and, for the areas that group modules, baker/stages/X and baker/evaluators/X."""
+    baker = root / "baker"
+    folders = []
+    for d in sorted(p for p in baker.iterdir() if p.is_dir()):
+        folders.append(f"baker/{d.name}")
+        if d.name in ("stages", "evaluators"):
+            folders += [f"baker/{d.name}/{s.name}" for s in sorted(p for p in d.iterdir() if p.is_dir())]
+    return folders
+
+
+def architecture_offences(root):
+    doc = root / "docs" / "architecture.md"
+    text = doc.read_text(errors="replace")
+    named = set(re.findall(r"baker/[a-z_]+(?:/[a-z_]+)?", text))
+    for group, members in re.findall(r"(baker/[a-z_]+)/\{([a-z_,]+)\}", text):
+        named |= {group} | {f"{group}/{m}" for m in members.split(",")}
+    folders = module_folders(root)
+    found = [f"docs/architecture.md: does not name the module folder {f}" for f in folders if f not in named]
+    for f in sorted(named):
+        top = "/".join(f.split("/")[:2])
+        if not (root / f).exists() and (f.count("/") == 1 or top in ("baker/stages", "baker/evaluators")):
+            found.append(f"docs/architecture.md: names {f}, which does not exist")
+    return found
+
+
 def main():
     root = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parent.parent
     found = offences(root)
-    for line in found:
+    layout = architecture_offences(root)
+    for line in found + layout:
         print(line)
     if not found:
         print("evaluators are peers: no evaluator includes another, no stage includes one")
+    if not layout:
+        print("docs/architecture.md names every module folder and none that is gone")
+    found += layout
     return 1 if found else 0
 
 
