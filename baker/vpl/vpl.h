@@ -22,7 +22,8 @@ struct Vpl {
 };
 
 struct WalkOptions {
-  int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights)
+  int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights); the
+                           // library's default, which irbake bake always replaces (--quality: app/quality.cpp)
   std::optional<int> maxBounces;  // unset: auto (autoBounceDepth, tail added); set (≥ 0): exactly this deepest
                                   // bounce, no tail added
   double tailEnergy = 1e-3;      // auto: stop once the light not yet placed, ρ̄^(J+1), is below this fraction
