@@ -99,7 +99,7 @@ void addModel(Scene& scene, const std::string& spec) {
 // A furnished room (≥ 50k triangles) built here: 4 × 3 × 4 m room of div×div-cell walls, a
 // checker-textured floor, three boxes as furniture, an emissive ceiling panel and a point light. By
 // default it goes through the atlas like any scene; --room-grids scores hand-made texel grids on the
-// floor and the back wall instead (the earliest rows of the results).
+// floor and the back wall instead (bench/results/speed_error_fixed_clamp_k16.csv).
 Scene furnishedRoom(int div, std::vector<TexelSamples>& texels, int grid) {
   using namespace irbake::testing;
   Scene s;

@@ -3,8 +3,8 @@
 
 usage: python3 bench/speed_error_plot.py bench/results/speed_error.csv docs/performance.png [BEFORE.csv]
                                          [--cycles bench/results/cycles_X.csv ...]
-BEFORE.csv (optional, e.g. bench/results/speed_error_session1.csv) is drawn dashed and faded: the
-estimator of an earlier version on the same scenes.
+BEFORE.csv (optional, e.g. bench/results/speed_error_gl_fixed_faces.csv) is drawn dashed and faded: an
+earlier estimator or backend on the same scenes.
 x: backend seconds (the VPL evaluation: GL or Embree), y: relative RMSE against the reference with the
 reference's own noise removed (column relative_rmse_corrected). Points are labelled with N (paths).
 --cycles (bench/cycles/compare.py's CSVs) adds a second panel: the error against Blender Cycles baked into

@@ -300,26 +300,53 @@ def t_gallery_walk():
     return table(["walk", "seeds", "mean ratio, ours/converged", "rel. RMSE 4×4, median", "worst seed"], out)
 
 
+# The Cycles comparison behind each timed preset case: (scene, options) of quality_presets.csv -> the compare.py
+# CSV, its mode (map: page 0; view: every view, summarised by their mean) and the options compare.py gave
+# besides --quality (the same scene as the timed one, its light in the file or on the command line).
+PRESET_ERRORS = {
+    ("cornell_sample", ""): ("cycles_cornell_sample.csv", "map", ""),
+    ("sponza_sun_sky", "--sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7"): ("cycles_sponza_sun_sky.csv", "view", "--sky 0.4,0.5,0.7"),
+}
+
+
+def preset_errors(name, mode, base):
+    """preset -> the latest row of each view (or the map) for that preset's options."""
+    found = {}
+    for r in read(name):
+        if r["mode"] != mode or not r["our_options"].startswith(base):
+            continue
+        rest = r["our_options"][len(base):].split()
+        preset = "default" if not rest else rest[1] if rest[:1] == ["--quality"] and len(rest) == 2 else None
+        if preset:
+            views = found.setdefault(preset, {})
+            if r["view"] not in views or r["date"] >= views[r["view"]]["date"]:
+                views[r["view"]] = r
+    return {p: [v[k] for k in sorted(v)] for p, v in found.items()}
+
+
 def t_quality_presets():
-    """Each --quality preset: time and memory (quality_presets.py) beside its map error against Cycles (compare.py)."""
+    """Each --quality preset: time and memory (quality_presets.py) beside its error against Cycles (compare.py):
+    the map's, or the mean over the views with each view's in brackets."""
     timing = latest(read("quality_presets.csv"), lambda r: (r["scene"], r["options"], r["preset"]))
-    errors = {}
-    for name in ["cycles_cornell_sample.csv"]:
-        for r in read(name):
-            if r["mode"] != "map":
-                continue
-            options = r["our_options"].split()
-            preset = options[1] if options[:1] == ["--quality"] and len(options) == 2 else "default" if not options else None
-            if preset and (preset not in errors or r["date"] >= errors[preset]["date"]):
-                errors[preset] = r
+    errors = {case: preset_errors(*source) for case, source in PRESET_ERRORS.items()}
     out = []
     for t in timing:
-        e = errors.get(t["preset"]) if t["scene"] == "cornell_sample" and not t["options"] else None
-        out.append([t["scene"], f"`{t['preset']}`", f"`{t['commit']}`", f"{int(t['page_texels']) / 1e3:.0f}k", t["runs"],
-                    t["median_wall_s"], t["peak_memory_mib"], t["load_average"],
-                    f"**{pct(e['rel_rmse_4_corrected'])}**" if e else "", num(e["mean_ratio"], 3) if e else ""])
-    return table(["scene", "preset", "baker", "page texels", "runs", "median wall (s)", "peak memory (MiB)",
-                  "load average", "rel. RMSE 4×4 against Cycles, noise removed", "mean ours/Cycles"], out)
+        e = errors.get((t["scene"], t["options"]), {}).get(t["preset"], [])
+        compared, error, ratio = "", "", ""
+        if len(e) == 1:
+            compared, error, ratio = "map", f"**{pct(e[0]['rel_rmse_4_corrected'])}**", num(e[0]["mean_ratio"], 3)
+        elif e:
+            values = [float(r["rel_rmse_4_corrected"]) for r in e]
+            ratios = [float(r["mean_ratio"]) for r in e]
+            compared = "views " + " / ".join(r["view"] for r in e)
+            error = f"**{pct(statistics.fmean(values))}** ({' / '.join(f'{100 * v:.2f}' for v in values)}%)"
+            ratio = f"{min(ratios):.3f}…{max(ratios):.3f}"
+        out.append([t["scene"], f"`{t['options']}`" if t["options"] else "", f"`{t['preset']}`", f"`{t['commit']}`",
+                    f"{int(t['page_texels']) / 1e3:.0f}k", t["runs"], t["median_wall_s"], t["peak_memory_mib"],
+                    t.get("load_before_runs") or "", t["load_average"], compared, error, ratio])
+    return table(["scene", "options", "preset", "baker", "page texels", "runs", "median wall (s)", "peak memory (MiB)",
+                  "load before runs", "load after", "compared with Cycles", "rel. RMSE 4×4, noise removed",
+                  "mean ours/Cycles"], out)
 
 
 TABLES = {name[2:]: fn for name, fn in globals().items() if name.startswith("t_")}

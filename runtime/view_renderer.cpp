@@ -493,7 +493,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   // Culling only for closed outward solids (isClosedOutward): a wall seen from behind is still drawn,
-  // but the hidden far side of a closed object costs no rasterisation (furnished room −30% CPU).
+  // but the hidden far side of a closed object costs no rasterisation.
   glCullFace(GL_BACK);
   glFrontFace(GL_CCW);
   glDisable(GL_BLEND);
@@ -502,9 +502,8 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   const bool sh = settings.lightmapMode == LightmapMode::Sh;
   // Front to back, by the distance to each primitive's farthest bounding-box corner (a room's walls,
   // whose far corner is the farthest thing in view, go last): llvmpipe tests depth before shading,
-  // so what is drawn behind something already drawn costs no shading (furnished-room bench: 1.72 M
-  // → 1.10 M fragments pass the depth test, −13% CPU). Program switches cost less than that, so the
-  // order ignores the shader variant.
+  // so what is drawn behind something already drawn costs no shading. Program switches cost less than
+  // that saves, so the order ignores the shader variant.
   const glm::vec3 eye = camera.position();
   std::vector<std::pair<float, size_t>> order(I.prims.size());  // (squared distance, primitive index)
   for (size_t i = 0; i < I.prims.size(); ++i) {

@@ -9,8 +9,8 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p out/samples
 ./build/baker/irbake samples out/samples
-# Default options (--quality default): about 610k texels and 4096 light paths; its error against Blender
-# Cycles baked into the same atlas is in docs/validation.md, "Cornell boxes".
+# Default options (--quality default; `--dump-config FILE` writes them out); the bake's error against
+# Blender Cycles baked into the same atlas is in docs/validation.md, "Cornell boxes".
 ./build/baker/irbake bake out/samples/cornell_box.gltf -o out "$@"
 echo
 echo "glTF with MOZ_lightmap: $(pwd)/out/scene.gltf"

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include <tbb/global_control.h>
 
@@ -23,8 +24,12 @@
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "export/gltf_export.h"
+#include "pipeline/backend_choice.h"
 #include "pipeline/bake.h"
 #include "pipeline/vpl_sum_file.h"
+#include "stages/compensation/clamp_compensation.h"
+#include "stages/interleave/interleaved_sampling.h"
+#include "transport/geometry_term.h"
 #include "common/atomic_file.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_files.h"
@@ -55,6 +60,18 @@ struct BakeArguments {
 constexpr double kSmallestClamp = 1e-30;
 // Light from the command line: at most this much (W/m², W/(m² sr)), so sums over the bake stay finite in float.
 constexpr double kLargestLight = 1e20;
+
+// A default as the help quotes it, read from where the default is defined: integers in full, others as %g.
+template <typename T>
+std::string shown(T value) {
+  if constexpr (std::is_integral_v<T>) {
+    return std::to_string(value);
+  } else {
+    std::ostringstream s;
+    s << value;
+    return s.str();
+  }
+}
 
 // --sun, --sky and --env as light a bake can use: a direction that is not zero (any length), amounts in
 // [0, kLargestLight], not both a sky and a map. Throws Error(Usage) naming the option.
@@ -116,66 +133,80 @@ void groupOptions(CLI::App& app) {
 // The scene, the output, the backend, the walk and the texels.
 void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
+  const BakeOptions d;
+  const QualityPreset& q = defaultQualityPreset();
   app->add_option("SCENE", a.scenes, "the glTF/GLB scene to bake");
   app->add_option("-o,--output", command.out, "output folder (OUTDIR), or OUT.glb / OUT.gltf: that glTF, the rest beside it")->type_name("OUTDIR");
   app->add_option("--backend", a.backend,
-                  "evaluator (default auto: GL on a GPU or for scenes ≤ 10k triangles,\n"
+                  "evaluator (default auto: GL on a GPU or for scenes ≤ " + shown(kGlTriangleHint / 1000) + "k triangles,\n"
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
   app->add_option("--paths,--vpls", a.paths,
-                  "light paths of the quasi-random walk (default auto: by --quality;\n"
-                  "4096, or 3072 where the final gather runs, which reads their map averaged)")
+                  "light paths of the quasi-random walk (default auto: by --quality;\n" + shown(q.paths) + ", or " +
+                      shown(q.pathsUnderGather) + " where the final gather runs, which reads their map averaged)")
       ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
   app->add_option("--walk-split", a.walkSplit,
                   "paths fork into N where they leave bounce 1, each child carrying 1/N\n"
-                  "(default auto: 1/(share of that light meeting the scene again), at most 4;\n"
+                  "(default auto: 1/(share of that light meeting the scene again), at most " +
+                      shown(d.walk.maxAutoSplit) + ";\n"
                   "1 in closed scenes; 1 = Keller's plain walk)")
       ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
   app->add_option("--vpl-importance", a.vplImportance,
                   "importance-driven VPLs: the walk places F times the VPLs and --vpl-keep of\n"
                   "the plain walk's count is kept, chosen by what they add to dim texels\n"
                   "(default auto: where the final gather runs and a pilot finds them uneven,\n"
-                  "F up to 16 while probes × candidates ≤ 64M; 1: the plain walk)")
+                  "F up to " + shown(d.vplImportance.maxFactor) + " while probes × candidates ≤ " +
+                      shown(d.vplImportance.pairBudget / 1e6) + "M; 1: the plain walk)")
       ->transform(cli::numberOrAuto(1.0, 64.0, 0.0))->type_name("F|auto");
   app->add_option("--vpl-probes", o.vplImportance.probes,
-                  "importance-driven VPLs: texel samples the candidates are measured at (default 1024)")
+                  "importance-driven VPLs: texel samples the candidates are measured at (default " +
+                      shown(d.vplImportance.probes) + ")")
       ->transform(cli::integerIn(16, 65536))->type_name("N");
   app->add_option("--vpl-keep", o.vplImportance.keepShare,
-                  "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default 0.5)")
+                  "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default " +
+                      shown(d.vplImportance.keepShare) + ")")
       ->transform(cli::numberIn(0.05, 4.0))->type_name("S");
-  app->add_option("--texels-per-unit", a.tpu, "texels per metre (default: about one 1024² page, ≥ 64 per triangle)")
+  app->add_option("--texels-per-unit", a.tpu, "texels per metre (default: about one " + shown(q.autoPageSize) + "² page, ≥ " +
+                                                   shown(d.atlas.texelsPerTriangle) + " per triangle)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
   app->add_option("--max-texels", o.atlas.maxTexels,
-                  "texel budget of all pages together (default 16777216 = 16M);\n"
+                  "texel budget of all pages together (default " + shown(d.atlas.maxTexels) + " = " +
+                      shown(d.atlas.maxTexels >> 20) + "M);\n"
                   "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
       ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
-  app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default 1)")
+  app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default " + shown(d.texels.supersample) + ")")
       ->transform(cli::integerIn(1, 8))->type_name("S");
 }
 
 // The clamp and its compensation, the final gather, interleaving, the GL backend's cubes.
 void addStageOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
+  const BakeOptions d;
+  const QualityPreset& q = defaultQualityPreset();
   a.clampOption =
       app->add_option("--clamp", a.clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
           ->transform(cli::numberIn(0.0, 1e30))
           ->type_name("B");
   app->add_option("--clamp-k", o.clampVplsPerMean,
                   "derived clamp: no VPL adds more than 1/K of the mean\n"
-                  "(default with bias compensation: 256, or 1024 in a scene\nwithout emissive surfaces; 16 without; 0 = automatic)")
+                  "(default with bias compensation: " + shown(kCompensatedClampVplsPerMean) + ", or " +
+                      shown(kCompensatedClampVplsPerMeanNoEmitters) + " in a scene\nwithout emissive surfaces; " +
+                      shown(kClampVplsPerMean) + " without; 0 = automatic)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
   app->add_flag("--no-bias-compensation", a.noBiasCompensation,
                "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");
   app->add_flag("--bias-compensation", a.biasCompensation, "the default (kept for old scripts)");
-  app->add_option("--comp-rays", o.compensation.rays, "bias compensation: rays per texel sample, first round (default 16)")
+  app->add_option("--comp-rays", o.compensation.rays,
+                  "bias compensation: rays per texel sample, first round (default " + shown(q.compensationRays) + ")")
       ->transform(cli::integerIn(1, 4096))->type_name("N");
-  app->add_option("--comp-refine", o.compensation.refineRays, "bias compensation: extra rays where needed (default 112)")
+  app->add_option("--comp-refine", o.compensation.refineRays,
+                  "bias compensation: extra rays where needed (default " + shown(q.compensationRefine) + ")")
       ->transform(cli::integerIn(0, 65536))->type_name("N");
   app->add_option("--comp-ray-budget", o.compensation.rayBudget,
-                  "bias compensation: first-round rays over all samples (default 2097152;\n"
-                  "a large page gets fewer per sample, never below 4; 0 = no cap)")
+                  "bias compensation: first-round rays over all samples (default " + shown(q.compensationBudget) +
+                      ";\na large page gets fewer per sample, never below " + shown(d.compensation.minRays) + "; 0 = no cap)")
       ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
   app->add_option("--comp-filter", a.compFilter,
                   "bias compensation: the residual averaged over (2R+1)² texels on\n"
@@ -187,53 +218,61 @@ void addStageOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
                   "read from the VPLs that reach each texel (docs/units.md): on, off,\n"
                   "or auto (default: on in scenes without emissive or see-through surfaces)")
       ->check(CLI::IsMember({"off", "on", "auto"}))->type_name("off|on|auto");
-  app->add_option("--gather-rays", o.gather.rays, "final gather: cosine rays per texel sample (default 16)")
+  app->add_option("--gather-rays", o.gather.rays, "final gather: cosine rays per texel sample (default " + shown(q.gatherRays) + ")")
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--gather-pre-rays", o.gather.preRays,
-                  "final gather: rays per sample of a first, cheaper gather whose map\nthe final rays read (default 2; 0 = none)")
+                  "final gather: rays per sample of a first, cheaper gather whose map\nthe final rays read (default " +
+                      shown(d.gather.preRays) + "; 0 = none)")
       ->transform(cli::integerIn(0, 4096))->type_name("N");
   app->add_option("--gather-ray-budget", o.gather.rayBudget,
-                  "final gather: rays over all samples (default 50331648; a large\n"
-                  "page gets fewer per sample, never below 4; 0 = no cap)")
+                  "final gather: rays over all samples (default " + shown(q.gatherRayBudget) + "; a large\n"
+                  "page gets fewer per sample, never below " + shown(d.gather.minRays) + "; 0 = no cap)")
       ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
   app->add_option("--gather-filter", o.gather.filterRadius,
-                  "final gather: the gathered light averaged over (2R+1)² texels on\nthe same surface (default 3; 0 = none)")
+                  "final gather: the gathered light averaged over (2R+1)² texels on\nthe same surface (default " +
+                      shown(d.gather.filterRadius) + "; 0 = none)")
       ->transform(cli::integerIn(0, 8))->type_name("R");
   app->add_option("--interleave", a.interleave,
                   "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                   "of the VPLs, then a filter on the surface mixes them\n"
-                  "(default auto: 1..6 from the texel size and the clamp radius;\n1 = every VPL everywhere)")
+                  "(default auto: 1.." + shown(kMaxAutoInterleave) + " from the texel size and the clamp radius;\n"
+                  "1 = every VPL everywhere)")
       ->transform(cli::integerOrAuto(1, 8, 0))->type_name("N|auto");
   app->add_option("--cube-face", a.cubeFace,
                   "GL backend: VPL depth-cube face size in texels\n"
-                  "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, 128..256)")
+                  "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, " +
+                      shown(d.gl.minCubeFaceSize) + ".." + shown(d.gl.maxCubeFaceSize) + ")")
       ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
 }
 
 // The seed, light from the command line, and what is written.
 void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
+  const BakeOptions d;
+  const BakeCommand dc;
+  const QualityPreset& q = defaultQualityPreset();
   app->add_option("--seed", a.seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
-  app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default 256)")
+  app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default " + shown(d.referenceSpp) + ")")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
   app->add_option("--sun", a.sun, "add a directional light travelling along D with irradiance E (W/m²)")
       ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
   app->add_option("--sky", a.sky, "a uniform sky of that radiance (W/(m² sr))")
       ->transform(cli::numberList(3))->type_name("R,G,B");
-  app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default 64)")
+  app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default " + shown(q.skyRays) + ")")
       ->transform(cli::integerIn(8, 4096))->type_name("N");
   app->add_option("--sky-ray-budget", o.sky.maxRays,
-                  "sky and environment: rays over all samples (default 8388608; a large\n"
-                  "page gets fewer per sample, never below 8, or 4 where the final\n"
+                  "sky and environment: rays over all samples (default " + shown(q.skyRayBudget) + "; a large\n"
+                  "page gets fewer per sample, never below " + shown(d.sky.minRays) + ", or 4 where the final\n"
                   "gather counts a uniform sky itself)")
       ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
-                  "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default 8; 0 or 1: the centre alone)")
+                  "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
+                      shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
   app->add_option("--env", a.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
-  app->add_option("--env-intensity", a.envIntensity, "scales --env (default 1)")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
-  app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default 0)")
+  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default " + shown(LightAdditions{}.environmentRotation) + ")")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--directional", o.directional,
@@ -245,13 +284,15 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->type_name("FILE.glb");
   app->add_option("--portable-exposure", command.portableExposure,
                   "--portable: scale on the shown values before the 8-bit sRGB encode\n"
-                  "(default 1: the map as it is; values above 1 clip)")
+                  "(default " + shown(dc.portableExposure) + ": the map as it is; values above 1 clip)")
       ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
 }
 
 // Diagnostics, threads and logging, distributed and resumable bakes, presets and config files.
 void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   BakeOptions& o = command.options;
+  const BakeOptions d;
+  const BakeCommand dc;
   app->add_flag("--no-leak-control", a.noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", a.noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", a.noSeams, "diagnostics: no seam stitching");
@@ -267,10 +308,11 @@ void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
                 "continue from OUTDIR's checkpoint (left by a bake that was killed);\n"
                 "the outputs are byte-identical to an uninterrupted bake");
   app->add_option("--checkpoint-seconds", command.checkpointSeconds,
-                  "at most this long between checkpoints of the VPL sums (default 5;\n0: after every VPL block)")
+                  "at most this long between checkpoints of the VPL sums (default " + shown(dc.checkpointSeconds) +
+                      ";\n0: after every VPL block)")
       ->transform(cli::numberIn(0.0, 1e9))->type_name("S");
   app->add_option("--vpl-block", o.vplBlock,
-                  "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default 512)")
+                  "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default " + shown(d.vplBlock) + ")")
       ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
   app->add_option("--quality", a.quality,
                   "paths and rays together (default: default; docs/validation.md)")
@@ -370,8 +412,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (a.interleave > 0) o.interleave = a.interleave;
   if (a.compFilter >= 0) o.compensation.filterRadius = a.compFilter;
   if (a.cubeFace > 0) o.gl.cubeFaceSize = a.cubeFace;
-  // Where the final gather runs, fewer paths (the preset's pathsUnderGather): it reads the VPLs' map averaged
-  // over each texel's hemisphere, so more paths barely lower the error there (docs/validation.md, "Sponza").
+  // Where the final gather runs, the preset's pathsUnderGather (app/quality.cpp).
   const QualityPreset& preset = *findQualityPreset(a.quality);
   o.walk.paths = a.paths > 0 ? a.paths : preset.paths;
   if (a.paths == 0) o.finalGatherPaths = preset.pathsUnderGather;

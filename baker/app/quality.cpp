@@ -1,16 +1,56 @@
 #include "app/quality.h"
 
+#include "pipeline/bake.h"
+
 namespace irbake::app {
 
+namespace {
+
+// The command's light paths (--paths auto at --quality default). The library's WalkOptions::paths is the
+// smaller default its own callers are tuned to; the command always sets the walk's paths from here.
+constexpr int kDefaultPaths = 4096;
+
+// value × num / den: a preset as a multiple of the default bake.
+struct Scale {
+  long long num = 1, den = 1;
+  template <typename T>
+  T of(T value) const { return static_cast<T>(static_cast<long long>(value) * num / den); }
+};
+
+// Where the final gather runs, three quarters of the paths: it reads their map averaged over each texel's
+// hemisphere, so more paths barely lower the error there.
+constexpr Scale kPathsUnderGather{3, 4};
+
+// The default bake scaled: paths, every stage's rays and ray budgets, the shadow-edge sub-samples per axis and
+// the automatic page edge. The rays, budgets, sub-samples and page edge start from each stage's option struct.
+QualityPreset scaledDefault(const char* name, Scale paths, Scale rays, Scale edgeSamples, Scale page) {
+  const BakeOptions base;
+  const int p = paths.of(kDefaultPaths);
+  return {name,
+          p,
+          kPathsUnderGather.of(p),
+          rays.of(base.gather.rays),
+          rays.of(base.gather.rayBudget),
+          rays.of(base.compensation.rays),
+          rays.of(base.compensation.refineRays),
+          rays.of(base.compensation.rayBudget),
+          rays.of(base.sky.raysPerSample),
+          rays.of(base.sky.maxRays),
+          edgeSamples.of(base.shadowEdges.subSamples),
+          page.of(base.atlas.targetPageSize)};
+}
+
+}  // namespace
+
 const std::vector<QualityPreset>& qualityPresets() {
-  // default: the paths and rays that reach about 2% on the Cornell boxes against Cycles (docs/validation.md);
-  // preview: an eighth of the paths, a quarter of the rays, and a quarter of the texels where the density is automatic
-  // (every per-texel stage costs that much less); high and production: twice and four times the paths and rays.
+  // preview: an eighth of the paths, a quarter of the rays, half the shadow-edge sub-samples per axis and a quarter
+  // of the texels where the density is automatic (every per-texel stage costs that much less); high and
+  // production: twice and four times the paths and rays (production also 1.5× the sub-samples per axis).
   static const std::vector<QualityPreset> presets = {
-      {"preview", 512, 384, 4, 12u << 20, 4, 28, 1u << 19, 16, 2 << 20, 4, 512},
-      {"default", 4096, 3072, 16, 48u << 20, 16, 112, 1u << 21, 64, 8 << 20, 8, 1024},
-      {"high", 8192, 6144, 32, 96u << 20, 32, 224, 1u << 22, 128, 16 << 20, 8, 1024},
-      {"production", 16384, 12288, 64, 192u << 20, 64, 448, 1u << 23, 256, 32 << 20, 12, 1024},
+      scaledDefault("preview", {1, 8}, {1, 4}, {1, 2}, {1, 2}),
+      scaledDefault("default", {}, {}, {}, {}),
+      scaledDefault("high", {2, 1}, {2, 1}, {}, {}),
+      scaledDefault("production", {4, 1}, {4, 1}, {3, 2}, {}),
   };
   return presets;
 }
@@ -20,5 +60,7 @@ const QualityPreset* findQualityPreset(const std::string& name) {
     if (name == p.name) return &p;
   return nullptr;
 }
+
+const QualityPreset& defaultQualityPreset() { return *findQualityPreset("default"); }
 
 }  // namespace irbake::app

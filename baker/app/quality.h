@@ -1,6 +1,8 @@
 // --quality: named sets of the sampling knobs a user would otherwise tune one by one. `default` is the
-// command's default bake; every knob it sets is still overridden by its own option when given.
-// Figures for each (time, memory, error against Cycles): docs/validation.md.
+// command's default bake: its rays, budgets, shadow-edge sub-samples and page edge are the stages' own option
+// defaults, its light paths are set in quality.cpp, and the other presets scale it. Every knob a preset sets is
+// still overridden by its own option when given. Figures for each (time, memory, error against Cycles):
+// docs/validation.md.
 #pragma once
 #include <cstddef>
 #include <string>
@@ -27,5 +29,7 @@ struct QualityPreset {
 const std::vector<QualityPreset>& qualityPresets();
 // The preset of that name; nullptr when there is none.
 const QualityPreset* findQualityPreset(const std::string& name);
+// --quality default: the command's defaults (its help quotes them).
+const QualityPreset& defaultQualityPreset();
 
 }  // namespace irbake::app

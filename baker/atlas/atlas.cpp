@@ -219,9 +219,8 @@ void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOpt
 // Texels per unit length: given, or chosen so the charts' area fills about 60% of a texel count that follows
 // the scene: one target page, or texelsPerTriangle per triangle where that is more (capped at
 // maxAutoTexels). Shading varies on the scale of the geometry (columns, mouldings, the sun's shadows of
-// them), so a level with many triangles needs more texels than a box: Sponza with a sun at one page's
-// density (9.2 texels/m) was 4.2–4.7% off Cycles in three views, mostly along shadow edges, and 2.3–2.8%
-// at 18 texels/m.
+// them), so a level with many triangles needs more texels than a box (at one page's density a level's error
+// sits mostly along shadow edges).
 double chooseDensity(const std::vector<ChartUv>& charts, const AtlasOptions& options, const Scene& scene) {
   double totalArea = 0.0;
   for (const ChartUv& c : charts) totalArea += c.area3d;

@@ -14,8 +14,7 @@ struct AtlasOptions {
   double texelsPerUnit = 0.0;  // texels per metre; 0 = auto-fit so the charts fill about one targetPageSize page
   int targetPageSize = 1024;   // page edge used by the auto-fit when texelsPerUnit is 0
   float texelsPerTriangle = 64.0f;       // auto-fit: at least this many chart texels per triangle, so a
-                                         // detailed level gets a finer map than one page (Sponza, 66k
-                                         // triangles: 18 texels/m instead of 9.2)
+                                         // detailed level gets a finer map than one page
   size_t maxAutoTexels = size_t(1) << 22;  // auto-fit: chart texels never above this (4M), whatever the
                                            // triangle count
   int padding = 2;             // empty texels kept around every chart (bilinear-safe)

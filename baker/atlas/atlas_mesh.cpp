@@ -88,7 +88,7 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   OmMesh om;
   // Edges: V + F − χ by Euler's formula, so V + F is enough for any union of discs and spheres (an
   // open grid has V + F − 1; faces·3/2, the closed-mesh count, was short there and the edge array
-  // doubled while full: 96 → 192 MB plus the old copy for a 2M-triangle grid). Never more than 3F.
+  // doubled while full). Never more than 3F.
   om.reserve(mesh.vertexPos.size(), std::min(mesh.vertexPos.size() + faces, 3 * faces), faces);
   for (const glm::dvec3& p : mesh.vertexPos) om.add_vertex(OmMesh::Point(float(p.x), float(p.y), float(p.z)));
   std::vector<uint32_t> faceOfOm;

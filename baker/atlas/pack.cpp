@@ -223,8 +223,8 @@ class PageGrid {
     return false;
   }
   // Where to start looking: an earlier chart about as large (both box sides ≥ 90% of it) found no room
-  // below its row, so this one starts there. A heuristic (shapes differ): it costs a little density
-  // (helmet 66.8% -> 64.5%) and halves the packing time of scenes with many similar charts.
+  // below its row, so this one starts there. A heuristic (shapes differ): it costs a little density and
+  // halves the packing time of scenes with many similar charts.
   int searchStart(const Mask& m) const {
     const int lo = std::min(m.w, m.h), hi = std::max(m.w, m.h);
     int y = 0;
@@ -382,7 +382,7 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
     std::sort(widths.begin(), widths.end());
     widths.erase(std::unique(widths.begin(), widths.end()), widths.end());
   }
-  // The trials run in parallel (Sponza's 6,685 charts: 1.2 s one after another); a finished trial's area lets
+  // The trials run in parallel (a level has thousands of charts); a finished trial's area lets
   // the others give up early; the smallest area wins, the narrowest width on a tie.
   struct Trial {
     double area = 1e300;

@@ -329,8 +329,8 @@ void compactDocument(GltfDocument& doc) {
     }
   keepUsed(root, "bufferViews", usedViews, viewRefs);
   // Writes for views before k end at or before moves[k].to ≤ moves[k].from, so packing in view order
-  // never overwrites bytes a later view still has to read. In place, buffer 0 is not held twice (for a
-  // 2M-triangle bake: the source's buffers plus the new geometry, ~100 MB, at the export's peak).
+  // never overwrites bytes a later view still has to read. In place, buffer 0 is not held twice (the
+  // source's buffers plus the new geometry are the export's peak).
   std::vector<uint8_t> fresh;
   if (!inPlace) fresh.resize(size);
   uint8_t* out = inPlace ? doc.bin.data() : fresh.data();

@@ -33,8 +33,8 @@ class GlProgram {
 };
 
 // Programs built once per context and reused, keyed by their stages, defines and version. Interleaved
-// sampling calls the GL backend n² + 1 times per bake; rebuilding its programs each time cost ≈ 20 ms
-// per call on llvmpipe, which also JIT-compiles a program's state variants again at its first draws.
+// sampling calls the GL backend n² + 1 times per bake; rebuilding its programs each time is slow on llvmpipe,
+// which also JIT-compiles a program's state variants again at its first draws.
 // Owned by GlContext (GlContext::programs), destroyed with the context current.
 class GlProgramCache {
  public:

@@ -1,7 +1,7 @@
 // Image files and encoded images through OpenImageIO, loaded on first use.
 //
 // OpenImageIO links about 260 shared libraries (OpenCV, GDAL, FFmpeg, DCMTK, ...). Linked into the
-// commands, the dynamic loader spent ~0.3 s of every start resolving their symbols, even for
+// commands, the dynamic loader spent a noticeable time at every start resolving their symbols, even for
 // `irbake info` on a missing file. Only this small interface is linked; the OpenImageIO side is a
 // plugin (libirbake_imageio_oiio.so, plugin/oiio_plugin.cpp) opened with dlopen the first time an
 // image is decoded, encoded, read or written (docs/validation.md, "Start-up").

@@ -97,7 +97,7 @@ inline glm::vec3 readLightmap(const Lightmap& m, const std::vector<glm::vec3>& v
 // unpredictable place): every texel one 32-bit word, RGB with 9-bit mantissas and a shared 5-bit exponent
 // (EXT_texture_shared_exponent's RGB9E5, relative to a power-of-two scale per page), in 4×4-texel tiles of 64
 // bytes. A footprint then touches one or two cache lines instead of four (two rows of floats, two of validity
-// bytes), and Sponza's 3.2M-texel page is 13 MB, inside the last-level cache, instead of 48 MB. The largest
+// bytes), and a level's page of millions of texels shrinks to a quarter, inside the last-level cache. The largest
 // channel keeps a relative precision of 2^-9 (rounded to nearest); a channel 2^k times smaller loses k more bits,
 // well below the noise of the gathers that read it. Invalid texels hold a sentinel no value encodes to.
 // read() returns what readLightmap returns over the decoded values.

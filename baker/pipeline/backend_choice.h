@@ -4,7 +4,7 @@
 // pass rasterises every triangle once per VPL cube face on the CPU, so above it Embree is faster. On a
 // hardware GPU the shadow pass is nearly free, but the GL backend still traces its contact texels with
 // rays and reads each interleave class back: above it GL was no faster than Embree and took more memory,
-// while on the Cornell boxes it was faster. So one threshold serves both renderers; only the reason differs.
+// while on small scenes it was faster. So one threshold serves both renderers; only the reason differs.
 #pragma once
 #include <cstddef>
 #include <functional>

@@ -323,7 +323,7 @@ double stitchSeams(std::vector<Lightmap>& maps, const std::vector<SeamEdge>& sea
   };
   // Jacobi preconditioner: the diagonal wd + ws Σ_s (r_s)_i². Unknowns that only a seam sample's far bilinear
   // corner touches have a diagonal near wd, the rest near ws: without it the system's condition number is
-  // ~ws/wd and plain CG ran into its 200-iteration cap on Sponza (1.6 s, a tenth of the bake's serial time).
+  // ~ws/wd and plain CG runs into its iteration cap on a level's seams.
   const std::vector<double> inverseDiagonal = jacobiInverseDiagonal(columnStart, columns, ws, wd);
   std::vector<glm::dvec3> x0(n), x(n), r(n), z(n), p(n), ap(n);
   for (size_t i = 0; i < n; ++i) x[i] = x0[i] = glm::dvec3(texel(globalOf[i]));

@@ -39,11 +39,11 @@ class RayTracer {
   // Closest hits of n rays from one origin (tmin 0, tmax ∞) in packets of 8 (rtcIntersect8; single rays where
   // this Embree build has no native 8-wide packets): hits[i] as intersect(origin, dirs[i], 0, ∞) gives it.
   // HitDetail::Surface leaves position and shadingNormal unset (the final gather reads the map and the
-  // material at the hit's triangle and barycentrics only: 42M hits on Sponza).
+  // material at the hit's triangle and barycentrics only, for tens of millions of hits).
   enum class HitDetail { Full, Surface };
   // Traversal::Robust: Embree's robust mode (RTC_SCENE_FLAG_ROBUST), as every other query here: a ray through an
   // edge or a corner shared by two triangles never slips between them. Traversal::Fast: a second BVH over the
-  // same geometries without it, ~13% faster on Sponza's gather rays, where a ray aimed exactly through a shared
+  // same geometries without it, faster on the gather's rays, where a ray aimed exactly through a shared
   // edge may slip (RayTracer.FastTraversalHitsWhereRobustDoesOffExactEdges: 5 of 4096 such rays, none of a grid
   // that passes beside the edges). For the final gather's tens of millions of cosine rays from jittered samples,
   // each one of a texel's 16 and filtered over 49 texels; not for leak tests or visibility.

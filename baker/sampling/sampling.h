@@ -16,7 +16,7 @@ namespace irbake {
 // seed gives a low-discrepancy sequence (each prefix of b^m points stays stratified in every dimension)
 // whose every point is uniform over seeds, independently across dimensions. Why not Keller's plain Φ_b:
 // unscrambled low dimensions (light choice, start point) with one shared permutation for the direction
-// dimensions biased the walk in Sponza's upper gallery, dark for every seed (docs/units.md).
+// dimensions bias the walk: a region lit through several bounces came out dark for every seed.
 class Halton {
  public:
   Halton(int dimensions, uint32_t seed);
@@ -62,7 +62,7 @@ glm::vec3 cosineHemisphere(const glm::vec3& n, double u, double v);
 // The rotated Fibonacci lattice of cosine rays that the per-sample stages trace (the sky, the clamp compensation,
 // the final gather): ray i of count at (u, v) = ({(i + ½)/count + r1}, {i/φ + r2}) through cosineHemisphere.
 // next() gives rays 0, 1, ... in turn, as cosineHemisphere would up to rounding, but with the frame made once and
-// the azimuth turned by a rotation per ray instead of a sine and cosine (the gather traces 42M rays on Sponza).
+// the azimuth turned by a rotation per ray instead of a sine and cosine (the gather traces tens of millions).
 class CosineLattice {
  public:
   CosineLattice(const glm::vec3& n, int count, double r1, double r2);

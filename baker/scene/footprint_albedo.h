@@ -3,9 +3,9 @@
 // averages out anyway).
 //
 // Each base-colour texture gets a box-filtered mip chain; each triangle the level whose texel is no larger than a
-// light-map texel on it (from the two UV sets' areas). On Sponza (1024² textures, 5.5 cm map texels) the gather's
-// 35M hits then read levels of a few hundred kilobytes that stay in cache instead of missing it in 16 MB ones,
-// and each read is the texture's mean over the footprint rather than one point of it.
+// light-map texel on it (from the two UV sets' areas). The gather's hits then read small levels that stay in
+// cache instead of missing it in full-size ones, and each read is the texture's mean over the footprint rather
+// than one point of it.
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -1,8 +1,7 @@
 // One bake's surface filters: each page's neighbour tests made once (a SurfaceFilterPlan at kMaxRadius over
 // the page's validity) and shared by every stage that filters on the surface: the interleave's mix of its
-// texel classes, the sky, the compensation's sweeps and the final gather. On Sponza's 3.2M-texel page these
-// were four filters that tested each neighbour again (r = 5, 2, 4 and 3: 250 tests per texel); the plan
-// tests each pair once (60 per texel). A request the plan cannot serve (a wider window, other thresholds,
+// texel classes, the sky, the compensation's sweeps and the final gather. Four filters that each tested every
+// neighbour (r = 5, 2, 4 and 3: 250 tests per texel) become one plan that tests each pair once (60 per texel). A request the plan cannot serve (a wider window, other thresholds,
 // another validity mask) is filtered by a SurfaceFilter made for it, with the same bits.
 // Thread-safe (the compensation's rays may be traced while the GL backend's classes are mixed).
 #pragma once

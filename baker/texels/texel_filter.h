@@ -61,8 +61,8 @@ class SurfaceFilter {
 };
 
 // A SurfaceFilter's neighbour tests over one validity mask, made once for every window up to a radius: a page
-// filtered several times (the interleave's mix, the sky, the compensation's sweeps, the final gather: four
-// filters, 250 tests per texel on Sponza's 3.2M-texel page) then pays only for the sums. The test is symmetric
+// filtered several times (the interleave's mix, the sky, the compensation's sweeps, the final gather) then pays
+// only for the sums. The test is symmetric
 // (normals and distance compare the same both ways, and both texels must be valid), so each pair of texels is
 // tested once: 60 tests per texel at radius 5. apply() gives the bits of SurfaceFilter::apply with the same
 // arguments for any radius up to the plan's, symmetric or not, box or tent. Costs 16 bytes per texel.

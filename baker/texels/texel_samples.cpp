@@ -119,14 +119,14 @@ void leakDirections(const glm::vec3& n, glm::vec3 out[kLeakRays]) {
 // A sample leaks when it sits behind a nearby back face (a wall cutting the texel) or inside a
 // closed solid (every ray, or all but one that slipped through a crack, leaves through a back face).
 // Not a majority: a ceiling 1 cm above a one-sided emitter sees the emitter's back in most directions
-// but is lit through the gap at grazing angles, and Cycles finds those texels lit (3-10% of the room's
-// mean within a few centimetres of the emitter's edge); a majority rule filled them by dilation.
+// but is lit through the gap at grazing angles, and a path tracer finds those texels lit; a majority rule
+// filled them by dilation.
 // Double-sided surfaces have no inside.
 bool leaks(const RayTracer& rt, const Scene& scene, const SurfacePoint& s, float nearDistance, float farDistance) {
   glm::vec3 dirs[kLeakRays];
   leakDirections(s.geometricNormal, dirs);
   const glm::vec3 origin = s.position + s.geometricNormal * rt.epsilon();
-  // One packet from one origin (and the ninth ray alone), sides and distances only: 21M rays on Sponza's page.
+  // One packet from one origin (and the ninth ray alone), sides and distances only: every sample of a page.
   RayHit hits[kLeakRays];
   rt.intersectPackets(origin, dirs, kLeakRays, hits, RayTracer::HitDetail::Surface);
   int backHits = 0;

@@ -136,9 +136,7 @@ std::vector<double> measureVplImportance(const Scene& scene, const RayTracer& rt
   std::nth_element(positive.begin(), positive.begin() + positive.size() / 2, positive.end());
   const double floor = options.floorFraction * positive[positive.size() / 2];
   // I_v = √(Σ_t (c_vt / E_t)²): with p_v ∝ I_v the kept set's Σ_t Var_t / E_t² (the relative variances the
-  // probes see, Horvitz–Thompson: Σ_v (c_vt/E_t)² (1/p_v − 1)) is least for its expected count. The plain
-  // sum Σ_t c_vt/E_t did worse on Sponza (keep 0.5, seeds 0/1: views 2/3 2.78/2.62, 5.11/5.61% against
-  // 2.75/2.38, 4.80/5.36%).
+  // probes see, Horvitz–Thompson: Σ_v (c_vt/E_t)² (1/p_v − 1)) is least for its expected count.
   for (size_t t = 0; t < probes.size(); ++t) {
     const double inv = 1.0 / std::max(total[t], floor);
     for (const auto& [v, c] : seen[t]) importance[v] += (c * inv) * (c * inv);

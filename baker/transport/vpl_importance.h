@@ -3,8 +3,8 @@
 // the VPLs it keeps; each candidate's contribution is measured at about a thousand random texel samples,
 // relative to what those texels receive in all (so a VPL that lights a dim region counts as much as one
 // that lights a bright one), I = √(Σ_t (c_t/E_t)²), and it is kept with probability p = clamp(I/I*, p_min, 1),
-// carrying Φ/p: unbiased for any p > 0 (E[kept Φ/p] = Φ). Dim regions that only a few VPLs reach (Sponza's
-// upper gallery) then keep all of theirs, while the many VPLs that light already bright texels are
+// carrying Φ/p: unbiased for any p > 0 (E[kept Φ/p] = Φ). Dim regions that only a few VPLs reach (a gallery
+// lit through several bounces) then keep all of theirs, while the many VPLs that light already bright texels are
 // thinned. A probe's total is its direct light (punctual lights by shadow ray, the sky by cosine rays) plus
 // every candidate's clamped contribution; the probes and the systematic draws are seeded, so the bytes are
 // deterministic. docs/units.md has the maths.
@@ -27,8 +27,8 @@ struct VplImportanceOptions {
                                                 // plain walk's count is kept; 1 (default): off, the plain
                                                 // walk; unset: auto (a pilot, chooseCandidateFactor; the bake
                                                 // runs it only under the final gather). Off in the library:
-                                                // without the final gather it trades Sponza's view 2 for
-                                                // view 3 (docs/units.md)
+                                                // without the final gather it trades one region's error for
+                                                // another's (docs/validation.md, "Tried and not kept")
   int probes = 1024;             // texel samples the candidates are measured at (uniform over valid samples)
   int pilotProbes = 256;         // auto: the plain walk's VPLs measured at this many probes first, and
   double maxEvenness = 0.3;      // the selection runs only where their evenness (below) is at most this
@@ -36,11 +36,10 @@ struct VplImportanceOptions {
   double maxFactor = 16.0;       // auto f at most this
   double keepShare = 0.5;        // VPLs kept = this × the plain walk's count (the kept ones are the useful
                                  // ones: each meets more receivers, so costs the Embree backend more shadow
-                                 // rays; Sponza: 0.5 of the count ≈ the plain walk's backend time)
+                                 // rays; 0.5 of the count costs about the plain walk's backend time)
   double maxBoost = 4.0;         // a kept VPL carries at most this × a plain-walk VPL's power: every candidate
                                  // is kept at least with probability keepFraction / maxBoost (its light is
-                                 // never lost, and no rare pick lights a region up as one bright VPL;
-                                 // McGuire's box with p ≥ 0.01 and f = 4: one seed of three +2.5%, 3.3%)
+                                 // never lost, and no rare pick lights a region up as one bright VPL)
   double floorFraction = 0.05;   // a probe's total is taken as at least this × the probes' median
   int skyRays = 64;              // cosine rays per probe for the sky's share of its total (with a sky)
 };

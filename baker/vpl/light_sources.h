@@ -38,7 +38,7 @@ LightSources collectLightSources(const Scene& scene);
 // ρ̄: the area-weighted mean over all triangles of the largest channel of the base colour (each
 // triangle's albedo averaged at four points, so textures count), clamped to [0, 0.999]. Keller's mean
 // reflectivity. The largest channel, not the channel mean: a bounce-j VPL carries Π(a_k/ρ̄) and with the
-// mean the strongest channel grows as (a/ρ̄)^j (Cornell box: red ×18 by bounce 11, splotches).
+// mean the strongest channel grows as (a/ρ̄)^j, into splotches of a saturated wall's colour.
 double meanReflectivity(const Scene& scene);
 
 }  // namespace irbake

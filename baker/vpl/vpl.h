@@ -22,7 +22,8 @@ struct Vpl {
 };
 
 struct WalkOptions {
-  int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights)
+  int paths = 1024;        // N: paths started from the lights (area emitters and punctual lights); the
+                           // library's default, which irbake bake always replaces (--quality: app/quality.cpp)
   std::optional<int> maxBounces;  // unset: auto (autoBounceDepth, tail added); set (≥ 0): exactly this deepest
                                   // bounce, no tail added
   double tailEnergy = 1e-3;      // auto: stop once the light not yet placed, ρ̄^(J+1), is below this fraction
@@ -30,8 +31,7 @@ struct WalkOptions {
   bool geometricTail = true;     // auto: the bounces beyond J added to bounce J as a geometric series
   std::optional<int> split;      // paths fork into this many where they leave bounce 1 (unset: auto, from the
                                  // share of bounce-1 light that meets the scene again; 1 = Keller's walk)
-  int maxAutoSplit = 4;          // auto: at most this many children per path (on Sponza 8 gave the gallery no
-                                 // less error than 4 and cost GL on llvmpipe twice the time)
+  int maxAutoSplit = 4;          // auto: at most this many children per path (more cost time for no less error)
   uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };

@@ -320,17 +320,15 @@ void orderByBounce(const std::vector<std::vector<Vpl>>& perPath, int maxBounce, 
 // The bounces beyond J (auto depth only): their power, P_J r/(1 − r), shared by the VPLs of the deeper
 // half of the walk (bounces ⌈J/2⌉…J, in proportion to their power). Deep bounces have forgotten where
 // the light entered, so they share one distribution; many VPLs carrying the tail instead of bounce J's
-// few keeps its noise down (furnace ρ = 0.9, 1024 paths: 1.0% → see vpl_test).
+// few keeps its noise down (vpl_test's furnace).
 void addGeometricTail(VplSet& out) {
   const int J = out.bounces, from = std::max(1, (J + 1) / 2);
   // The ratio r pooled over the same bounces (P_j for j = from−1…J, bounce 0 counted as the emitted
-  // power): deep bounces have few paths, and one bounce's ratio alone can be far off (an open corner,
-  // 16 paths left at J = 24, came out +18% against the reference).
+  // power): deep bounces have few paths, and one bounce's ratio alone can be far off.
   auto bouncePower = [&](int j) { return j == 0 ? out.emittedPower : out.powerPerBounce[j]; };
   // Only bounces that many paths reach tell the ratio: the few paths alive at depth are those that stayed
-  // among bright, enclosed surfaces, so their bounces decay slower than the scene's light does (Sponza,
-  // walk seed 2: one path trapped in the upper gallery made r = 0.91 over bounces 8–16, against 0.55–0.7
-  // over bounces 2–6, and the tail doubled that path's VPLs: its gallery came out +35%). So the pool skips
+  // among bright, enclosed surfaces, so their bounces decay slower than the scene's light does, and the
+  // tail would multiply one trapped path's VPLs. So the pool skips
   // bounces with fewer than kTailMinVpls VPLs, and when the deeper half has none, it takes the deepest
   // bounces that have them.
   constexpr size_t kTailMinVpls = 16;
@@ -403,7 +401,7 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   if (!options.split.has_value() && maxBounce >= 2) {
     // Auto: how much of the light leaving bounce 1 meets the scene again, from the unsplit walk's counts
     // (V_2 / V_1 against M_2 / M_1). In a closed scene that is 1 and nothing changes; in an open one
-    // (Sponza's courtyard: 7%) the deeper bounces would rest on a few dozen VPLs, so paths split.
+    // (an open courtyard) the deeper bounces would rest on a few dozen VPLs, so paths split.
     size_t v1 = 0, v2 = 0;
     for (const auto& path : perPath)
       for (const Vpl& v : path) v1 += v.bounce == 1, v2 += v.bounce == 2;

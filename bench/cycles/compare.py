@@ -19,9 +19,8 @@ For each option set (--opts, repeatable; "" = defaults) it runs `irbake bake SCE
         each spp (seed 3) and scores it against the reference the same way: Cycles' time for an error.
   VIEW  (--views): cycles_render.py renders the input SCENE from glTF camera i at W x H (two renders of spp/2,
         seeds 1 and 2); irview renders our export at sW x sH, averaged sxs down (s = --view-supersample, 16:
-        Cycles' pixels average the textures over their area, and irview's mipmapped lookups at 4x differ from that
-        area average by 1.1% on Sponza's 4x4 bins, at 16x by 0.2%, from the textures alone; column
-        rel_rmse_4_ss4 keeps the 4x figure of sessions up to 13). Pixels left out: emitters
+        Cycles' pixels average the textures over their area, which irview's mipmapped lookups approach only
+        when supersampled; column rel_rmse_4_ss4 is the same score at 4x). Pixels left out: emitters
         (either image above --emitter-cut in any channel, dilated by one pixel), background (both zero; with
         --sky R,G,B, Cycles renders through bench/cycles/cycles_render_sky.py and its sky pixels are background), and
         1-pixel edges: pixels whose `irview --view charts` colour at W x H differs from any 4-neighbour's

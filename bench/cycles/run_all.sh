@@ -22,6 +22,14 @@ SPONZA=$S/sponza_sun_x4.glb  # textures upsampled 4x: Cycles filters them in sRG
     --view-spp 8192 --save-diff
 # Sponza's map against Cycles' own bake (the sun kept: cycles_bake_lights.py), its ladder up to our error (~50 min).
 "${C[@]}" $SPONZA --name sponza_sun_x4 --opts "" --maps --bake-lights --map-spp 256 --map-ladder 4,16,64,96 --save-diff
+# Sponza with the sun and a sky, each --quality preset (the default's rows are the table's sun + sky rows):
+# views 0-2 against 1024 spp, the gallery (view 3) against 8192 spp (~20 min).
+for views in "0,1,2 1024" "3 8192"; do
+  set -- $views
+  "${C[@]}" $S/sponza_sun.glb --name sponza_sun_sky --sky 0.4,0.5,0.7 --opts "--sky 0.4,0.5,0.7 --quality preview" \
+      --opts "--sky 0.4,0.5,0.7" --opts "--sky 0.4,0.5,0.7 --quality high" --opts "--sky 0.4,0.5,0.7 --quality production" \
+      --views "$1" --view-size 160x100 --view-spp "$2" --save-diff
+done
 # Sibenik lit by its interior lamp alone (glass made opaque: scenes.py); no emitters, so no emitter cut.
 "${C[@]}" $S/sibenik/sibenik_lamp.glb --name sibenik_lamp --opts "" --views 0,1,2,3,4,5 --view-size 160x100 --view-spp 1024 \
     --emitter-cut 1e30 --save-diff

@@ -45,8 +45,8 @@ Pixels decodeMemory(const uint8_t* bytes, size_t size, const char* format, const
 }
 
 std::vector<uint8_t> encodePngMemory(const uint8_t* rgba, int width, int height, const std::string& name) {
-  // zlib level 3, not libpng's 6: Sponza's 1700×1908 page encodes in 0.3 s instead of 0.7 s (serial, at the end
-  // of the bake) for 14% more bytes (2.04 against 1.78 MB); level 1 was no faster.
+  // zlib level 3, not libpng's 6: a large page encodes in half the time (serial, at the end of the bake) for a
+  // few more bytes; level 1 was no faster.
   constexpr int level = 3;
   std::vector<unsigned char> out;
   OIIO::Filesystem::IOVecOutput writer(out);
@@ -82,8 +82,7 @@ void writeFile(const std::string& file, const char* format, const Pixels& px, in
   if (!out) throw Error(ErrorCode::Io, name, std::string("OpenImageIO has no ") + format + " writer: " + OIIO::geterror());
   const bool isFloat = px.u8.empty();
   OIIO::ImageSpec spec(px.width, px.height, px.channels, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  // No compression: a light map's float noise does not compress (zip saved 4% of a Cornell page, 7.7 vs 8.0 MB)
-  // and cost about 0.5 s of an 8 s bake.
+  // No compression: a light map's float noise hardly compresses, and zip costs a noticeable share of the bake.
   if (std::string(format) == "openexr") spec.attribute("compression", "none");
   // Byte-identical outputs for identical bakes: OpenEXR's writer stamps the current time (capDate) unless a
   // DateTime is given, so give the reproducible-builds one: SOURCE_DATE_EPOCH when set, else the epoch.

@@ -352,8 +352,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
   bool tailAdded = false;
   constexpr int kFirstTailSweep = 3;  // at least 4 sweeps before the tail: the ratio creeps up over the first few
   std::vector<std::vector<glm::vec3>> previous(maps.size());  // current before the sweep (for the tail)
-  // The filter's neighbour tests are made once for all sweeps (they were 3/4 of a sweep's time on Sponza) and
-  // shared with the bake's other filters: the page's plan in SurfaceFilterCache.
+  // The filter's neighbour tests are made once for all sweeps (otherwise most of a sweep's time) and shared
+  // with the bake's other filters: the page's plan in SurfaceFilterCache.
   std::vector<TexelFilterOptions> filterOptions(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) filterOptions[p].radius = radii[p];
   for (int sweep = 0; sweep < std::max(1, options.sweeps); ++sweep) {
@@ -398,9 +398,8 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
     const bool converged = sweep > 0 && std::abs(step) <= tolerance;
     // Or add the rest at once: the steps are a Neumann series, step_{k+1} = T step_k, so once their
     // ratio q has settled the remaining sweeps add step_k · q/(1 − q), texel by texel. Settled: the
-    // tails predicted by this ratio and the last one differ by at most the tolerance (Sponza: steps
-    // 4.1, 1.6, 0.67, 0.30% of the map, ratios 0.39, 0.41, 0.45: 4 sweeps and a tail within 0.03% of 8;
-    // the ratio creeps up over the first few sweeps as longer paths reach narrower gaps).
+    // tails predicted by this ratio and the last one differ by at most the tolerance (the ratio creeps up
+    // over the first few sweeps as longer paths reach narrower gaps).
     if (!converged && options.extrapolateTail && sweep >= kFirstTailSweep && lastStep > 0.0 && step > 0.0) {
       const double q = step / lastStep, qBefore = lastStep / stepBefore;
       auto tailOf = [&](double r) { return step * r / (1.0 - r); };

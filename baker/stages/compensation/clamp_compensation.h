@@ -29,18 +29,12 @@
 namespace irbake {
 
 // k of deriveClampBound when the residual is compensated: a tighter clamp (clamp radius ≈ 9 VPL spacings
-// instead of 2.3) removes the VPL splotches and the gather gives the near-field back. Cornell box, 9.7k
-// texels, 1024 paths: relative RMSE 7.97% (k = 16, no compensation) → 3.25% (k = 256, compensated);
-// 4096 paths: 3.42% → 1.55%. k = 512 / 1024 were worse (3.97% / 6.2%: the gather's own noise).
+// instead of 2.3) removes the VPL splotches and the gather gives the near-field back; a larger k lets the
+// gather's own noise (its rays finding a small bright emitter) dominate (docs/validation.md).
 constexpr double kCompensatedClampVplsPerMean = 256.0;
 // The same without emissive surfaces (punctual lights, sun, sky): the gather then reads only ρ·M (the
-// direct light in M exact), while what limited k above was its rays finding a small bright emitter. A
-// tighter clamp hands more of the transport to the gather instead of to the few VPLs that reach a region:
-// Sponza's upper gallery, lit by a sunlit patch of its own floor and the courtyard, is one (4 texels/m
-// against our path tracer, 4 walk seeds: 0.85 / 0.79 / 1.66 / 1.14 of it at k = 256, 0.99 / 0.96 / 1.11 /
-// 1.02 at k = 4096). Against Cycles at full density (views 2 / 3, 4×4 bins): sun alone 2.5 / 7.4% at
-// k = 256, 2.4 / 6.0% at 512, 3.2 / 5.7% at 1024, 3.8 / 6.2% at 2048; sun + sky 2.5 / 12.4%, 2.8 / 9.7%,
-// 3.1 / 7.8%, 3.2 / 7.5%: a sharp sunlit map makes the gather noisy in close-ups (view 2) as k grows.
+// direct light in M exact), so a tighter clamp hands more of the transport to the gather instead of to the
+// few VPLs that reach a dim region; past this a sharp sunlit map makes the gather noisy in close-ups.
 constexpr double kCompensatedClampVplsPerMeanNoEmitters = 1024.0;
 
 struct ClampCompensationOptions {
@@ -49,18 +43,16 @@ struct ClampCompensationOptions {
   size_t rayBudget = 1 << 21;  // first-round rays over all samples (0: no cap); large pages get fewer rays
                                // per sample and a wider filter instead
   int refineRays = 112;        // extra rays (scaled like rays, within the budget again) at samples where at
-  float refineFraction = 0.0f; // least this fraction of the first rays hit clamped transport (0: any hit;
-                               // Cornell 9.7k texels, 1024 paths: 3.25% with 0, 4.42% with 0.25)
+  float refineFraction = 0.0f; // least this fraction of the first rays hit clamped transport (0: any hit)
   std::optional<int> filterRadius;  // residual smoothed over (2r+1)² texels on the same surface (0: none); unset:
                                     // auto (below 32 rays: r ≤ 4 with r texels ≤ r_c / 20, r_c = 1/√B)
   int sweeps = 8;              // at most this many Jacobi sweeps; each reads the map with the previous sweep's
-                               // residual added (furnished room, N = 1024: 3 sweeps 2.75%, 8: 2.54%)
+                               // residual added
   double sweepTolerance = 5e-4;  // stop when a sweep changes the summed map by less than this fraction (< 0: never),
                                  // or when the extrapolated tail is known to within it
   bool extrapolateTail = true;   // once the sweeps' ratio settles, add the remaining sweeps as a geometric tail
   bool filterEachSweep = true;   // false: the summed residual filtered once, after the last sweep (the pipeline's
-                                 // choice with the final gather, whose rays and windows average this map again:
-                                 // Sponza's sweeps 0.62 → 0.33 s each, views 3 2.57 / 3.28% → 2.57 / 3.27%)
+                                 // choice with the final gather, whose rays and windows average this map again)
   uint32_t seed = 0;           // rotates the per-sample ray lattices (deterministic per seed)
   bool directional = false;    // keep each kept hit's direction for applyDirectional (12 bytes a hit)
 };

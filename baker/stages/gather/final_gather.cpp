@@ -27,7 +27,7 @@ namespace {
 
 // The base colour per texel of each page: the coverage-weighted mean over its samples of in.albedoAtHit at the
 // sample (valid texels; others 0). The gather reads ρ M from one packed map instead of ρ at every hit and M
-// beside it: on Sponza 47M texture reads fewer (the footprint albedo is already a map texel's mean, so a
+// beside it: a texture read fewer per hit (the footprint albedo is already a map texel's mean, so a
 // bilinear read of ρ M differs from ρ(hit) × a bilinear read of M only across a material border in a texel).
 std::vector<std::vector<glm::vec3>> texelAlbedo(const BakeInputs& in) {
   const Scene& scene = in.scene;

@@ -28,24 +28,21 @@
 namespace irbake {
 
 struct FinalGatherOptions {
-  int rays = 16;               // cosine rays per texel sample (fewer on big pages, within rayBudget). Sponza
-                               // views 2 / 3 against Cycles: 4 rays 3.37 / 6.34%, 16: 1.92 / 4.56%, 64: 1.52 /
-                               // 4.08%; rays × the sample's bounced share (M − D)/M, at most 24, were worse
-                               // than 16 everywhere (2.49 / 4.68%): the arches' share is small but not their noise
+  int rays = 16;               // cosine rays per texel sample (fewer on big pages, within rayBudget; the choice
+                               // against Cycles: docs/validation.md, "Tried and not kept")
   int minRays = 4;             // never fewer than this per sample
-  size_t rayBudget = 48 << 20; // rays over all samples (0: no cap): Sponza's 2.6M samples get 16
+  size_t rayBudget = 48 << 20; // rays over all samples (0: no cap): a level's few million samples still get 16
   int filterRadius = 3;        // the gathered light averaged over (2r+1)² texels on the same surface (0: none)
   glm::vec3 missRadiance{0.0f};  // what a ray that leaves the scene brings: a uniform sky's L when D leaves the sky
                                  // to the gather (the pipeline does: 16 cosine rays per sample instead of the
                                  // sky stage's 8), else 0 (D holds the sky)
   bool interleave = true;      // neighbouring texels' lattices interleaved, one class per texel of a filter window
-                               // (Sponza views 2 / 3, seeds 0 / 1 / 2: 1.57 / 1.83 / 2.04% and 3.04 / 3.18 / 3.27%
-                               // against Cycles; independent rotations 1.98 / 2.11 / 2.05% and 3.63 / 3.81 / 3.86%)
+                               // (the window averages one stratified lattice instead of independent ones)
   uint32_t seed = 0;           // rotates the per-sample ray lattices
   int preRays = 2;             // a first, cheaper gather (these rays per sample, preFilterRadius) whose map the
                                // final pass reads instead of M: the walk's blotches averaged once more before the
-                               // final rays see them; it lowers Sponza's error against Cycles in every view
-                               // tried, for a few seconds of rays (docs/validation.md, "Sponza"). 0: off
+                               // final rays see them, which lowers the error against Cycles for a few
+                               // seconds of rays. 0: off
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
 };
 

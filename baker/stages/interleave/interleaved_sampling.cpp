@@ -79,7 +79,7 @@ std::vector<VplSet> classVplSubsets(const VplSet& vpls, int n) {
       // alone estimates the bounce's whole sum. A bounce with fewer VPLs than classes leaves some chunks
       // empty: there every VPL is in a class of its own and counts m times (the mix averages the m
       // classes, so each VPL is counted exactly once); count/1 would drop (m − count)/m of its light
-      // (Sponza's deep bounces, 1–13 VPLs each with 16–36 classes).
+      // (a level's deep bounces hold fewer VPLs than there are classes).
       const size_t count = list.size(), b0 = count * c / m, b1 = count * (c + 1) / m;
       if (b1 <= b0) continue;
       const float scale = count >= static_cast<size_t>(m) ? static_cast<float>(count) / static_cast<float>(b1 - b0)
@@ -108,7 +108,7 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<const st
     fo.radius = n - 1;
     fo.tent = true;
     fo.symmetric = false;  // here every class must keep its share of the window, which mirror pairs do not
-                           // (the emitter-over-floor test: bias −0.22% at the page border with them)
+                           // (they bias the page border)
     mixed = filterOnSurface(filters, page, vplParts, vplValid, fo);
   }
   for (size_t c = 0; c < maps.size() && c < vplParts.size(); ++c) {

@@ -34,12 +34,13 @@ std::vector<TexelSamples> interleaveClass(const std::vector<TexelSamples>& pages
 
 // The automatic n: the class filter (half-width n texels) must stay well inside the scale on which the
 // clamped VPL sum varies, the clamp radius r_c = 1/√B: n = clamp(⌊r_c / (10 h)⌋, 1, maxN), h the median
-// texel spacing over the pages. Cornell box, 1024 paths: 9.7k texels (h = 14 mm) → 1; 609k (1.75 mm),
-// 6144 paths (r_c = 10.6 cm) → 6. maxN = 6: against Cycles, 6×6 classes beat 4×4 in accuracy for less
+// texel spacing over the pages (a small box: 14 mm texels at 1024 paths → 1; 1.75 mm texels at 6144 paths,
+// r_c = 10.6 cm → 6). At most kMaxAutoInterleave: against Cycles, 6×6 classes beat 4×4 in accuracy for less
 // time, while 8×8 blurs (docs/validation.md, "Tried and not kept").
 // filters: the bake's surface filters (their spacings), or null.
+constexpr int kMaxAutoInterleave = 6;
 int chooseInterleave(const std::vector<TexelSamples>& pages, float clampBound, SurfaceFilterCache* filters = nullptr,
-                     int maxN = 6);
+                     int maxN = kMaxAutoInterleave);
 
 // The VPLs of each of the n² classes (class c = cx + n·cy): per bounce the c-th contiguous chunk in path
 // order, power × bounce count / chunk count. n ≤ 1: one class with every VPL, unscaled, in path order.

@@ -140,7 +140,7 @@ L1Vectors skyDirectionalAt(const BakeInputs& in, const glm::vec3& x, const glm::
     // The open hemisphere's vector, L n (its tangential part is 0), less what the blocked rays miss:
     // g/π = L n − (2/N) Σ L (1 − T) ω over uniform hemisphere rays (pdf 1/(2π)). An open plane gets t = 0
     // exactly, and every term is bounded (through skyLightAt's cosine rays a term is ω/cosθ, unbounded at
-    // the horizon: an open floor's t came out 1.2% of L at 4096 rays).
+    // the horizon, which left an open floor a tangential part).
     const glm::dvec3 radiance(sky.uniformRadiance());
     for (int k = 0; k < 3; ++k) g[k] = radiance * double(n[k]);
     glm::vec3 tu, tv;

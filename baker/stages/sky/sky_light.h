@@ -22,11 +22,9 @@ struct SkyLightOptions {
   int raysPerSample = 64;    // per texel sample (halved per strategy for a map)
   int maxRays = 8 << 20;     // budget over all samples: fewer rays per sample on big pages (never below minRays)
   int minRays = 8;           // per sample at least (the pipeline asks 4 where the final gather counts a uniform
-                             // sky itself and this stage's light is read only at the gather's hits: Sponza view 3
-                             // 3.64% at 8 rays, 3.62% at 64)
-  int filterRadius = 3;      // (2r+1)² window of the texel filter on the same surface; 0: none. 3 (was 1):
-                             // where a thin slice of sky shows (Sponza's gallery), 8 rays per sample leave
-                             // texel-sized blotches; view 3 against Cycles 6.21/6.27/6.77% → 5.65/5.72/6.46%
+                             // sky itself and this stage's light is read only at the gather's hits)
+  int filterRadius = 3;      // (2r+1)² window of the texel filter on the same surface; 0: none. Where a thin
+                             // slice of sky shows, a few rays per sample leave texel-sized blotches otherwise
   bool interleave = true;    // the lattices of a filter window's texels interleaved (sampling/sample_lattice.h)
                              // instead of rotated independently
   uint32_t seed = 0;         // rotates the per-sample lattices
