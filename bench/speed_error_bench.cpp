@@ -37,11 +37,11 @@
 #include "common/progress.h"
 #include "pipeline/diff.h"
 #include "raytrace/ray_tracer.h"
-#include "raytrace/test_scenes.h"
 #include "scene/gltf_loader.h"
 #include "texels/texel_area.h"
 #include "texels/texel_samples.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 

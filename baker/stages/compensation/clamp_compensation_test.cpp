@@ -15,9 +15,9 @@
 #include "common/maths.h"
 #include "transport/geometry_term.h"
 #include "evaluators/gl/gl_backend.h"
-#include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

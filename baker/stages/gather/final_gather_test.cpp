@@ -13,8 +13,8 @@
 #include "lightmap/lightmap_read.h"
 #include "sampling/sample_lattice.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

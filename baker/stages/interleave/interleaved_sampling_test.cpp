@@ -9,8 +9,8 @@
 
 #include "evaluators/embree/embree_backend.h"
 #include "transport/geometry_term.h"
-#include "raytrace/test_scenes.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {
