@@ -335,7 +335,7 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("COMP_SWEEPS")) compensationOptions.sweeps = std::atoi(e);
         if (const char* e = std::getenv("COMP_TOL")) compensationOptions.sweepTolerance = std::atof(e);
         ClampCompensationStats cst;
-        compensateClamp(in, maps, compensationOptions, &cst);
+        ClampGather(in, compensationOptions).apply(maps, &cst);
         if (std::getenv("GL_VERBOSE") && glStats.facesRendered > 0)
           std::printf("  gl: %zu faces, %.0f triangles drawn per face (of %zu)\n", glStats.facesRendered,
                       double(glStats.trianglesDrawn) / glStats.facesRendered, scene.triangleCount());

@@ -17,7 +17,7 @@ ProbeBake bakeProbesCompensated(const AtlasedScene& atlased, const std::vector<T
   std::vector<Lightmap> maps = bakeEmbree(in);
   ProbeBake out;
   out.clamped.assign(maps.begin() + atlased.pages.size(), maps.end());
-  compensateClamp(in, maps, options);
+  ClampGather(in, options).apply(maps);
   out.compensated.assign(maps.begin() + atlased.pages.size(), maps.end());
   return out;
 }
