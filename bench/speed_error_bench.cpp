@@ -321,9 +321,9 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
         const EmbreeEvaluator contacts;
         const GlEvaluator gl(glOptions, &contacts);
-        maps = irbake::testing::bakeBackendStage(in, classes, [&](const BakeInputs& i) { return gl.evaluate(i); });
+        maps = irbake::testing::bakeBackendStage(in, classes, gl);
       } else {
-        maps = irbake::testing::bakeBackendStage(in, classes, [](const BakeInputs& i) { return bakeEmbree(i); });
+        maps = irbake::testing::bakeBackendStage(in, classes, EmbreeEvaluator());
       }
       double compensationSeconds = 0.0;
       if (compensate) {

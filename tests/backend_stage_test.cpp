@@ -45,7 +45,7 @@ TEST(BackendStage, IsTheBakesBackendStageBitForBit) {
     const BakeInputs in{scene, rt, texels, r.vpls, eval, {}};
     int calls = 0;
     const std::vector<Lightmap> maps =
-        irbake::testing::bakeBackendStage(in, n, [](const BakeInputs& i) { return bakeEmbree(i); }, &calls);
+        irbake::testing::bakeBackendStage(in, n, EmbreeEvaluator(), &calls);
 
     EXPECT_EQ(calls, r.report["interleave"]["backendCalls"].get<int>()) << "n = " << n;
     EXPECT_EQ(calls, 1 + n * n) << "n = " << n;  // the spot light, then every class has VPLs

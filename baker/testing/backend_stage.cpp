@@ -10,14 +10,14 @@ namespace irbake::testing {
 namespace {
 
 // The punctual lights alone (the bake's directEval), or blank pages whose valid flags are the samples'.
-std::vector<Lightmap> directMaps(const BakeInputs& in, const VplBackend& backend, int& calls) {
+std::vector<Lightmap> directMaps(const BakeInputs& in, const Evaluator& evaluator, int& calls) {
   std::vector<Lightmap> maps;
   if (in.eval.includeDirect && !in.scene.lights.empty()) {
     const VplSet none;
     BakeInputs direct{in.scene, in.rayTracer, in.texels, none, in.eval, {}};
     direct.eval.includeVpls = false;
     direct.eval.biasCompensation = false;
-    maps = backend(direct);
+    maps = evaluator.evaluate(direct);
     ++calls;
   } else {
     for (const TexelSamples& ts : in.texels) maps.push_back(blankLightmap(ts));
@@ -29,10 +29,10 @@ std::vector<Lightmap> directMaps(const BakeInputs& in, const VplBackend& backend
 
 }  // namespace
 
-std::vector<Lightmap> bakeBackendStage(const BakeInputs& in, int n, const VplBackend& backend, int* backendCalls) {
+std::vector<Lightmap> bakeBackendStage(const BakeInputs& in, int n, const Evaluator& evaluator, int* backendCalls) {
   n = std::max(1, n);
   int calls = 0;
-  std::vector<Lightmap> maps = directMaps(in, backend, calls);
+  std::vector<Lightmap> maps = directMaps(in, evaluator, calls);
   if (in.eval.includeVpls && !in.vpls.vpls.empty()) {
     std::vector<std::vector<glm::vec3>> vplPart(in.texels.size());
     std::vector<std::vector<uint8_t>> vplValid(in.texels.size());
@@ -48,7 +48,7 @@ std::vector<Lightmap> bakeBackendStage(const BakeInputs& in, int n, const VplBac
       BakeInputs part{in.scene, in.rayTracer, pages, subsets[c], in.eval, {}};
       part.eval.includeDirect = false;
       part.eval.biasCompensation = false;
-      const std::vector<Lightmap> classMaps = backend(part);
+      const std::vector<Lightmap> classMaps = evaluator.evaluate(part);
       ++calls;
       // Class texel (x, y) is texel (n·x + cx, n·y + cy) of its page; only the texels the backend found valid count.
       for (size_t p = 0; p < classMaps.size() && p < in.texels.size(); ++p) {

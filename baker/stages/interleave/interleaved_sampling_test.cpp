@@ -19,7 +19,7 @@ namespace {
 using namespace irbake::testing;
 constexpr double kPi = 3.14159265358979323846;
 
-const VplBackend kEmbree = [](const BakeInputs& in) { return bakeEmbree(in); };
+const EmbreeEvaluator kEmbree;
 
 TEST(InterleavedSampling, ClassesPartitionTheTexels) {
   TexelSamples page = gridSamples(glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), 7, 5);
