@@ -11,7 +11,7 @@
 
 #include "atlas/atlas.h"
 #include "lightmap/lightmap_read.h"
-#include "sampling/sample_lattice.h"
+#include "texels/sample_lattice.h"
 #include "common/maths.h"
 #include "samples/sample_scenes.h"
 #include "testing/scenes.h"

@@ -27,7 +27,7 @@ struct SkyLightOptions {
   int filterRadius = 3;      // (2r+1)² window of the texel filter on the same surface; 0: none. 3 (was 1):
                              // where a thin slice of sky shows (Sponza's gallery), 8 rays per sample leave
                              // texel-sized blotches; view 3 against Cycles 6.21/6.27/6.77% → 5.65/5.72/6.46%
-  bool interleave = true;    // the lattices of a filter window's texels interleaved (sampling/sample_lattice.h)
+  bool interleave = true;    // the lattices of a filter window's texels interleaved (texels/sample_lattice.h)
                              // instead of rotated independently
   uint32_t seed = 0;         // rotates the per-sample lattices
 };
