@@ -21,9 +21,9 @@
 #include "transport/geometry_term.h"
 #include "evaluators/reference/reference_integrator.h"
 #include "common/atomic_file.h"
-#include "raytrace/test_scenes.h"
 #include "sampling/sampling.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

@@ -1,7 +1,8 @@
 // Speed against error: both VPL backends (GL on EGL, Embree) at N = 64 … 4096
 // light paths on the same atlas, texel samples and VPL sets, scored against a converged reference
 // bake (path tracer) of that atlas; time per stage. Plus the per-VPL cost of the GL backend's two
-// stages (shadow cube, accumulation) on a synthetic ~100k-triangle scene and a 1M-texel page.
+// stages (shadow cube, accumulation) on a synthetic ~100k-triangle scene and a 1M-texel page. Each backend
+// runs as the bake's backend stage runs it (testing/backend_stage.h: the punctual lights, then the VPLs by class).
 //
 //   speed_error_bench scene GLTF [--add GLB:scale:x,y,z]... [--page 256] [--ns 64,256,1024,4096]
 //                     [--spp 256] [--name NAME] [--csv OUT.csv] [--clamp-k 16] [--compensate]
@@ -37,11 +38,12 @@
 #include "common/progress.h"
 #include "pipeline/diff.h"
 #include "raytrace/ray_tracer.h"
-#include "raytrace/test_scenes.h"
 #include "scene/gltf_loader.h"
 #include "texels/texel_area.h"
 #include "texels/texel_samples.h"
 #include "vpl/vpl.h"
+#include "testing/backend_stage.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 
@@ -319,9 +321,9 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("NORMAL_OFFSET")) glOptions.normalOffset = std::atof(e);  // diagnostics
         const EmbreeEvaluator contacts;
         const GlEvaluator gl(glOptions, &contacts);
-        maps = bakeInterleaved(in, classes, [&](const BakeInputs& i) { return gl.evaluate(i); });
+        maps = irbake::testing::bakeBackendStage(in, classes, gl);
       } else {
-        maps = bakeInterleaved(in, classes, [](const BakeInputs& i) { return bakeEmbree(i); });
+        maps = irbake::testing::bakeBackendStage(in, classes, EmbreeEvaluator());
       }
       double compensationSeconds = 0.0;
       if (compensate) {
@@ -335,7 +337,7 @@ int sceneBench(const std::vector<std::string>& args) {
         if (const char* e = std::getenv("COMP_SWEEPS")) compensationOptions.sweeps = std::atoi(e);
         if (const char* e = std::getenv("COMP_TOL")) compensationOptions.sweepTolerance = std::atof(e);
         ClampCompensationStats cst;
-        compensateClamp(in, maps, compensationOptions, &cst);
+        ClampGather(in, compensationOptions).apply(maps, &cst);
         if (std::getenv("GL_VERBOSE") && glStats.facesRendered > 0)
           std::printf("  gl: %zu faces, %.0f triangles drawn per face (of %zu)\n", glStats.facesRendered,
                       double(glStats.trianglesDrawn) / glStats.facesRendered, scene.triangleCount());

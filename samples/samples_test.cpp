@@ -5,7 +5,7 @@
 
 #include "samples/sample_scenes.h"
 #include "scene/gltf_loader.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 using namespace irbake;
 using namespace irbake::samples;

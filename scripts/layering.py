@@ -3,10 +3,10 @@
 file under baker/evaluators/X includes "evaluators/Y/..." for another evaluator Y, or a file under
 baker/stages includes an evaluator implementation (evaluators/{gl,embree,reference}/...): both may include
 only the interface (evaluators/evaluator.h, evaluators/bake_inputs.h), and whoever builds the evaluators
-(baker/pipeline) wires them together. Tests (*_test.cpp and the test_*.h helpers they include) may compare
-or combine evaluators and are left out. Also fails when docs/architecture.md does not name a module folder
-(baker/X, baker/stages/X, baker/evaluators/X, written out or as baker/evaluators/{a,b}) or names one that is
-gone. ROOT: the repository (default: the folder above this script)."""
+(baker/pipeline) wires them together. Tests (*_test.cpp) may compare or combine evaluators and are left out;
+their shared helpers live in baker/testing, outside both folders. Also fails when docs/architecture.md does not
+name a module folder (baker/X, baker/stages/X, baker/evaluators/X, written out or as baker/evaluators/{a,b}) or
+names one that is gone. ROOT: the repository (default: the folder above this script)."""
 import os
 import pathlib
 import re
@@ -17,7 +17,7 @@ SOURCES = {".h", ".hpp", ".cpp", ".cc", ".inl"}
 
 
 def is_test(path):
-    return path.name.endswith("_test.cpp") or path.name.startswith("test_")
+    return path.name.endswith("_test.cpp")
 
 
 def evaluator_of(include, path, root, evaluators_dir):

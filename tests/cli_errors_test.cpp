@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 using namespace irbake;
 using json = nlohmann::json;

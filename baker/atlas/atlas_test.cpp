@@ -16,7 +16,7 @@
 #include "common/maths.h"
 #include "export/gltf_export.h"
 #include "scene/gltf_loader.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 namespace irbake {
 namespace {

@@ -13,7 +13,7 @@
 #include "export/gltf_writer.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_codec.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 using namespace irbake;
 using json = nlohmann::json;

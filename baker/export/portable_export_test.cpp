@@ -10,7 +10,7 @@
 #include "export/portable_export.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 using namespace irbake;
 using json = nlohmann::json;

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "raytrace/test_scenes.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

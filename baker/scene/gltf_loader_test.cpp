@@ -11,7 +11,7 @@
 #include "scene/environment.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_codec.h"
-#include "scene/test_gltf_builder.h"
+#include "testing/gltf_builder.h"
 
 using namespace irbake;
 using irbake::testing::meshDocument;

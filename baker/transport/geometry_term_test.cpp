@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

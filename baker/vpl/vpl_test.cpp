@@ -4,10 +4,10 @@
 #include <cmath>
 #include <set>
 
-#include "raytrace/test_scenes.h"
 #include "vpl/light_sources.h"
 #include "sampling/sampling.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

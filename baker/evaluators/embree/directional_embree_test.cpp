@@ -7,8 +7,8 @@
 
 #include "evaluators/embree/embree_backend.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
 #include "transport/directional.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

@@ -7,12 +7,12 @@
 #include <cstdlib>
 #include <string>
 
-#include "stages/compensation/test_probe_bake.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
 #include "transport/geometry_term.h"
 #include "vpl/light_sources.h"
+#include "testing/probe_bake.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

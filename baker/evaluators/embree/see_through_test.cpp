@@ -9,8 +9,8 @@
 #include "evaluators/embree/embree_backend.h"
 #include "common/maths.h"
 #include "evaluators/reference/reference_integrator.h"
-#include "raytrace/test_scenes.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

@@ -13,7 +13,7 @@
 #include "glcontext/gl_context.h"
 #include "glcontext/gl_program.h"
 #include "raytrace/ray_tracer.h"
-#include "raytrace/test_scenes.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstdio>
 
-#include "stages/compensation/test_probe_bake.h"
 #include "evaluators/embree/embree_backend.h"
 #include "common/error.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
 #include "transport/geometry_term.h"
+#include "testing/probe_bake.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

@@ -493,12 +493,4 @@ void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& a
   }
 }
 
-void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options,
-                     ClampCompensationStats* stats) {
-  if (maps.size() != in.texels.size()) return;
-  ClampGather(in, options).apply(maps, stats);
-}
-
-
-
 }  // namespace irbake

@@ -74,17 +74,18 @@ struct ClampCompensationStats {
   }
 };
 
-// The two halves of compensateClamp. Construction traces the rays and keeps the hits inside the clamp
+// The compensation in two halves. Construction traces the rays and keeps the hits inside the clamp
 // radius: it reads the geometry and the texel samples only, not the maps, so it can run while a backend
 // bakes them (the pipeline does so for the GL backend, whose rasteriser leaves CPU time idle; on a GPU
 // the whole trace hides behind it). apply() then runs the sweeps on the baked maps. `in` must outlive it.
+// in.eval.clampBound is B: with B ≤ 0, or the VPLs not evaluated, apply() changes nothing.
 class ClampGather {
  public:
   explicit ClampGather(const BakeInputs& in, const ClampCompensationOptions& options = {});
   ~ClampGather();
   ClampGather(const ClampGather&) = delete;
   ClampGather& operator=(const ClampGather&) = delete;
-  // Adds the residual to maps (one per page of the inputs' texels, same order and size).
+  // Adds the residual to maps (one per page of the inputs' texels, same order and size); only valid texels change.
   void apply(std::vector<Lightmap>& maps, ClampCompensationStats* stats = nullptr) const;
   // Directional maps (transport/directional.h): adds the residual's tangential irradiance vector to the L1
   // pages (axes x, y, z; one Lightmap per page each). Call after apply, with the maps it returned: at the
@@ -99,10 +100,5 @@ class ClampGather {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Adds the clamp residual to maps (one per page of in.texels, same order; in.eval.clampBound is B).
-// Does nothing when B ≤ 0 or the VPLs are not evaluated. Only valid texels change. = ClampGather + apply.
-void compensateClamp(const BakeInputs& in, std::vector<Lightmap>& maps, const ClampCompensationOptions& options = {},
-                     ClampCompensationStats* stats = nullptr);
 
 }  // namespace irbake

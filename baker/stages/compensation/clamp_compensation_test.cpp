@@ -1,5 +1,6 @@
-// The clamp residual gathered from the baked map: closed forms (emitter near a receiver), the furnace
-// with both VPL backends (mean within 1% of Le/(1−ρ)), and that it is a no-op without a clamp.
+// The clamp residual gathered from the baked map by ClampGather, as the bake's compensation stage runs it:
+// closed forms (emitter near a receiver), the furnace with both VPL backends (mean within 1% of Le/(1−ρ)),
+// and that it is a no-op without a clamp.
 #include "stages/compensation/clamp_compensation.h"
 
 #include <gtest/gtest.h>
@@ -15,9 +16,9 @@
 #include "common/maths.h"
 #include "transport/geometry_term.h"
 #include "evaluators/gl/gl_backend.h"
-#include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {
@@ -45,7 +46,7 @@ TEST(ClampCompensation, NoClampAddsNothing) {
   BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};  // clampBound 0
   std::vector<Lightmap> maps = bakeEmbree(in), before = maps;
   ClampCompensationStats stats;
-  compensateClamp(in, maps, {}, &stats);
+  ClampGather(in).apply(maps, &stats);
   for (size_t p = 0; p < maps.size(); ++p) EXPECT_EQ(maps[p].texels, before[p].texels);
   EXPECT_EQ(stats.raysTraced, 0u);
 }
@@ -87,7 +88,7 @@ TEST(ClampCompensation, EmitterCloseToFloorMatchesFormFactor) {
   ClampCompensationOptions options;
   options.rays = 64;
   options.refineRays = 448;
-  compensateClamp(in, maps, options);
+  ClampGather(in, options).apply(maps);
   const std::vector<glm::dvec3>& poly = scene.poly;
   double se = 0, se0 = 0, ref2 = 0;
   for (size_t i = 0; i < maps[0].size(); ++i) {
@@ -170,7 +171,7 @@ struct FurnaceBake {
 void expectFurnaceCompensated(const std::vector<Lightmap>& clamped, std::vector<Lightmap> maps, const BakeInputs& in,
                               const char* backend) {
   ClampCompensationStats stats;
-  compensateClamp(in, maps, {}, &stats);
+  ClampGather(in).apply(maps, &stats);
   std::vector<double> err;
   for (const auto& m : maps)
     for (size_t i = 0; i < m.size(); ++i)
@@ -207,7 +208,7 @@ TEST(ClampCompensation, FilteringOnceAfterTheSweepsKeepsTheFurnace) {
     o.filterEachSweep = eachSweep;
     o.filterRadius = 3;  // auto gives none at 16 rays
     ClampCompensationStats stats;
-    compensateClamp(in, maps, o, &stats);
+    ClampGather(in, o).apply(maps, &stats);
     EXPECT_EQ(stats.filterRadius, 3);
     return maps;
   };
@@ -231,7 +232,7 @@ TEST(ClampCompensation, SweepsStopWhenAnotherBounceNoLongerChangesTheMap) {
     o.sweeps = sweeps;
     o.sweepTolerance = tolerance;
     ClampCompensationStats stats;
-    compensateClamp(in, maps, o, &stats);
+    ClampGather(in, o).apply(maps, &stats);
     if (done) *done = stats.sweeps;
     return validMean(maps);
   };
@@ -260,7 +261,7 @@ TEST(ClampCompensation, GeometricTailMatchesManySweepsAfterFewer) {
     o.sweeps = sweeps;
     o.sweepTolerance = tolerance;
     o.extrapolateTail = tail;
-    compensateClamp(in, maps, o, stats);
+    ClampGather(in, o).apply(maps, stats);
     return validMean(maps);
   };
   ClampCompensationStats withTail, cut, full;

@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lightmap/lightmap_read.h"
-#include "sampling/sample_lattice.h"
+#include "texels/sample_lattice.h"
 #include "common/error.h"
 #include "common/maths.h"
 #include "common/progress.h"
@@ -155,7 +155,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     // Interleaved rotations (sample_lattice.h): every filter window averages one stratified lattice of rays
     // instead of independent rays per sample, so the filter removes more of their noise.
     const InterleavedRotations interleaved(ts, options.seed, stream, options.interleave ? options.filterRadius : 0, rays);
-    forEachSampleLattice(in, ts, options.seed, stream,
+    forEachSampleLattice(in.rayTracer, ts, options.seed, stream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
                            slotValue[s] = gatherAtPacked(in, packedSource, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
                                                    directional ? &slotVector[s] : nullptr);

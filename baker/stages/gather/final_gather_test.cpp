@@ -11,10 +11,10 @@
 
 #include "atlas/atlas.h"
 #include "lightmap/lightmap_read.h"
-#include "sampling/sample_lattice.h"
+#include "texels/sample_lattice.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
 #include "samples/sample_scenes.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

@@ -9,9 +9,9 @@
 // axis give each class the same total weight), keeping only neighbours on the same surface
 // (texels/texel_filter.h): on a smooth VPL sum this recovers most of the full set's smoothness.
 // Only the VPL part is interleaved: punctual lights (exact, one shadow map) are evaluated on every
-// texel by a separate call and never filtered, so their shadows stay sharp.
+// texel by a separate call and never filtered, so their shadows stay sharp. The bake composes the pieces
+// below (pipeline/bake.cpp, StagedBake: one backend call per block of a class's VPLs, added exactly, then mixed).
 #pragma once
-#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -21,11 +21,9 @@
 
 namespace irbake {
 
-using VplBackend = std::function<std::vector<Lightmap>(const BakeInputs&)>;
-
 struct InterleaveStats {
   int classes = 1;        // n²
-  int backendCalls = 0;   // VPL calls (n² here; one per VPL block in the bake) + 1 when there are punctual lights
+  int backendCalls = 0;   // one per VPL block (blocks split each class's VPLs) + 1 when there are punctual lights
   nlohmann::json toJson() const { return {{"classes", classes}, {"backendCalls", backendCalls}}; }
 };
 
@@ -56,9 +54,5 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<glm::vec
 void addMixedClasses(const TexelSamples& page, int n, const std::vector<const std::vector<glm::vec3>*>& vplParts,
                      const std::vector<uint8_t>& vplValid, const std::vector<Lightmap*>& maps,
                      SurfaceFilterCache* filters = nullptr);
-
-// n ≤ 1 or no VPLs: backend(inputs). Otherwise as above; same page layout and valid flags as backend(inputs).
-std::vector<Lightmap> bakeInterleaved(const BakeInputs& inputs, int n, const VplBackend& backend,
-                                      InterleaveStats* stats = nullptr);
 
 }  // namespace irbake

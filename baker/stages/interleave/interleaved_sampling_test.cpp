@@ -1,5 +1,6 @@
-// Interleaved sampling around the Embree backend: the classes partition the texels, punctual lights stay
-// exact, and on closed forms the interleaved estimate matches the exact answer like the full one does.
+// Interleaved sampling around the Embree backend, its pieces composed as the bake's backend stage composes them
+// (testing::bakeBackendStage): the classes partition the texels, punctual lights stay exact, and on closed forms
+// the interleaved estimate matches the exact answer like the full one does.
 #include "stages/interleave/interleaved_sampling.h"
 
 #include <gtest/gtest.h>
@@ -9,15 +10,16 @@
 
 #include "evaluators/embree/embree_backend.h"
 #include "transport/geometry_term.h"
-#include "raytrace/test_scenes.h"
 #include "vpl/vpl.h"
+#include "testing/backend_stage.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {
 using namespace irbake::testing;
 constexpr double kPi = 3.14159265358979323846;
 
-const VplBackend kEmbree = [](const BakeInputs& in) { return bakeEmbree(in); };
+const EmbreeEvaluator kEmbree;
 
 TEST(InterleavedSampling, ClassesPartitionTheTexels) {
   TexelSamples page = gridSamples(glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), 7, 5);
@@ -79,10 +81,10 @@ TEST(InterleavedSampling, PunctualLightsStayExact) {
   VplEvalOptions eval;
   eval.clampBound = deriveClampBound(s, vpls);
   BakeInputs in{s, rt, texels, vpls, eval, {}};
-  InterleaveStats st;
-  const auto maps = bakeInterleaved(in, 2, kEmbree, &st);
-  EXPECT_EQ(st.classes, 4);
-  EXPECT_EQ(st.backendCalls, 5);
+  int calls = 0;
+  const auto maps = bakeBackendStage(in, 2, kEmbree, &calls);
+  EXPECT_EQ(classVplSubsets(vpls, 2).size(), 4u);
+  EXPECT_EQ(calls, 5);  // the point light once, then one call per class
   double worst = 0.0;
   for (size_t i = 0; i < maps[0].size(); ++i) {
     const glm::dvec3 d = glm::dvec3(L) - glm::dvec3(glm::vec3(texels[0].positionWeight[i]));
@@ -113,7 +115,7 @@ TEST(InterleavedSampling, EmitterOverFloorMatchesFormFactor) {
   BakeInputs in{s, rt, texels, vpls, VplEvalOptions{}, {}};  // no clamp: nothing closer than 0.5 m
   const std::vector<glm::dvec3> poly = {{-0.5, -0.5, h}, {0.5, -0.5, h}, {0.5, 0.5, h}, {-0.5, 0.5, h}};
   for (int n : {1, 2, 4}) {
-    const auto maps = bakeInterleaved(in, n, kEmbree);
+    const auto maps = bakeBackendStage(in, n, kEmbree);
     double se = 0, ref2 = 0, sum = 0, sumRef = 0;
     for (size_t i = 0; i < maps[0].size(); ++i) {
       const double exact = polygonFormFactor(glm::dvec3(glm::vec3(texels[0].positionWeight[i])), glm::dvec3(0, 0, 1), poly);

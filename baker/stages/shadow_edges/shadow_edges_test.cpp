@@ -15,7 +15,7 @@
 #include "atlas/atlas.h"
 #include "evaluators/embree/embree_backend.h"
 #include "common/maths.h"
-#include "raytrace/test_scenes.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "stages/sky/sky_light.h"
-#include "raytrace/test_scenes.h"
 #include "scene/environment.h"
+#include "testing/scenes.h"
 
 using namespace irbake;
 using namespace irbake::testing;

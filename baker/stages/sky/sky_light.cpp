@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "sampling/sample_lattice.h"
+#include "texels/sample_lattice.h"
 #include "common/maths.h"
 #include "common/progress.h"
 #include "texels/surface_filter_cache.h"
@@ -102,7 +102,7 @@ void forEachSkySample(const BakeInputs& in, const TexelSamples& ts, const SkyLig
   const int latticeRays = in.scene.environment.isUniform() ? rays : std::max(1, rays / 2);
   const InterleavedRotations interleaved(ts, options.seed, kSkyStream, options.interleave ? options.filterRadius : 0,
                                          latticeRays);
-  forEachSampleLattice(in, ts, options.seed, kSkyStream, at, &interleaved);
+  forEachSampleLattice(in.rayTracer, ts, options.seed, kSkyStream, at, &interleaved);
 }
 
 void addSkyLight(const BakeInputs& in, std::vector<Lightmap>& maps, const SkyLightOptions& options,

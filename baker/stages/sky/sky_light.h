@@ -25,7 +25,7 @@ struct SkyLightOptions {
                              // sky itself and this stage's light is read only at the gather's hits)
   int filterRadius = 3;      // (2r+1)² window of the texel filter on the same surface; 0: none. Where a thin
                              // slice of sky shows, a few rays per sample leave texel-sized blotches otherwise
-  bool interleave = true;    // the lattices of a filter window's texels interleaved (sampling/sample_lattice.h)
+  bool interleave = true;    // the lattices of a filter window's texels interleaved (texels/sample_lattice.h)
                              // instead of rotated independently
   uint32_t seed = 0;         // rotates the per-sample lattices
 };

@@ -9,9 +9,9 @@
 
 #include "evaluators/embree/embree_backend.h"
 #include "stages/sky/sky_light.h"
-#include "raytrace/test_scenes.h"
 #include "vpl/light_sources.h"
 #include "vpl/vpl.h"
+#include "testing/scenes.h"
 
 namespace irbake {
 namespace {

@@ -11,8 +11,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "evaluators/bake_inputs.h"
+#include "raytrace/ray_tracer.h"
 #include "sampling/sampling.h"
+#include "texels/texel_samples.h"
 
 namespace irbake {
 
@@ -63,15 +64,15 @@ class InterleavedRotations {
 // stream keeps its rotations apart from another stage's, and the same for every thread count.
 // With interleaved (active), the rotations are its instead of independent ones.
 template <class At>
-void forEachSampleLattice(const BakeInputs& in, const TexelSamples& ts, uint64_t seed, uint64_t stream, At&& at,
+void forEachSampleLattice(const RayTracer& rayTracer, const TexelSamples& ts, uint64_t seed, uint64_t stream, At&& at,
                           const InterleavedRotations* interleaved = nullptr) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.slotCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t s = r.begin(); s != r.end(); ++s) {
       if (!(ts.positionWeight[s].w > 0.0f)) continue;
       glm::vec3 x(ts.positionWeight[s]);
       const glm::vec3 n(ts.normal[s]);
-      if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size())
-        x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+      if (s < ts.primitive.size() && ts.primitive[s] < rayTracer.scene().primitives.size())
+        x = rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
       double r1, r2;
       if (interleaved && interleaved->active()) {
         interleaved->of(s, r1, r2);
