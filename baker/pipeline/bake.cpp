@@ -501,6 +501,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   report["surfaceFilters"] = {{"plans", s.surfaceFilters->plansMade()}, {"fallbacks", s.surfaceFilters->fallbacks()}};
   if (s.plan.directional) directionalStage(ctx, r.directional);
   const PostStats post = postStage(ctx, r.maps);
+  probeStage(ctx, r.maps, r.probes);
   s.seconds["bake"] = s.total.seconds();
   s.describe(report, post);
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,
