@@ -13,7 +13,7 @@ namespace irbake {
 namespace {
 
 using json = nlohmann::json;
-constexpr int kFloat = 5126, kUnsignedByte = 5121;
+constexpr int kFloat = 5126;
 
 int addAccessor(GltfDocument& doc, const void* data, size_t bytes, int componentType, size_t count, const char* type) {
   const int view = doc.addBufferView(data, bytes);
@@ -52,13 +52,16 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
   std::vector<glm::vec3> coefficients;
   coefficients.reserve(n * kShCoefficients);
   for (const ShCoefficients& c : grid.coefficients) coefficients.insert(coefficients.end(), c.begin(), c.end());
+  // Validity as float 0/1: an UNSIGNED_BYTE accessor came back scrambled through gltf-transform optimize (its
+  // meshopt compression pads such streams to 4-byte elements), floats come back bit for bit.
+  std::vector<float> valid(grid.valid.begin(), grid.valid.end());
   json ext = {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
               {"spacing", grid.spacing},
               {"counts", {grid.counts.x, grid.counts.y, grid.counts.z}},
               {"coefficients", addAccessor(doc, coefficients.data(), coefficients.size() * sizeof(glm::vec3), kFloat,
                                            coefficients.size(), "VEC3")},
               {"offsets", addAccessor(doc, grid.offsets.data(), n * sizeof(glm::vec3), kFloat, n, "VEC3")},
-              {"valid", addAccessor(doc, grid.valid.data(), n, kUnsignedByte, n, "SCALAR")},
+              {"valid", addAccessor(doc, valid.data(), n * sizeof(float), kFloat, n, "SCALAR")},
               {"units", "irradiance/pi"},
               {"convention", "three.js SphericalHarmonics3"}};
   doc.root["extensions"][kLightProbesExtension] = std::move(ext);
@@ -108,21 +111,24 @@ LightProbeGrid readLightProbes(const std::filesystem::path& path) {
   const size_t n = g.size();
   const AccessorBytes c = probeAccessor(doc, *ext, "coefficients", kFloat, "VEC3", n * kShCoefficients, file);
   const AccessorBytes o = probeAccessor(doc, *ext, "offsets", kFloat, "VEC3", n, file);
-  const AccessorBytes v = probeAccessor(doc, *ext, "valid", kUnsignedByte, "SCALAR", n, file);
+  const AccessorBytes v = probeAccessor(doc, *ext, "valid", kFloat, "SCALAR", n, file);
   g.coefficients.resize(n);
   g.offsets.resize(n);
   std::memcpy(g.coefficients.data(), c.bytes.data(), n * sizeof(ShCoefficients));
   std::memcpy(g.offsets.data(), o.bytes.data(), n * sizeof(glm::vec3));
-  g.valid.assign(v.bytes.begin(), v.bytes.end());
+  std::vector<float> valid(n);
+  std::memcpy(valid.data(), v.bytes.data(), n * sizeof(float));
+  g.valid.resize(n);
   for (size_t i = 0; i < n; ++i) {
     bool finite = std::isfinite(g.offsets[i].x) && std::isfinite(g.offsets[i].y) && std::isfinite(g.offsets[i].z);
     for (const glm::vec3& k : g.coefficients[i]) finite = finite && std::isfinite(k.x) && std::isfinite(k.y) && std::isfinite(k.z);
     if (!finite)
       throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ": probe " + std::to_string(i) +
                                                     " has a non-finite coefficient or offset");
-    if (g.valid[i] > 1)
+    if (valid[i] != 0.0f && valid[i] != 1.0f)
       throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".valid: probe " + std::to_string(i) +
-                                                    " holds " + std::to_string(g.valid[i]) + " (0 or 1)");
+                                                    " holds " + std::to_string(valid[i]) + " (0 or 1)");
+    g.valid[i] = valid[i] == 1.0f;
   }
   return g;
 }

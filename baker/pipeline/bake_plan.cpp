@@ -140,7 +140,7 @@ void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options
   plan.probes.spacing = spacing;
   plan.probes.box = volume;
   plan.settle("probe-spacing", spacing,
-              std::string(automatic ? "the volume's longest extent / 16" : "asked for") + ": " +
+              std::string(automatic ? "about 1024 probes over the volume: cbrt(volume / 1024)" : "asked for") + ": " +
                   std::to_string(grid.counts.x) + " x " + std::to_string(grid.counts.y) + " x " +
                   std::to_string(grid.counts.z) + " probes",
               automatic);

@@ -16,6 +16,7 @@ namespace {
 
 constexpr uint64_t kProbeStream = 0x9b;  // the probes' lattice rotations
 constexpr double kGoldenRatio = 1.6180339887498949;
+constexpr double kAutoProbes = 1024.0;   // about this many probes at the automatic spacing, whatever the scale
 
 // What one probe's lattice rays found.
 struct ProbeTrace {
@@ -105,7 +106,9 @@ size_t addPunctualLights(const BakeInputs& in, const glm::vec3& p, ShCoefficient
 
 float chooseProbeSpacing(const Bounds3& volume) {
   const glm::vec3 e = volume.extent();
-  return std::max(0.01f, std::max({e.x, e.y, e.z}) / 16.0f);
+  const double longest = std::max({e.x, e.y, e.z}), shortest = longest / 16.0;
+  const double v = std::max<double>(e.x, shortest) * std::max<double>(e.y, shortest) * std::max<double>(e.z, shortest);
+  return std::max(0.01f, static_cast<float>(std::cbrt(v / kAutoProbes)));
 }
 
 LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes) {

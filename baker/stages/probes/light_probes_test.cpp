@@ -180,11 +180,15 @@ TEST(LightProbes, GridFollowsTheVolumeAndRefusesTooManyProbes) {
   Bounds3 b;
   b.extend(glm::vec3(-1, 0, 0));
   b.extend(glm::vec3(3, 1, 0.5f));
-  EXPECT_FLOAT_EQ(chooseProbeSpacing(b), 0.25f);
+  EXPECT_FLOAT_EQ(chooseProbeSpacing(b), 0.125f);  // cbrt(4 · 1 · 0.5 / 1024)
   const LightProbeGrid g = probeGridOver(b, 0.25f, 1000);
   EXPECT_EQ(g.counts, glm::ivec3(16, 4, 2));
   EXPECT_NEAR(g.origin.x, -0.875f, 1e-6f);  // half a step in from the face
   EXPECT_NEAR(g.gridPoint(15, 3, 1).z, 0.375f, 1e-6f);
+  Bounds3 flat;  // a 10 × 10 m plane: its thickness held to 10/16 m
+  flat.extend(glm::vec3(-5, 0, -5));
+  flat.extend(glm::vec3(5, 0, 5));
+  EXPECT_NEAR(chooseProbeSpacing(flat), std::cbrt(62.5 / 1024.0), 1e-6);
   EXPECT_THROW(probeGridOver(b, 0.01f, 1000), Error);
   EXPECT_THROW(probeGridOver(b, 0.0f, 1000), Error);
 }
