@@ -104,6 +104,14 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
   // L2 kernel at c = 1, 17/16; the lit plane below adds at most 3/32 of ∫ ρ M dω/π ≤ 3/32 · 2 · 0.5 · 10/π = 0.3.
   const std::vector<double> up = probeValue(dir, gltf, "0,0.5,0", "0,1,0");
   EXPECT_NEAR(up[0], 10.0 / (M_PI * 0.25) * 17.0 / 16.0, 0.3);
+  // A bake of that export replaces its probes; with --probes off it drops them (no stale accessor indices).
+  ASSERT_EQ(runIrbake(dir, {"bake", gltf.string(), "-o", (dir / "again").string(), "--probes", "3", "--quiet"}).code, 0);
+  EXPECT_EQ(readJson(dir / "again" / "scene.gltf")["extensions"]["IRBAKE_light_probes"]["spacing"], 3.0);
+  EXPECT_EQ(runIrbake(dir, {"probe", (dir / "again" / "scene.gltf").string(), "--at", "0,0.5,0"}).code, 0);
+  ASSERT_EQ(runIrbake(dir, {"bake", gltf.string(), "-o", (dir / "again_off").string(), "--probes", "off", "--quiet"}).code, 0);
+  const json againOff = readJson(dir / "again_off" / "scene.gltf");
+  EXPECT_FALSE(againOff.contains("extensions") && againOff["extensions"].contains("IRBAKE_light_probes"));
+  EXPECT_EQ(std::count(againOff["extensionsUsed"].begin(), againOff["extensionsUsed"].end(), "IRBAKE_light_probes"), 0);
   // Damaged copies: each refused with exit 5, naming the file and the problem.
   const json good = readJson(gltf);
   const std::string bin = fileText(dir / "on" / "scene.bin");

@@ -176,6 +176,35 @@ TEST(LightProbes, NothingCrossesTheThinWall) {
   EXPECT_GT(litMean / lit, 0.05);  // I/(π r²) · 1/4 ≈ 0.8 at 1 m: the lit side is lit
 }
 
+TEST(LightProbes, TrilinearBlendIsExactOnLinearDataAndSkipsInvalidProbes) {
+  // c_0 = 1 + 2x − y + 0.5z at each probe: the trilinear blend reproduces a linear function exactly, inside
+  // the grid; an invalid corner drops out and the other seven's weights are renormalised.
+  Bounds3 b;
+  b.extend(glm::vec3(0.0f));
+  b.extend(glm::vec3(3.0f, 2.0f, 2.0f));
+  LightProbeGrid g = probeGridOver(b, 1.0f, 100);  // 3 × 2 × 2 at 0.5 … 2.5, 0.5 … 1.5
+  const auto f = [](glm::vec3 p) { return 1.0f + 2.0f * p.x - p.y + 0.5f * p.z; };
+  g.coefficients.assign(g.size(), ShCoefficients{});
+  g.valid.assign(g.size(), 1);
+  for (size_t i = 0; i < g.size(); ++i) g.coefficients[i][0] = glm::vec3(f(g.position(i)));
+  for (const glm::vec3 p : {glm::vec3(0.7f, 0.9f, 1.2f), glm::vec3(2.2f, 1.4f, 0.6f), glm::vec3(1.3f, 1.1f, 0.9f)}) {
+    const ProbeBlend blend = interpolateProbes(g, p);
+    EXPECT_EQ(blend.probes, 8);
+    EXPECT_NEAR(blend.weight, 1.0f, 1e-5f);
+    EXPECT_NEAR(blend.coefficients[0].x, f(p), 1e-5f);
+  }
+  // Outside the grid: clamped to its border.
+  EXPECT_NEAR(interpolateProbes(g, glm::vec3(-4.0f, 1.0f, 1.0f)).coefficients[0].x, f(glm::vec3(0.5f, 1.0f, 1.0f)), 1e-5f);
+  // Probe (0, 0, 0) invalid: at p the others carry weights 1 − w0, and the blend is their weighted mean.
+  g.valid[g.index(0, 0, 0)] = 0;
+  const glm::vec3 p(0.75f, 0.75f, 0.75f);  // t = (0.25, 0.25, 0.25): w0 = 0.75³
+  const ProbeBlend blend = interpolateProbes(g, p);
+  const float w0 = 0.421875f;
+  EXPECT_EQ(blend.probes, 7);
+  EXPECT_NEAR(blend.weight, 1.0f - w0, 1e-5f);
+  EXPECT_NEAR(blend.coefficients[0].x, (f(p) - w0 * f(g.position(g.index(0, 0, 0)))) / (1.0f - w0), 1e-5f);
+}
+
 TEST(LightProbes, GridFollowsTheVolumeAndRefusesTooManyProbes) {
   Bounds3 b;
   b.extend(glm::vec3(-1, 0, 0));
