@@ -44,6 +44,7 @@ struct BakeArguments {
   std::string backend = "auto", shard, finalGather = "auto", quality = "default";
   std::string config, dumpConfig;  // --config FILE (read before parsing), --dump-config FILE
   std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
+  std::string probes = "auto", probeBox;  // --probes auto|off|SPACING, --probe-box as given
   double envIntensity = 1.0, envRotation = 0.0;
   bool helpAll = false;
   CLI::Option* shardOption = nullptr;
@@ -100,9 +101,30 @@ LightAdditions lightArguments(const BakeArguments& a) {
   return lights;
 }
 
+// --probes auto|off|SPACING and --probe-box into the probe stage's options. Throws Error(Usage) naming the option.
+void probeArguments(const BakeArguments& a, ProbeOptions& o) {
+  o.enabled = a.probes != "off";
+  if (o.enabled && a.probes != "auto") {
+    char* end = nullptr;
+    const double spacing = std::strtod(a.probes.c_str(), &end);
+    if (a.probes.empty() || *end != '\0' || !(spacing >= 0.01) || !(spacing <= 1e6))
+      throw Error(ErrorCode::Usage, "", "--probes needs auto, off or a spacing in metres from 0.01 to 1e6 (got '" + a.probes + "')");
+    o.spacing = static_cast<float>(spacing);
+  }
+  if (!a.probeBox.empty()) {
+    const std::vector<double> b = cli::parseNumberList(a.probeBox);
+    Bounds3 box;
+    box.min = glm::vec3(b[0], b[1], b[2]);
+    box.max = glm::vec3(b[3], b[4], b[5]);
+    if (!(box.min.x <= box.max.x && box.min.y <= box.max.y && box.min.z <= box.max.z))
+      throw Error(ErrorCode::Usage, "", "--probe-box needs X0,Y0,Z0,X1,Y1,Z1 with each minimum ≤ its maximum (got '" + a.probeBox + "')");
+    o.box = box;
+  }
+}
+
 // The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
 const std::vector<std::string> kCommonOptions = {"SCENE", "output", "quality", "config", "sun", "sky", "env",
-                                                 "texels-per-unit", "directional", "seed", "threads", "report",
+                                                 "texels-per-unit", "directional", "probes", "seed", "threads", "report",
                                                  "quiet", "portable", "help", "help-all"};
 const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroups = {
     {"Light paths and VPLs", {"paths", "bounces", "walk-split", "vpl-importance", "vpl-probes", "vpl-keep", "vpl-block"}},
@@ -112,6 +134,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples"}},
+    {"Irradiance probes", {"probe-box", "probe-rays"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -275,6 +298,14 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
   app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default " + shown(LightAdditions{}.environmentRotation) + ")")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
+  app->add_option("--probes", a.probes,
+                  "irradiance probes for moving objects (IRBAKE_light_probes): auto (default:\n"
+                  "about 1024 probes on a grid over the scene), off, or a spacing in metres")
+      ->type_name("auto|off|M");
+  app->add_option("--probe-box", a.probeBox, "the probes fill this box instead of the scene's bounds")
+      ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
+  app->add_option("--probe-rays", o.probes.rays, "rays per probe (default 1024)")
+      ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");
@@ -393,6 +424,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
   if (a.clampOption->count() > 0 && a.clamp > 0.0 && a.clamp < kSmallestClamp)
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
   command.lights = lightArguments(a);
+  probeArguments(a, o.probes);
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");

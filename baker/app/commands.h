@@ -12,4 +12,5 @@ int runBake(const Args& args);
 int runMerge(const Args& args);
 int runDiff(const Args& args);
 int runSamples(const Args& args);
+int runProbe(const Args& args);
 }  // namespace irbake::app

@@ -19,6 +19,7 @@ const char* kUsage =
     "  merge DIR... -o OUTDIR           finish a bake from its shards (bake --shard K/N)\n"
     "  diff A B                         compare two bakes of the same atlas\n"
     "  samples OUTDIR                   write the built-in sample scenes\n"
+    "  probe GLTF --at X,Y,Z            the baked irradiance probes read at a point (JSON)\n"
     "  --version                        print the version and exit\n"
     "run 'irbake <command> --help' for a command's options\n";
 }
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
     if (cmd == "merge") return irbake::app::runMerge(args);
     if (cmd == "diff") return irbake::app::runDiff(args);
     if (cmd == "samples") return irbake::app::runSamples(args);
+    if (cmd == "probe") return irbake::app::runProbe(args);
     std::fprintf(stderr, "irbake: error: unknown command '%s'\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const irbake::Error& e) {

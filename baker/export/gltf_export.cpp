@@ -27,6 +27,7 @@
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
 #include "export/directional_export.h"
+#include "export/light_probes_export.h"
 #include "export/lightmap_png.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_source.h"
@@ -100,9 +101,9 @@ bool readFileInto(const std::filesystem::path& path, std::vector<uint8_t>& bin, 
   return length == 0 || static_cast<bool>(in.read(reinterpret_cast<char*>(bin.data() + offset), static_cast<std::streamsize>(length)));
 }
 
-// The source document with all buffers merged into buffer 0 and every image embedded. `extraBytes`:
-// what the caller will append (reserved up front, so buffer 0 is not copied while it grows; reserved
-// pages it does not use are never touched, so cost no memory).
+}  // namespace
+
+// (gltf_export.h) Reserved pages it does not use are never touched, so cost no memory.
 GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t extraBytes) {
   GltfSource src = readGltfSource(sourcePath);
   json root = std::move(src.json);
@@ -164,6 +165,8 @@ GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t 
     }
   return doc;
 }
+
+namespace {
 
 std::string pageUri(const ExportOptions& options, int page) { return options.exrPrefix + "_" + std::to_string(page) + ".exr"; }
 
@@ -531,6 +534,9 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   }
   if (doc.root.contains("images"))
     for (auto& image : doc.root["images"]) image.erase(kSourceUriKey);
+  // After the last compaction, which knows nothing of the probes' accessors; a source's own probes go.
+  removeLightProbesExtension(doc.root);
+  if (options.probes && options.probes->size() > 0) addLightProbesExtension(doc, *options.probes);
   std::vector<PendingFile> docFiles = doc.files(options.output);
   files.insert(files.begin(), docFiles.begin(), docFiles.end());
   if (options.writeExrPages) {

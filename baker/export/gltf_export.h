@@ -10,7 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "lightmap/lightmap.h"
+#include "lightmap/probe_grid.h"
 #include "common/atomic_file.h"
+#include "export/gltf_writer.h"
 #include "export/lightmap_png.h"
 #include "scene/scene.h"
 
@@ -24,6 +26,8 @@ struct ExportOptions {
   std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
   // Directional maps' L1 pages (x, y, z; export/directional_export.h), or null: no extension, no files.
   const std::array<std::vector<Lightmap>, 3>* directional = nullptr;
+  // Irradiance probes (export/light_probes_export.h), or null (or empty): no IRBAKE_light_probes.
+  const LightProbeGrid* probes = nullptr;
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;
@@ -41,6 +45,10 @@ std::filesystem::path outputFolderOf(const std::filesystem::path& output);
 // empty: then only TEXCOORD_1 and extras.lightmap are added, as `irbake unwrap` does). Every file is
 // written to a temp name and renamed only when all succeeded. Throws Error(Io) naming the file.
 void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const ExportOptions& options);
+
+// The document of a glTF/GLB file with all its buffers merged into buffer 0 and every image embedded;
+// extraBytes: what the caller will append (reserved up front). Throws Error naming the file.
+GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t extraBytes = 0);
 
 // The scene's sky as the export's root extras "irbakeSky": {"radiance": [r, g, b]} for a uniform sky,
 // {"environment": file, "meanRadiance": [...], "rotation": radians} for a map (its file is not copied).

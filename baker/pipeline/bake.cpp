@@ -457,6 +457,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   report["surfaceFilters"] = {{"plans", s.surfaceFilters->plansMade()}, {"fallbacks", s.surfaceFilters->fallbacks()}};
   if (s.plan.directional) directionalStage(ctx, r.directional);
   const PostStats post = postStage(ctx, r.maps);
+  probeStage(ctx, r.maps, r.probes);
   s.seconds["bake"] = s.total.seconds();
   describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, s.glStats, s.interleaveStats,
                          s.blocks.size(), s.importanceStats, post},

@@ -29,6 +29,7 @@ struct BakeResult {
   // With BakeOptions::directional: the L1x, L1y, L1z pages (transport/directional.h), one per page each,
   // from the backend's own passes and exact sums like maps, post-processed like them; empty otherwise.
   L1Pages directional;
+  LightProbeGrid probes;             // with BakeOptions::probes enabled: the grid, baked; size() 0 otherwise
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

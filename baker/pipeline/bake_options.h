@@ -10,6 +10,7 @@
 #include "pipeline/backend_choice.h"
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/gather/final_gather.h"
+#include "stages/probes/light_probes.h"
 #include "stages/shadow_edges/shadow_edges.h"
 #include "stages/sky/sky_light.h"
 #include "texels/texel_samples.h"
@@ -80,6 +81,8 @@ struct BakeOptions {
   bool directional = false;               // also bake the L1 pages (BakeResult::directional) in the
                                           // backend's passes (4 coefficients in the exact sums); the map's
                                           // bytes are the same. Off: no extra work, the same bytes as before
+  ProbeOptions probes;                    // irradiance probes read from the finished map (stages/probes); off:
+                                          // none, and every other output the same bytes
   ProgressCallback progress;
 };
 

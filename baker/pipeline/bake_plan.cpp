@@ -127,6 +127,25 @@ void settleSky(BakePlan& plan, const Scene& scene, const RayTracer& rayTracer, c
   if (plan.skyByGather) plan.gather.missRadiance = scene.environment.uniformRadiance();
 }
 
+// The probes' grid: its volume (the box asked for, else the scene's bounds) and spacing, checked here so that a
+// spacing too small for the volume is refused before the bake rather than after it.
+void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
+  plan.probes = options.probes;
+  plan.probes.seed = options.walk.seed;
+  if (!plan.probes.enabled) return;
+  const Bounds3 volume = options.probes.box ? *options.probes.box : scene.bounds();
+  const bool automatic = !options.probes.spacing;
+  const float spacing = automatic ? chooseProbeSpacing(volume) : *options.probes.spacing;
+  const LightProbeGrid grid = probeGridOver(volume, spacing, plan.probes.maxProbes);
+  plan.probes.spacing = spacing;
+  plan.probes.box = volume;
+  plan.settle("probe-spacing", spacing,
+              std::string(automatic ? "about 1024 probes over the volume: cbrt(volume / 1024)" : "asked for") + ": " +
+                  std::to_string(grid.counts.x) + " x " + std::to_string(grid.counts.y) + " x " +
+                  std::to_string(grid.counts.z) + " probes",
+              automatic);
+}
+
 }  // namespace
 
 BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
@@ -139,6 +158,7 @@ BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOpti
   settleCompensation(plan, options, probeGl);
   settleSky(plan, scene, rayTracer, options);
   plan.shadowEdges = options.shadowEdges;
+  settleProbes(plan, scene, options);
   plan.post.dilate = options.postDilate;
   plan.post.stitchSeams = options.postSeams;
   plan.eval = options.eval;

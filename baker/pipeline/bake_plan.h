@@ -43,6 +43,7 @@ struct BakePlan {
   SkyLightOptions sky;                      // as the sky stage runs
   FinalGatherOptions gather;                // as the final gather runs
   ShadowEdgeOptions shadowEdges;            // as the shadow-edge stage runs
+  ProbeOptions probes;                      // as the probe stage runs (spacing and box settled when enabled)
   PostOptions post;                         // dilation and seams
   // Settled once the walk's VPLs are known (settleClamp, settleBlocks):
   VplEvalOptions eval;                      // with the clamp bound

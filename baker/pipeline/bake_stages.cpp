@@ -5,6 +5,7 @@
 
 #include "common/progress.h"
 #include "stages/gather/final_gather.h"
+#include "stages/probes/light_probes.h"
 #include "stages/shadow_edges/shadow_edges.h"
 #include "stages/sky/sky_light.h"
 
@@ -115,6 +116,21 @@ PostStats postStage(StageContext& ctx, std::vector<Lightmap>& maps) {
     if (ctx.progress) ctx.progress("post", 1.0);
   });
   return stats;
+}
+
+void probeStage(StageContext& ctx, const std::vector<Lightmap>& maps, LightProbeGrid& grid) {
+  const ProbeOptions& o = ctx.plan.probes;
+  if (!o.enabled || !o.spacing || !o.box) return;
+  ctx.timed("probes", [&] {
+    if (ctx.progress) ctx.progress("probes", 0.0);
+    grid = probeGridOver(*o.box, *o.spacing, o.maxProbes);
+    ProbeStats stats;
+    bakeLightProbes(ctx.inputs, maps, grid, o, &stats);
+    if (ctx.progress) ctx.progress("probes", 1.0);
+    ctx.report["probes"] = stats.toJson();
+    ctx.report["probes"]["counts"] = {grid.counts.x, grid.counts.y, grid.counts.z};
+    ctx.report["probes"]["raysPerProbe"] = o.rays;
+  });
 }
 
 }  // namespace irbake

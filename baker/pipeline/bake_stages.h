@@ -9,6 +9,7 @@
 
 #include "evaluators/bake_inputs.h"
 #include "lightmap/lightmap.h"
+#include "lightmap/probe_grid.h"
 #include "pipeline/bake_plan.h"
 #include "post/post.h"
 #include "stages/compensation/clamp_compensation.h"
@@ -45,5 +46,8 @@ void finalGatherStage(StageContext& ctx, const std::vector<Lightmap>& direct, co
 void directionalStage(StageContext& ctx, L1Pages& axes);
 // Dilation and seams on the map pages.
 PostStats postStage(StageContext& ctx, std::vector<Lightmap>& maps);
+// Irradiance probes read from the final maps (after post: the seam stitching moves valid texels, not only
+// padding, and the probes must see the map the export writes); grid left empty when the plan has none.
+void probeStage(StageContext& ctx, const std::vector<Lightmap>& maps, LightProbeGrid& grid);
 
 }  // namespace irbake

@@ -71,6 +71,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
     ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
+    ex.probes = &result.probes;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;

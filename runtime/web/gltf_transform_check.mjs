@@ -1,17 +1,18 @@
 // Checks for gltf_transform_irbake.mjs (run by web_pipeline_test.sh):
-//   survives --modules DIR --input BAKE.gltf --output OPT.glb [--directional]
+//   survives --modules DIR --input BAKE.gltf --output OPT.glb [--directional] [--probes]
 //     every material of the bake that has MOZ_lightmap (and IRBAKE_lightmap_directional) has it in the output
 //     with the same numbers and texCoord 1 on an existing texture; every light-mapped primitive has TEXCOORD_1
-//     with POSITION's vertex count; the light-mapped triangles are as many as in the bake.
+//     with POSITION's vertex count; the light-mapped triangles are as many as in the bake; with --probes,
+//     IRBAKE_light_probes keeps its fields and every accessor value.
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
-//     read → write keeps both extensions' JSON exactly; bad input (missing texture, texCoord ≠ 1, negative or
-//     non-numeric intensity, incomplete directional extension) and bad output (no TEXCOORD_1, fewer triangles)
+//     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
+//     non-numeric intensity, incomplete directional extension, a probe grid that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
 //     throw an Error naming the material or mesh.
 // Exit 0 when every check passes, 1 with the failures listed.
 import fs from 'node:fs';
 import path from 'node:path';
-import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHTMAP_DIRECTIONAL, MOZ_LIGHTMAP }
-  from './gltf_transform_irbake.mjs';
+import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHT_PROBES, IRBAKE_LIGHTMAP_DIRECTIONAL,
+  MOZ_LIGHTMAP, PROBE_ACCESSORS } from './gltf_transform_irbake.mjs';
 
 const [mode, ...rest] = process.argv.slice(2);
 // --name value, or --name alone (a flag: true).
@@ -27,8 +28,8 @@ const { ALL_EXTENSIONS } = await importPackage(modules, '@gltf-transform/extensi
 const functions = await importPackage(modules, '@gltf-transform/functions');
 const { MeshoptDecoder } = await importPackage(modules, 'meshoptimizer');
 await MeshoptDecoder.ready;
-const { MozLightmap, IrbakeLightmapDirectional } = defineIrbakeExtensions(core);
-const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional])
+const { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes } = defineIrbakeExtensions(core);
+const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes])
   .registerDependencies({ 'meshopt.decoder': MeshoptDecoder });
 io.setLogger(new core.Logger(core.Logger.Verbosity.ERROR));
 
@@ -94,8 +95,29 @@ function survives() {
     const total = d => [...countLightmappedTriangles(d).values()].reduce((x, y) => x + y, 0);
     const before = total(a), after = total(b);
     check(before === after && before > 0, `light-mapped triangles ${before} → ${after}`);
-    console.log(JSON.stringify({ output: args.output, materials, directional, primitives, triangles: after }));
+    const probes = args.probes ? probesSurvive(a, b, input, output) : 0;
+    console.log(JSON.stringify({ output: args.output, materials, directional, primitives, triangles: after, probes }));
   });
+}
+
+// IRBAKE_light_probes: the same grid fields in the output's JSON, and its accessors' values (as glTF-Transform
+// decodes them, meshopt or not) equal to the bake's, bit for bit. Returns the probe count.
+function probesSurvive(inDoc, outDoc, inJson, outJson) {
+  const inDef = inJson.extensions?.[IRBAKE_LIGHT_PROBES], outDef = outJson.extensions?.[IRBAKE_LIGHT_PROBES];
+  check(inDef, `${args.input}: no ${IRBAKE_LIGHT_PROBES}`);
+  check(outDef, `${args.output}: ${IRBAKE_LIGHT_PROBES} lost`);
+  check((outJson.extensionsUsed ?? []).includes(IRBAKE_LIGHT_PROBES), `${args.output}: ${IRBAKE_LIGHT_PROBES} not in extensionsUsed`);
+  check(!(outJson.extensionsRequired ?? []).includes(IRBAKE_LIGHT_PROBES), `${args.output}: ${IRBAKE_LIGHT_PROBES} required`);
+  if (!inDef || !outDef) return 0;
+  const fields = d => Object.fromEntries(Object.entries(d).filter(([k]) => !(k in PROBE_ACCESSORS)));
+  check(same(fields(inDef), fields(outDef)), `${IRBAKE_LIGHT_PROBES}: fields ${JSON.stringify(fields(outDef))}`);
+  const gridA = inDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES), gridB = outDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
+  for (const key of Object.keys(PROBE_ACCESSORS)) {
+    const a = gridA?.getAccessor(key)?.getArray(), b = gridB?.getAccessor(key)?.getArray();
+    check(a && b && a.length === b.length && a.every((v, i) => Object.is(v, b[i])),
+          `${IRBAKE_LIGHT_PROBES}.${key}: ${a?.length} values in, ${b?.length} out${a && b && a.length === b.length ? ', some differ' : ''}`);
+  }
+  return inDef.counts.reduce((x, y) => x * y, 1);
 }
 
 // Runs fn and requires an Error whose message has every one of the texts.
@@ -141,6 +163,20 @@ async function refusals() {
   await throws('L1 texCoord 0', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[2].texCoord = 0; }), label, 'l1[2]', 'texCoord 0');
   await throws('L1 missing texture', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[1].index = 42; }), label, 'texture 42 does not exist');
   await throws('L1 negative scale', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[0].scale = -2; }), label, 'scale -2');
+
+  // IRBAKE_light_probes: read → write keeps its fields; a grid that does not fit its accessors is refused.
+  if (original.json.extensions?.[IRBAKE_LIGHT_PROBES]) {
+    const fields = d => Object.fromEntries(Object.entries(d).filter(([k]) => !(k in PROBE_ACCESSORS)));
+    check(same(fields(written.json.extensions[IRBAKE_LIGHT_PROBES]), fields(original.json.extensions[IRBAKE_LIGHT_PROBES])),
+          `read → write changed ${IRBAKE_LIGHT_PROBES}`);
+    const badGrid = mutate => () => { const doc = clone(); mutate(doc.json.extensions[IRBAKE_LIGHT_PROBES]); return io.readJSON(doc); };
+    await throws('probe counts', badGrid(e => { e.counts[0] += 1; }), `${IRBAKE_LIGHT_PROBES}.coefficients`, 'the grid needs');
+    await throws('probe spacing', badGrid(e => { e.spacing = -1; }), `${IRBAKE_LIGHT_PROBES}.spacing -1`);
+    await throws('probe accessor', badGrid(e => { e.valid = 9999; }), `${IRBAKE_LIGHT_PROBES}.valid`, 'does not exist');
+    await throws('probe counts type', badGrid(e => { e.counts = [2, 2]; }), `${IRBAKE_LIGHT_PROBES}.counts`);
+  } else {
+    failures.push(`${args.input}: no ${IRBAKE_LIGHT_PROBES} (baked with --probes off?)`);
+  }
 
   // Bad output: a light-mapped primitive without TEXCOORD_1; one triangle fewer (what simplification does).
   const lightmapped = doc => doc.getRoot().listMeshes().flatMap(m => m.listPrimitives().map(p => [m, p]))

@@ -1,21 +1,25 @@
-// irbake's light-map extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap and
+// irbake's extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap and
 // IRBAKE_lightmap_directional as extension properties whose textures are real Texture references
 // (TextureInfo, texCoord 1), so prune, dedup, resize and texture compression treat the maps as used textures and
 // keep TEXCOORD_1. Reading refuses what irbake's viewers would show wrongly (a missing texture, a texCoord other
 // than 1, a negative or non-numeric intensity, an incomplete directional extension) with an Error naming the
-// material. Writing refuses an output on which the bake no longer fits its geometry: a light-mapped primitive
+// material. IRBAKE_light_probes (on the root) keeps its accessors as Accessor references; reading refuses a grid
+// whose fields or accessors do not fit, naming the field. Writing refuses an output on which the bake no longer fits its geometry: a light-mapped primitive
 // without TEXCOORD_1, or fewer light-mapped triangles than were read (simplification).
 //
 // The classes must extend the very @gltf-transform/core the caller (the CLI) uses, so they are made from it:
 //   const core = await importPackage(modulesDir, '@gltf-transform/core');
-//   const { MozLightmap, IrbakeLightmapDirectional } = defineIrbakeExtensions(core);
-//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional]);
+//   const { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes } = defineIrbakeExtensions(core);
+//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes]);
 import fs from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 
 export const MOZ_LIGHTMAP = 'MOZ_lightmap';
 export const IRBAKE_LIGHTMAP_DIRECTIONAL = 'IRBAKE_lightmap_directional';
+export const IRBAKE_LIGHT_PROBES = 'IRBAKE_light_probes';
+// The probe grid's accessors (docs/export.md, "IRBAKE_light_probes"): component type, type and elements per probe.
+export const PROBE_ACCESSORS = { coefficients: [5126, 'VEC3', 9], offsets: [5126, 'VEC3', 1], valid: [5126, 'SCALAR', 1] };
 // The UV set of every light map (docs/export.md): TEXCOORD_1.
 export const LIGHTMAP_TEXCOORD = 1;
 const AXES = ['x', 'y', 'z'];
@@ -338,7 +342,79 @@ export function defineIrbakeExtensions(core) {
     write() { return this; }
   }
 
-  return { MozLightmap, IrbakeLightmapDirectional, Lightmap, DirectionalLightmap };
+  // IRBAKE_light_probes on the root: the grid's fields as read, and its three accessors as real Accessor
+  // references, so prune and dedup keep them and the writer renumbers them.
+  class LightProbeGrid extends ExtensionProperty {
+    static EXTENSION_NAME = IRBAKE_LIGHT_PROBES;
+    init() {
+      this.extensionName = IRBAKE_LIGHT_PROBES;
+      this.propertyType = 'LightProbeGrid';
+      this.parentTypes = [PropertyType.ROOT];
+    }
+    getDefaults() {
+      return Object.assign(super.getDefaults(), { coefficients: null, offsets: null, valid: null, fields: {} });
+    }
+    getAccessor(key) { return this.getRef(key); }
+    setAccessor(key, accessor) { return this.setRef(key, accessor, { usage: 'OTHER' }); }  // no vertex data: a view of its own
+    getFields() { return this.get('fields'); }  // origin, spacing, counts, units, convention, anything else
+    setFields(fields) { return this.set('fields', fields); }
+  }
+
+  class IrbakeLightProbes extends Extension {
+    static EXTENSION_NAME = IRBAKE_LIGHT_PROBES;
+    extensionName = IRBAKE_LIGHT_PROBES;
+
+    createLightProbeGrid() { return new LightProbeGrid(this.document.getGraph()); }
+
+    read(context) {
+      const json = context.jsonDoc.json, def = json.extensions?.[IRBAKE_LIGHT_PROBES];
+      if (def === undefined) return this;
+      const probes = checkProbeGrid(def);
+      const grid = this.createLightProbeGrid().setFields(without(def, Object.keys(PROBE_ACCESSORS)));
+      for (const [key, [componentType, type, per]] of Object.entries(PROBE_ACCESSORS)) {
+        const index = def[key], accessorDef = json.accessors?.[index];
+        const what = `${IRBAKE_LIGHT_PROBES}.${key}`;
+        if (!Number.isInteger(index) || accessorDef === undefined) throw new Error(`${what}: accessor ${JSON.stringify(index)} does not exist`);
+        if (accessorDef.componentType !== componentType || accessorDef.type !== type || accessorDef.count !== probes * per)
+          throw new Error(`${what}: accessor ${index} is ${accessorDef.count} × ${accessorDef.type} of componentType ` +
+                          `${accessorDef.componentType}, the grid needs ${probes * per} × ${type} of ${componentType}`);
+        grid.setAccessor(key, context.accessors[index]);
+      }
+      this.document.getRoot().setExtension(IRBAKE_LIGHT_PROBES, grid);
+      return this;
+    }
+
+    write(context) {
+      const grid = this.document.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
+      if (!grid) return this;
+      const def = { ...grid.getFields() };
+      for (const key of Object.keys(PROBE_ACCESSORS)) {
+        const accessor = grid.getAccessor(key);
+        const index = accessor ? context.accessorIndexMap.get(accessor) : undefined;
+        if (index === undefined) throw new Error(`${IRBAKE_LIGHT_PROBES}: the ${key} accessor was lost`);
+        def[key] = index;
+      }
+      const json = context.jsonDoc.json;
+      json.extensions = json.extensions ?? {};
+      json.extensions[IRBAKE_LIGHT_PROBES] = def;
+      return this;
+    }
+  }
+
+  return { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes, Lightmap, DirectionalLightmap, LightProbeGrid };
+}
+
+// The probe count of an IRBAKE_light_probes definition, or an Error naming the field that is wrong.
+export function checkProbeGrid(def) {
+  const what = IRBAKE_LIGHT_PROBES;
+  if (!isObject(def)) throw new Error(`${what} is not an object`);
+  const numbers = (v, n) => Array.isArray(v) && v.length === n && v.every(x => typeof x === 'number' && Number.isFinite(x));
+  if (!numbers(def.origin, 3)) throw new Error(`${what}.origin ${JSON.stringify(def.origin)} needs 3 finite numbers`);
+  if (!(typeof def.spacing === 'number' && Number.isFinite(def.spacing) && def.spacing > 0))
+    throw new Error(`${what}.spacing ${JSON.stringify(def.spacing)} must be a finite number > 0`);
+  if (!numbers(def.counts, 3) || !def.counts.every(c => Number.isInteger(c) && c >= 1))
+    throw new Error(`${what}.counts ${JSON.stringify(def.counts)} needs 3 whole numbers ≥ 1`);
+  return def.counts[0] * def.counts[1] * def.counts[2];
 }
 
 // Texture infos inside a material definition (every object with an integer 'index': core slots and

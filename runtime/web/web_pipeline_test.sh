@@ -5,7 +5,8 @@
 #   - the normal-mapped plane of make_directional_scene.mjs with --directional: optimize with its default
 #     simplify must refuse (the plane's grid simplifies), with --simplify false it must pass;
 #   - the DamagedHelmet from ../shared with --directional (skipped with a message when absent).
-# Each output: every MOZ_lightmap / IRBAKE_lightmap_directional and every TEXCOORD_1 survives with the bake's
+# Each output: every MOZ_lightmap / IRBAKE_lightmap_directional, every TEXCOORD_1 and (Cornell) the
+# IRBAKE_light_probes grid with its accessors' values survives with the bake's
 # numbers and triangle count (gltf_transform_check.mjs survives); three.js renders it (render_compare.mjs)
 # within a mean absolute difference of 3 (8-bit) of irview on the original bake; the Khronos validator finds
 # no error and no new warning (validate.mjs). Then the module's refusals of bad input and output
@@ -45,7 +46,7 @@ for kind in plain directional; do
   "$irview" "$work/cornell_$kind/scene.gltf" --camera 0 --width 320 --height 320 \
     --screenshot "$work/cornell_${kind}_irview.png" >> "$work/irview.log" 2>&1
   optimize "$work/cornell_$kind/scene.gltf" "$work/cornell_$kind.glb"
-  survives "$work/cornell_$kind/scene.gltf" "$work/cornell_$kind.glb" $flag
+  survives "$work/cornell_$kind/scene.gltf" "$work/cornell_$kind.glb" $flag --probes
   compare "$work/cornell_$kind.glb" "$work/cornell_${kind}_irview.png" "$work/cornell_${kind}_web.png" 320
   validate "$work/cornell_$kind.glb" "$work/cornell_$kind/scene.gltf"
 done

@@ -1,0 +1,136 @@
+#include "export/light_probes_export.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "common/error.h"
+#include "export/gltf_compact.h"
+#include "export/gltf_export.h"
+
+namespace irbake {
+namespace {
+
+using json = nlohmann::json;
+constexpr int kFloat = 5126;
+
+int addAccessor(GltfDocument& doc, const void* data, size_t bytes, int componentType, size_t count, const char* type) {
+  const int view = doc.addBufferView(data, bytes);
+  return doc.append("accessors", {{"bufferView", view}, {"componentType", componentType}, {"count", count}, {"type", type}});
+}
+
+// Accessor `key` of the extension as tightly packed bytes, checked against the type and count the grid needs.
+AccessorBytes probeAccessor(const GltfDocument& doc, const json& ext, const char* key, int componentType,
+                            const char* type, size_t count, const std::string& file) {
+  const std::string what = std::string(kLightProbesExtension) + "." + key;
+  if (!ext.contains(key) || !ext[key].is_number_integer()) throw Error(ErrorCode::InvalidData, file, what + ": no accessor index");
+  AccessorBytes a = readAccessor(doc, ext[key].get<int>(), file);
+  if (a.componentType != componentType || a.type != type)
+    throw Error(ErrorCode::InvalidData, file, what + ": accessor of componentType " + std::to_string(a.componentType) +
+                                                  " " + a.type + ", expected " + std::to_string(componentType) + " " + type);
+  if (a.count != count)
+    throw Error(ErrorCode::InvalidData, file, what + ": " + std::to_string(a.count) + " elements, the grid needs " +
+                                                  std::to_string(count));
+  return a;
+}
+
+glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file) {
+  const json* v = ext.contains(key) ? &ext[key] : nullptr;
+  if (!v || !v->is_array() || v->size() != 3 || !(*v)[0].is_number() || !(*v)[1].is_number() || !(*v)[2].is_number())
+    throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + "." + key + ": needs 3 numbers");
+  const glm::vec3 r((*v)[0].get<float>(), (*v)[1].get<float>(), (*v)[2].get<float>());
+  if (!std::isfinite(r.x) || !std::isfinite(r.y) || !std::isfinite(r.z))
+    throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + "." + key + ": not finite");
+  return r;
+}
+
+}  // namespace
+
+void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
+  const size_t n = grid.size();
+  std::vector<glm::vec3> coefficients;
+  coefficients.reserve(n * kShCoefficients);
+  for (const ShCoefficients& c : grid.coefficients) coefficients.insert(coefficients.end(), c.begin(), c.end());
+  // Validity as float 0/1: an UNSIGNED_BYTE accessor came back scrambled through gltf-transform optimize (its
+  // meshopt compression pads such streams to 4-byte elements), floats come back bit for bit.
+  std::vector<float> valid(grid.valid.begin(), grid.valid.end());
+  json ext = {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
+              {"spacing", grid.spacing},
+              {"counts", {grid.counts.x, grid.counts.y, grid.counts.z}},
+              {"coefficients", addAccessor(doc, coefficients.data(), coefficients.size() * sizeof(glm::vec3), kFloat,
+                                           coefficients.size(), "VEC3")},
+              {"offsets", addAccessor(doc, grid.offsets.data(), n * sizeof(glm::vec3), kFloat, n, "VEC3")},
+              {"valid", addAccessor(doc, valid.data(), n * sizeof(float), kFloat, n, "SCALAR")},
+              {"units", "irradiance/pi"},
+              {"convention", "three.js SphericalHarmonics3"}};
+  doc.root["extensions"][kLightProbesExtension] = std::move(ext);
+  doc.useExtension(kLightProbesExtension);
+}
+
+void removeLightProbesExtension(json& root) {
+  if (root.contains("extensions") && root["extensions"].is_object() && root["extensions"].contains(kLightProbesExtension)) {
+    root["extensions"].erase(kLightProbesExtension);
+    if (root["extensions"].empty()) root.erase("extensions");
+  }
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (!root.contains(list) || !root[list].is_array()) continue;
+    if (std::find(root[list].begin(), root[list].end(), json(kLightProbesExtension)) == root[list].end()) continue;
+    json kept = json::array();
+    for (const json& e : root[list])
+      if (e != kLightProbesExtension) kept.push_back(e);
+    if (kept.empty()) root.erase(list);
+    else root[list] = std::move(kept);
+  }
+}
+
+LightProbeGrid readLightProbes(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  const GltfDocument doc = documentFromSource(path);
+  const json* ext = nullptr;
+  if (doc.root.contains("extensions") && doc.root["extensions"].is_object() && doc.root["extensions"].contains(kLightProbesExtension))
+    ext = &doc.root["extensions"][kLightProbesExtension];
+  if (!ext || !ext->is_object())
+    throw Error(ErrorCode::InvalidData, file, std::string("no ") + kLightProbesExtension + " extension (baked with --probes off?)");
+  LightProbeGrid g;
+  g.origin = vec3Of(*ext, "origin", file);
+  const glm::vec3 counts = vec3Of(*ext, "counts", file);
+  double total = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    if (!(counts[a] >= 1.0f) || counts[a] != std::floor(counts[a]) || counts[a] > 1e6f)
+      throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".counts: " + std::to_string(counts[a]) +
+                                                    " is not a whole number from 1 to 10^6");
+    g.counts[a] = static_cast<int>(counts[a]);
+    total *= counts[a];
+  }
+  if (total > 1e8) throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".counts: more than 10^8 probes");
+  if (!ext->contains("spacing") || !(*ext)["spacing"].is_number() || !((*ext)["spacing"].get<float>() > 0.0f) ||
+      !std::isfinite((*ext)["spacing"].get<float>()))
+    throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".spacing: needs a positive finite number");
+  g.spacing = (*ext)["spacing"].get<float>();
+  const size_t n = g.size();
+  const AccessorBytes c = probeAccessor(doc, *ext, "coefficients", kFloat, "VEC3", n * kShCoefficients, file);
+  const AccessorBytes o = probeAccessor(doc, *ext, "offsets", kFloat, "VEC3", n, file);
+  const AccessorBytes v = probeAccessor(doc, *ext, "valid", kFloat, "SCALAR", n, file);
+  g.coefficients.resize(n);
+  g.offsets.resize(n);
+  std::memcpy(g.coefficients.data(), c.bytes.data(), n * sizeof(ShCoefficients));
+  std::memcpy(g.offsets.data(), o.bytes.data(), n * sizeof(glm::vec3));
+  std::vector<float> valid(n);
+  std::memcpy(valid.data(), v.bytes.data(), n * sizeof(float));
+  g.valid.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    bool finite = std::isfinite(g.offsets[i].x) && std::isfinite(g.offsets[i].y) && std::isfinite(g.offsets[i].z);
+    for (const glm::vec3& k : g.coefficients[i]) finite = finite && std::isfinite(k.x) && std::isfinite(k.y) && std::isfinite(k.z);
+    if (!finite)
+      throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ": probe " + std::to_string(i) +
+                                                    " has a non-finite coefficient or offset");
+    if (valid[i] != 0.0f && valid[i] != 1.0f)
+      throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".valid: probe " + std::to_string(i) +
+                                                    " holds " + std::to_string(valid[i]) + " (0 or 1)");
+    g.valid[i] = valid[i] == 1.0f;
+  }
+  return g;
+}
+
+}  // namespace irbake

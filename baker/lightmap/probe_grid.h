@@ -1,0 +1,129 @@
+// Irradiance probes on a regular grid: each probe holds the light arriving at a point as L2 spherical
+// harmonics (9 RGB coefficients), in the map's units, in three.js's SphericalHarmonics3 / LightProbe convention
+// (docs/export.md, "IRBAKE_light_probes"):
+//   c_k = (1/π) ∫ L(ω) Y_k(ω) dω,  k = 0..8, world axes of the glTF (+Y up), Y_k three.js's real basis
+//   Y_0 = 0.282095; Y_1..3 = 0.488603 (y, z, x); Y_4 = 1.092548 xy, Y_5 = 1.092548 yz,
+//   Y_6 = 0.315392 (3z² − 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x² − y²)
+// so that SphericalHarmonics3.getIrradianceAt(n) (the shader's shGetIrradianceAt: Σ Â_l c_k Y_k(n), Â = π,
+// 2π/3, π/4) gives E(n)/π: the value a light-map texel facing n would hold there.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace irbake {
+
+constexpr int kShCoefficients = 9;
+using ShCoefficients = std::array<glm::vec3, kShCoefficients>;
+
+// three.js's real SH basis at unit direction d.
+inline std::array<float, kShCoefficients> shBasis(const glm::vec3& d) {
+  const float x = d.x, y = d.y, z = d.z;
+  return {0.282095f,          0.488603f * y,      0.488603f * z,
+          0.488603f * x,      1.092548f * x * y,  1.092548f * y * z,
+          0.315392f * (3.0f * z * z - 1.0f),      1.092548f * x * z, 0.546274f * (x * x - y * y)};
+}
+
+// Σ Â_l c_k Y_k(n) as three.js's getIrradianceAt writes it: E(n)/π for coefficients in map units.
+inline glm::vec3 shIrradiance(const ShCoefficients& c, const glm::vec3& n) {
+  const float x = n.x, y = n.y, z = n.z;
+  glm::vec3 r = c[0] * 0.886227f;
+  r += c[1] * (2.0f * 0.511664f * y) + c[2] * (2.0f * 0.511664f * z) + c[3] * (2.0f * 0.511664f * x);
+  r += c[4] * (2.0f * 0.429043f * x * y) + c[5] * (2.0f * 0.429043f * y * z);
+  r += c[6] * (0.743125f * z * z - 0.247708f) + c[7] * (2.0f * 0.429043f * x * z);
+  r += c[8] * (0.429043f * (x * x - y * y));
+  return r;
+}
+
+// The mean of E(n)/π over every direction n: the L0 term alone (0.886227 · c_0).
+inline glm::vec3 shAverage(const ShCoefficients& c) { return c[0] * 0.886227f; }
+
+// Adds a light of map value `value` (E/π at normal incidence) from direction d: c_k += value · Y_k(d).
+inline void shAddDirectional(ShCoefficients& c, const glm::vec3& d, const glm::vec3& value) {
+  const auto y = shBasis(d);
+  for (int k = 0; k < kShCoefficients; ++k) c[k] += value * y[k];
+}
+
+struct LightProbeGrid {
+  glm::vec3 origin{0.0f};        // position of probe (0, 0, 0), metres, world space
+  float spacing = 0.0f;          // between neighbours along each axis
+  glm::ivec3 counts{0};          // probes along x, y, z; probe (i, j, k) is index i + nx (j + ny k)
+  std::vector<ShCoefficients> coefficients;  // one per probe (map units: see above)
+  std::vector<glm::vec3> offsets;            // where each probe was baked, relative to its grid point
+  std::vector<uint8_t> valid;                // 0: inside geometry or behind a wall, left out of interpolation
+
+  size_t size() const { return static_cast<size_t>(counts.x) * counts.y * counts.z; }
+  size_t index(int i, int j, int k) const {
+    return static_cast<size_t>(i) + static_cast<size_t>(counts.x) * (static_cast<size_t>(j) + static_cast<size_t>(counts.y) * k);
+  }
+  glm::vec3 gridPoint(int i, int j, int k) const { return origin + spacing * glm::vec3(i, j, k); }
+  glm::vec3 position(size_t index) const {
+    const int i = static_cast<int>(index % counts.x), j = static_cast<int>(index / counts.x % counts.y),
+              k = static_cast<int>(index / (static_cast<size_t>(counts.x) * counts.y));
+    return gridPoint(i, j, k) + (index < offsets.size() ? offsets[index] : glm::vec3(0.0f));
+  }
+};
+
+// What interpolation found at a point: the blended coefficients and the weight they carried.
+struct ProbeBlend {
+  ShCoefficients coefficients{};
+  int probes = 0;       // valid, visible probes blended
+  float weight = 0.0f;  // their summed trilinear weight (0: none; coefficients then 0)
+};
+
+// Trilinear over the 8 probes around p (clamped to the grid), each weighted by its validity and, when
+// `visible` is given, by whether p sees the probe's baked position (a wall between them: weight 0, so light
+// never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p.
+inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
+                                    const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
+  ProbeBlend out;
+  if (g.size() == 0 || !(g.spacing > 0.0f)) return out;
+  const glm::vec3 f = (p - g.origin) / g.spacing;
+  glm::ivec3 base;
+  glm::vec3 t;
+  for (int a = 0; a < 3; ++a) {
+    const float hi = static_cast<float>(g.counts[a] - 1);
+    const float c = std::clamp(f[a], 0.0f, hi);
+    base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.counts[a] - 2));
+    t[a] = g.counts[a] > 1 ? c - static_cast<float>(base[a]) : 0.0f;
+  }
+  auto use = [&](size_t idx) { return g.valid[idx] && (!visible || visible(p, g.position(idx))); };
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::ivec3 d(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    const glm::ivec3 q = glm::min(base + d, g.counts - 1);
+    if (glm::any(glm::notEqual(base + d, q))) continue;  // a one-probe axis: its single layer counted once
+    float w = 1.0f;
+    for (int a = 0; a < 3; ++a) w *= d[a] ? t[a] : 1.0f - t[a];
+    const size_t idx = g.index(q.x, q.y, q.z);
+    if (w <= 0.0f || !use(idx)) continue;
+    for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += w * g.coefficients[idx][k];
+    out.weight += w;
+    ++out.probes;
+  }
+  if (out.weight > 0.0f) {
+    for (auto& c : out.coefficients) c /= out.weight;
+    return out;
+  }
+  float best = 1e30f;
+  size_t nearest = g.size();
+  for (int k = base.z - 1; k <= base.z + 2; ++k)
+    for (int j = base.y - 1; j <= base.y + 2; ++j)
+      for (int i = base.x - 1; i <= base.x + 2; ++i) {
+        if (i < 0 || j < 0 || k < 0 || i >= g.counts.x || j >= g.counts.y || k >= g.counts.z) continue;
+        const size_t idx = g.index(i, j, k);
+        const glm::vec3 d = g.position(idx) - p;
+        if (glm::dot(d, d) < best && use(idx)) best = glm::dot(d, d), nearest = idx;
+      }
+  if (nearest == g.size()) return out;
+  out.coefficients = g.coefficients[nearest];
+  out.probes = 1;
+  out.weight = 1.0f;
+  return out;
+}
+
+}  // namespace irbake

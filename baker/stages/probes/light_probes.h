@@ -1,0 +1,65 @@
+// Irradiance probes for moving objects: a regular grid over the scene (or a box), each probe the light arriving
+// there from every direction as L2 spherical harmonics (lightmap/probe_grid.h), from the same light as the maps:
+//   punctual lights exact (a shadow ray each, their map value at normal incidence projected as a delta);
+//   every other direction by N rays on a rotated spherical Fibonacci lattice, c_k = (4π/N)(1/π) Σ L_i Y_k(ω_i):
+//   a ray that escapes brings the sky's radiance, one that hits a front face the surface's outgoing radiance
+//   Le + ρ M read from the finished map (M = E/π, so ρ M is the radiance a Lambertian surface sends; docs/units.md),
+//   one that hits a back face nothing.
+// A probe whose rays meet back faces in more than maxBackFaceShare of the directions is inside geometry: moved
+// through the nearest back face (at most half a spacing), else left invalid. Walls between a point and a probe
+// are the reader's to test (interpolateProbes' visibility), so no light crosses them.
+#pragma once
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "evaluators/bake_inputs.h"
+#include "lightmap/lightmap.h"
+#include "lightmap/lightmap_read.h"
+#include "lightmap/probe_grid.h"
+
+namespace irbake {
+
+struct ProbeOptions {
+  bool enabled = true;                // --probes off: no probes, no extension, nothing else changes
+  std::optional<float> spacing;       // metres; unset: automatic (chooseProbeSpacing)
+  std::optional<Bounds3> box;         // the volume the grid fills; unset: the scene's bounds
+  int rays = 1024;                    // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
+                                      // for independent rays, far less on the lattice)
+  float maxBackFaceShare = 0.5f;      // above this share of back-face hits (double-sided surfaces have none) a
+                                      // probe is inside geometry: "mostly back faces". A quarter, the share a
+                                      // probe beside a wall of two coincident opposite quads meets (makeThinWall:
+                                      // the ray finds either), lost 104 of its 1024 valid lit-side probes
+  size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
+  uint32_t seed = 0;                  // turns each probe's lattice
+};
+
+struct ProbeStats {
+  size_t count = 0, valid = 0, moved = 0;
+  float spacing = 0.0f;
+  size_t rays = 0;  // lattice and shadow rays, relocation tests included
+  double seconds = 0.0;
+  nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
+    return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays}};
+  }
+};
+
+// The automatic spacing: about 1024 probes over the volume, cbrt(V / 1024) with each side of V held to at least
+// 1/16 of the longest (a flat scene keeps two layers), never below 1 cm. A fixed count follows the scene's scale
+// and keeps the cost small beside the bake: the longest side / 16 gave a cube 4096 probes, 21% of a
+// DamagedHelmet bake's time (Sponza: 2.0 m, 18 × 8 × 8).
+float chooseProbeSpacing(const Bounds3& volume);
+
+// The grid over `volume` at `spacing`: ceil(extent / spacing) probes per axis (at least 1), centred in the
+// volume, so probes sit half a step in from its faces rather than on walls and floors at its border.
+// Throws Error(Usage) when it would hold more than maxProbes.
+LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes);
+
+// Bakes every probe of `grid` (counts, origin, spacing set) from `maps`, the finished light maps (one per page of
+// in.texels); fills coefficients, offsets and valid.
+void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, LightProbeGrid& grid,
+                     const ProbeOptions& options = {}, ProbeStats* stats = nullptr);
+
+}  // namespace irbake
