@@ -12,6 +12,7 @@
 #include "lightmap/lightmap.h"
 #include "common/atomic_file.h"
 #include "export/lightmap_png.h"
+#include "export/shadow_mask_export.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -24,6 +25,8 @@ struct ExportOptions {
   std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
   // Directional maps' L1 pages (x, y, z; export/directional_export.h), or null: no extension, no files.
   const std::array<std::vector<Lightmap>, 3>* directional = nullptr;
+  // Shadow-mask pages and their lights (export/shadow_mask_export.h), or null: no extension, no files.
+  const ShadowMaskExport* shadowMask = nullptr;
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;

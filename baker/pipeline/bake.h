@@ -14,6 +14,7 @@
 #include "export/portable_export.h"
 #include "lightmap/lightmap.h"
 #include "pipeline/bake_options.h"
+#include "stages/shadow_mask/shadow_mask.h"
 #include "pipeline/bake_plan.h"
 #include "pipeline/vpl_sums.h"
 #include "scene/scene.h"
@@ -29,6 +30,11 @@ struct BakeResult {
   // With BakeOptions::directional: the L1x, L1y, L1z pages (transport/directional.h), one per page each,
   // from the backend's own passes and exact sums like maps, post-processed like them; empty otherwise.
   L1Pages directional;
+  // With shadow-mask lights (BakeOptions::lightModes): their visibility per page, post-processed like maps;
+  // ShadowMaskChannels in lightModes says which light is in which channel. Empty otherwise.
+  ShadowMaskPages shadowMask;
+  std::vector<LightMode> lightModes;   // per scene light, as settled (fallbacks applied)
+  ShadowMaskChannels maskChannels;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

@@ -449,6 +449,22 @@ class Loader {
     scene_.cameras.push_back(cam);
   }
 
+  // extras: {"irbake": {"mode": "baked" | "indirect" | "shadowmask"}} on the glTF light. A bad value is a
+  // bake setting the user must fix (exit 2, as --light-mode's), not a broken file.
+  void readExtrasMode(int li, const std::string& what, Light& light) const {
+    const json* mode = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
+    mode = mode && mode->is_array() && li < static_cast<int>(mode->size()) ? &(*mode)[static_cast<size_t>(li)] : nullptr;
+    const json* irbake = mode ? path(*mode, {"extras", "irbake"}) : nullptr;
+    if (!irbake) return;
+    mode = child(*irbake, "mode");
+    if (!irbake->is_object() || !mode)
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" (got " + irbake->dump() + ")");
+    if (!mode->is_string() || !parseLightMode(mode->get<std::string>(), light.extrasMode))
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake.mode must be \"baked\", \"indirect\" or \"shadowmask\" (got " +
+                                               mode->dump() + ")");
+    light.hasExtrasMode = true;
+  }
+
   void addLight(int n, const json* lightRef, const glm::mat4& world) {
     if (!lightRef->is_number_integer()) invalid("node " + std::to_string(n) + nodeName(n) + " has a non-integer light index");
     int li = lightRef->get<int>();
@@ -486,6 +502,8 @@ class Loader {
     float len = glm::length(dir);
     light.direction = len > 0.0f ? dir / len : glm::vec3(0, 0, -1);
     light.node = n;
+    light.gltfLight = li;
+    readExtrasMode(li, what, light);
     scene_.lights.push_back(light);
   }
 
