@@ -33,7 +33,7 @@ bool names(const std::string& request, const Light& light) {
 }  // namespace
 
 std::string lightModeName(const Light& light) {
-  if (light.node < 0 && light.gltfLight < 0) return "sun";
+  if (light.node < 0 && light.gltfLight < 0 && light.name.rfind("sun (command line)", 0) == 0) return "sun";
   if (!light.name.empty()) return light.name;
   return "#" + std::to_string(light.gltfLight);
 }
