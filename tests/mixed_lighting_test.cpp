@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -160,6 +161,35 @@ TEST(MixedLighting, CommandRefusesBadModesWithExit2AndNoOutput) {
     EXPECT_NE(output.find(message), std::string::npos) << output;
     EXPECT_FALSE(std::filesystem::exists(dir / "out" / "report.json")) << args;
   }
+}
+
+// Five point lights over one triangle, all reaching it: four get channels, the dimmest bakes as indirect with a
+// warning naming it, and the report and the export say so.
+TEST(MixedLighting, FifthOverlappingMaskLightFallsBackWithAWarning) {
+  const std::filesystem::path dir = testFolder("mixed_lighting_fallback");
+  GltfDocument doc = meshDocument({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
+  nlohmann::json lights = nlohmann::json::array();
+  for (int i = 0; i < 5; ++i) {
+    lights.push_back({{"type", "point"}, {"intensity", 10 - i}, {"name", "l" + std::to_string(i)}});
+    doc.root["nodes"].push_back({{"translation", {0.1 * i, 0.2, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}});
+    doc.root["scenes"][0]["nodes"].push_back(i + 1);
+  }
+  doc.root["extensions"]["KHR_lights_punctual"]["lights"] = lights;
+  writeDocument(doc, dir / "five.gltf");
+  std::string output;
+  ASSERT_EQ(runIrbake("bake " + (dir / "five.gltf").string() + " -o " + (dir / "out").string() +
+                          " --vpls 64 --light-mode '*=shadowmask'", output), 0) << output;
+  EXPECT_NE(output.find("light 'l4' falls back from shadowmask to indirect"), std::string::npos) << output;
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "out" / "report.json"));
+  const nlohmann::json& assignment = report["shadowMask"]["assignment"];
+  EXPECT_EQ(assignment["channels"], 4);
+  EXPECT_EQ(assignment["fellBackToIndirect"], nlohmann::json::array({"l4"}));
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(assignment["lights"][i]["channel"], i) << assignment.dump();
+  EXPECT_EQ(report["plan"]["light-mode l4 #4"]["value"], "indirect");
+  const nlohmann::json gltf = nlohmann::json::parse(std::ifstream(dir / "out" / "scene.gltf"));
+  EXPECT_EQ(gltf["extensions"]["IRBAKE_shadowmask"]["lights"].size(), 4u);
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "lightmap_0_shadowmask.exr"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "lightmap_0_shadowmask.png"));
 }
 
 }  // namespace
