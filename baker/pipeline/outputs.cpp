@@ -115,6 +115,19 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     fs::remove(stale, removeError);
     log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
   }
+  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
+  for (size_t page = 0;; ++page) {
+    bool found = false;
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
+      if (!fs::exists(stale)) continue;
+      found = true;
+      if (page < result.shadowMask.rgb.size()) continue;
+      fs::remove(stale, removeError);
+      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
+    }
+    if (!found && page >= result.shadowMask.rgb.size()) break;
+  }
   written.push_back(reportPath);
   return written;
 }

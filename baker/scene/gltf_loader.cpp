@@ -452,16 +452,17 @@ class Loader {
   // extras: {"irbake": {"mode": "baked" | "indirect" | "shadowmask"}} on the glTF light. A bad value is a
   // bake setting the user must fix (exit 2, as --light-mode's), not a broken file.
   void readExtrasMode(int li, const std::string& what, Light& light) const {
-    const json* mode = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
-    mode = mode && mode->is_array() && li < static_cast<int>(mode->size()) ? &(*mode)[static_cast<size_t>(li)] : nullptr;
-    const json* irbake = mode ? path(*mode, {"extras", "irbake"}) : nullptr;
+    const json* lights = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
+    if (!lights || !lights->is_array() || li >= static_cast<int>(lights->size())) return;
+    const json* irbake = path((*lights)[static_cast<size_t>(li)], {"extras", "irbake"});
     if (!irbake) return;
-    mode = child(*irbake, "mode");
-    if (!irbake->is_object() || !mode)
-      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" (got " + irbake->dump() + ")");
+    const json* mode = child(*irbake, "mode");
+    if (!mode)
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" (got " +
+                                               irbake->dump().substr(0, 80) + ")");
     if (!mode->is_string() || !parseLightMode(mode->get<std::string>(), light.extrasMode))
       throw Error(ErrorCode::Usage, file_, what + ": extras.irbake.mode must be \"baked\", \"indirect\" or \"shadowmask\" (got " +
-                                               mode->dump() + ")");
+                                               mode->dump().substr(0, 80) + ")");
     light.hasExtrasMode = true;
   }
 
