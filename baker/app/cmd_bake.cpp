@@ -45,6 +45,7 @@ struct BakeArguments {
   std::string config, dumpConfig;  // --config FILE (read before parsing), --dump-config FILE
   std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
   std::string probes = "auto", probeBox;  // --probes auto|off|SPACING, --probe-box as given
+  std::vector<std::string> lightModes;  // --light-mode NAME=MODE as given
   double envIntensity = 1.0, envRotation = 0.0;
   bool helpAll = false;
   CLI::Option* shardOption = nullptr;
@@ -133,7 +134,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
                                     "comp-refine", "comp-ray-budget", "comp-filter"}},
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
-                                              "shadow-edge-samples"}},
+                                              "shadow-edge-samples", "light-mode"}},
     {"Irradiance probes", {"probe-box", "probe-rays"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
@@ -288,6 +289,12 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
                   "page gets fewer per sample, never below " + shown(d.sky.minRays) + ", or 4 where the final\n"
                   "gather counts a uniform sky itself)")
       ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
+  app->add_option("--light-mode", a.lightModes,
+                  "a punctual light's bake mode: baked (default), indirect (its bounces\n"
+                  "only) or shadowmask (indirect plus its visibility in a mask page);\n"
+                  "NAME: the glTF light's name, sun (--sun), #I (KHR light I) or *\n"
+                  "(every punctual light); repeatable, beats extras.irbake.mode")
+      ->type_name("NAME=MODE");
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
                   "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
                       shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)")
@@ -425,6 +432,15 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
   command.lights = lightArguments(a);
   probeArguments(a, o.probes);
+  for (const std::string& entry : a.lightModes) {
+    const size_t eq = entry.rfind('=');
+    LightModeRequest request;
+    if (eq == std::string::npos || eq == 0 || !parseLightMode(entry.substr(eq + 1), request.mode))
+      throw Error(ErrorCode::Usage, "", "--light-mode needs NAME=MODE with MODE baked, indirect or shadowmask (got '" +
+                                            entry + "')");
+    request.light = entry.substr(0, eq);
+    o.lightModes.push_back(request);
+  }
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
@@ -704,7 +720,8 @@ bool isPageName(const std::string& name) {
   while (at < name.size() && std::isdigit(static_cast<unsigned char>(name[at]))) ++at, ++digits;
   if (digits == 0) return false;
   const std::string rest = name.substr(at);
-  return rest == ".exr" || rest == ".png" || rest == "_l1x.exr" || rest == "_l1y.exr" || rest == "_l1z.exr";
+  return rest == ".exr" || rest == ".png" || rest == "_l1x.exr" || rest == "_l1y.exr" || rest == "_l1z.exr" ||
+         rest == "_shadowmask.exr" || rest == "_shadowmask.png";
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // What every evaluator (evaluators/evaluator.h: gl, embree, reference) receives; each returns one Lightmap per page.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include "lightmap/lightmap.h"
@@ -19,6 +20,9 @@ struct VplEvalOptions {
                                    // (stages/compensation) after the backends; no backend reads it
   bool includeDirect = true;       // punctual lights evaluated exactly (shadow ray / shadow map)
   bool includeVpls = true;         // area emitters and bounces through the VPLs
+  std::vector<uint8_t> directLights;  // per scene light, 1: the direct term includes it (empty: every light;
+                                      // mixed lighting splits the lights written from those left out)
+  bool directIncludes(size_t light) const { return directLights.empty() || (light < directLights.size() && directLights[light]); }
 };
 
 struct BakeInputs {

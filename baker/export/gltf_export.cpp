@@ -508,6 +508,12 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
       for (const auto& m : maps)
         for (int k = 0; k < 3; ++k) pageUris.push_back(directionalPageUri(options.exrPrefix, m.page, k));
   }
+  const bool masked = options.shadowMask && !options.shadowMask->empty();
+  if (masked) {
+    addShadowMaskExtension(doc, *options.shadowMask, options.writeExrPages ? options.exrPrefix : std::string());
+    if (options.writeExrPages)
+      for (const Lightmap& m : *options.shadowMask->rgb) pageUris.push_back(shadowMaskPageUri(options.exrPrefix, m.page));
+  }
 
   std::vector<PendingFile> files;
   const std::filesystem::path folder = options.output.parent_path();
@@ -552,6 +558,11 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
           const std::filesystem::path finalPath = folder / directionalPageUri(options.exrPrefix, m.page, k);
           files.push_back({finalPath, [map, finalPath](const std::filesystem::path& temp) { writeExrFile(*map, temp, finalPath); }});
         }
+    for (size_t i = 0; masked && i < options.shadowMask->rgb->size(); ++i) {
+      const ShadowMaskExport* mask = options.shadowMask;
+      const std::filesystem::path finalPath = folder / shadowMaskPageUri(options.exrPrefix, (*mask->rgb)[i].page);
+      files.push_back({finalPath, [mask, i, finalPath](const std::filesystem::path& temp) { writeShadowMaskExr(*mask, i, temp, finalPath); }});
+    }
   }
   files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
   refuseOverwritingInputs(files, options.inputs);

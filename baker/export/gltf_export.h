@@ -14,6 +14,7 @@
 #include "common/atomic_file.h"
 #include "export/gltf_writer.h"
 #include "export/lightmap_png.h"
+#include "export/shadow_mask_export.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -28,6 +29,8 @@ struct ExportOptions {
   const std::array<std::vector<Lightmap>, 3>* directional = nullptr;
   // Irradiance probes (export/light_probes_export.h), or null (or empty): no IRBAKE_light_probes.
   const LightProbeGrid* probes = nullptr;
+  // Shadow-mask pages and their lights (export/shadow_mask_export.h), or null: no extension, no files.
+  const ShadowMaskExport* shadowMask = nullptr;
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;

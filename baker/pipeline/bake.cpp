@@ -105,6 +105,8 @@ struct StagedBake::State {
   std::unique_ptr<SurfaceFilterCache> surfaceFilters;  // each page's neighbour tests, made once for all filters
   std::future<std::unique_ptr<ClampGather>> gather;  // traced while the GL backend bakes (GPU only)
   std::vector<Lightmap> directMaps;                 // the final gather's D: punctual lights and sky, exact
+  std::vector<Lightmap> leftOutDirect;              // mixed lighting: the direct light of the lights not baked,
+                                                    // in every stage's map, taken out of what is written
   L1Pages directL1;                                 // with --directional: D's L1 pages
   nlohmann::json seconds = nlohmann::json::object();
   Stopwatch total;
@@ -138,6 +140,7 @@ struct StagedBake::State {
     // The backend first (the GL context is made here: its time counts to the backend, as it did): the
     // reference backend reads no VPLs, so it needs no VPL selection.
     timed("backend", [&] { chooseBackend(); });
+    settleLightModes(plan, options, scene, texels);
     const bool autoDensity = !(options.atlas.texelsPerUnit > 0.0);
     plan.settle("texels-per-unit", atlas.stats.texelsPerUnit,
                 autoDensity ? "about one page at the preset's size, more for many triangles" : "asked for", autoDensity);
@@ -309,11 +312,27 @@ struct StagedBake::State {
   }
 
   // Punctual lights on every texel, exact and unfiltered (blank valid pages when there are none); with l1,
-  // their L1 pages too.
+  // their L1 pages too. With lights left out of the map (plan.leftOut) they are evaluated apart, into
+  // leftOutDirect, and added: the stages after read every light's direct light, the written map lacks theirs.
   std::vector<Lightmap> directStage(L1Pages* l1) {
-    if (plan.eval.includeDirect && !scene.lights.empty()) {
-      const VplSet none;
-      return runVplBackend(inputs(texels, none, directEval(plan.eval)), l1);
+    if (plan.leftOut.empty()) return directCall(l1, {});
+    std::vector<uint8_t> written(plan.leftOut.size());
+    for (size_t i = 0; i < written.size(); ++i) written[i] = !plan.leftOut[i];
+    std::vector<Lightmap> maps = std::find(written.begin(), written.end(), 1) != written.end() ? directCall(nullptr, written)
+                                                                                                : directCall(nullptr, {}, true);
+    leftOutDirect = directCall(nullptr, plan.leftOut);
+    for (size_t p = 0; p < maps.size() && p < leftOutDirect.size(); ++p)
+      for (size_t t = 0; t < maps[p].size() && t < leftOutDirect[p].size(); ++t) maps[p].texels[t] += leftOutDirect[p].texels[t];
+    return maps;
+  }
+
+  // One direct call over the lights marked in `lights` (empty: all), or blank pages (none).
+  std::vector<Lightmap> directCall(L1Pages* l1, const std::vector<uint8_t>& lights, bool none = false) {
+    if (!none && plan.eval.includeDirect && !scene.lights.empty()) {
+      const VplSet noVpls;
+      VplEvalOptions e = directEval(plan.eval);
+      e.directLights = lights;
+      return runVplBackend(inputs(texels, noVpls, e), l1);
     }
     std::vector<Lightmap> maps;
     for (const TexelSamples& ts : texels) {
@@ -346,7 +365,7 @@ struct StagedBake::State {
                                                                 " pages for " + std::to_string(texels.size()));
     // On the punctual lights alone, before D is kept for the final gather: its sources see the same edges.
     StageContext ctx = stageContext(report);
-    shadowEdgeStage(ctx, maps, l1);
+    shadowEdgeStage(ctx, maps, l1, leftOutDirect.empty() ? nullptr : &leftOutDirect);
     if (plan.finalGather) {
       directMaps = maps;
       for (size_t p = 0; p < directMaps.size(); ++p)
@@ -388,6 +407,7 @@ StagedBake::StagedBake(Scene scene, const BakeOptions& options) : state_(std::ma
   s.scene = std::move(scene);
   if (s.scene.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.scene.sourcePath, "no triangles to bake");
   checkOptionRanges(options);
+  checkLightModes(options, s.scene);  // a bad light name costs nothing
   s.prepare();
 }
 
@@ -452,12 +472,18 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   skyStage(ctx, r.maps, s.directMaps);
   compensationStage(ctx, r.maps, l1, s.gather.valid() ? s.gather.get() : nullptr);
   finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
+  leaveOutDirect(r.maps, s.leftOutDirect);
+  s.leftOutDirect = {};
+  r.shadowMask = shadowMaskStage(ctx);
+  r.lightModes = s.plan.lightModes;
+  r.maskChannels = s.plan.maskChannels;
   s.directMaps = {};
   s.directL1 = {};
   report["surfaceFilters"] = {{"plans", s.surfaceFilters->plansMade()}, {"fallbacks", s.surfaceFilters->fallbacks()}};
   if (s.plan.directional) directionalStage(ctx, r.directional);
   const PostStats post = postStage(ctx, r.maps);
   probeStage(ctx, r.maps, r.probes);
+  if (!r.shadowMask.empty()) shadowMaskPostStage(ctx, r.shadowMask);
   s.seconds["bake"] = s.total.seconds();
   describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, s.glStats, s.interleaveStats,
                          s.blocks.size(), s.importanceStats, post},

@@ -14,6 +14,7 @@
 #include "export/portable_export.h"
 #include "lightmap/lightmap.h"
 #include "pipeline/bake_options.h"
+#include "stages/shadow_mask/shadow_mask.h"
 #include "pipeline/bake_plan.h"
 #include "pipeline/vpl_sums.h"
 #include "scene/scene.h"
@@ -30,6 +31,11 @@ struct BakeResult {
   // from the backend's own passes and exact sums like maps, post-processed like them; empty otherwise.
   L1Pages directional;
   LightProbeGrid probes;             // with BakeOptions::probes enabled: the grid, baked; size() 0 otherwise
+  // With shadow-mask lights (BakeOptions::lightModes): their visibility per page, post-processed like maps;
+  // ShadowMaskChannels in lightModes says which light is in which channel. Empty otherwise.
+  ShadowMaskPages shadowMask;
+  std::vector<LightMode> lightModes;   // per scene light, as settled (fallbacks applied)
+  ShadowMaskChannels maskChannels;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

@@ -2,6 +2,8 @@
 // what they leave automatic.
 #pragma once
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "atlas/atlas.h"
 #include "common/progress.h"
@@ -12,6 +14,7 @@
 #include "stages/gather/final_gather.h"
 #include "stages/probes/light_probes.h"
 #include "stages/shadow_edges/shadow_edges.h"
+#include "stages/shadow_mask/shadow_mask.h"
 #include "stages/sky/sky_light.h"
 #include "texels/texel_samples.h"
 #include "transport/vpl_importance.h"
@@ -40,6 +43,13 @@ enum class FinalGatherMode {
   On,    // in every scene the VPL backends bake
   Auto,  // on where the scene has no emissive surface (the rays would find small emitters by chance) and no
          // see-through one (the gather reads the glass's own map, not what lies behind it)
+};
+
+// One --light-mode NAME=MODE: light is a punctual light's name, "sun" for --sun's, "#i" for KHR light i, or
+// "*" for every punctual light.
+struct LightModeRequest {
+  std::string light;
+  LightMode mode = LightMode::Baked;
 };
 
 // The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
@@ -83,6 +93,9 @@ struct BakeOptions {
                                           // bytes are the same. Off: no extra work, the same bytes as before
   ProbeOptions probes;                    // irradiance probes read from the finished map (stages/probes); off:
                                           // none, and every other output the same bytes
+  ShadowMaskOptions shadowMask;           // the shadow-mask lights' visibility pages (stages/shadow_mask)
+  std::vector<LightModeRequest> lightModes;  // --light-mode in the order given (a name wins over "*", the last
+                                            // of each over earlier ones; any over the glTF's extras.irbake.mode)
   ProgressCallback progress;
 };
 

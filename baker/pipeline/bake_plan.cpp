@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/log.h"
 #include "evaluators/gl/shadow_views.h"
+#include "pipeline/light_modes.h"
 #include "stages/interleave/interleaved_sampling.h"
 #include "transport/geometry_term.h"
 
@@ -159,6 +160,7 @@ BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOpti
   settleSky(plan, scene, rayTracer, options);
   plan.shadowEdges = options.shadowEdges;
   settleProbes(plan, scene, options);
+  plan.shadowMask = options.shadowMask;
   plan.post.dilate = options.postDilate;
   plan.post.stitchSeams = options.postSeams;
   plan.eval = options.eval;
@@ -201,6 +203,54 @@ void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<
                                             plan.gl.minCubeFaceSize, plan.gl.maxCubeFaceSize)
                              .size;
   plan.settle("cube-face", *plan.gl.cubeFaceSize, "a shadow texel's footprint held to the light-map texel spacing");
+}
+
+void checkLightModes(const BakeOptions& options, const Scene& scene) {
+  const std::vector<RequestedLightMode> modes = resolveLightModes(scene, options.lightModes);
+  for (size_t i = 0; i < modes.size(); ++i) {
+    if (modes[i].mode == LightMode::Baked) continue;
+    const std::string what = "light '" + lightModeName(scene.lights[i]) + "' in mode " + toString(modes[i].mode) +
+                             " (" + modes[i].reason + ")";
+    // The reference integrator finds every light itself, and the L1 pages have no split by light yet.
+    if (options.backend == BackendKind::Reference)
+      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": needs a VPL backend (gl, embree or auto), not reference");
+    if (options.directional)
+      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": --directional bakes every light for now (leave it out)");
+  }
+}
+
+void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& scene,
+                      const std::vector<TexelSamples>& texels) {
+  checkLightModes(options, scene);
+  const std::vector<RequestedLightMode> modes = resolveLightModes(scene, options.lightModes);
+  plan.lightModes.assign(modes.size(), LightMode::Baked);
+  std::vector<uint8_t> wants(modes.size(), 0);
+  for (size_t i = 0; i < modes.size(); ++i) {
+    plan.lightModes[i] = modes[i].mode;
+    wants[i] = modes[i].mode == LightMode::ShadowMask;
+  }
+  plan.maskChannels = assignShadowMaskChannels(scene, texels, wants, plan.shadowMask);
+  for (size_t i : plan.maskChannels.fellBack) {
+    plan.lightModes[i] = LightMode::Indirect;
+    log::warn("light '" + lightModeName(scene.lights[i]) + "' falls back from shadowmask to indirect: its light meets " +
+              std::to_string(kShadowMaskChannels) + " other shadow-mask lights' at some texel and the mask has " +
+              std::to_string(kShadowMaskChannels) + " channels");
+  }
+  bool anyLeftOut = false;
+  for (LightMode m : plan.lightModes) anyLeftOut |= m != LightMode::Baked;
+  plan.leftOut.clear();
+  if (anyLeftOut)
+    for (LightMode m : plan.lightModes) plan.leftOut.push_back(m != LightMode::Baked);
+  for (size_t i = 0; i < modes.size(); ++i) {
+    const bool fell = std::find(plan.maskChannels.fellBack.begin(), plan.maskChannels.fellBack.end(), i) !=
+                      plan.maskChannels.fellBack.end();
+    const std::string reason = fell ? modes[i].reason + "; no shadow-mask channel left: indirect" : modes[i].reason;
+    plan.settle("light-mode " + lightModeName(scene.lights[i]) + " #" + std::to_string(i), toString(plan.lightModes[i]),
+                reason, fell);
+  }
+  if (!plan.maskChannels.channel.empty() && (plan.maskChannels.used() > 0 || !plan.maskChannels.fellBack.empty()))
+    plan.settle("shadow-mask-channels", plan.maskChannels.toJson(scene),
+                "the shadow-mask lights' overlap graph coloured with 4 channels, brightest first");
 }
 
 }  // namespace irbake

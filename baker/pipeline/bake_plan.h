@@ -19,6 +19,7 @@
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/gather/final_gather.h"
 #include "stages/shadow_edges/shadow_edges.h"
+#include "stages/shadow_mask/shadow_mask.h"
 #include "stages/sky/sky_light.h"
 #include "vpl/vpl.h"
 
@@ -45,6 +46,12 @@ struct BakePlan {
   ShadowEdgeOptions shadowEdges;            // as the shadow-edge stage runs
   ProbeOptions probes;                      // as the probe stage runs (spacing and box settled when enabled)
   PostOptions post;                         // dilation and seams
+  // Mixed lighting, settled once the texels are known (settleLightModes):
+  std::vector<LightMode> lightModes;        // per scene light
+  std::vector<uint8_t> leftOut;             // per scene light, 1: its direct light is left out of what is
+                                            // written (indirect, shadowmask); empty: every light is baked
+  ShadowMaskOptions shadowMask;             // as the shadow-mask stage runs
+  ShadowMaskChannels maskChannels;          // the shadow-mask lights' channels
   // Settled once the walk's VPLs are known (settleClamp, settleBlocks):
   VplEvalOptions eval;                      // with the clamp bound
   double clampK = 0.0;                      // k of deriveClampBound (0: the clamp was not derived)
@@ -70,6 +77,14 @@ std::string seeThroughMaterials(const Scene& scene);
 // context (the caller keeps it) and is called where the choice depends on it.
 BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
                   const std::function<GlProbe()>& probeGl);
+
+// Each punctual light's mode (--light-mode, extras, baked) and the shadow-mask channels; a shadow-mask light
+// that gets no channel falls back to indirect with a warning naming it. Throws Error(Usage) for a bad name or
+// a mode other than baked with the reference backend or --directional (not supported yet).
+void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& scene,
+                      const std::vector<TexelSamples>& texels);
+// The checks of settleLightModes that need no texels, made before anything is traced.
+void checkLightModes(const BakeOptions& options, const Scene& scene);
 
 // The clamp: fixed, off, or derived from the scene and these VPLs (sets plan.eval.clampBound).
 void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls);

@@ -17,14 +17,15 @@ void StageContext::timed(const char* name, const std::function<void()>& stage) {
   seconds[name] = seconds.value(name, 0.0) + watch.seconds();
 }
 
-void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1) {
+void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1, std::vector<Lightmap>* leftOut) {
   const BakePlan& plan = ctx.plan;
   if (!plan.eval.includeDirect || ctx.scene.lights.empty() || plan.shadowEdges.subSamples <= 1) return;
   // The L1 pages keep the centre's direction, scaled with the value per channel so that |L1| stays within
   // what L0 allows (a refined texel's light comes from the same lights; where the centre was dark, L1 is 0).
   std::vector<Lightmap> before;
   if (l1) before = maps;
-  const ShadowEdgeStats st = refineShadowEdges(ctx.inputs, maps, plan.shadowEdges);
+  ShadowEdgePart part{&plan.leftOut, leftOut};
+  const ShadowEdgeStats st = refineShadowEdges(ctx.inputs, maps, plan.shadowEdges, leftOut ? &part : nullptr);
   for (size_t p = 0; l1 && p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t) {
       const glm::vec3 &was = before[p].texels[t], &now = maps[p].texels[t];
@@ -94,6 +95,33 @@ void finalGatherStage(StageContext& ctx, const std::vector<Lightmap>& direct, co
     finalGather(ctx.inputs, direct, maps, ctx.plan.gather, &stats, l1 ? directL1 : nullptr, l1);
     if (ctx.progress) ctx.progress("gather", 1.0);
     ctx.report["finalGather"] = stats.toJson();
+  });
+}
+
+void leaveOutDirect(std::vector<Lightmap>& maps, const std::vector<Lightmap>& leftOut) {
+  for (size_t p = 0; p < maps.size() && p < leftOut.size(); ++p)
+    for (size_t t = 0; t < maps[p].size() && t < leftOut[p].size(); ++t)
+      maps[p].texels[t] = glm::max(maps[p].texels[t] - leftOut[p].texels[t], glm::vec3(0.0f));
+}
+
+ShadowMaskPages shadowMaskStage(StageContext& ctx) {
+  ShadowMaskPages pages;
+  if (ctx.plan.maskChannels.used() == 0) return pages;
+  ctx.timed("shadowMask", [&] {
+    ShadowMaskStats stats;
+    if (ctx.progress) ctx.progress("shadowmask", 0.0);
+    pages = bakeShadowMask(ctx.inputs, ctx.plan.maskChannels, ctx.plan.shadowMask, &stats);
+    if (ctx.progress) ctx.progress("shadowmask", 1.0);
+    ctx.report["shadowMask"] = stats.toJson();
+    ctx.report["shadowMask"]["assignment"] = ctx.plan.maskChannels.toJson(ctx.scene);
+  });
+  return pages;
+}
+
+void shadowMaskPostStage(StageContext& ctx, ShadowMaskPages& mask) {
+  ctx.timed("shadowMaskPost", [&] {
+    postProcess(ctx.scene, mask.rgb, ctx.plan.post);
+    if (!mask.alpha.empty()) postProcess(ctx.scene, mask.alpha, ctx.plan.post);
   });
 }
 

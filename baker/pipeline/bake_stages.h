@@ -13,6 +13,7 @@
 #include "pipeline/bake_plan.h"
 #include "post/post.h"
 #include "stages/compensation/clamp_compensation.h"
+#include "stages/shadow_mask/shadow_mask.h"
 
 namespace irbake {
 
@@ -30,8 +31,10 @@ struct StageContext {
   void timed(const char* name, const std::function<void()>& stage);
 };
 
-// Punctual lights' shadow edges area-averaged, on their map alone (l1: scaled with it).
-void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1);
+// Punctual lights' shadow edges area-averaged, on their map alone (l1: scaled with it); leftOut: the direct
+// pages of the lights left out of the map (plan.leftOut), refined on the same edge texels.
+void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,
+                     std::vector<Lightmap>* leftOut = nullptr);
 // The sky's direct light, traced (every VPL evaluator; the reference integrator finds the sky itself).
 // Under the final gather an environment map's light goes into its D (direct) as well.
 void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct);
@@ -42,6 +45,13 @@ void compensationStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* 
 // Each texel's bounced light read from the finished map one bounce away; direct: D (and its L1 pages).
 void finalGatherStage(StageContext& ctx, const std::vector<Lightmap>& direct, const L1Pages* directL1,
                       std::vector<Lightmap>& maps, L1Pages* l1);
+// Mixed lighting: the left-out lights' direct light taken out of the finished map (never below 0), after
+// every stage that reads the map one bounce away.
+void leaveOutDirect(std::vector<Lightmap>& maps, const std::vector<Lightmap>& leftOut);
+// The shadow-mask lights' visibility pages (empty when there are none).
+ShadowMaskPages shadowMaskStage(StageContext& ctx);
+// Dilation and seams on the shadow-mask pages, as on the map's.
+void shadowMaskPostStage(StageContext& ctx, ShadowMaskPages& mask);
 // The L1 pages' sky share, then post per axis.
 void directionalStage(StageContext& ctx, L1Pages& axes);
 // Dilation and seams on the map pages.

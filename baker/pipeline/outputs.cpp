@@ -11,6 +11,7 @@
 #include "export/gltf_export.h"
 #include "export/portable_export.h"
 #include "pipeline/bake.h"
+#include "pipeline/light_modes.h"
 
 namespace irbake {
 
@@ -30,6 +31,16 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   for (int k = 0; k < 3; ++k)
     for (const Lightmap& m : result.directional[k])
       l1Exrs.push_back({outDir / directionalPageUri("lightmap", m.page, k), &m});
+  // Shadow masks: lightmap_<page>_shadowmask.exr beside the pages (and PNGs in the glTF).
+  ShadowMaskExport mask;
+  if (!result.shadowMask.empty()) {
+    mask.rgb = &result.shadowMask.rgb;
+    mask.alpha = &result.shadowMask.alpha;
+    for (size_t i = 0; i < result.maskChannels.channel.size(); ++i)
+      if (result.maskChannels.channel[i] >= 0)
+        mask.lights.push_back({&result.scene.lights[i], lightModeName(result.scene.lights[i]), result.maskChannels.channel[i]});
+    for (const Lightmap& m : result.shadowMask.rgb) l1Exrs.push_back({outDir / shadowMaskPageUri("lightmap", m.page), &m});
+  }
   const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   std::vector<fs::path> written;
   if (options.writeGltf) written.push_back(gltfPath);
@@ -72,6 +83,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
+    if (!mask.empty()) ex.shadowMask = &mask;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;
@@ -80,10 +92,14 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
       const fs::path finalPath = exrs[i];
       files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
     }
-    for (const auto& [path, m] : l1Exrs) {
-      const Lightmap* map = m;
-      const fs::path finalPath = path;
-      files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
+    const size_t l1Count = l1Exrs.size() - (mask.empty() ? 0 : mask.rgb->size());
+    for (size_t i = 0; i < l1Exrs.size(); ++i) {
+      const Lightmap* map = l1Exrs[i].second;
+      const fs::path finalPath = l1Exrs[i].first;
+      const ShadowMaskExport* m = &mask;
+      const size_t page = i - l1Count;
+      if (i < l1Count) files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
+      else files.push_back({finalPath, [m, page, finalPath](const fs::path& temp) { writeShadowMaskExr(*m, page, temp, finalPath); }});
     }
     files.push_back(reportFile);
     files.insert(files.end(), portable.begin(), portable.end());
@@ -99,6 +115,19 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     if (!fs::exists(stale)) break;
     fs::remove(stale, removeError);
     log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
+  }
+  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
+  for (size_t page = 0;; ++page) {
+    bool found = false;
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
+      if (!fs::exists(stale)) continue;
+      found = true;
+      if (page < result.shadowMask.rgb.size()) continue;
+      fs::remove(stale, removeError);
+      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
+    }
+    if (!found && page >= result.shadowMask.rgb.size()) break;
   }
   written.push_back(reportPath);
   return written;

@@ -449,6 +449,23 @@ class Loader {
     scene_.cameras.push_back(cam);
   }
 
+  // extras: {"irbake": {"mode": "baked" | "indirect" | "shadowmask"}} on the glTF light. A bad value is a
+  // bake setting the user must fix (exit 2, as --light-mode's), not a broken file.
+  void readExtrasMode(int li, const std::string& what, Light& light) const {
+    const json* lights = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
+    if (!lights || !lights->is_array() || li >= static_cast<int>(lights->size())) return;
+    const json* irbake = path((*lights)[static_cast<size_t>(li)], {"extras", "irbake"});
+    if (!irbake) return;
+    const json* mode = child(*irbake, "mode");
+    if (!mode)
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" (got " +
+                                               irbake->dump().substr(0, 80) + ")");
+    if (!mode->is_string() || !parseLightMode(mode->get<std::string>(), light.extrasMode))
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake.mode must be \"baked\", \"indirect\" or \"shadowmask\" (got " +
+                                               mode->dump().substr(0, 80) + ")");
+    light.hasExtrasMode = true;
+  }
+
   void addLight(int n, const json* lightRef, const glm::mat4& world) {
     if (!lightRef->is_number_integer()) invalid("node " + std::to_string(n) + nodeName(n) + " has a non-integer light index");
     int li = lightRef->get<int>();
@@ -486,6 +503,8 @@ class Loader {
     float len = glm::length(dir);
     light.direction = len > 0.0f ? dir / len : glm::vec3(0, 0, -1);
     light.node = n;
+    light.gltfLight = li;
+    readExtrasMode(li, what, light);
     scene_.lights.push_back(light);
   }
 

@@ -304,6 +304,39 @@ TEST(GltfLoader, PerspectiveCameraFromNode) {
   expectNear(-glm::vec3(s.cameras[0].cameraToWorld[2]), {0, 0, 1});  // looks down −Z locally → +Z
 }
 
+// extras.irbake.mode on a light (mixed lighting): read per light, the KHR index kept; absent: no mode given.
+TEST(GltfLoader, ReadsEachLightsBakeModeFromExtras) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
+      {{{"type", "point"}, {"name", "plain"}},
+       {{"type", "point"}, {"name", "masked"}, {"extras", {{"irbake", {{"mode", "shadowmask"}}}, {"other", 1}}}},
+       {{"type", "directional"}, {"extras", {{"irbake", {{"mode", "indirect"}}}}}}});
+  for (int i = 0; i < 3; ++i)
+    doc.root["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}});
+  doc.root["scenes"][0]["nodes"] = {0, 1, 2, 3};
+  auto dir = testFolder("loader_light_modes");
+  writeDocument(doc, dir / "l.gltf");
+  const Scene s = loadScene(dir / "l.gltf");
+  ASSERT_EQ(s.lights.size(), 3u);
+  EXPECT_FALSE(s.lights[0].hasExtrasMode);
+  EXPECT_TRUE(s.lights[1].hasExtrasMode);
+  EXPECT_EQ(s.lights[1].extrasMode, LightMode::ShadowMask);
+  EXPECT_EQ(s.lights[2].extrasMode, LightMode::Indirect);
+  EXPECT_EQ(s.lights[2].gltfLight, 2);
+  // A mode that is not a string or not one of the three stops the load naming the light (exit 2, as --light-mode).
+  for (const json& bad : {json("bright"), json(3), json::object()}) {
+    doc.root["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"]["irbake"]["mode"] = bad;
+    writeDocument(doc, dir / "bad.gltf");
+    try {
+      loadScene(dir / "bad.gltf");
+      ADD_FAILURE() << "accepted mode " << bad.dump();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Usage);
+      EXPECT_NE(std::string(e.what()).find("light 1 ('masked'): extras.irbake.mode must be"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
   auto& prim = doc.root["meshes"][0]["primitives"][0];

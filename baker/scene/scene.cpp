@@ -7,6 +7,25 @@
 
 namespace irbake {
 
+const char* toString(LightMode mode) {
+  switch (mode) {
+    case LightMode::Baked: return "baked";
+    case LightMode::Indirect: return "indirect";
+    case LightMode::ShadowMask: return "shadowmask";
+  }
+  return "baked";
+}
+
+bool parseLightMode(const std::string& text, LightMode& mode) {
+  for (LightMode m : {LightMode::Baked, LightMode::Indirect, LightMode::ShadowMask})
+    if (text == toString(m)) {
+      mode = m;
+      return true;
+    }
+  return false;
+}
+
+
 namespace {
 
 float wrapCoord(float t, WrapMode mode) {

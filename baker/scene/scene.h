@@ -102,6 +102,14 @@ struct Primitive {
 
 enum class LightType { Point, Spot, Directional };
 
+// How a punctual light reaches the light map (mixed lighting): baked: its direct light and its bounces;
+// indirect: its bounces only (the runtime shades its direct light); shadowmask: as indirect, plus its baked
+// visibility in one channel of the shadow-mask pages (stages/shadow_mask).
+enum class LightMode { Baked, Indirect, ShadowMask };
+const char* toString(LightMode mode);
+// "baked", "indirect" or "shadowmask"; false for anything else.
+bool parseLightMode(const std::string& text, LightMode& mode);
+
 // KHR_lights_punctual. intensity is radiant intensity (W/sr) for point/spot, irradiance (W/m²) for
 // directional, so a point light gives E = I cosθ / r² and a directional light E = I cosθ.
 struct Light {
@@ -115,6 +123,9 @@ struct Light {
   glm::vec3 position{0.0f};            // world (point/spot)
   glm::vec3 direction{0.0f, 0.0f, -1.0f};  // world, unit, direction light travels (spot/directional)
   int node = -1;                       // -1 for lights from the command line
+  int gltfLight = -1;                  // index in KHR_lights_punctual's lights (-1: from the command line)
+  bool hasExtrasMode = false;          // the glTF light's extras.irbake.mode was given (then extrasMode holds it)
+  LightMode extrasMode = LightMode::Baked;
   // Radiant intensity (W/sr, RGB) towards a direction leaving the light (unit vector), spot falloff
   // included (glTF's recommended smooth falloff, linear in cosθ between outer and inner cone).
   glm::vec3 intensityToward(const glm::vec3& dirFromLight) const;

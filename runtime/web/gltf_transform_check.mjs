@@ -8,18 +8,22 @@
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
 //     non-numeric intensity, incomplete directional extension, a probe grid that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
 //     throw an Error naming the material or mesh.
+//   shadowmask --modules DIR --input BAKE.gltf   (a bake with --light-mode ...=shadowmask)
+//     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
+//     light → channel map exactly; a missing texture, texCoord ≠ 1, a channel outside 0..3 and a material mask
+//     without the root map are refused with an Error naming the material.
 // Exit 0 when every check passes, 1 with the failures listed.
 import fs from 'node:fs';
 import path from 'node:path';
 import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHT_PROBES, IRBAKE_LIGHTMAP_DIRECTIONAL,
-  MOZ_LIGHTMAP, PROBE_ACCESSORS } from './gltf_transform_irbake.mjs';
+  IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS } from './gltf_transform_irbake.mjs';
 
 const [mode, ...rest] = process.argv.slice(2);
 // --name value, or --name alone (a flag: true).
 const args = Object.fromEntries(rest.reduce((a, v, i, all) =>
   (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1] === undefined || all[i + 1].startsWith('--') ? true : all[i + 1]]] : a), []));
-if (!['survives', 'refusals'].includes(mode) || !args.modules || !args.input) {
-  console.error('usage: gltf_transform_check.mjs survives|refusals --modules DIR --input FILE [--output FILE] [--directional]');
+if (!['survives', 'refusals', 'shadowmask'].includes(mode) || !args.modules || !args.input) {
+  console.error('usage: gltf_transform_check.mjs survives|refusals|shadowmask --modules DIR --input FILE [--output FILE] [--directional]');
   process.exit(2);
 }
 const modules = path.resolve(args.modules);
@@ -28,8 +32,8 @@ const { ALL_EXTENSIONS } = await importPackage(modules, '@gltf-transform/extensi
 const functions = await importPackage(modules, '@gltf-transform/functions');
 const { MeshoptDecoder } = await importPackage(modules, 'meshoptimizer');
 await MeshoptDecoder.ready;
-const { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes } = defineIrbakeExtensions(core);
-const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes])
+const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes } = defineIrbakeExtensions(core);
+const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes])
   .registerDependencies({ 'meshopt.decoder': MeshoptDecoder });
 io.setLogger(new core.Logger(core.Logger.Verbosity.ERROR));
 
@@ -213,7 +217,35 @@ async function refusals() {
   }
 }
 
-await (mode === 'survives' ? survives() : refusals());
+async function shadowmask() {
+  const original = await io.readAsJSON(args.input);
+  const clone = () => ({ json: structuredClone(original.json), resources: original.resources });
+  const masked = (original.json.materials ?? []).filter(m => m.extensions?.[IRBAKE_SHADOWMASK]);
+  check(masked.length > 0 && original.json.extensions?.[IRBAKE_SHADOWMASK], `${args.input}: no ${IRBAKE_SHADOWMASK}`);
+  const doc = await io.readJSON(clone());
+  await doc.transform(functions.prune(), functions.dedup());
+  const json = (await io.writeJSON(doc)).json;
+  check(same(json.extensions?.[IRBAKE_SHADOWMASK], original.json.extensions[IRBAKE_SHADOWMASK]),
+        `root ${IRBAKE_SHADOWMASK}: ${JSON.stringify(json.extensions?.[IRBAKE_SHADOWMASK])}`);
+  const byName = new Map((json.materials ?? []).map(m => [m.name, m]));
+  for (const inMat of masked) {
+    const a = inMat.extensions[IRBAKE_SHADOWMASK], b = byName.get(inMat.name)?.extensions?.[IRBAKE_SHADOWMASK];
+    check(b && b.texCoord === 1 && b.exr === a.exr && hasImage(json, b), `material '${inMat.name}': mask ${JSON.stringify(b)}`);
+    const image = b && json.images[json.textures[b.index].source];
+    check(!b || image.name === original.json.images[original.json.textures[a.index].source].name,
+          `material '${inMat.name}': the mask's texture is now image '${image?.name}'`);
+  }
+  const name = masked[0].name;
+  const edited = edit => { const c = clone(); edit(c.json); return () => io.readJSON(c); };
+  const firstMask = j => j.materials.find(m => m.name === name).extensions[IRBAKE_SHADOWMASK];
+  await throws('mask texture 999', edited(j => { firstMask(j).index = 999; }), `('${name}')`, 'texture 999 does not exist');
+  await throws('mask texCoord 0', edited(j => { firstMask(j).texCoord = 0; }), `('${name}')`, 'texCoord 0');
+  await throws('channel 5', edited(j => { j.extensions[IRBAKE_SHADOWMASK].lights[0].channel = 5; }), 'channel 0..3');
+  await throws('no root map', edited(j => { delete j.extensions[IRBAKE_SHADOWMASK]; }), `('${name}')`, 'without the root');
+  console.log(JSON.stringify({ maskedMaterials: masked.length, refusalsChecked: refused }));
+}
+
+await (mode === 'survives' ? survives() : mode === 'refusals' ? refusals() : shadowmask());
 if (failures.length) {
   console.error(`gltf_transform_check ${mode}:\n  ${failures.join('\n  ')}`);
   process.exit(1);

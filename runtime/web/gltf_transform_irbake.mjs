@@ -1,5 +1,5 @@
-// irbake's extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap and
-// IRBAKE_lightmap_directional as extension properties whose textures are real Texture references
+// irbake's light-map extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap,
+// IRBAKE_lightmap_directional, IRBAKE_shadowmask and IRBAKE_light_probes as extension properties whose textures are real Texture references
 // (TextureInfo, texCoord 1), so prune, dedup, resize and texture compression treat the maps as used textures and
 // keep TEXCOORD_1. Reading refuses what irbake's viewers would show wrongly (a missing texture, a texCoord other
 // than 1, a negative or non-numeric intensity, an incomplete directional extension) with an Error naming the
@@ -9,8 +9,8 @@
 //
 // The classes must extend the very @gltf-transform/core the caller (the CLI) uses, so they are made from it:
 //   const core = await importPackage(modulesDir, '@gltf-transform/core');
-//   const { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes } = defineIrbakeExtensions(core);
-//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes]);
+//   const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes } = defineIrbakeExtensions(core);
+//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes]);
 import fs from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
@@ -20,6 +20,7 @@ export const IRBAKE_LIGHTMAP_DIRECTIONAL = 'IRBAKE_lightmap_directional';
 export const IRBAKE_LIGHT_PROBES = 'IRBAKE_light_probes';
 // The probe grid's accessors (docs/export.md, "IRBAKE_light_probes"): component type, type and elements per probe.
 export const PROBE_ACCESSORS = { coefficients: [5126, 'VEC3', 9], offsets: [5126, 'VEC3', 1], valid: [5126, 'SCALAR', 1] };
+export const IRBAKE_SHADOWMASK = 'IRBAKE_shadowmask';
 // The UV set of every light map (docs/export.md): TEXCOORD_1.
 export const LIGHTMAP_TEXCOORD = 1;
 const AXES = ['x', 'y', 'z'];
@@ -401,7 +402,103 @@ export function defineIrbakeExtensions(core) {
     }
   }
 
-  return { MozLightmap, IrbakeLightmapDirectional, IrbakeLightProbes, Lightmap, DirectionalLightmap, LightProbeGrid };
+  // IRBAKE_shadowmask on a material: its page's RGBA mask (linear, TEXCOORD_1) and the name of its EXR copy.
+  class ShadowMask extends ExtensionProperty {
+    static EXTENSION_NAME = IRBAKE_SHADOWMASK;
+    init() {
+      this.extensionName = IRBAKE_SHADOWMASK;
+      this.propertyType = 'ShadowMask';
+      this.parentTypes = [PropertyType.MATERIAL];
+    }
+    getDefaults() {
+      return Object.assign(super.getDefaults(), {
+        maskTexture: null,
+        maskTextureInfo: new TextureInfo(this.graph, 'maskTextureInfo').setTexCoord(LIGHTMAP_TEXCOORD),
+        exr: null,
+        otherFields: {},
+      });
+    }
+    getTexture() { return this.getRef('maskTexture'); }
+    getTextureInfo() { return this.getRef('maskTexture') ? this.getRef('maskTextureInfo') : null; }
+    // Four channels of data, never colour: texture compression must keep alpha and skip sRGB.
+    setTexture(texture) { return this.setRef('maskTexture', texture, { channels: RGB | TextureChannel.A, isColor: false }); }
+    getExr() { return this.get('exr'); }
+    setExr(exr) { return this.set('exr', exr ?? null); }
+    getOtherFields() { return this.get('otherFields'); }
+    setOtherFields(fields) { return this.set('otherFields', fields); }
+  }
+
+  // The root's light → channel map: [{name, channel 0..3, light (KHR index) | directional {...}}, ...].
+  function checkMaskLights(lights, what) {
+    if (!Array.isArray(lights) || lights.some(l => !isObject(l) || !Number.isInteger(l.channel) || l.channel < 0 || l.channel > 3))
+      throw new Error(`${what}: lights ${JSON.stringify(lights)} must be objects with a channel 0..3`);
+  }
+
+  class IrbakeShadowmask extends Extension {
+    static EXTENSION_NAME = IRBAKE_SHADOWMASK;
+    extensionName = IRBAKE_SHADOWMASK;
+    prereadTypes = [PropertyType.MESH];
+    prewriteTypes = [PropertyType.MESH];
+    lights = null;  // the root extension's definition, written back as read
+
+    createShadowMask() { return new ShadowMask(this.document.getGraph()); }
+
+    preread(context) {
+      const root = context.jsonDoc.json.extensions?.[IRBAKE_SHADOWMASK];
+      if (root !== undefined) {
+        checkMaskLights(root?.lights, `root ${IRBAKE_SHADOWMASK}`);
+        this.lights = structuredClone(root);
+      }
+      (context.jsonDoc.json.materials ?? []).forEach((materialDef, index) => {
+        const def = materialDef.extensions?.[IRBAKE_SHADOWMASK];
+        if (def === undefined) return;
+        const what = `${materialLabel(index, materialDef)}: ${IRBAKE_SHADOWMASK}`;
+        if (!isObject(def)) throw new Error(`${what} is not an object`);
+        if (!this.lights) throw new Error(`${what} without the root ${IRBAKE_SHADOWMASK} that maps lights to channels`);
+        const texture = textureOf(context, def, what);
+        checkTexCoord(def, what);
+        const mask = this.createShadowMask();
+        context.setTextureInfo(mask.getRef('maskTextureInfo'), def);
+        mask.setTexture(texture).setExr(def.exr).setOtherFields(without(def, ['index', 'texCoord', 'exr', 'extras']));
+        context.materials[index].setExtension(IRBAKE_SHADOWMASK, mask);
+      });
+      return this;
+    }
+
+    read() { return this; }
+
+    prewrite(context) {
+      let used = false;
+      for (const material of this.document.getRoot().listMaterials()) {
+        const mask = material.getExtension(IRBAKE_SHADOWMASK);
+        if (!mask) continue;
+        const what = `${materialName(material, this.document)}: ${IRBAKE_SHADOWMASK}`;
+        if (!mask.getTexture()) throw new Error(`${what} has no texture`);
+        const def = context.createTextureInfoDef(mask.getTexture(), mask.getTextureInfo());
+        def.texCoord = mask.getTextureInfo().getTexCoord();
+        if (mask.getExr()) def.exr = mask.getExr();
+        Object.assign(def, mask.getOtherFields());
+        const materialDef = context.jsonDoc.json.materials[context.materialIndexMap.get(material)];
+        materialDef.extensions = materialDef.extensions ?? {};
+        materialDef.extensions[IRBAKE_SHADOWMASK] = def;
+        used = true;
+      }
+      if (used && this.lights) {
+        const json = context.jsonDoc.json;
+        json.extensions = json.extensions ?? {};
+        json.extensions[IRBAKE_SHADOWMASK] = this.lights;
+      }
+      return this;
+    }
+
+    // MOZ_lightmap's write moves the mask's texCoord with the light map's (moveLightmapToSet1).
+    write() {
+      return this;
+    }
+  }
+
+  return { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, Lightmap, DirectionalLightmap, ShadowMask,
+           LightProbeGrid };
 }
 
 // The probe count of an IRBAKE_light_probes definition, or an Error naming the field that is wrong.
@@ -450,7 +547,8 @@ function moveLightmapToSet1(json, materialDef, primDef, where, moved) {
   moved.set(materialDef, { from: k, mode });
   if (mode === 'alias') {
     const directional = materialDef.extensions[IRBAKE_LIGHTMAP_DIRECTIONAL];
-    for (const info of [lightmap, ...(directional?.l1 ?? [])]) info.texCoord = LIGHTMAP_TEXCOORD;
+    const mask = materialDef.extensions[IRBAKE_SHADOWMASK];
+    for (const info of [lightmap, ...(directional?.l1 ?? []), ...(mask ? [mask] : [])]) info.texCoord = LIGHTMAP_TEXCOORD;
   } else {
     for (const info of textureInfoDefs(materialDef)) {
       const t = info.texCoord ?? 0;

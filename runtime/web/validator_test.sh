@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Khronos glTF-Validator on every kind of export: the baked Cornell box (.gltf + .bin +
-# images), the same as one GLB, the same with --directional, `irbake unwrap` output, and the DamagedHelmet from ../shared baked with
+# images), the same as one GLB, the same with --directional, a shadow-mask bake (.gltf and GLB), `irbake unwrap` output, and the DamagedHelmet from ../shared baked with
 # --sun (skipped with a message when absent). Each: 0 errors, no warning its input did not have, no
 # UNUSED_OBJECT for a mesh or an accessor (runtime/web/validate.mjs).
 # Usage (from ctest): validator_test.sh IRBAKE MODULES_DIR WORK_DIR SOURCE_DIR
@@ -20,6 +20,12 @@ validate "$work/glb/cornell.glb" "$cornell"
 # Directional maps: IRBAKE_lightmap_directional on the materials, in extensionsUsed only.
 "$irbake" bake "$cornell" -o "$work/directional" --vpls 128 --texels-per-unit 60 --directional --quiet >> "$work/bake.log" 2>&1
 validate "$work/directional/scene.gltf" "$cornell"
+# Shadow masks: IRBAKE_shadowmask on the materials and the root, in extensionsUsed only; as .gltf and GLB.
+wall="$work/samples/thin_wall.gltf"
+"$irbake" bake "$wall" -o "$work/shadowmask" --vpls 128 --light-mode '*=shadowmask' --quiet >> "$work/bake.log" 2>&1
+validate "$work/shadowmask/scene.gltf" "$wall"
+"$irbake" bake "$wall" -o "$work/shadowmask_glb/wall.glb" --vpls 128 --light-mode '*=shadowmask' --quiet >> "$work/bake.log" 2>&1
+validate "$work/shadowmask_glb/wall.glb" "$wall"
 "$irbake" unwrap "$cornell" -o "$work/unwrap/cornell.gltf" > "$work/unwrap.log" 2>&1
 validate "$work/unwrap/cornell.gltf" "$cornell"
 helmet="$source/../shared/scenes/damaged_helmet/DamagedHelmet.gltf"

@@ -124,8 +124,9 @@ void gatherVplBlock(const BakeInputs& in, float bound, const glm::vec3& x, const
 template <typename Visit>
 void visitDirect(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Visit&& visit) {
   const float eps = in.rayTracer.epsilon();
-  for (const Light& l : in.scene.lights) {
-    PunctualContribution c = punctualDirect(l, x, n);
+  for (size_t i = 0; i < in.scene.lights.size(); ++i) {
+    if (!in.eval.directIncludes(i)) continue;
+    PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
     if (c.mapValue == glm::vec3(0.0f)) continue;
     glm::vec3 origin = x + n * eps;
     float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;

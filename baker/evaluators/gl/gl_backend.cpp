@@ -510,7 +510,7 @@ std::vector<Lightmap> GlBaker::run() {
     }
   }
   for (size_t i = 0; i < lightCount; ++i) {
-    bakeDirect(in_.scene.lights[i]);
+    if (in_.eval.directIncludes(i)) bakeDirect(in_.scene.lights[i]);
     ++stats_.passes;
     if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * vplsPerPass) / std::max<size_t>(1, totalWork));
   }

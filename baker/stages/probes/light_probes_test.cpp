@@ -171,7 +171,9 @@ TEST(LightProbes, NothingCrossesTheThinWall) {
         const ProbeBlend bright = interpolateProbes(g, glm::vec3(-x, y, z), visible);
         litMean += shAverage(bright.coefficients).x, ++lit;
         // Without the visibility test, the straddling cells would carry the lit side's light over.
-        if (x < 0.15f) EXPECT_GT(shAverage(interpolateProbes(g, glm::vec3(x, y, z)).coefficients).x, 0.0f);
+        if (x < 0.15f) {
+          EXPECT_GT(shAverage(interpolateProbes(g, glm::vec3(x, y, z)).coefficients).x, 0.0f);
+        }
       }
   EXPECT_GT(litMean / lit, 0.05);  // I/(π r²) · 1/4 ≈ 0.8 at 1 m: the lit side is lit
 }

@@ -28,9 +28,16 @@ struct ShadowEdgeStats {
   double seconds = 0.0;
 };
 
+// A subset of the lights whose own refined value is wanted beside the total, on the same edge texels
+// (mixed lighting: the lights left out of what is written). pages: their direct pages, refined in place.
+struct ShadowEdgePart {
+  const std::vector<uint8_t>* lights = nullptr;  // per scene light, 1: in the part
+  std::vector<Lightmap>* pages = nullptr;
+};
+
 // In place on the punctual lights' pages (one per in.texels page, as the direct stage returns them). Pages
 // with supersampled texels (S > 1) are left alone: their samples already spread over the texel.
 ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& directPages,
-                                  const ShadowEdgeOptions& options = {});
+                                  const ShadowEdgeOptions& options = {}, const ShadowEdgePart* part = nullptr);
 
 }  // namespace irbake

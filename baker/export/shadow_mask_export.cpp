@@ -1,0 +1,107 @@
+#include "export/shadow_mask_export.h"
+
+#include <cmath>
+#include <map>
+
+#include "common/error.h"
+#include "imageio/image_io.h"
+#include "scene/image_codec.h"
+
+namespace irbake {
+
+namespace {
+
+// The page a MOZ_lightmap texture shows, from its image's name (lightmap_<page>); -1 when none.
+int pageOfTexture(const GltfDocument& doc, int texture) {
+  const nlohmann::json& root = doc.root;
+  if (!root.contains("textures") || texture < 0 || texture >= int(root["textures"].size())) return -1;
+  const int image = root["textures"][texture].value("source", -1);
+  if (!root.contains("images") || image < 0 || image >= int(root["images"].size())) return -1;
+  const std::string name = root["images"][image].value("name", std::string());
+  if (name.rfind("lightmap_", 0) != 0 || name.size() == 9 || name.find_first_not_of("0123456789", 9) != std::string::npos)
+    return -1;
+  return std::stoi(name.substr(9));
+}
+
+nlohmann::json lightJson(const ShadowMaskLight& l) {
+  nlohmann::json j = {{"name", l.name}, {"channel", l.channel}};
+  if (l.light->gltfLight >= 0) {
+    j["light"] = l.light->gltfLight;  // index into KHR_lights_punctual.lights
+  } else {  // --sun: not in the document, so described here for the runtime to shade it
+    const glm::vec3 d = l.light->direction, e = l.light->color * l.light->intensity;
+    j["directional"] = {{"direction", {d.x, d.y, d.z}}, {"irradiance", {e.x, e.y, e.z}}};
+  }
+  return j;
+}
+
+}  // namespace
+
+Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name) {
+  const Lightmap& rgb = (*mask.rgb)[i];
+  const Lightmap* alpha = mask.alpha && i < mask.alpha->size() ? &(*mask.alpha)[i] : nullptr;
+  Texture t;
+  t.name = name;
+  t.width = rgb.width;
+  t.height = rgb.height;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  t.texels.resize(rgb.texels.size());
+  for (size_t k = 0; k < rgb.texels.size(); ++k)
+    t.texels[k] = glm::clamp(glm::vec4(rgb.texels[k], alpha ? alpha->texels[k].x : 1.0f), 0.0f, 1.0f);
+  return t;
+}
+
+std::string shadowMaskPageUri(const std::string& prefix, int page) {
+  return prefix + "_" + std::to_string(page) + "_shadowmask.exr";
+}
+
+void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::filesystem::path& file,
+                        const std::filesystem::path& finalPath) {
+  const Texture t = shadowMaskTexture(mask, i, finalPath.string());
+  for (const glm::vec4& v : t.texels)
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w))
+      throw Error(ErrorCode::NumericError, finalPath.string(), "shadow-mask page holds NaN/Inf");
+  imageio::Pixels px;
+  px.width = t.width;
+  px.height = t.height;
+  px.channels = 4;
+  px.f32.assign(&t.texels[0].x, &t.texels[0].x + t.texels.size() * 4);
+  imageio::api().writeFile(file.string(), "openexr", px, (*mask.rgb)[i].page, finalPath.string());
+}
+
+void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, const std::string& exrPrefix) {
+  using nlohmann::json;
+  if (mask.empty() || !doc.root.contains("materials")) return;
+  std::map<int, json> extensionOfPage;
+  auto extensionFor = [&](int page) -> const json* {
+    auto it = extensionOfPage.find(page);
+    if (it != extensionOfPage.end()) return &it->second;
+    for (size_t i = 0; i < mask.rgb->size(); ++i) {
+      if ((*mask.rgb)[i].page != page) continue;
+      const std::string name = "lightmap_" + std::to_string(page) + "_shadowmask";
+      // Linear 8-bit: a mask is a visibility in [0, 1], so steps of 1/255 are finer than the 1/64 of its
+      // 8×8 edge rays and invisible on a light's direct term.
+      const std::vector<uint8_t> png = encodePng(shadowMaskTexture(mask, i, name), false);
+      const int texture = doc.addTexture(doc.addPngImage(png, name),
+                                         doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
+      json ext = {{"index", texture}, {"texCoord", 1}};
+      if (!exrPrefix.empty()) ext["exr"] = shadowMaskPageUri(exrPrefix, page);
+      return &(extensionOfPage[page] = std::move(ext));
+    }
+    return nullptr;
+  };
+  bool used = false;
+  for (auto& mat : doc.root["materials"]) {
+    if (!mat.contains("extensions") || !mat["extensions"].contains("MOZ_lightmap")) continue;
+    const json* ext = extensionFor(pageOfTexture(doc, mat["extensions"]["MOZ_lightmap"].value("index", -1)));
+    if (!ext) continue;
+    mat["extensions"][kShadowMaskExtension] = *ext;
+    used = true;
+  }
+  if (!used) return;
+  json lights = json::array();
+  for (const ShadowMaskLight& l : mask.lights) lights.push_back(lightJson(l));
+  doc.root["extensions"][kShadowMaskExtension] = {{"lights", lights}};
+  doc.useExtension(kShadowMaskExtension);
+}
+
+}  // namespace irbake

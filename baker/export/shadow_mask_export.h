@@ -1,0 +1,44 @@
+// Shadow masks in the export (docs/export.md "IRBAKE_shadowmask"): per light-map page one RGBA mask page, as
+// an 8-bit linear PNG referenced from a vendor extension on each light-mapped material and as a float EXR;
+// the root extension maps each shadow-mask light to its channel. MOZ_lightmap is unchanged.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "export/gltf_writer.h"
+#include "lightmap/lightmap.h"
+#include "scene/scene.h"
+
+namespace irbake {
+
+constexpr const char* kShadowMaskExtension = "IRBAKE_shadowmask";
+
+struct ShadowMaskLight {
+  const Light* light = nullptr;  // the scene's light (its KHR_lights_punctual index, or the command line's sun)
+  std::string name;              // as --light-mode names it
+  int channel = 0;               // 0..3: R, G, B, A
+};
+
+struct ShadowMaskExport {
+  const std::vector<Lightmap>* rgb = nullptr;    // channels 0–2 per page
+  const std::vector<Lightmap>* alpha = nullptr;  // channel 3 (x) per page, or null / empty: 1
+  std::vector<ShadowMaskLight> lights;
+  bool empty() const { return !rgb || rgb->empty(); }
+};
+
+// Page i of the mask as RGBA in [0, 1].
+Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name);
+
+// EXR file name of a page's mask: <prefix>_<page>_shadowmask.exr.
+std::string shadowMaskPageUri(const std::string& prefix, int page);
+
+// Writes page i's mask as a 4-channel float EXR.
+void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::filesystem::path& file,
+                        const std::filesystem::path& finalPath);
+
+// Adds each page's PNG and {"index", "texCoord": 1, "exr"} on every material whose MOZ_lightmap is that
+// page's, and the root extension {"lights": [{"light", "name", "channel"}, ...]}; lists it in extensionsUsed.
+void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, const std::string& exrPrefix);
+
+}  // namespace irbake
