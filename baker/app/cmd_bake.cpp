@@ -383,6 +383,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
   command.lights = lightArguments(a);
   probeArguments(a, o.probes);
+  if (command.noGltf) o.probes.enabled = false;  // the probes live in the glTF: none to write them to
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
