@@ -432,6 +432,7 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
   command.lights = lightArguments(a);
   probeArguments(a, o.probes);
+  if (command.noGltf) o.probes.enabled = false;  // the probes live in the glTF: none to write them to
   for (const std::string& entry : a.lightModes) {
     const size_t eq = entry.rfind('=');
     LightModeRequest request;

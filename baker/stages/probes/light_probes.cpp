@@ -73,8 +73,10 @@ ProbeTrace traceProbe(const MapReader& reader, const glm::vec3& p, int rays, dou
       if (!hit.hit) {
         if (scene.environment.present()) L = scene.environment.radiance(dirs[k]);
       } else if (hit.backFace) {  // no map on a back face; a double-sided surface's back is no inside
-        if (!doubleSided(scene, hit.primitive)) ++out.backFaces;
-        if (hit.t < out.nearestBack) out.nearestBack = hit.t, out.nearestBackDir = dirs[k];
+        if (!doubleSided(scene, hit.primitive)) {
+          ++out.backFaces;
+          if (hit.t < out.nearestBack) out.nearestBack = hit.t, out.nearestBackDir = dirs[k];
+        }
       } else {
         L = reader.radiance(hit);
       }
