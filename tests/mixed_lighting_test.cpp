@@ -36,23 +36,25 @@ Scene boxScene() {
   return s;
 }
 
-BakeOptions smallBake() {
+BakeOptions smallBake(BackendKind backend = BackendKind::Embree) {
   BakeOptions o;
-  o.backend = BackendKind::Embree;
+  o.backend = backend;
   o.atlas.targetPageSize = o.atlas.maxPageSize = 64;
   o.walk.paths = 4000;
   o.finalGather = FinalGatherMode::On;
   return o;
 }
 
+// Both VPL evaluators: GL draws each light's shadow map in its own pass, Embree traces its rays.
 TEST(MixedLighting, BakedEqualsIndirectPlusTheLightsDirectTerm) {
-  const BakeResult baked = bake(boxScene(), smallBake());
-  BakeOptions indirect = smallBake();
+  for (const BackendKind backend : {BackendKind::Embree, BackendKind::Gl}) {
+  const BakeResult baked = bake(boxScene(), smallBake(backend));
+  BakeOptions indirect = smallBake(backend);
   indirect.lightModes = {{"b", LightMode::Indirect}};
   const BakeResult without = bake(boxScene(), indirect);
   // direct(b): the direct stage alone with a left out, so its edge texels are the same as the bakes' (found on
   // both lights' light) and the value is b's mean over them.
-  BakeOptions direct = smallBake();
+  BakeOptions direct = smallBake(backend);
   direct.eval.includeVpls = false;
   direct.eval.biasCompensation = false;
   direct.finalGather = FinalGatherMode::Off;
@@ -77,8 +79,9 @@ TEST(MixedLighting, BakedEqualsIndirectPlusTheLightsDirectTerm) {
   ASSERT_GT(texels, 1000u);
   EXPECT_LT(worst, 1e-4) << "texel " << worstAt;
   EXPECT_GT(bShare / total, 0.05);  // b's direct light is a real part of the map
-  std::printf("[ figure ] %zu texels: max |baked − (indirect + direct(b))| / baked = %.2e; direct(b) is %.1f%% of the map\n",
-              texels, worst, 100.0 * bShare / total);
+  std::printf("[ figure ] %s: %zu texels: max |baked − (indirect + direct(b))| / baked = %.2e; direct(b) is %.1f%% of the map\n",
+              toString(backend), texels, worst, 100.0 * bShare / total);
+  }
 }
 
 TEST(MixedLighting, PlaneUnderAnIndirectLightBakesToZero) {
