@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -72,5 +73,10 @@ struct AtlasedScene {
   std::vector<TexelSamples> pages;
   AtlasedScene(Scene s, int pageSize);
 };
+
+// Of the part of texel t's square on its own triangle where visible(p), the share where lit(p), from a 64×64 grid
+// of points (closed-form predicates, no rays); -1 where no point is in that part.
+double exactLitShare(const Scene& s, const TexelSamples& ts, size_t t, const std::function<bool(glm::vec3)>& lit,
+                     const std::function<bool(glm::vec3)>& visible = [](glm::vec3) { return true; });
 
 }  // namespace irbake::testing

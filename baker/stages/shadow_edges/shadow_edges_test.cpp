@@ -52,34 +52,6 @@ struct SunOverFloor {
   }
 };
 
-// Of the floor's part inside texel t's square, its own triangle and visible(p), the share where lit(p), from a
-// 64×64 grid of points (no rays: closed-form predicates); -1 where no point is in that part.
-double exactLitShare(const Scene& s, const TexelSamples& ts, size_t t, const std::function<bool(glm::vec3)>& lit,
-                     const std::function<bool(glm::vec3)>& visible = [](glm::vec3) { return true; }) {
-  const Primitive& prim = s.primitives[ts.primitive[t]];
-  const uint32_t tri = ts.triangle[t];
-  const glm::vec2 size(ts.width, ts.height);
-  const glm::vec2 a = prim.uv1[prim.indices[3 * tri]] * size, b = prim.uv1[prim.indices[3 * tri + 1]] * size,
-                  c = prim.uv1[prim.indices[3 * tri + 2]] * size;
-  const glm::vec3 &pa = prim.positions[prim.indices[3 * tri]], &pb = prim.positions[prim.indices[3 * tri + 1]],
-                  &pc = prim.positions[prim.indices[3 * tri + 2]];
-  auto cross2 = [](glm::vec2 u, glm::vec2 v) { return u.x * v.y - u.y * v.x; };
-  const float area = cross2(b - a, c - a);
-  const int x = static_cast<int>(t % ts.width), y = static_cast<int>(t / ts.width), K = 64;
-  int inside = 0, litCount = 0;
-  for (int j = 0; j < K; ++j)
-    for (int i = 0; i < K; ++i) {
-      const glm::vec2 q(x + (i + 0.5f) / K, y + (j + 0.5f) / K);
-      const float u = cross2(q - a, c - a) / area, v = cross2(b - a, q - a) / area;
-      if (u < 0 || v < 0 || u + v > 1) continue;
-      const glm::vec3 p = (1 - u - v) * pa + u * pb + v * pc;
-      if (!visible(p)) continue;
-      ++inside;
-      litCount += lit(p) ? 1 : 0;
-    }
-  return inside ? double(litCount) / inside : -1.0;
-}
-
 TEST(ShadowEdges, EdgeTexelsGetTheLitShareOfTheirSquare) {
   SunOverFloor f(false);
   const BakeInputs in = f.inputs();

@@ -40,31 +40,6 @@ struct BoxUnderPointLight {
   BakeInputs inputs() { return BakeInputs{s, *rt, texels, none, VplEvalOptions{}, {}}; }
 };
 
-// The share of texel t's square (on its own triangle) outside the umbra, from a 64×64 grid of points.
-double exactLitShare(const Scene& s, const TexelSamples& ts, size_t t) {
-  const Primitive& prim = s.primitives[ts.primitive[t]];
-  const uint32_t tri = ts.triangle[t];
-  const glm::vec2 size(ts.width, ts.height);
-  const glm::vec2 a = prim.uv1[prim.indices[3 * tri]] * size, b = prim.uv1[prim.indices[3 * tri + 1]] * size,
-                  c = prim.uv1[prim.indices[3 * tri + 2]] * size;
-  const glm::vec3 &pa = prim.positions[prim.indices[3 * tri]], &pb = prim.positions[prim.indices[3 * tri + 1]],
-                  &pc = prim.positions[prim.indices[3 * tri + 2]];
-  auto cross2 = [](glm::vec2 u, glm::vec2 v) { return u.x * v.y - u.y * v.x; };
-  const float area = cross2(b - a, c - a);
-  const int x = static_cast<int>(t % ts.width), y = static_cast<int>(t / ts.width), K = 64;
-  int inside = 0, lit = 0;
-  for (int j = 0; j < K; ++j)
-    for (int i = 0; i < K; ++i) {
-      const glm::vec2 q(x + (i + 0.5f) / K, y + (j + 0.5f) / K);
-      const float u = cross2(q - a, c - a) / area, v = cross2(b - a, q - a) / area;
-      if (u < 0 || v < 0 || u + v > 1) continue;
-      const glm::vec3 p = (1 - u - v) * pa + u * pb + v * pc;
-      ++inside;
-      lit += (std::abs(p.x) < kHalfShadow && std::abs(p.y) < kHalfShadow) ? 0 : 1;
-    }
-  return inside ? double(lit) / inside : -1.0;
-}
-
 TEST(ShadowMask, UmbraZeroLitOneEdgesTheLitShare) {
   BoxUnderPointLight scene;
   const ShadowMaskChannels channels = assignShadowMaskChannels(scene.s, scene.texels, {1}, {});
@@ -82,7 +57,9 @@ TEST(ShadowMask, UmbraZeroLitOneEdgesTheLitShare) {
     const TexelSamples& ts = scene.texels[p];
     for (size_t t = 0; t < ts.layerSize(); ++t) {
       if (!ts.valid[t] || ts.primitive[t] != 0) continue;  // the floor's texels
-      const double exact = exactLitShare(scene.s, ts, t);
+      const double exact = exactLitShare(scene.s, ts, t, [](glm::vec3 p) {  // outside the umbra
+        return !(std::abs(p.x) < kHalfShadow && std::abs(p.y) < kHalfShadow);
+      });
       const float m = mask.rgb[p].texels[t].x;
       EXPECT_EQ(mask.rgb[p].texels[t].y, 1.0f);  // unused channels: nothing shadows
       if (exact == 0.0) {
