@@ -104,4 +104,29 @@ void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, con
   doc.useExtension(kShadowMaskExtension);
 }
 
+void recordLightModes(GltfDocument& doc, const Scene& scene, const std::vector<LightMode>& modes) {
+  using nlohmann::json;
+  if (modes.size() != scene.lights.size()) return;
+  json* khr = nullptr;
+  if (doc.root.contains("extensions") && doc.root["extensions"].contains("KHR_lights_punctual") &&
+      doc.root["extensions"]["KHR_lights_punctual"].contains("lights") &&
+      doc.root["extensions"]["KHR_lights_punctual"]["lights"].is_array())
+    khr = &doc.root["extensions"]["KHR_lights_punctual"]["lights"];
+  for (size_t i = 0; i < modes.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (l.gltfLight < 0) {  // the command line's sun: not in the document
+      if (modes[i] == LightMode::Baked || (doc.root.contains("extras") && !doc.root["extras"].is_object())) continue;
+      const glm::vec3 d = l.direction, e = l.color * l.intensity;
+      doc.root["extras"]["irbakeSun"] = {{"mode", toString(modes[i])}, {"direction", {d.x, d.y, d.z}},
+                                         {"irradiance", {e.x, e.y, e.z}}};
+      continue;
+    }
+    if (!khr || l.gltfLight >= static_cast<int>(khr->size())) continue;
+    json& light = (*khr)[static_cast<size_t>(l.gltfLight)];
+    if (modes[i] == LightMode::Baked && !l.hasExtrasMode) continue;
+    if (light.contains("extras") && !light["extras"].is_object()) continue;  // a source's own non-object extras stay
+    light["extras"]["irbake"]["mode"] = toString(modes[i]);
+  }
+}
+
 }  // namespace irbake

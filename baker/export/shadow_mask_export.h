@@ -41,4 +41,10 @@ void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::files
 // page's, and the root extension {"lights": [{"light", "name", "channel"}, ...]}; lists it in extensionsUsed.
 void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, const std::string& exrPrefix);
 
+// Records each punctual light's settled mode where a client finds it (docs/export.md "Mixed lights"): a KHR light
+// that is not baked, or whose source extras named a mode, gets extras.irbake.mode; the command line's sun when
+// not baked gets the root extras "irbakeSun" {"mode", "direction", "irradiance"}. `modes` is per scene light
+// (empty: every light baked, nothing written).
+void recordLightModes(GltfDocument& doc, const Scene& scene, const std::vector<LightMode>& modes);
+
 }  // namespace irbake

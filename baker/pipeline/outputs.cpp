@@ -84,6 +84,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
     if (!mask.empty()) ex.shadowMask = &mask;
+    ex.lightModes = &result.lightModes;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;
