@@ -211,11 +211,12 @@ void checkLightModes(const BakeOptions& options, const Scene& scene) {
     if (modes[i].mode == LightMode::Baked) continue;
     const std::string what = "light '" + lightModeName(scene.lights[i]) + "' in mode " + toString(modes[i].mode) +
                              " (" + modes[i].reason + ")";
-    // The reference integrator finds every light itself, and the L1 pages have no split by light yet.
+    // The reference integrator finds every light itself, and the L1 pages hold every light's direct term (they
+    // have no split by light), so both are refused before anything is traced.
     if (options.backend == BackendKind::Reference)
       throw Error(ErrorCode::Usage, scene.sourcePath, what + ": needs a VPL backend (gl, embree or auto), not reference");
     if (options.directional)
-      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": --directional bakes every light for now (leave it out)");
+      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": --directional bakes every light's direct term into its L1 pages; leave out --directional or the mode");
   }
 }
 
