@@ -24,8 +24,14 @@ struct ShadowMaskExport {
   const std::vector<Lightmap>* rgb = nullptr;    // channels 0–2 per page
   const std::vector<Lightmap>* alpha = nullptr;  // channel 3 (x) per page, or null / empty: 1
   std::vector<ShadowMaskLight> lights;
+  const Scene* scene = nullptr;  // the lights' scene (documentLightIndex); null: only gltfLight says
   bool empty() const { return !rgb || rgb->empty(); }
 };
+
+// The index of scene light `l` in the exported document's KHR_lights_punctual.lights: its source index, or for
+// a scene the export generates (no source file) its place in Scene::lights, which the writer keeps; -1 for a
+// light the document does not have (the command line's --sun over a source file).
+int documentLightIndex(const Scene* scene, const Light& l);
 
 // Page i of the mask as RGBA in [0, 1].
 Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name);
