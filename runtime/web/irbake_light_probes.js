@@ -142,7 +142,16 @@ export async function readProbeGrid(json, accessor) {
     if (def.componentType !== FLOAT || def.type !== type)
       fail(key, `accessor of componentType ${def.componentType} ${def.type}, expected ${FLOAT} ${type}`);
     if (def.count !== count) fail(key, `${def.count} elements, the grid needs ${count}`);
-    const attribute = await accessor(index);
+    const view = json.bufferViews?.[def.bufferView];
+    const bytes = (def.byteOffset ?? 0) + 4 * COMPONENTS[type] * count;
+    if (!view || (view.byteStride === undefined && bytes > view.byteLength))
+      fail(key, `accessor ${index} needs ${bytes} bytes of its buffer view, which has ${view?.byteLength ?? 'none'}`);
+    let attribute;
+    try {
+      attribute = await accessor(index);
+    } catch (e) {
+      fail(key, `accessor ${index} cannot be read: ${e.message}`);
+    }
     const values = new Float32Array(count * COMPONENTS[type]);
     for (let i = 0; i < count; ++i)
       for (let c = 0; c < COMPONENTS[type]; ++c) values[i * COMPONENTS[type] + c] = attribute.getComponent(i, c);

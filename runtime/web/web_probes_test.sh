@@ -3,7 +3,8 @@
 # (albedo 1) lit by the probes into the same look-at view in irview (--probe-object, PNG) and in three.js
 # (irbake_light_probes.js, ?probeObject=) and require the sphere's pixels to agree: mean absolute difference
 # ≤ 1 (8-bit; what is left is the three.js sphere's tessellated normals and the two sRGB encoders' rounding).
-# Then the page must refuse two corrupted grids (too-short accessors, a NaN coefficient) naming the problem.
+# Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
+# the problem.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
@@ -21,5 +22,7 @@ node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene.gltf" --re
 node "$here/corrupt_probes.mjs" "$work/bake/scene.gltf"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_counts.gltf" \
   --expect-error "IRBAKE_light_probes.coefficients: "
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_zero.gltf" \
+  --expect-error "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_nan.gltf" \
   --expect-error "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
