@@ -9,7 +9,7 @@
 // value as irview, since three.js shades irradiance × albedo/π and the material's probe term is π × E/π.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
-import { Box3, Vector3 } from 'three';
+import { Box3, SphericalHarmonics3, Vector3 } from 'three';
 
 export const LIGHT_PROBES = 'IRBAKE_light_probes';
 const FLOAT = 5126;
@@ -111,6 +111,12 @@ export function applyProbeSh(material, coefficients) {
   };
   material.customProgramCacheKey = () => 'irbake-light-probes';
   material.needsUpdate = true;
+}
+
+// A blend's coefficients as three.js's SphericalHarmonics3 (for a LightProbe of intensity π, which lights a whole
+// scene rather than one object).
+export function toSphericalHarmonics3(coefficients) {
+  return new SphericalHarmonics3().fromArray(Array.from(coefficients));
 }
 
 function fail(field, message) { throw new Error(`${LIGHT_PROBES}${field ? '.' + field : ''}: ${message}`); }
