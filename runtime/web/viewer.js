@@ -4,11 +4,16 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 import { IrbakeShadowmaskExtension } from './irbake_shadowmask.js';
+import { IrbakeLightProbesExtension } from './irbake_light_probes.js';
+import { addProbeObjects, lookAtCamera } from './probe_objects.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
-// plugin false: plain GLTFLoader without MOZ_lightmap, as a viewer that does not know it (the portable GLB).
+// plugin false: plain GLTFLoader without our plugins (MOZ_lightmap, IRBAKE_light_probes), as a viewer that does not know them.
 // mixedLights false: MOZ_lightmap only, every light removed (the map alone, as a client without irbake_shadowmask.js).
-export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true, mixedLights = true }) {
+// probeObjects: [[x, y, z, r], ...] white spheres lit by IRBAKE_light_probes (probe_objects.js); view: { eye,
+// target, fov } a look-at camera instead of glTF camera `camera`, as irview --eye/--target/--fov.
+export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true,
+                                       mixedLights = true, probeObjects = [], view = null }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
@@ -22,6 +27,7 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   let shadowmask = null;  // mixed lighting: the lights the bake left to the client, shadowed by the mask pages
   if (plugin) {
     loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
+    loader.register(parser => new IrbakeLightProbesExtension(parser));
     if (mixedLights) loader.register(parser => (shadowmask = new IrbakeShadowmaskExtension(parser)));
   }
   const gltf = await loader.loadAsync(scene);
@@ -33,7 +39,8 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   shadowmask?.syncLights(gltf.scene);
   gltf.scene.updateMatrixWorld(true);
 
-  const cam = gltf.cameras[camera];
+  const probes = addProbeObjects(gltf, probeObjects, scene);
+  const cam = view ? lookAtCamera(view) : gltf.cameras[camera];
   if (!cam) throw new Error(`${scene}: no camera ${camera}`);
   cam.aspect = width / height;  // irview uses the viewport's aspect
   cam.updateProjectionMatrix();
@@ -47,7 +54,7 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   return { width, height, lights: lights.length, lightmapMode, plugin,
            runtimeLights: shadowmask?.runtimeLights.length ?? 0, maskedMaterials: shadowmask?.maskedMaterials ?? 0,
            directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
-           generatedTangents: lightmapExtension?.generatedTangents ?? 0 };
+           generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes };
 }
 
 export { canvasPixels } from './canvas_pixels.js';
