@@ -571,6 +571,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   } else {
     drawAll(static_cast<int>(settings.mode));
   }
+  for (const Overlay& overlay : overlays_) overlay(camera, vp, settings);
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
   glDisable(GL_CULL_FACE);
