@@ -20,7 +20,11 @@ Pixels compared: the sphere's image disc from the camera (vertical fov, pixel ce
 top), each pixel fully covered (8x8 sub-pixel rays) and so are its 8 neighbours (the silhouette's 1-pixel ring
 is left out). Figures: ratio ours/Cycles of the summed RGB over the kept pixels, and on each quarter of the
 disc (split at the projected centre, which is the image centre: the camera targets it); the reference's noise
-= half the difference of its two halves over their mean. Rows are appended to bench/results/probe_spheres.csv.
+= half the difference of its two halves over their mean. Diagnosis: `ratio_exact_direct` and
+`worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone (the sun,
+times the sphere's sunlit share, and the emitters seen from the centre, as exact clamped cosines in place of
+their L2 parts): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
+probes around the centre that see the sun (a sun shadow edge between probes shows as a share below `sunlit`). Rows are appended to bench/results/probe_spheres.csv.
 Every process runs under `nice -n 15`; Cycles with --threads 2.
 """
 import argparse
@@ -42,6 +46,7 @@ REPO = compare.REPO
 NICE = compare.NICE
 SPHERE_SEGMENTS, SPHERE_RINGS = 96, 48
 SUN = (0.35, -1.0, 0.2)  # scenes.py SUN_DIR: the direction the sun's light travels
+SUN_IRRADIANCE = 5.0  # scenes.py SUN_IRRADIANCE (W/m^2)
 SPONZA_SKY = "0.4,0.5,0.7"
 
 # name, centre (glTF world, metres), radius, camera direction from the centre, camera distance, vertical fov.
@@ -62,9 +67,9 @@ SCENES = {  # scene file under --scenes-dir, irbake options, Cycles sky
     "cornell": ("mcguire_cornell.gltf", "", ""),
     "sponza": ("sponza_sun.glb", "--sky " + SPONZA_SKY, SPONZA_SKY),
 }
-CSV_FIELDS = ["date", "commit", "scene", "place", "centre", "radius", "sunlit", "clearance", "eye", "fov", "size",
-              "our_seed", "ours", "kept", "ratio", "q_upper_left", "q_upper_right", "q_lower_left", "q_lower_right",
-              "worst_quarter", "cycles_mean", "ref_spp", "ref_noise", "ref_noise_quarter_max", "cycles_s"]
+CSV_FIELDS = ["date", "commit", "scene", "place", "centre", "radius", "sunlit", "probe_sun_share", "clearance", "eye", "fov", "size",
+              "our_seed", "our_options", "ours", "cycles_sphere", "kept", "ratio", "q_upper_left", "q_upper_right", "q_lower_left", "q_lower_right",
+              "worst_quarter", "ratio_exact_direct", "worst_quarter_exact_direct", "cycles_mean", "ref_spp", "ref_noise", "ref_noise_quarter_max", "cycles_s"]
 
 
 def log(*a):
@@ -100,9 +105,17 @@ def read_accessor(doc, bufs, i):
 
 
 def scene_triangles(path):
-    """Every triangle of the default scene in world space, (T, 3, 3)."""
+    """Every triangle of the default scene in world space, (T, 3, 3), and its emission (T, 3): emissiveFactor
+    times KHR_materials_emissive_strength."""
     doc, bufs = compare.load_gltf(path)
-    tris = []
+    tris, emission = [], []
+
+    def emitted(p):
+        if "material" not in p:
+            return np.zeros(3)
+        m = doc["materials"][p["material"]]
+        strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+        return np.array(m.get("emissiveFactor", [0, 0, 0]), dtype=np.float64) * strength
 
     def visit(i, parent):
         n = doc["nodes"][i]
@@ -116,11 +129,12 @@ def scene_triangles(path):
                 idx = (read_accessor(doc, bufs, p["indices"]).ravel() if "indices" in p
                        else np.arange(len(pos))).astype(np.int64)
                 tris.append(pos[idx.reshape(-1, 3)])
+                emission.append(np.repeat(emitted(p)[None], len(idx) // 3, 0))
         for c in n.get("children", []):
             visit(c, m)
     for r in doc["scenes"][doc.get("scene", 0)]["nodes"]:
         visit(r, np.eye(4))
-    return np.concatenate(tris)
+    return np.concatenate(tris), np.concatenate(emission)
 
 
 def ray_hits(tris, origins, dirs, tmax=np.inf):
@@ -310,6 +324,109 @@ def ours_from_probe(args, gltf, eye, target, fov, size, centre, radius):
     return img.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
 
 
+def direct_light(tris, emission, centre, sunlit, has_sun):
+    """The direct light at the centre as deltas (unit directions, RGB weights: E(n) = sum w max(n.w_k, 0)) and
+    how many lead the list as suns: the sun (times the sphere's sunlit share), then the emitters seen from the
+    centre (front faces, 50k lattice rays)."""
+    dirs, weights = [], []
+    if has_sun and sunlit > 0:
+        dirs.append(-np.array(SUN)[None] / np.linalg.norm(SUN))
+        weights.append(np.full((1, 3), SUN_IRRADIANCE * sunlit))
+    if emission.max(initial=0.0) > 0:
+        n = 50000
+        d = fibonacci_dirs(n)
+        best, which = np.full(n, np.inf), np.full(n, -1)
+        o = np.array(centre, float)
+        for k in range(len(tris)):  # few triangles (the box): loop over them, rays vectorised
+            a, e1, e2 = tris[k, 0], tris[k, 1] - tris[k, 0], tris[k, 2] - tris[k, 0]
+            p = np.cross(d, e2)
+            det = p @ e1
+            inv = np.where(np.abs(det) > 1e-12, 1.0 / np.where(np.abs(det) > 1e-12, det, 1.0), 0.0)
+            u = (p @ (o - a)) * inv
+            q = np.cross(o - a, e1)
+            v = (d @ q) * inv
+            t = (q @ e2) * inv
+            hit = (inv != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < best)
+            best[hit], which[hit] = t[hit], k
+        front = which >= 0
+        front[front] &= emission[which[front]].max(axis=1) > 0
+        front[front] &= np.einsum("ij,ij->i", d[front], np.cross(tris[which[front], 1] - tris[which[front], 0],
+                                                                  tris[which[front], 2] - tris[which[front], 0])) < 0
+        dirs.append(d[front])
+        weights.append(emission[which[front]] * 4 * math.pi / n)
+    suns = 1 if has_sun and sunlit > 0 else 0
+    if not dirs:
+        return np.zeros((0, 3)), np.zeros((0, 3)), 0
+    return np.concatenate(dirs), np.concatenate(weights), suns
+
+
+def emitter_points(tris, emission, per_side=24):
+    """Points on the emitting triangles (front faces): positions, unit normals, RGB power weights Le x area."""
+    pts, nrm, wts = [], [], []
+    i, j = np.meshgrid(np.arange(per_side), np.arange(per_side), indexing="ij")
+    keep = i + j < per_side  # a barycentric grid of sub-triangle centres, equal areas
+    u, v = ((i + 1 / 3) / per_side)[keep], ((j + 1 / 3) / per_side)[keep]
+    for k in np.flatnonzero(emission.max(axis=1) > 0):
+        a, e1, e2 = tris[k, 0], tris[k, 1] - tris[k, 0], tris[k, 2] - tris[k, 0]
+        c = np.cross(e1, e2)
+        area = 0.5 * np.linalg.norm(c)
+        pts.append(a + u[:, None] * e1 + v[:, None] * e2)
+        nrm.append(np.repeat((c / np.linalg.norm(c))[None], len(u), 0))
+        wts.append(np.repeat(emission[k][None] * area / len(u), len(u), 0))
+    if not pts:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3))
+    return np.concatenate(pts), np.concatenate(nrm), np.concatenate(wts)
+
+
+def direct_l2_residual(eye, target, fov, size, centre, radius, dirs, weights, suns, emitters):
+    """What an L2 probe at the centre misses of the sphere's direct light, per pixel (2x2 sub-pixel points):
+    the exact direct E(p, n)/pi at the surface point p (the sun's clamped cosine; the emitters' area integral at
+    p, unoccluded, so with their 1/r^2 across the sphere) minus the L2 part of the direct light at the centre
+    (a delta of weight w along l gives w (3/32 + c/2 + 15c^2/32), c = n.l: the clamped cosine's Legendre series
+    to l = 2)."""
+    sub = 2
+    hit, n = sphere_hits(eye, camera_rays(eye, target, fov, size, sub), centre, radius)
+    n = n.reshape(-1, 3)
+    p = np.array(centre, float) + radius * n
+    out = np.zeros((len(n), 3))
+    for k in range(0, len(dirs), 256):
+        c = n @ dirs[k:k + 256].T
+        out -= (3 / 32 + c / 2 + 15 * c * c / 32) @ weights[k:k + 256]
+    for k in range(suns):  # the sun: no 1/r^2, its clamped cosine at every point
+        out += np.maximum(n @ dirs[k], 0)[:, None] * weights[k][None]
+    q, qn, qw = emitters
+    for k in range(0, len(q), 64):
+        d = q[None, k:k + 64] - p[:, None]
+        r2 = np.einsum("ijk,ijk->ij", d, d)
+        w = np.maximum(np.einsum("ijk,jk->ij", d, -qn[k:k + 64]), 0) * np.maximum(np.einsum("ijk,ik->ij", d, n), 0)
+        out += (w / (r2 * r2)) @ qw[k:k + 64]
+    out = np.where(hit.reshape(-1, 1), out / math.pi, 0.0)
+    return out.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
+
+
+def probe_sun_share(gltf, tris, centre):
+    """The trilinear weight (valid probes, renormalised, as irview blends them) of the 8 probes around the centre
+    whose baked position (grid point + offset) sees the sun: the sun's share the blended probe carries."""
+    doc, bufs = compare.load_gltf(gltf)
+    ext = doc["extensions"]["IRBAKE_light_probes"]
+    origin, spacing, counts = np.array(ext["origin"]), float(ext["spacing"]), ext["counts"]
+    offsets = read_accessor(doc, bufs, ext["offsets"]).astype(np.float64)
+    valid = read_accessor(doc, bufs, ext["valid"]).ravel()
+    g = np.clip((np.array(centre) - origin) / spacing, 0, np.array(counts) - 1.000001)
+    base, f = np.floor(g).astype(int), g - np.floor(g)
+    to_sun = -np.array(SUN) / np.linalg.norm(SUN)
+    pts, wts = [], []
+    for corner in np.ndindex(2, 2, 2):
+        ijk = np.minimum(base + corner, np.array(counts) - 1)
+        index = ijk[0] + counts[0] * (ijk[1] + counts[1] * ijk[2])
+        w = np.prod(np.where(np.array(corner) == 1, f, 1 - f))
+        if valid[index] > 0.5 and w > 0:
+            pts.append(origin + spacing * ijk + offsets[index])
+            wts.append(w)
+    lit = np.isinf(ray_hits(tris, np.array(pts), np.repeat(to_sun[None], len(pts), 0)))
+    return float(np.dot(wts, lit) / np.sum(wts))
+
+
 def ours_from_irview(args, gltf, eye, target, fov, size, centre, radius, path):
     ss = 4
     compare.run(NICE + [args.irview, gltf, "--probe-object", ",".join("%.6g" % x for x in tuple(centre) + (radius,)),
@@ -332,13 +449,17 @@ def our_bake(args, scene, opts, seed, out):
     compare.run(cmd, out + ".log")
 
 
-def cycles_pair(args, sphere_scene, sky, eye, target, fov):
+def cycles_pair(args, sphere_scene, sky, eye, target, fov, camera_only=False):
     script = args.render_script
     base = ["--eye=" + ",".join("%.6g" % x for x in eye), "--target=" + ",".join("%.6g" % x for x in target),
             "--fov", "%.6g" % fov, "--width", str(args.size), "--height", str(args.size),
             "--max-bounces", "64", "--threads", "2"]
     key = None
-    if sky:
+    if camera_only:  # the sphere seen by camera rays only: what a probe-lit object is
+        script = os.path.join(REPO, "bench", "cycles", "cycles_render_probe_object.py")
+        base += ["--object", "probe_sphere", "--cycles-dir", args.cycles_dir] + (["--sky", sky] if sky else [])
+        key = compare.gltf_files(sphere_scene) + [args.render_script]
+    elif sky:
         script = os.path.join(REPO, "bench", "cycles", "cycles_render_sky.py")
         base += ["--sky", sky, "--cycles-dir", args.cycles_dir]
         key = compare.gltf_files(sphere_scene) + [args.render_script]
@@ -366,10 +487,12 @@ def run_scene(args, name, rows):
     scene = os.path.join(args.scenes_dir, file)
     if not os.path.isfile(scene):
         compare.fail("%s not found: build it with bench/cycles/scenes.py" % scene)
-    tris = scene_triangles(scene)
+    tris, emission = scene_triangles(scene)
     commit = compare.git_commit(args.irbake)
+    opts = (opts + " " + args.bake_opts).strip()
+    work = os.path.join(args.work, name + ("_" + compare.slug(args.bake_opts) if args.bake_opts else ""))
     for seed in ([] if args.cycles_only else args.seed_list):
-        our_bake(args, scene, opts, seed, os.path.join(args.work, name, "seed%d" % seed))
+        our_bake(args, scene, opts, seed, os.path.join(work, "seed%d" % seed))
     for place, centre, radius, view, dist, fov in PLACES[name]:
         v = np.array(view) / np.linalg.norm(view)
         eye = tuple(np.array(centre) + dist * v)
@@ -380,11 +503,14 @@ def run_scene(args, name, rows):
             compare.fail("%s/%s: the camera does not see the sphere or it is within R of geometry" % (name, place))
         sphere_scene = write_sphere_scene(scene, os.path.join(os.path.dirname(scene), "probe_sphere_%s_%s.glb" % (
             name, place)), centre, radius)
-        refs = cycles_pair(args, sphere_scene, sky, eye, centre, fov)
+        refs = cycles_pair(args, sphere_scene, sky, eye, centre, fov, args.cycles_sphere == "camera")
         a, b = (compare.read_exr(r[0])[..., :3] for r in refs)
         keep = kept_mask(eye, centre, fov, args.size, centre, radius)
+        residual = direct_l2_residual(eye, centre, fov, args.size, centre, radius,
+                                      *direct_light(tris, emission, centre, sunlit, name == "sponza"),
+                                      emitter_points(tris, emission))
         for seed in ([] if args.cycles_only else args.seed_list):
-            out = os.path.join(args.work, name, "seed%d" % seed)
+            out = os.path.join(work, "seed%d" % seed)
             gltf = os.path.join(out, "scene.gltf")
             if args.ours == "irview":
                 ours = ours_from_irview(args, gltf, eye, centre, fov, args.size, centre, radius,
@@ -392,10 +518,14 @@ def run_scene(args, name, rows):
             else:
                 ours = ours_from_probe(args, gltf, eye, centre, fov, args.size, centre, radius)
             f = figures(ours, a, b, keep, args.size)
+            if name == "sponza":
+                f["probe_sun_share"] = probe_sun_share(gltf, tris, centre)
+            fs = figures(ours + residual, a, b, keep, args.size)
+            f["ratio_exact_direct"], f["worst_quarter_exact_direct"] = fs["ratio"], fs["worst_quarter"]
             row = {"date": datetime.date.today().isoformat(), "commit": commit, "scene": name, "place": place,
                    "centre": " ".join("%g" % x for x in centre), "radius": radius, "sunlit": round(sunlit, 3),
                    "clearance": round(clearance, 3), "eye": " ".join("%.4g" % x for x in eye), "fov": fov,
-                   "size": args.size, "our_seed": seed, "ours": args.ours, "ref_spp": 2 * max(1, args.spp // 2),
+                   "size": args.size, "our_seed": seed, "our_options": args.bake_opts, "ours": args.ours, "cycles_sphere": args.cycles_sphere, "ref_spp": 2 * max(1, args.spp // 2),
                    "cycles_s": round(sum(r[1].get("render_time_s", r[1].get("wall_s", 0.0)) for r in refs), 1)}
             row.update({k: (round(float(v), 5) if isinstance(v, (float, np.floating)) else v) for k, v in f.items()})
             rows.append(row)
@@ -411,6 +541,10 @@ def main():
     ap.add_argument("--spp", type=int, default=1024, help="Cycles samples per pixel (two halves)")
     ap.add_argument("--size", type=int, default=96, help="image width and height (pixels)")
     ap.add_argument("--ours", choices=["irview", "probe"], default="irview")
+    ap.add_argument("--cycles-sphere", choices=["scene", "camera"], default="scene",
+                    help="Cycles' sphere: part of the scene (it shadows and lights its surroundings), or seen by "
+                         "camera rays only (cycles_render_probe_object.py), as a probe-lit object is")
+    ap.add_argument("--bake-opts", default="", help='more irbake bake options, e.g. "--probes 1" (own work folder)')
     ap.add_argument("--cycles-only", action="store_true", help="only the Cycles renders (to fill the cache)")
     ap.add_argument("--reuse-bakes", action="store_true", help="keep our bakes already in --work")
     ap.add_argument("--irbake", default=os.path.join(REPO, "build", "baker", "irbake"))
