@@ -3,7 +3,8 @@
 
 usage (from the repository root; Debian's /usr/bin/python3 with python3-numpy and python3-openimageio):
   /usr/bin/python3 bench/cycles/probe_spheres.py [--scenes cornell,sponza] [--seeds 0,1,2,3,4]
-      [--spp 1024] [--size 96] [--ours irview|probe] [--irbake build/baker/irbake --irview build/runtime/irview]
+      [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere scene|camera] [--bake-opts "--probes 1"]
+      [--irbake build/baker/irbake --irview build/runtime/irview]
 
 For each scene (build/cycles-scenes from scenes.py: the McGuire Cornell box; Sponza with its sun and the sky
 0.4,0.5,0.7) and each place (PLACES: a centre and radius R, away from walls, and a camera framing it):
