@@ -29,14 +29,13 @@ probes around the centre that see the sun (a sun shadow edge between probes show
 Every process runs under `nice -n 15`; Cycles with --threads 2.
 """
 import argparse
+import csv
 import datetime
 import json
 import math
 import os
-import struct
 import subprocess
 import sys
-import time
 
 import numpy as np
 
@@ -563,7 +562,6 @@ def main():
     for name in args.scenes.split(","):
         run_scene(args, name, rows)
     new = not os.path.isfile(args.csv)
-    import csv
     with open(args.csv, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
         if new:
