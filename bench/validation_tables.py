@@ -256,6 +256,28 @@ def t_directional():
                   "directional stage (s)", "EXR pages (MiB)"], out)
 
 
+def t_probe_spheres():
+    """A white sphere lit by our probes (irview --probe-object) against Cycles (bench/cycles/probe_spheres.py):
+    the latest row per scene, place, seed and shading path."""
+    rows = latest(read("probe_spheres.csv"), lambda r: (r["scene"], r["place"], r["our_seed"], r["ours"],
+                                                             r["cycles_sphere"], r["our_options"]))
+    out = []
+    for r in sorted(rows, key=lambda r: (r["scene"], r["cycles_sphere"] != "scene", r["our_options"],
+                                         int(r["our_seed"]), r["ours"])):
+        quarters = " / ".join(num(r[q], 3) for q in ("q_upper_left", "q_upper_right", "q_lower_left", "q_lower_right"))
+        ok = abs(float(r["ratio"]) - 1) <= 0.03 and float(r["worst_quarter"]) <= 0.05
+        out.append([r["scene"], r["place"], r["centre"], r["radius"], num(r["sunlit"], 2),
+                    num(r["probe_sun_share"], 2), r["cycles_sphere"],
+                    r["our_seed"], r["our_options"] or "default" if r["ours"] == "irview" else f"{r['our_options']} (irbake probe)",
+                    f"`{r['commit']}`", f"**{num(r['ratio'], 3)}**", quarters, pct(r["worst_quarter"], 1),
+                    "yes" if ok else "**no**", num(r["ratio_exact_direct"], 3), pct(r["worst_quarter_exact_direct"], 1),
+                    pct(r["ref_noise"]), pct(r["ref_noise_quarter_max"]), r["ref_spp"]])
+    return table(["scene", "place", "centre (m)", "R (m)", "sunlit", "probes' sun share", "Cycles' sphere", "seed", "our options", "baker",
+                  "ours/Cycles", "quarters UL / UR / LL / LR", "worst quarter", "within 3% / 5%",
+                  "exact direct: ours/Cycles", "exact direct: worst quarter", "Cycles' noise", "noise, quarters",
+                  "Cycles spp"], out)
+
+
 def t_export_meshes():
     out = [[r["meshes"], r["input"], r["materials"], r["runs"], num(r["seconds_median"], 3), num(r["seconds_min"], 3),
             num(r["seconds_max"], 3)] for r in read("export_meshes.csv")]

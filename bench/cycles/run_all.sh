@@ -33,4 +33,11 @@ done
 # Sibenik lit by its interior lamp alone (glass made opaque: scenes.py); no emitters, so no emitter cut.
 "${C[@]}" $S/sibenik/sibenik_lamp.glb --name sibenik_lamp --opts "" --views 0,1,2,3,4,5 --view-size 160x100 --view-spp 1024 \
     --emitter-cut 1e30 --save-diff
+# Irradiance probes: a white sphere at three places in the McGuire box and in Sponza sun + sky (~1 h cold).
+P=(nice -n 15 /usr/bin/python3 bench/cycles/probe_spheres.py --irbake "$IRBAKE" --irview "$IRVIEW")
+"${P[@]}" --seeds 0,1,2
+"${P[@]}" --seeds 0 --spp 512 --cycles-sphere camera
+"${P[@]}" --scenes sponza --seeds 0 --bake-opts "--probes 1"
+"${P[@]}" --scenes cornell --seeds 0,1,2 --bake-opts "--probe-rays 16384"
+"${P[@]}" --scenes cornell --seeds 0 --bake-opts "--probes 0.1"
 /usr/bin/python3 bench/cycles/table.py bench/results/cycles_*.csv
