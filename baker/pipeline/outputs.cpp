@@ -46,6 +46,14 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
+  // With --error-map: each texel's standard error (BakeResult::standardError) as error_<page>.exr.
+  std::vector<PendingFile> errorPages;
+  for (const Lightmap& m : result.standardError) {
+    const fs::path path = outDir / ("error_" + std::to_string(m.page) + ".exr");
+    const Lightmap* map = &m;
+    errorPages.push_back({path, [map, path](const fs::path& temp) { writeExrFile(*map, temp, path); }});
+    written.push_back(path);
+  }
   // The portable GLB is built now (its report entry says how), written with the rest.
   std::vector<PendingFile> portable;
   nlohmann::json portableSummary;
@@ -80,6 +88,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.exrPrefix = "lightmap";
     ex.alsoWrite = {reportFile};
     ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
+    ex.alsoWrite.insert(ex.alsoWrite.end(), errorPages.begin(), errorPages.end());
     ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
@@ -103,6 +112,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     }
     files.push_back(reportFile);
     files.insert(files.end(), portable.begin(), portable.end());
+    files.insert(files.end(), errorPages.begin(), errorPages.end());
     refuseOverwritingInputs(files, options.inputs);
     writeAllAtomically(files);
   }

@@ -266,6 +266,8 @@ def map_mode(args, out, rep, row, rows):
     base = ["--uv", "UVMap.001", "--width", str(w), "--height", str(h), "--max-bounces", str(args.max_bounces)]
     if args.bake_lights:
         base += ["--cycles-dir", args.cycles_dir]
+        if args.sky:  # the world gets the sky's radiance (cycles_bake_lights.py --sky)
+            base += ["--sky", args.sky]
     half = max(1, args.map_spp // 2)
     kf = [export_key_file(scene, out)]
     refs = [cycles_cached(args, args.bake_script, scene, base + ["--spp", str(half), "--seed", str(s)], "map.exr", kf)
@@ -394,8 +396,8 @@ def main():
     ap.add_argument("--emitter-cut", type=float, default=3.0, help="radiance above which a pixel is an emitter")
     ap.add_argument("--hidden-cut", type=float, default=0.02,
                     help="maps: covered texels darker than this fraction of the mean in Cycles are hidden (left out)")
-    ap.add_argument("--sky", default="", help="views: Cycles' world = this uniform radiance R,G,B (as irbake "
-                    "--sky; put --sky in --opts too); sky pixels are left out as background")
+    ap.add_argument("--sky", default="", help="views (and maps with --bake-lights): Cycles' world = this uniform "
+                    "radiance R,G,B (as irbake --sky; put --sky in --opts too); sky pixels are left out as background")
     ap.add_argument("--save-diff", action="store_true", help="write view<i>_ratio.exr (ours/Cycles) beside our bake")
     ap.add_argument("--csv", help="append rows here (default bench/results/cycles_NAME.csv)")
     args = ap.parse_args()
