@@ -106,6 +106,7 @@ struct StagedBake::State {
   std::vector<Lightmap> cachedDirect;               // the punctual lights' pages, made once for the rounds
   nlohmann::json rounds = nlohmann::json::array();  // the estimate after each round
   std::string stoppedBy;
+  nlohmann::json stageNoise = nlohmann::json::object();  // a stage's own ray noise (RMS on bins, map units)
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
   std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
@@ -301,16 +302,45 @@ struct StagedBake::State {
     return e.relative * (plan.finalGather ? gatherNoiseRatio : 1.0);
   }
 
+  // A stage's own ray noise: the stage again with rays of another seed on the same input; one stage's
+  // variance per bin is half the two results' squared difference (twice replicateError's s²/2 of the pair).
+  double rayNoise(const std::vector<Lightmap>& once, const std::vector<Lightmap>& twice) const {
+    return std::sqrt(2.0) * replicateError({once, twice}, nullptr, options.errorEstimate.bin).noiseRms;
+  }
+  void compensationRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
+    ClampCompensationOptions o = plan.compensation;
+    o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x636f6d70ull));  // "comp"
+    ClampGather(*wholeInputs, o).apply(before);
+    stageNoise["compensationRays"] = rayNoise(after, before);
+  }
+  void gatherRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
+    FinalGatherOptions o = plan.gather;
+    o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x676174686572ull));  // "gather"
+    finalGather(*wholeInputs, directMaps, before, o);
+    stageNoise["finalGatherRays"] = rayNoise(after, before);
+  }
+
   // The finished bake's estimate (before post, on the map as the stages left it) into the report.
   std::vector<Lightmap> finalEstimate(const std::vector<Lightmap>& maps, nlohmann::json& report) const {
     std::vector<std::vector<Lightmap>> reps = plan.finalGather ? gatheredHalves()
                                                                : std::vector<std::vector<Lightmap>>{halves[0], halves[1]};
-    const BinnedError e = replicateError(reps, &maps, options.errorEstimate.bin);
+    BinnedError e = replicateError(reps, &maps, options.errorEstimate.bin);
+    // The stages' own ray noise is independent of the walk's: the variances add.
+    nlohmann::json breakdown = {{"vpls", e.relative}};
+    double noise2 = e.noiseRms * e.noiseRms;
+    for (const auto& [stage, rms] : stageNoise.items()) {
+      noise2 += rms.get<double>() * rms.get<double>();
+      breakdown[stage] = e.signalRms > 0.0 ? rms.get<double>() / e.signalRms : 0.0;
+    }
+    e.noiseRms = std::sqrt(noise2);
+    e.relative = e.signalRms > 0.0 ? e.noiseRms / e.signalRms : 0.0;
     nlohmann::json& j = report["estimatedError"] = e.toJson();
+    j["replicates"] = replicates.size();
+    j["breakdown"] = breakdown;
     j["binTexels"] = options.errorEstimate.bin;
-    j["covers"] = plan.finalGather ? "the VPL sum's noise (two independent halves of the walk), mixed and gathered as the map"
-                                   : "the VPL sum's noise (two independent halves of the walk), mixed as the map";
-    j["notCovered"] = "bias (clamp after compensation, final gather), the sky's and the gathers' own ray noise";
+    j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
+                  "compensation's and final gather's own ray noise (each run again with another seed)";
+    j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
     j["rounds"] = rounds;
     if (options.errorEstimate.targetError > 0.0) {
       j["targetError"] = options.errorEstimate.targetError;
@@ -689,9 +719,14 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   StageContext ctx = s.stageContext(report);
   L1Pages* l1 = s.plan.directional ? &r.directional : nullptr;
   skyStage(ctx, r.maps, s.directMaps);
+  const bool estimate = !s.halves[0].empty();
+  std::vector<Lightmap> beforeStage = estimate && s.plan.compensate ? r.maps : std::vector<Lightmap>{};
   compensationStage(ctx, r.maps, l1, s.gather.valid() ? s.gather.get() : nullptr);
+  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.compensationRayNoise(std::move(beforeStage), r.maps); });
+  beforeStage = estimate && s.plan.finalGather ? r.maps : std::vector<Lightmap>{};
   finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
-  if (!s.halves[0].empty()) s.timed("errorEstimate", [&] {
+  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.gatherRayNoise(std::move(beforeStage), r.maps); });
+  if (estimate) s.timed("errorEstimate", [&] {
       std::vector<Lightmap> errorPages = s.finalEstimate(r.maps, report);
       if (s.options.errorEstimate.errorMap) r.standardError = std::move(errorPages);
     });
