@@ -372,8 +372,7 @@ void addErrorOptions(CLI::App* app, BakeCommand& command) {
                 "report the bake's estimated error (report.json estimatedError:\n"
                 "relative RMS on 4x4-texel bins, as bench/cycles/compare.py scores)");
   app->add_option("--target-error", e.targetError,
-                  "estimate the error and add rounds of the plan's paths until it is at\n"
-                  "most E (relative, e.g. 0.02), or --max-rounds / --max-time stop it")
+                  "add rounds of paths until the estimated error is at most E (e.g. 0.02)")
       ->transform(cli::numberIn(1e-6, 1.0))->type_name("E");
   app->add_option("--max-rounds", e.maxRounds,
                   "--target-error: at most this many rounds (default " + shown(d.maxRounds) + ")")

@@ -15,6 +15,23 @@
 
 namespace irbake {
 
+namespace {
+
+// With --error-map: each texel's standard error (BakeResult::standardError) as error_<page>.exr.
+std::vector<PendingFile> errorPageFiles(const BakeResult& result, const std::filesystem::path& outDir,
+                                        std::vector<std::filesystem::path>& written) {
+  std::vector<PendingFile> files;
+  for (const Lightmap& m : result.standardError) {
+    const std::filesystem::path path = outDir / ("error_" + std::to_string(m.page) + ".exr");
+    const Lightmap* map = &m;
+    files.push_back({path, [map, path](const std::filesystem::path& temp) { writeExrFile(*map, temp, path); }});
+    written.push_back(path);
+  }
+  return files;
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
   namespace fs = std::filesystem;
   // -o OUT.glb / OUT.gltf names the glTF itself (a GLB embeds its images); its folder takes the rest.
@@ -46,14 +63,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
-  // With --error-map: each texel's standard error (BakeResult::standardError) as error_<page>.exr.
-  std::vector<PendingFile> errorPages;
-  for (const Lightmap& m : result.standardError) {
-    const fs::path path = outDir / ("error_" + std::to_string(m.page) + ".exr");
-    const Lightmap* map = &m;
-    errorPages.push_back({path, [map, path](const fs::path& temp) { writeExrFile(*map, temp, path); }});
-    written.push_back(path);
-  }
+  const std::vector<PendingFile> errorPages = errorPageFiles(result, outDir, written);
   // The portable GLB is built now (its report entry says how), written with the rest.
   std::vector<PendingFile> portable;
   nlohmann::json portableSummary;
