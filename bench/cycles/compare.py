@@ -130,11 +130,17 @@ def export_key_file(scene, workdir):
     with the same atlas share one Cycles map bake, whatever their VPL options."""
     doc, bufs = load_gltf(scene)
     h = hashlib.sha256()
+    # The irradiance probes (IRBAKE_light_probes: its JSON and accessors) are read from the map, Cycles never
+    # sees them: left out, so bakes of other seeds share the reference.
+    probes = doc.get("extensions", {}).get("IRBAKE_light_probes", {})
+    probe_accessors = {probes.get(k) for k in ("coefficients", "offsets", "valid")} - {None}
 
     def view_bytes(i):
         v = doc["bufferViews"][i]
         return bufs[v.get("buffer", 0)][v.get("byteOffset", 0):v.get("byteOffset", 0) + v["byteLength"]]
-    for a in doc.get("accessors", []):
+    for i, a in enumerate(doc.get("accessors", [])):
+        if i in probe_accessors:
+            continue
         h.update(json.dumps(a, sort_keys=True).encode())
         if "bufferView" in a:
             h.update(view_bytes(a["bufferView"]))
@@ -148,7 +154,8 @@ def export_key_file(scene, workdir):
     mats = json.loads(json.dumps(doc.get("materials", [])))
     for m in mats:
         m.get("extensions", {}).pop("MOZ_lightmap", None)
-    h.update(json.dumps([mats, doc.get("meshes"), doc.get("nodes"), doc.get("extensions"), doc.get("cameras")],
+    extensions = {k: v for k, v in doc.get("extensions", {}).items() if k != "IRBAKE_light_probes"}
+    h.update(json.dumps([mats, doc.get("meshes"), doc.get("nodes"), extensions, doc.get("cameras")],
                         sort_keys=True).encode())
     key = os.path.join(workdir, "export.key")
     with open(key, "w") as f:
