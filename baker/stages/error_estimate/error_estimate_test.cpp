@@ -31,8 +31,8 @@ std::vector<std::vector<Lightmap>> gaussianReplicates(int R, int W, int H, glm::
   return reps;
 }
 
-// Closed form: the mean of R replicates of a bin of n valid texels has standard error sigma/sqrt(nR), so on
-// full bins (n = 14 or 15 of 16 here) the relative figure is sigma/sqrt(nR) / |mu|rms.
+// Closed form: the mean of R replicates of a bin of n valid texels has standard error sigma/sqrt(nR), so the
+// figure's square is the mean over bins of sigma²/(nR) (n = 13 or 14 of 16 here), over |mu|rms².
 TEST(ErrorEstimate, MatchesTheClosedFormStandardErrorOfTheMean) {
   const glm::vec3 mu(1.0f, 0.5f, 0.25f);
   const float sigma = 0.3f;
@@ -40,8 +40,15 @@ TEST(ErrorEstimate, MatchesTheClosedFormStandardErrorOfTheMean) {
     const auto reps = gaussianReplicates(R, 256, 256, mu, sigma, 17u + R);
     const BinnedError e = replicateError(reps, nullptr);
     ASSERT_EQ(e.bins, 64u * 64u);
-    // Each 4×4 bin has 16 texels, those with t % 7 == 3 invalid: 13 to 14 of 16 valid (all bins kept).
-    const double expectedNoise = sigma / std::sqrt(13.7 * R);
+    double meanInverseN = 0.0;  // over bins, 1/n of its valid texels (those with t % 7 == 3 are invalid)
+    for (int by = 0; by < 256; by += 4)
+      for (int bx = 0; bx < 256; bx += 4) {
+        int n = 0;
+        for (int y = by; y < by + 4; ++y)
+          for (int x = bx; x < bx + 4; ++x) n += (static_cast<size_t>(y) * 256 + x) % 7 != 3;
+        meanInverseN += 1.0 / n / (64.0 * 64.0);
+      }
+    const double expectedNoise = sigma * std::sqrt(meanInverseN / R);
     const double muRms = std::sqrt((1.0 + 0.25 + 0.0625) / 3.0);
     // 12288 bin-channels with R − 1 degrees of freedom each: the RMS is within 1.5% (3σ) at R = 2.
     EXPECT_NEAR(e.noiseRms / expectedNoise, 1.0, 0.03) << "R = " << R;
