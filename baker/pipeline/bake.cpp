@@ -307,17 +307,18 @@ struct StagedBake::State {
   double rayNoise(const std::vector<Lightmap>& once, const std::vector<Lightmap>& twice) const {
     return std::sqrt(2.0) * replicateError({once, twice}, nullptr, options.errorEstimate.bin).noiseRms;
   }
-  void compensationRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
+  // before: the compensation's input, replaced by its second run's output.
+  void compensationRayNoise(std::vector<Lightmap>& before, const std::vector<Lightmap>& after) {
     ClampCompensationOptions o = plan.compensation;
     o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x636f6d70ull));  // "comp"
     ClampGather(*wholeInputs, o).apply(before);
-    stageNoise["compensationRays"] = rayNoise(after, before);
+    if (!plan.finalGather) stageNoise["compensationRays"] = rayNoise(after, before);
   }
   void gatherRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
     FinalGatherOptions o = plan.gather;
     o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x676174686572ull));  // "gather"
     finalGather(*wholeInputs, directMaps, before, o);
-    stageNoise["finalGatherRays"] = rayNoise(after, before);
+    stageNoise[plan.compensate ? "compensationAndGatherRays" : "finalGatherRays"] = rayNoise(after, before);
   }
 
   // The finished bake's estimate (before post, on the map as the stages left it) into the report.
@@ -722,10 +723,12 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   const bool estimate = !s.halves[0].empty();
   std::vector<Lightmap> beforeStage = estimate && s.plan.compensate ? r.maps : std::vector<Lightmap>{};
   compensationStage(ctx, r.maps, l1, s.gather.valid() ? s.gather.get() : nullptr);
-  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.compensationRayNoise(std::move(beforeStage), r.maps); });
-  beforeStage = estimate && s.plan.finalGather ? r.maps : std::vector<Lightmap>{};
+  // Under the final gather the map the gather reads is not written: the compensation's second run is
+  // gathered again (with another gather seed), so both stages' ray noise is measured where it shows.
+  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.compensationRayNoise(beforeStage, r.maps); });
+  if (estimate && s.plan.finalGather && beforeStage.empty()) beforeStage = r.maps;
   finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
-  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.gatherRayNoise(std::move(beforeStage), r.maps); });
+  if (s.plan.finalGather && !beforeStage.empty()) s.timed("errorEstimate", [&] { s.gatherRayNoise(std::move(beforeStage), r.maps); });
   if (estimate) s.timed("errorEstimate", [&] {
       std::vector<Lightmap> errorPages = s.finalEstimate(r.maps, report);
       if (s.options.errorEstimate.errorMap) r.standardError = std::move(errorPages);
