@@ -253,7 +253,7 @@ def t_error_estimate():
                     f"**{pct(rms('estimated'))}**", "", "", f"**{pct(rms('rel_rmse_4_corrected'))}**",
                     f"**{num(rms('estimated') / rms('rel_rmse_4_corrected'), 2)}**", ""])
     return table(["scene", "options", "seed", "baker", "texels", "estimate: walk", "compensation rays",
-                  "gather rays", "estimate", "measured", "Cycles' noise", "measured, noise removed",
+                  "final-gather rays (and the compensation's under it)", "estimate", "measured", "Cycles' noise", "measured, noise removed",
                   "estimate / measured", "Cycles spp"], out)
 
 

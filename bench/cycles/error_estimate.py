@@ -86,7 +86,7 @@ def main():
                "scene": args.name, "seed": opts.get("seed", "0"),
                "our_options": " ".join("--%s %s" % (k, v) for k, v in sorted(opts.items()) if k != "seed"),
                "texels": rep["texels"]["valid"], "estimated": e["relative"], "est_vpls": br.get("vpls", ""),
-               "est_compensation_rays": br.get("compensationRays", ""), "est_gather_rays": br.get("finalGatherRays", ""),
+               "est_compensation_rays": br.get("compensationRays", ""), "est_gather_rays": br.get("finalGatherRays", br.get("compensationAndGatherRays", "")),
                "rel_rmse_4": s["rel_rmse_4"], "ref_noise_4": s["ref_noise_4"], "rel_rmse_4_corrected": corrected,
                "ratio": e["relative"] / corrected if corrected > 0 else "", "mean_ratio": s["mean_ratio"], "ref_spp": spp,
                "our_bake_s": rep["timings"]["seconds"]["bake"], "load_1min": open("/proc/loadavg").read().split()[0]}
