@@ -4,6 +4,7 @@
 # wall and CPU seconds (user + system: less sensitive to a shared machine's load), the report's bake, backend,
 # shadow-mask and shadow-mask post seconds, map and mask pages and their EXR bytes, the 1-minute load average
 # at the end → bench/results/mixed_lighting.csv
+# How the clients show such a bake against the full one: bench/mixed_lighting_clients.sh.
 # Usage: bench/mixed_lighting_bench.sh BUILD_DIR [RUNS]
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)

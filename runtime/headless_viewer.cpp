@@ -3,6 +3,7 @@
 #include "common/log.h"
 #include "common/progress.h"
 #include "glcontext/gl_context.h"
+#include "probe_view.h"
 #include "screenshot.h"
 #include "view_renderer.h"
 
@@ -11,8 +12,10 @@ namespace irbake::view {
 std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const ViewerOptions& o) {
   // Check the output name before any GL work, so a typo fails fast.
   imageFormatFor(o.screenshot);
+  std::vector<ProbeSphere> probes = probeSpheresFor(o);
   GlContext gl;
   ViewRenderer renderer(v);
+  addProbeOverlay(renderer, std::move(probes));
   DrawSettings settings;
   settings.mode = o.mode;
   settings.lightmapMode = o.lightmapMode;

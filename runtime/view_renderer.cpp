@@ -11,6 +11,7 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "mixed_lights.h"
 #include "screenshot.h"
 #include "glcontext/gl_program.h"
 
@@ -129,12 +130,14 @@ struct Variant {
   int lightmap = 0;     // 1: the primitive has a light map
   int alphaMask = 0;    // 1: alphaMode MASK
   int directional = 0;  // L1 SH with the normal map: 0 off, 1 normal map on TEXCOORD_0, 2 on TEXCOORD_1
+  int mixed = 0;        // 1: shades the export's runtime lights (mixed_lights.h)
 
   int key() const {
-    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9 | directional << 10;
+    return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9 | directional << 10 |
+           mixed << 12;
   }
   static Variant fromKey(int k) {
-    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1, (k >> 10) & 3};
+    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1, (k >> 10) & 3, (k >> 12) & 1};
   }
   // `all`: every feature of the primitive; keeps those `mode` reads (and the SH only when `sh`).
   static Variant forMode(int mode, int output, const Variant& all, bool sh = true) {
@@ -148,11 +151,12 @@ struct Variant {
     v.emissiveTex = mode == 0 ? all.emissiveTex : 0;
     v.lightmap = mode == 0 || mode == 1 ? all.lightmap : 0;
     v.directional = v.lightmap && sh ? all.directional : 0;
+    v.mixed = mode == 0 ? all.mixed : 0;
     return v;
   }
   int needUv0() const { return baseTex == 1 || emissiveTex == 1 || directional == 1; }
-  int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4 || directional == 2; }
-  int needNormal() const { return mode == 3 || directional != 0; }
+  int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4 || directional == 2 || mixed; }
+  int needNormal() const { return mode == 3 || directional != 0 || mixed; }
   int needTangent() const { return directional != 0; }
   int needChart() const { return mode == 3 || mode == 4; }
 };
@@ -171,6 +175,7 @@ struct ViewRenderer::Impl {
     Variant features;                    // everything the material uses (mode and output unset)
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // world-space bounds, for the draw order
     bool cullBackFaces = false;          // closed outward solid, opaque: back faces only show from inside
+    GLuint shadowMask = 0;               // with Variant::mixed: the material's mask page (or white)
   };
   const Scene& scene;
   GLuint program = 0;                      // the bound variant
@@ -187,6 +192,7 @@ struct ViewRenderer::Impl {
   float environmentRotation = 0.0f;
   std::unique_ptr<GlProgram> skyPrograms[2];  // view_sky per OUTPUT (0 linear, 1 exposure + sRGB)
   GLuint skyVao = 0;                        // empty: the sky triangle comes from gl_VertexID
+  std::unique_ptr<MixedLights> mixed;       // the export's runtime lights and mask pages
 
   // Draws the environment map over the whole viewport, without depth, before the scene.
   void drawSky(const glm::mat4& viewProjection, int width, int height, bool encode, float exposure) {
@@ -241,11 +247,12 @@ struct ViewRenderer::Impl {
           define("HAS_LIGHTMAP", f.lightmap),   define("ALPHA_MASK", f.alphaMask),
           define("NEED_UV0", f.needUv0()),      define("NEED_UV1", f.needUv1()),
           define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart()),
-          define("DIRECTIONAL", f.directional), define("NEED_TANGENT", f.needTangent())};
+          define("DIRECTIONAL", f.directional), define("NEED_TANGENT", f.needTangent()),
+          define("MIXED_LIGHTS", f.mixed),      define("NEED_POSITION", f.mixed)};
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
-                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_mesh.frag"}}},
+                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_mixed_lights.glsl", "view_mesh.frag"}}},
                                  defines, "330 core"))
                .first;
     }
@@ -345,6 +352,7 @@ void RenderTarget::release() {
 
 ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(v.scene)) {
   Impl& I = *impl_;
+  I.mixed = std::make_unique<MixedLights>(v);
   for (const Lightmap& page : v.pages)
     I.pageTextures.push_back(page.size() > 0 && page.texels.size() == page.size()
                                  ? uploadLightmap(page.width, page.height, GL_RGB, page.texels.data())
@@ -421,6 +429,8 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     g.features.emissiveTex = I.colorTexture(m.emissiveTexture) ? (m.emissiveTexCoord == 1 ? 2 : 1) : 0;
     g.features.lightmap = g.lightmap ? 1 : 0;
     g.features.alphaMask = m.alphaMode == AlphaMode::Mask ? 1 : 0;
+    g.features.mixed = I.mixed->shades(g.lightmap != 0) ? 1 : 0;
+    if (g.features.mixed) g.shadowMask = I.mixed->maskTexture(p.material);
     // Directional maps only change what a normal map bends: at n = n_g the reconstruction is L0 itself
     // (the L1 pages hold t ⟂ n_g), so a primitive without a normal map keeps the plain shading and skips the
     // three fetches.
@@ -469,6 +479,7 @@ ViewRenderer::~ViewRenderer() {
       if (t) glDeleteTextures(1, &t);
   for (auto& [key, t] : I.directionalPngs) glDeleteTextures(1, &t);
   if (I.environmentTexture) glDeleteTextures(1, &I.environmentTexture);
+  I.mixed.reset();
   if (I.skyVao) glDeleteVertexArrays(1, &I.skyVao);
   for (auto& sky : I.skyPrograms) sky.reset();
   I.offscreen.reset();
@@ -527,6 +538,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
         glUniform1i(I.u("uL1y"), 5);
         glUniform1i(I.u("uL1z"), 6);
         glUniform3f(I.u("uLineColor"), 0.9f, 0.9f, 0.9f);
+        if (variant.mixed) I.mixed->setUniforms(I.program, 7);
       }
       const Material& m = I.scene.materials.at(g.material);
       glUniform4fv(I.u("uBaseColorFactor"), 1, &m.baseColorFactor[0]);
@@ -550,6 +562,10 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
           glBindTexture(GL_TEXTURE_2D, g.l1[k]);
         }
       }
+      if (variant.mixed) {
+        glActiveTexture(GL_TEXTURE7);
+        glBindTexture(GL_TEXTURE_2D, g.shadowMask);
+      }
       if (g.cullBackFaces)
         glEnable(GL_CULL_FACE);
       else
@@ -571,6 +587,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
   } else {
     drawAll(static_cast<int>(settings.mode));
   }
+  for (const Overlay& overlay : overlays_) overlay(camera, vp, settings);
   glBindVertexArray(0);
   glActiveTexture(GL_TEXTURE0);
   glDisable(GL_CULL_FACE);

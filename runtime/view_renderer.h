@@ -1,6 +1,7 @@
 // Draws a ViewerScene with OpenGL (3.3 core or later, current context required): one textured draw
 // per primitive, since the baked light is view-independent. Offscreen renders are linear radiance.
 #pragma once
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -75,12 +76,17 @@ class ViewRenderer {
   size_t triangleCount() const { return triangles_; }
   // Primitives shaded with directional maps and a normal map in LightmapMode::Sh (0: the mode changes nothing).
   size_t directionalPrimitiveCount() const { return directionalPrimitives_; }
+  // Something drawn after the scene in every draw(), depth test on against the scene's depth (the probe
+  // spheres, probe_view.h); it gets the camera, its view-projection and the frame's settings.
+  using Overlay = std::function<void(const ViewCamera&, const glm::mat4& viewProjection, const DrawSettings&)>;
+  void addOverlay(Overlay overlay) { overlays_.push_back(std::move(overlay)); }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   size_t triangles_ = 0;
   size_t directionalPrimitives_ = 0;
+  std::vector<Overlay> overlays_;
 };
 
 // The background colour for a scene: its sky's radiance (a map's mean radiance: the renderer draws the map itself

@@ -19,7 +19,35 @@ const char* kWindowKeys =
 struct RawOptions {
   std::vector<std::string> scenes;
   std::string eye, target, view, screenshot, lightmapMode;
+  std::vector<std::string> probeObjects;
 };
+
+// "X,Y,Z[,R]": a sphere's centre and radius (default 0.1 m), finite, R > 0.
+glm::vec4 parseProbeObject(const std::string& text) {
+  std::vector<double> v;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (part.empty() || used != part.size() || !std::isfinite(x))
+      throw Error(ErrorCode::Usage, "", "--probe-object: '" + text + "' is not X,Y,Z or X,Y,Z,R (finite numbers)");
+    v.push_back(x);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (v.size() != 3 && v.size() != 4)
+    throw Error(ErrorCode::Usage, "", "--probe-object: '" + text + "' needs 3 or 4 numbers (X,Y,Z[,R])");
+  const double radius = v.size() == 4 ? v[3] : 0.1;
+  if (!(radius > 0.0)) throw Error(ErrorCode::Usage, "", "--probe-object: the radius must be positive (got '" + text + "')");
+  return glm::vec4(v[0], v[1], v[2], radius);
+}
 
 std::unique_ptr<CLI::App> viewerApp(ViewerOptions& o, RawOptions& raw) {
   auto app = cli::makeApp("irview", "Shows a baked glTF (an irbake export) in a window, or renders it headless.");
@@ -40,7 +68,11 @@ std::unique_ptr<CLI::App> viewerApp(ViewerOptions& o, RawOptions& raw) {
   app->add_option("--walkthrough", o.walkthrough, "N frames OUT_0000.png.. along the glTF cameras (or an orbit)")
       ->transform(cli::integerIn(0, 100000))->type_name("N");
   app->add_option("--view", raw.view, "view mode")
-      ->check(CLI::IsMember({"lit", "lightmap", "albedo", "charts", "density", "wireframe"}));
+      ->check(CLI::IsMember({"lit", "lightmap", "albedo", "charts", "density", "wireframe", "probes"}));
+  app->add_option("--probe-object", raw.probeObjects,
+                  "a matte white sphere (albedo 1) lit by the baked probes (IRBAKE_light_probes) at its centre; "
+                  "repeatable; R default 0.1 m")
+      ->type_name("X,Y,Z[,R]")->allow_extra_args(false);
   app->add_option("--lightmap-mode", raw.lightmapMode,
                   "directional maps (IRBAKE_lightmap_directional): sh = L1 with the normal map (default), l0 = the "
                   "plain map only")
@@ -80,7 +112,11 @@ std::optional<ViewerOptions> parseViewerOptions(const std::vector<std::string>& 
   }
   if (o.walkthrough > 0 && o.screenshot.empty())
     throw Error(ErrorCode::Usage, "", "--walkthrough needs --screenshot OUT.png|OUT.exr (frames are OUT_0000...)");
-  if (!raw.view.empty()) o.mode = parseViewMode(raw.view);
+  if (raw.view == "probes")
+    o.showProbes = true;  // the lit view, with the probe grid drawn over it
+  else if (!raw.view.empty())
+    o.mode = parseViewMode(raw.view);
+  for (const std::string& object : raw.probeObjects) o.probeObjects.push_back(parseProbeObject(object));
   if (!raw.lightmapMode.empty()) o.lightmapMode = parseLightmapMode(raw.lightmapMode);
   return o;
 }

@@ -25,6 +25,8 @@ struct ViewerOptions {
   float exposure = 0.0f;                    // EV stops for PNG and the window
   bool window = false;                      // --window: open a window even when a screenshot is asked for
   int frames = 0;                           // window: close after this many frames (0: until closed)
+  std::vector<glm::vec4> probeObjects;      // --probe-object: white spheres lit by the probes (centre xyz, radius w)
+  bool showProbes = false;                  // --view probes: the lit view with a sphere at each probe
   bool headless() const { return !window && (!screenshot.empty() || walkthrough > 0); }
 };
 

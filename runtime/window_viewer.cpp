@@ -10,6 +10,7 @@
 
 #include "common/error.h"
 #include "common/log.h"
+#include "probe_view.h"
 #include "screenshot.h"
 #include "view_renderer.h"
 
@@ -95,6 +96,7 @@ struct GlfwSession {
 }  // namespace
 
 int runWindow(const ViewerScene& v, const ViewerOptions& o) {
+  std::vector<ProbeSphere> probes = probeSpheresFor(o);  // a bad probe grid fails before the window opens
   GlfwSession glfw;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -128,6 +130,7 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   {
     // The renderer's GL objects must go before the context does.
     ViewRenderer renderer(v);
+    addProbeOverlay(renderer, std::move(probes));
     s.renderer = &renderer;
     double last = glfwGetTime(), titleTime = last, frameSum = 0.0;
     int frame = 0, titleFrames = 0;

@@ -40,6 +40,9 @@
 #ifndef NEED_TANGENT
 #define NEED_TANGENT 0
 #endif
+#ifndef MIXED_LIGHTS
+#define MIXED_LIGHTS 0  // 1: add the export's runtime lights (view_mixed_lights.glsl), needs vPosition
+#endif
 
 #if NEED_NORMAL
 in vec3 vNormal;
@@ -55,6 +58,9 @@ flat in float vChart;
 #endif
 #if NEED_TANGENT
 in vec4 vTangent;
+#endif
+#if MIXED_LIGHTS
+in vec3 vPosition;
 #endif
 
 uniform vec4 uBaseColorFactor;
@@ -146,7 +152,11 @@ void main() {
 #if EMISSIVE_TEX
   emissive *= texture(uEmissiveTex, EMISSIVE_UV).rgb;
 #endif
-  color = baseColor().rgb * lightmap() + emissive;
+  vec3 base = baseColor().rgb;
+  color = base * lightmap() + emissive;
+#if MIXED_LIGHTS
+  color += base * (1.0 / 3.14159265358979) * mixedIrradiance(vPosition, normalize(vNormal), vUv1);
+#endif
 #elif VIEW_MODE == 1
   baseColor();  // alpha-mask holes stay holes
   color = lightmap();

@@ -17,6 +17,9 @@
 #ifndef NEED_TANGENT
 #define NEED_TANGENT 0
 #endif
+#ifndef NEED_POSITION
+#define NEED_POSITION 0  // the world position, for the mixed lights
+#endif
 
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
@@ -44,6 +47,9 @@ flat out float vChart;
 #if NEED_TANGENT
 out vec4 vTangent;
 #endif
+#if NEED_POSITION
+out vec3 vPosition;
+#endif
 
 void main() {
 #if NEED_NORMAL
@@ -60,6 +66,9 @@ void main() {
 #endif
 #if NEED_TANGENT
   vTangent = aTangent;
+#endif
+#if NEED_POSITION
+  vPosition = aPosition;
 #endif
   gl_Position = uViewProjection * vec4(aPosition, 1.0);
 }

@@ -157,7 +157,10 @@ TEST(MixedLighting, CommandRefusesBadModesWithExit2AndNoOutput) {
       {"good.gltf --light-mode lamp=dim", "--light-mode needs NAME=MODE"},
       {"good.gltf --light-mode lantern=indirect", "no punctual light is named 'lantern' (its punctual lights: lamp)"},
       {"good.gltf --light-mode sky=indirect", "'sky' is not a punctual light"},
-      {"good.gltf --sun 0,-1,0,3 --light-mode sun=indirect --backend reference", "needs a VPL backend"}};
+      {"good.gltf --sun 0,-1,0,3 --light-mode sun=indirect --backend reference", "needs a VPL backend"},
+      {"good.gltf --light-mode lamp=shadowmask --backend reference", "light 'lamp' in mode shadowmask (--light-mode lamp=shadowmask): needs a VPL backend"},
+      {"good.gltf --light-mode lamp=indirect --directional", "light 'lamp' in mode indirect (--light-mode lamp=indirect): --directional bakes every light's direct term into its L1 pages"},
+      {"good.gltf --sun 0,-1,0,3 --light-mode sun=shadowmask --directional", "light 'sun' in mode shadowmask"}};
   for (const auto& [args, message] : cases) {
     std::string output;
     EXPECT_EQ(runIrbake("bake " + (dir / args).string() + " -o " + out + " --quiet", output), 2) << args << ": " << output;

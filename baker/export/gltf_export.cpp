@@ -508,6 +508,7 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
       for (const auto& m : maps)
         for (int k = 0; k < 3; ++k) pageUris.push_back(directionalPageUri(options.exrPrefix, m.page, k));
   }
+  if (options.lightModes) recordLightModes(doc, scene, *options.lightModes);
   const bool masked = options.shadowMask && !options.shadowMask->empty();
   if (masked) {
     addShadowMaskExtension(doc, *options.shadowMask, options.writeExrPages ? options.exrPrefix : std::string());

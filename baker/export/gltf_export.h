@@ -31,6 +31,8 @@ struct ExportOptions {
   const LightProbeGrid* probes = nullptr;
   // Shadow-mask pages and their lights (export/shadow_mask_export.h), or null: no extension, no files.
   const ShadowMaskExport* shadowMask = nullptr;
+  // Each scene light's settled mode (recordLightModes), or null: nothing recorded.
+  const std::vector<LightMode>* lightModes = nullptr;
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;

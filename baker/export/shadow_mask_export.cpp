@@ -23,10 +23,10 @@ int pageOfTexture(const GltfDocument& doc, int texture) {
   return std::stoi(name.substr(9));
 }
 
-nlohmann::json lightJson(const ShadowMaskLight& l) {
+nlohmann::json lightJson(const ShadowMaskLight& l, const Scene* scene) {
   nlohmann::json j = {{"name", l.name}, {"channel", l.channel}};
-  if (l.light->gltfLight >= 0) {
-    j["light"] = l.light->gltfLight;  // index into KHR_lights_punctual.lights
+  if (const int index = documentLightIndex(scene, *l.light); index >= 0) {
+    j["light"] = index;  // index into KHR_lights_punctual.lights
   } else {  // --sun: not in the document, so described here for the runtime to shade it
     const glm::vec3 d = l.light->direction, e = l.light->color * l.light->intensity;
     j["directional"] = {{"direction", {d.x, d.y, d.z}}, {"irradiance", {e.x, e.y, e.z}}};
@@ -35,6 +35,14 @@ nlohmann::json lightJson(const ShadowMaskLight& l) {
 }
 
 }  // namespace
+
+int documentLightIndex(const Scene* scene, const Light& l) {
+  if (l.gltfLight >= 0) return l.gltfLight;
+  if (!scene || (!scene->sourcePath.empty() && std::filesystem::exists(scene->sourcePath))) return -1;
+  for (size_t i = 0; i < scene->lights.size(); ++i)
+    if (&scene->lights[i] == &l) return static_cast<int>(i);
+  return -1;
+}
 
 Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name) {
   const Lightmap& rgb = (*mask.rgb)[i];
@@ -99,9 +107,35 @@ void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, con
   }
   if (!used) return;
   json lights = json::array();
-  for (const ShadowMaskLight& l : mask.lights) lights.push_back(lightJson(l));
+  for (const ShadowMaskLight& l : mask.lights) lights.push_back(lightJson(l, mask.scene));
   doc.root["extensions"][kShadowMaskExtension] = {{"lights", lights}};
   doc.useExtension(kShadowMaskExtension);
+}
+
+void recordLightModes(GltfDocument& doc, const Scene& scene, const std::vector<LightMode>& modes) {
+  using nlohmann::json;
+  if (modes.size() != scene.lights.size()) return;
+  json* khr = nullptr;
+  if (doc.root.contains("extensions") && doc.root["extensions"].contains("KHR_lights_punctual") &&
+      doc.root["extensions"]["KHR_lights_punctual"].contains("lights") &&
+      doc.root["extensions"]["KHR_lights_punctual"]["lights"].is_array())
+    khr = &doc.root["extensions"]["KHR_lights_punctual"]["lights"];
+  for (size_t i = 0; i < modes.size(); ++i) {
+    const Light& l = scene.lights[i];
+    const int index = documentLightIndex(&scene, l);
+    if (index < 0) {  // the command line's sun: not in the document
+      if (modes[i] == LightMode::Baked || (doc.root.contains("extras") && !doc.root["extras"].is_object())) continue;
+      const glm::vec3 d = l.direction, e = l.color * l.intensity;
+      doc.root["extras"]["irbakeSun"] = {{"mode", toString(modes[i])}, {"direction", {d.x, d.y, d.z}},
+                                         {"irradiance", {e.x, e.y, e.z}}};
+      continue;
+    }
+    if (!khr || index >= static_cast<int>(khr->size())) continue;
+    json& light = (*khr)[static_cast<size_t>(index)];
+    if (modes[i] == LightMode::Baked && !l.hasExtrasMode) continue;
+    if (light.contains("extras") && !light["extras"].is_object()) continue;  // a source's own non-object extras stay
+    light["extras"]["irbake"]["mode"] = toString(modes[i]);
+  }
 }
 
 }  // namespace irbake

@@ -24,8 +24,14 @@ struct ShadowMaskExport {
   const std::vector<Lightmap>* rgb = nullptr;    // channels 0–2 per page
   const std::vector<Lightmap>* alpha = nullptr;  // channel 3 (x) per page, or null / empty: 1
   std::vector<ShadowMaskLight> lights;
+  const Scene* scene = nullptr;  // the lights' scene (documentLightIndex); null: only gltfLight says
   bool empty() const { return !rgb || rgb->empty(); }
 };
+
+// The index of scene light `l` in the exported document's KHR_lights_punctual.lights: its source index, or for
+// a scene the export generates (no source file) its place in Scene::lights, which the writer keeps; -1 for a
+// light the document does not have (the command line's --sun over a source file).
+int documentLightIndex(const Scene* scene, const Light& l);
 
 // Page i of the mask as RGBA in [0, 1].
 Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name);
@@ -40,5 +46,11 @@ void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::files
 // Adds each page's PNG and {"index", "texCoord": 1, "exr"} on every material whose MOZ_lightmap is that
 // page's, and the root extension {"lights": [{"light", "name", "channel"}, ...]}; lists it in extensionsUsed.
 void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, const std::string& exrPrefix);
+
+// Records each punctual light's settled mode where a client finds it (docs/export.md "Mixed lights"): a KHR light
+// that is not baked, or whose source extras named a mode, gets extras.irbake.mode; the command line's sun when
+// not baked gets the root extras "irbakeSun" {"mode", "direction", "irradiance"}. `modes` is per scene light
+// (empty: every light baked, nothing written).
+void recordLightModes(GltfDocument& doc, const Scene& scene, const std::vector<LightMode>& modes);
 
 }  // namespace irbake

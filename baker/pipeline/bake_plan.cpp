@@ -50,19 +50,43 @@ void settleBackend(BakePlan& plan, const Scene& scene, const BakeOptions& option
   plan.settle("backend", toString(plan.backend), choice.reason);
 }
 
-// The final gather: on where asked, or (auto) where the scene has no emissive surface (its rays would find
-// small emitters by chance) and no see-through one (the gather reads the glass's own map, not what lies behind).
+// The final gather: on where asked, or (auto) where its rays find every emitter reliably (none, or emitters
+// covering at least kGatheredEmitterShare of the surface: in a closed scene a ray meets an emitter with about
+// that probability, so small emitters would be found by chance) and no surface is see-through (the gather
+// reads the glass's own map, not what lies behind).
+constexpr double kGatheredEmitterShare = 0.5;
+
+double emissiveAreaShare(const Scene& scene) {
+  double emitting = 0.0, all = 0.0;
+  for (const Primitive& p : scene.primitives) {
+    const bool emits = scene.materials[p.material].isEmissive();
+    for (uint32_t t = 0; t < p.triangleCount(); ++t) {
+      const glm::dvec3 a(p.positions[p.indices[3 * t]]), b(p.positions[p.indices[3 * t + 1]]),
+          c(p.positions[p.indices[3 * t + 2]]);
+      const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+      all += area;
+      if (emits) emitting += area;
+    }
+  }
+  return all > 0.0 ? emitting / all : 0.0;
+}
+
 void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
   const bool vplBackend = plan.backend != BackendKind::Reference && options.eval.includeVpls;
   const std::string seeThrough = seeThroughMaterials(scene);
+  const double emitterShare = emissiveAreaShare(scene);
+  const bool smallEmitters = scene.hasEmissiveSurface() && emitterShare < kGatheredEmitterShare;
   plan.finalGather = vplBackend && (options.finalGather == FinalGatherMode::On ||
-                                    (options.finalGather == FinalGatherMode::Auto && !scene.hasEmissiveSurface() &&
+                                    (options.finalGather == FinalGatherMode::Auto && !smallEmitters &&
                                      seeThrough.empty()));
+  char share[96];
+  std::snprintf(share, sizeof share, "emitters cover %.1f%% of the surface", 100.0 * emitterShare);
   std::string reason;
   if (!vplBackend) reason = "no VPLs to gather from";
   else if (options.finalGather != FinalGatherMode::Auto) reason = "asked for";
-  else if (scene.hasEmissiveSurface()) reason = "auto: the scene has emissive surfaces";
+  else if (smallEmitters) reason = std::string("auto: ") + share + " (its rays would find them by chance)";
   else if (!seeThrough.empty()) reason = "auto: " + seeThrough;
+  else if (scene.hasEmissiveSurface()) reason = std::string("auto: ") + share + " (its rays find them)";
   else reason = "auto: no emissive or see-through surface";
   plan.settle("final-gather", onOff(plan.finalGather), reason, options.finalGather == FinalGatherMode::Auto);
 }
@@ -211,11 +235,12 @@ void checkLightModes(const BakeOptions& options, const Scene& scene) {
     if (modes[i].mode == LightMode::Baked) continue;
     const std::string what = "light '" + lightModeName(scene.lights[i]) + "' in mode " + toString(modes[i].mode) +
                              " (" + modes[i].reason + ")";
-    // The reference integrator finds every light itself, and the L1 pages have no split by light yet.
+    // The reference integrator finds every light itself, and the L1 pages hold every light's direct term (they
+    // have no split by light), so both are refused before anything is traced.
     if (options.backend == BackendKind::Reference)
       throw Error(ErrorCode::Usage, scene.sourcePath, what + ": needs a VPL backend (gl, embree or auto), not reference");
     if (options.directional)
-      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": --directional bakes every light for now (leave it out)");
+      throw Error(ErrorCode::Usage, scene.sourcePath, what + ": --directional bakes every light's direct term into its L1 pages; leave out --directional or the mode");
   }
 }
 

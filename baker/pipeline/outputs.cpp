@@ -53,6 +53,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   if (!result.shadowMask.empty()) {
     mask.rgb = &result.shadowMask.rgb;
     mask.alpha = &result.shadowMask.alpha;
+    mask.scene = &result.scene;
     for (size_t i = 0; i < result.maskChannels.channel.size(); ++i)
       if (result.maskChannels.channel[i] >= 0)
         mask.lights.push_back({&result.scene.lights[i], lightModeName(result.scene.lights[i]), result.maskChannels.channel[i]});
@@ -103,6 +104,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
     if (!mask.empty()) ex.shadowMask = &mask;
+    ex.lightModes = &result.lightModes;
     exportGltf(result.scene, result.maps, ex);
   } else {
     std::vector<PendingFile> files;

@@ -23,6 +23,7 @@
 #include "common/log.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
+#include "scene/runtime_lights.h"
 
 namespace irbake {
 
@@ -239,6 +240,7 @@ class Loader {
     decodeTextures();
     readLightmapPages();
     readSky();
+    if (options_.shadingMaps) readRuntimeLightsOfExport();
     for (const auto& w : scene_.stats.warnings) log::warn(file_ + ": " + w);
     return std::move(scene_);
   }
@@ -966,6 +968,7 @@ class Loader {
       m.normalTexCoord = g.normalTexture.texCoord;
       m.normalScale = std::isfinite(g.normalTexture.scale) ? static_cast<float>(g.normalTexture.scale) : 1.0f;
     }
+    readShadowMask(mj, m);
     const json* ext = path(mj, {"extensions", "IRBAKE_lightmap_directional"});
     if (!ext || !ext->is_object()) return;
     const json* l1 = child(*ext, "l1");
@@ -989,6 +992,31 @@ class Loader {
     if (exr && exr->is_array() && exr->size() == 3 && (*exr)[0].is_string() && (*exr)[1].is_string() && (*exr)[2].is_string())
       for (int k = 0; k < 3; ++k)
         m.directionalExrPaths[k] = (src_.folder / decodeUriEscapes((*exr)[k].get<std::string>())).string();
+  }
+
+  // IRBAKE_shadowmask on a material (docs/export.md): its RGBA mask page, linear, on the light map's TEXCOORD_1.
+  void readShadowMask(const json& mj, Material& m) {
+    const json* ext = path(mj, {"extensions", "IRBAKE_shadowmask"});
+    if (!ext) return;
+    const std::string what = "material '" + m.name + "': IRBAKE_shadowmask";
+    const json* index = child(*ext, "index");
+    if (!index || !index->is_number_integer() || index->get<int64_t>() < 0 ||
+        index->get<int64_t>() >= static_cast<int64_t>(model_.textures.size()))
+      invalid(what + " needs \"index\", a texture of the file");
+    if (numberOr(child(*ext, "texCoord"), 1.0) != 1.0) invalid(what + ": texCoord must be 1 (the light map's)");
+    m.shadowMaskTexture = textureIndex(index->get<int>(), false, m.name);
+  }
+
+  // The lights an export leaves to the client (scene/runtime_lights.h); a mask without the root's light map
+  // to channels could not be shaded, so it is refused.
+  void readRuntimeLightsOfExport() {
+    const json* khr = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
+    const size_t khrCount = khr && khr->is_array() ? khr->size() : 0;
+    scene_.runtimeLights = readRuntimeLights(src_.json, scene_.lights, khrCount, file_);
+    if (!path(src_.json, {"extensions", "IRBAKE_shadowmask"}))
+      for (const Material& m : scene_.materials)
+        if (m.shadowMaskTexture >= 0)
+          invalid("material '" + m.name + "': IRBAKE_shadowmask without the root IRBAKE_shadowmask that maps lights to channels");
   }
 
   // (glTF texture, colour space) → Scene texture; texels are filled by decodeTextures().

@@ -60,6 +60,8 @@ struct Material {
   std::array<int, 3> directionalTextures{-1, -1, -1};
   std::array<float, 3> directionalScales{1.0f, 1.0f, 1.0f};
   std::array<std::string, 3> directionalExrPaths;
+  // IRBAKE_shadowmask (docs/export.md): the RGBA mask page (index into Scene::textures, linear), -1 none.
+  int shadowMaskTexture = -1;
   bool hasDirectionalTextures() const {
     return directionalTextures[0] >= 0 && directionalTextures[1] >= 0 && directionalTextures[2] >= 0;
   }
@@ -160,6 +162,14 @@ struct SurfaceTransmission {
   glm::vec3 transmittance() const { return tint * fraction; }
 };
 
+// A light an irbake export leaves to the client (docs/export.md "Mixed lights"): its direct light is not in
+// the map, the client shades it, times channel `maskChannel` of the material's shadow mask (-1: unshadowed).
+struct RuntimeLight {
+  Light light;
+  LightMode mode = LightMode::Indirect;
+  int maskChannel = -1;  // 0..3 (R, G, B, A) for a shadowmask light
+};
+
 struct Scene {
   std::string sourcePath;          // the glTF it came from ("" for generated scenes)
   std::vector<Primitive> primitives;
@@ -172,6 +182,8 @@ struct Scene {
   // Baked float pages named in the root extras of an irbake export ("lightmapPages": [uri, ...]),
   // resolved to paths beside the glTF; empty for other scenes.
   std::vector<std::string> lightmapExrPaths;
+  // An export's mixed lights (read only with LoadOptions::shadingMaps, scene/runtime_lights.h).
+  std::vector<RuntimeLight> runtimeLights;
 
   Bounds3 bounds() const;
   size_t triangleCount() const;

@@ -5,7 +5,10 @@
 // Usage: node render_compare.mjs --modules DIR --scene FILE.gltf --camera N --width W --height H
 //          --reference REF.png --out WEB.png [--max-mean-abs 2] [--chromium /usr/bin/chromium]
 //          [--lightmap sh|l0] [--min-directional N: fail unless N materials were shaded with directional maps]
-//          [--plugin none: the client's glTF loader without our MOZ_lightmap plugin, as any viewer (the portable GLB)]
+//          [--plugin none: the client's glTF loader without our MOZ_lightmap plugin, as any viewer (the portable GLB);
+//           moz-only: MOZ_lightmap without irbake_shadowmask.js's mixed lights]
+//          [--min-runtime-lights N, --min-masked N: fail unless three.js shaded N lights in real time, N materials
+//           with a shadow mask]
 //          [--client three|babylon (default three)]
 import fs from 'node:fs';
 import path from 'node:path';
@@ -95,6 +98,11 @@ try {
     console.error(`render_compare: mean absolute difference ${result.meanAbs.toFixed(3)} > ${maxMeanAbs} (web ${args.out}, irview ${args.reference})`);
     code = 1;
   }
+  for (const [option, field] of [['min-runtime-lights', 'runtimeLights'], ['min-masked', 'maskedMaterials']])
+    if (args[option] !== undefined && !(result[field] >= Number(args[option]))) {
+      console.error(`render_compare: ${field} ${result[field]}, expected at least ${args[option]}`);
+      code = 1;
+    }
   if (args['min-directional'] !== undefined && !(result.directionalMaterials >= Number(args['min-directional']))) {
     console.error(`render_compare: ${result.directionalMaterials} materials with directional maps, expected at least ${args['min-directional']}`);
     code = 1;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Khronos glTF-Validator on every kind of export: the baked Cornell box (.gltf + .bin +
-# images), the same as one GLB, the same with --directional, a shadow-mask bake (.gltf and GLB), `irbake unwrap` output, and the DamagedHelmet from ../shared baked with
+# images), the same as one GLB, the same with --directional, a shadow-mask bake (.gltf and GLB), an indirect bake (its light records), `irbake unwrap` output, and the DamagedHelmet from ../shared baked with
 # --sun (skipped with a message when absent). Each: 0 errors, no warning its input did not have, no
 # UNUSED_OBJECT for a mesh or an accessor (runtime/web/validate.mjs).
 # Usage (from ctest): validator_test.sh IRBAKE MODULES_DIR WORK_DIR SOURCE_DIR
@@ -26,6 +26,11 @@ wall="$work/samples/thin_wall.gltf"
 validate "$work/shadowmask/scene.gltf" "$wall"
 "$irbake" bake "$wall" -o "$work/shadowmask_glb/wall.glb" --vpls 128 --light-mode '*=shadowmask' --quiet >> "$work/bake.log" 2>&1
 validate "$work/shadowmask_glb/wall.glb" "$wall"
+# Mixed-light records: an indirect KHR light (extras.irbake.mode) and an indirect --sun (root extras irbakeSun).
+"$irbake" bake "$wall" -o "$work/indirect" --vpls 128 --sun 0.3,-1,-0.4,3 --light-mode '*=indirect' --quiet >> "$work/bake.log" 2>&1
+grep -q '"irbakeSun"' "$work/indirect/scene.gltf" && grep -q '"mode": *"indirect"' "$work/indirect/scene.gltf" \
+  || { echo "the indirect bake does not record its lights"; exit 1; }
+validate "$work/indirect/scene.gltf" "$wall"
 "$irbake" unwrap "$cornell" -o "$work/unwrap/cornell.gltf" > "$work/unwrap.log" 2>&1
 validate "$work/unwrap/cornell.gltf" "$cornell"
 helmet="$source/../shared/scenes/damaged_helmet/DamagedHelmet.gltf"

@@ -3,10 +3,17 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
+import { IrbakeShadowmaskExtension } from './irbake_shadowmask.js';
+import { IrbakeLightProbesExtension } from './irbake_light_probes.js';
+import { addProbeObjects, lookAtCamera } from './probe_objects.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
-// plugin false: plain GLTFLoader without MOZ_lightmap, as a viewer that does not know it (the portable GLB).
-export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true }) {
+// plugin false: plain GLTFLoader without our plugins (MOZ_lightmap, IRBAKE_light_probes), as a viewer that does not know them.
+// mixedLights false: MOZ_lightmap only, every light removed (the map alone, as a client without irbake_shadowmask.js).
+// probeObjects: [[x, y, z, r], ...] white spheres lit by IRBAKE_light_probes (probe_objects.js); view: { eye,
+// target, fov } a look-at camera instead of glTF camera `camera`, as irview --eye/--target/--fov.
+export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true,
+                                       mixedLights = true, probeObjects = [], view = null }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
@@ -17,23 +24,37 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   const loader = new GLTFLoader();
   loader.setMeshoptDecoder(MeshoptDecoder);  // EXT_meshopt_compression: gltf-transform optimize's default
   let lightmapExtension = null;
-  if (plugin) loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
+  let shadowmask = null;  // mixed lighting: the lights the bake left to the client, shadowed by the mask pages
+  if (plugin) {
+    loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
+    loader.register(parser => new IrbakeLightProbesExtension(parser));
+    if (mixedLights) loader.register(parser => (shadowmask = new IrbakeShadowmaskExtension(parser)));
+  }
   const gltf = await loader.loadAsync(scene);
-  // The light maps hold the punctual lights' light already: drop the lights GLTFLoader made.
+  // The light maps hold the baked lights' light already: drop those; keep the ones the bake left to the client
+  // (indirect and shadowmask modes), which three.js shades in real time.
   const lights = [];
-  gltf.scene.traverse(o => { if (o.isLight) lights.push(o); });
+  gltf.scene.traverse(o => { if (o.isLight && !shadowmask?.isRuntimeLight(o)) lights.push(o); });
   for (const l of lights) l.parent.remove(l);
+  shadowmask?.syncLights(gltf.scene);
   gltf.scene.updateMatrixWorld(true);
 
-  const cam = gltf.cameras[camera];
+  const probes = addProbeObjects(gltf, probeObjects, scene);
+  const cam = view ? lookAtCamera(view) : gltf.cameras[camera];
   if (!cam) throw new Error(`${scene}: no camera ${camera}`);
   cam.aspect = width / height;  // irview uses the viewport's aspect
   cam.updateProjectionMatrix();
-  renderer.setClearColor(0x000000, 1);
+  // Behind the scene the bake's uniform sky (root extras irbakeSky), as irview draws it; else black.
+  const sky = gltf.parser.json.extras?.irbakeSky?.radiance;
+  if (Array.isArray(sky) && sky.length === 3 && sky.every(Number.isFinite))
+    renderer.setClearColor(new THREE.Color().setRGB(...sky, THREE.LinearSRGBColorSpace), 1);
+  else
+    renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);
   return { width, height, lights: lights.length, lightmapMode, plugin,
+           runtimeLights: shadowmask?.runtimeLights.length ?? 0, maskedMaterials: shadowmask?.maskedMaterials ?? 0,
            directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
-           generatedTangents: lightmapExtension?.generatedTangents ?? 0 };
+           generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes };
 }
 
 export { canvasPixels } from './canvas_pixels.js';

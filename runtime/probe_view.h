@@ -1,0 +1,45 @@
+// The baked irradiance probes (IRBAKE_light_probes, docs/export.md) in irview: matte white spheres lit by the
+// probes (--probe-object X,Y,Z[,R]: the probes' SH interpolated once at the centre, as a dynamic object would be),
+// and the grid itself (--view probes: a small sphere at each probe, lit by its own SH, invalid ones red).
+// A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(coefficients, n) at normal n, clamped at
+// 0 (L2 ringing); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
+#pragma once
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "lightmap/probe_grid.h"
+
+namespace irbake::view {
+
+class ViewRenderer;
+struct ViewerOptions;
+
+struct ProbeSphere {
+  glm::vec3 centre{0.0f};
+  float radius = 0.1f;
+  ShCoefficients coefficients{};  // E(n)/π = shIrradiance(coefficients, n)
+  bool valid = true;              // false: drawn in flat red (a probe left out of interpolation)
+};
+
+// The probes at a dynamic object's centre: trilinear over the 8 around it, valid ones only, weights renormalised
+// (interpolateProbes). irview has no ray tracer, so every probe counts as visible from the point, unlike `irbake
+// probe`, which drops the probes a wall hides; the two agree wherever the point sees its 8 probes. Throws
+// Error(InvalidData, file) when no valid probe is near.
+ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, float radius,
+                        const std::filesystem::path& file);
+
+// One sphere per probe at its baked position (grid point + offset), radius 0.12 × spacing.
+std::vector<ProbeSphere> probeGridSpheres(const LightProbeGrid& grid);
+
+// The spheres the options ask for (--probe-object, --view probes), with the grid read from the scene file
+// (readLightProbes: throws Error naming the file and the problem for a missing or malformed extension). Empty
+// when neither is asked for; the file is then not read for probes.
+std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& options);
+
+// Draws `spheres` after the scene in every frame of `renderer` (ViewRenderer::addOverlay); GL context current.
+void addProbeOverlay(ViewRenderer& renderer, std::vector<ProbeSphere> spheres);
+
+}  // namespace irbake::view

@@ -1,0 +1,196 @@
+// A GLTFLoader plugin for IRBAKE_light_probes (docs/export.md): irbake's grid of irradiance probes, read, checked
+// and used to light dynamic meshes the way irview's --probe-object does (runtime/probe_view.h).
+//   root.extensions.IRBAKE_light_probes = { origin, spacing, counts, coefficients, offsets, valid, ... }
+// Probe (i, j, k), index i + nx (j + ny k), stands at origin + spacing (i, j, k); it holds 9 RGB coefficients of
+// three.js's SphericalHarmonics3 of the incident radiance / π (E(n)/π = shGetIrradianceAt(n)), validity 0 or 1.
+// lightObject(mesh) blends the 8 probes around the mesh's centre (trilinear, valid ones only, weights
+// renormalised: baker/lightmap/probe_grid.h, interpolateProbes, without its visibility rays as irview) into one
+// SH per mesh, and its Lambert material then adds radiance = albedo × max(0, shGetIrradianceAt(n)): the same
+// value as irview, since three.js shades irradiance × albedo/π and the material's probe term is π × E/π.
+// A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
+// non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
+import { Box3, SphericalHarmonics3, Vector3 } from 'three';
+
+export const LIGHT_PROBES = 'IRBAKE_light_probes';
+const FLOAT = 5126;
+const COMPONENTS = { SCALAR: 1, VEC3: 3 };
+
+// The probe grid: coefficients (Float32Array, 27 per probe: SphericalHarmonics3.fromArray's layout), offsets
+// (3 per probe), valid (Uint8Array).
+export class IrbakeProbeGrid {
+  constructor({ origin, spacing, counts, coefficients, offsets, valid }) {
+    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid });
+  }
+
+  get size() { return this.counts[0] * this.counts[1] * this.counts[2]; }
+  index(i, j, k) { return i + this.counts[0] * (j + this.counts[1] * k); }
+  // Where probe `index` was baked: its grid point plus its offset.
+  position(index) {
+    const [nx, ny] = this.counts;
+    const ijk = [index % nx, Math.floor(index / nx) % ny, Math.floor(index / (nx * ny))];
+    return ijk.map((v, a) => this.origin[a] + this.spacing * v + this.offsets[3 * index + a]);
+  }
+
+  // The SH at point p ([x, y, z]): { coefficients: Float64Array(27), probes, weight }. Trilinear over the 8 probes
+  // around p (clamped to the grid), valid ones only; where none is valid, the nearest valid probe of the 4×4×4
+  // around p; probes 0 when there is none.
+  interpolate(p) {
+    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0 };
+    const base = [0, 0, 0], t = [0, 0, 0];
+    for (let a = 0; a < 3; ++a) {
+      const n = this.counts[a];
+      const f = Math.fround((Math.fround(p[a]) - this.origin[a]) / this.spacing);
+      const c = Math.min(Math.max(f, 0), n - 1);
+      base[a] = Math.min(Math.floor(c), Math.max(0, n - 2));
+      t[a] = n > 1 ? c - base[a] : 0;
+    }
+    for (let corner = 0; corner < 8; ++corner) {
+      const d = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+      const q = d.map((v, a) => base[a] + v);
+      if (q.some((v, a) => v > this.counts[a] - 1)) continue;  // a one-probe axis: its single layer counted once
+      let w = 1;
+      for (let a = 0; a < 3; ++a) w *= d[a] ? t[a] : 1 - t[a];
+      const idx = this.index(q[0], q[1], q[2]);
+      if (w <= 0 || !this.valid[idx]) continue;
+      for (let k = 0; k < 27; ++k) out.coefficients[k] += w * this.coefficients[27 * idx + k];
+      out.weight += w;
+      ++out.probes;
+    }
+    if (out.weight > 0) {
+      for (let k = 0; k < 27; ++k) out.coefficients[k] /= out.weight;
+      return out;
+    }
+    let best = Infinity, nearest = -1;
+    for (let k = base[2] - 1; k <= base[2] + 2; ++k)
+      for (let j = base[1] - 1; j <= base[1] + 2; ++j)
+        for (let i = base[0] - 1; i <= base[0] + 2; ++i) {
+          if (i < 0 || j < 0 || k < 0 || i >= this.counts[0] || j >= this.counts[1] || k >= this.counts[2]) continue;
+          const idx = this.index(i, j, k);
+          const q = this.position(idx);
+          const d2 = (q[0] - p[0]) ** 2 + (q[1] - p[1]) ** 2 + (q[2] - p[2]) ** 2;
+          if (d2 < best && this.valid[idx]) { best = d2; nearest = idx; }
+        }
+    if (nearest < 0) return out;
+    out.coefficients.set(this.coefficients.subarray(27 * nearest, 27 * nearest + 27));
+    out.probes = 1;
+    out.weight = 1;
+    return out;
+  }
+
+  // Lights `mesh` (its material must be a MeshLambertMaterial, cloned here so meshes do not share probes) with
+  // the probes at `point` (default: the centre of its world bounding box). Returns the blend; throws when no
+  // valid probe is near.
+  lightObject(mesh, point = null) {
+    if (!point) {
+      mesh.updateWorldMatrix(true, false);
+      point = new Box3().setFromObject(mesh).getCenter(new Vector3()).toArray();
+    }
+    const blend = this.interpolate(point);
+    if (blend.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
+    mesh.material = mesh.material.clone();
+    applyProbeSh(mesh.material, blend.coefficients);
+    return blend;
+  }
+}
+
+// Adds π × max(0, shGetIrradianceAt(n, sh)) to a Lambert (or any lit) material's indirect irradiance, n the world
+// normal: three.js's own light-probe term, per material instead of per scene, clamped at 0 as irview.
+export function applyProbeSh(material, coefficients) {
+  const sh = [];
+  for (let k = 0; k < 9; ++k) sh.push(new Vector3(coefficients[3 * k], coefficients[3 * k + 1], coefficients[3 * k + 2]));
+  material.userData.irbakeProbeSh = { value: sh };
+  material.onBeforeCompile = shader => {
+    shader.uniforms.irbakeProbeSh = material.userData.irbakeProbeSh;
+    const anchor = '#include <lights_fragment_maps>';
+    if (!shader.fragmentShader.includes(anchor)) throw new Error(`${LIGHT_PROBES}: this three.js has no ${anchor}`);
+    shader.fragmentShader = shader.fragmentShader
+      .replace('void main() {', 'uniform vec3 irbakeProbeSh[ 9 ];\nvoid main() {')
+      .replace(anchor, `${anchor}
+  irradiance += PI * max( shGetIrradianceAt( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ),
+                                             irbakeProbeSh ), vec3( 0.0 ) );`);
+  };
+  material.customProgramCacheKey = () => 'irbake-light-probes';
+  material.needsUpdate = true;
+}
+
+// A blend's coefficients as three.js's SphericalHarmonics3 (for a LightProbe of intensity π, which lights a whole
+// scene rather than one object).
+export function toSphericalHarmonics3(coefficients) {
+  return new SphericalHarmonics3().fromArray(Array.from(coefficients));
+}
+
+function fail(field, message) { throw new Error(`${LIGHT_PROBES}${field ? '.' + field : ''}: ${message}`); }
+
+function threeNumbers(ext, key) {
+  const v = ext[key];
+  if (!Array.isArray(v) || v.length !== 3 || !v.every(x => typeof x === 'number')) fail(key, 'needs 3 numbers');
+  if (!v.every(Number.isFinite)) fail(key, 'not finite');
+  return v;
+}
+
+// The grid of a parsed glTF JSON whose accessors `accessor(i)` resolves (a three.js BufferAttribute). Throws an
+// Error naming the field for a grid that does not fit, as irbake's reader (readLightProbes) does.
+export async function readProbeGrid(json, accessor) {
+  const ext = json.extensions?.[LIGHT_PROBES];
+  if (!ext || typeof ext !== 'object') fail('', 'no extension');
+  const origin = threeNumbers(ext, 'origin').map(Math.fround);
+  const counts = threeNumbers(ext, 'counts');
+  for (const c of counts) if (!(c >= 1 && Number.isInteger(c) && c <= 1e6)) fail('counts', `${c} is not a whole number from 1 to 10^6`);
+  const n = counts[0] * counts[1] * counts[2];
+  if (n > 1e8) fail('counts', 'more than 10^8 probes');
+  const spacing = ext.spacing;
+  if (typeof spacing !== 'number' || !(spacing > 0) || !Number.isFinite(spacing)) fail('spacing', 'needs a positive finite number');
+  const read = async (key, type, count) => {
+    const index = ext[key];
+    if (!Number.isInteger(index)) fail(key, 'no accessor index');
+    const def = json.accessors?.[index];
+    if (!def) fail(key, `accessor ${index} does not exist`);
+    if (def.componentType !== FLOAT || def.type !== type)
+      fail(key, `accessor of componentType ${def.componentType} ${def.type}, expected ${FLOAT} ${type}`);
+    if (def.count !== count) fail(key, `${def.count} elements, the grid needs ${count}`);
+    const view = json.bufferViews?.[def.bufferView];
+    const bytes = (def.byteOffset ?? 0) + 4 * COMPONENTS[type] * count;
+    if (!view || (view.byteStride === undefined && bytes > view.byteLength))
+      fail(key, `accessor ${index} needs ${bytes} bytes of its buffer view, which has ${view?.byteLength ?? 'none'}`);
+    let attribute;
+    try {
+      attribute = await accessor(index);
+    } catch (e) {
+      fail(key, `accessor ${index} cannot be read: ${e.message}`);
+    }
+    const values = new Float32Array(count * COMPONENTS[type]);
+    for (let i = 0; i < count; ++i)
+      for (let c = 0; c < COMPONENTS[type]; ++c) values[i * COMPONENTS[type] + c] = attribute.getComponent(i, c);
+    return values;
+  };
+  const coefficients = await read('coefficients', 'VEC3', 9 * n);
+  const offsets = await read('offsets', 'VEC3', n);
+  const validity = await read('valid', 'SCALAR', n);
+  const valid = new Uint8Array(n);
+  for (let i = 0; i < n; ++i) {
+    let finite = Number.isFinite(offsets[3 * i]) && Number.isFinite(offsets[3 * i + 1]) && Number.isFinite(offsets[3 * i + 2]);
+    for (let k = 0; k < 27; ++k) finite = finite && Number.isFinite(coefficients[27 * i + k]);
+    if (!finite) fail('', `probe ${i} has a non-finite coefficient or offset`);
+    if (validity[i] !== 0 && validity[i] !== 1) fail('valid', `probe ${i} holds ${validity[i]} (0 or 1)`);
+    valid[i] = validity[i];
+  }
+  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid });
+}
+
+// The loader plugin: after the document loads, gltf.userData.irbakeLightProbes is the grid (null without the
+// extension); a malformed grid rejects the load.
+export class IrbakeLightProbesExtension {
+  constructor(parser) {
+    this.parser = parser;
+    this.name = LIGHT_PROBES;
+    this.grid = null;
+  }
+
+  async afterRoot(result) {
+    result.userData ??= {};
+    result.userData.irbakeLightProbes = null;
+    if (!this.parser.json.extensions?.[LIGHT_PROBES]) return;
+    this.grid = await readProbeGrid(this.parser.json, i => this.parser.getDependency('accessor', i));
+    result.userData.irbakeLightProbes = this.grid;
+  }
+}

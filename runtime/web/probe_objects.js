@@ -1,0 +1,39 @@
+// The viewer page's dynamic objects: matte white spheres (albedo 1, Lambert) lit by the scene's
+// IRBAKE_light_probes (irbake_light_probes.js), as irview --probe-object X,Y,Z,R; and the look-at camera of
+// irview --eye/--target/--fov.
+import * as THREE from 'three';
+
+// Adds one sphere per [x, y, z, r] to gltf.scene, each lit by the probes at its centre. Returns what each blended
+// ({ probes, weight }). Throws naming the scene when it has no probes.
+export function addProbeObjects(gltf, objects, sceneName) {
+  if (!objects.length) return [];
+  const grid = gltf.userData?.irbakeLightProbes;
+  if (!grid) throw new Error(`${sceneName}: no IRBAKE_light_probes extension (baked with --probes off?)`);
+  return objects.map(([x, y, z, r]) => {
+    // Fine enough that the tessellation's normals stay within 0.1° of the sphere's (what a pixel shows).
+    const mesh = new THREE.Mesh(new THREE.SphereGeometry(r, 256, 128),
+                                new THREE.MeshLambertMaterial({ color: new THREE.Color(1, 1, 1) }));
+    mesh.position.set(x, y, z);
+    gltf.scene.add(mesh);
+    const { probes, weight } = grid.lightObject(mesh, [x, y, z]);
+    return { probes, weight };
+  });
+}
+
+// A perspective camera at `eye` looking at `target` (+Y up), vertical fov in degrees.
+export function lookAtCamera({ eye, target, fov, aspect = 1 }) {
+  const cam = new THREE.PerspectiveCamera(fov, aspect, 0.01, 1000);
+  cam.position.set(...eye);
+  cam.lookAt(new THREE.Vector3(...target));
+  cam.updateMatrixWorld(true);
+  return cam;
+}
+
+// "x,y,z[,r]" (r default 0.1 m, as irview) → [x, y, z, r]; throws for anything else.
+export function parseProbeObject(text) {
+  const v = text.split(',').map(Number);
+  if ((v.length !== 3 && v.length !== 4) || !v.every(Number.isFinite)) throw new Error(`probeObject '${text}': X,Y,Z[,R]`);
+  if (v.length === 3) v.push(0.1);
+  if (!(v[3] > 0)) throw new Error(`probeObject '${text}': the radius must be positive`);
+  return v;
+}

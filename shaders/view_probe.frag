@@ -1,0 +1,43 @@
+// irview's probe spheres: the ray from the eye through this fragment meets the sphere at p, normal
+// n = (p − centre)/r; a white Lambert surface there shows E(n)/π, the probes' SH convolved with the clamped
+// cosine as three.js's shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0.
+uniform mat4 uViewProjection;
+uniform vec3 uEye;
+uniform vec3 uCentre;
+uniform float uRadius;
+uniform vec3 uSh[9];
+uniform int uValid;
+uniform float uExposureScale;
+in vec3 vWorld;
+out vec4 fragColor;
+
+vec3 shIrradiance(vec3 n) {
+  float x = n.x, y = n.y, z = n.z;
+  vec3 r = uSh[0] * 0.886227;
+  r += uSh[1] * (2.0 * 0.511664 * y) + uSh[2] * (2.0 * 0.511664 * z) + uSh[3] * (2.0 * 0.511664 * x);
+  r += uSh[4] * (2.0 * 0.429043 * x * y) + uSh[5] * (2.0 * 0.429043 * y * z);
+  r += uSh[6] * (0.743125 * z * z - 0.247708) + uSh[7] * (2.0 * 0.429043 * x * z);
+  r += uSh[8] * (0.429043 * (x * x - y * y));
+  return r;
+}
+
+void main() {
+  vec3 d = normalize(vWorld - uEye);
+  vec3 oc = uEye - uCentre;
+  float b = dot(oc, d);
+  vec3 closest = oc - b * d;  // centre → the ray's closest point: h below without b² − c's cancellation
+  float h = uRadius * uRadius - dot(closest, closest);
+  if (h < 0.0) discard;
+  float t = -b - sqrt(h);
+  if (t < 0.0) discard;  // the eye is inside the sphere or past it
+  vec3 p = uEye + t * d;
+  vec3 n = normalize(p - uCentre);
+  vec4 clip = uViewProjection * vec4(p, 1.0);
+  gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+  vec3 radiance = uValid != 0 ? max(shIrradiance(n), vec3(0.0)) : vec3(1.0, 0.0, 0.0);
+#if OUTPUT == 1
+  fragColor = vec4(encodeSrgb(radiance * uExposureScale), 1.0);
+#else
+  fragColor = vec4(radiance, 1.0);
+#endif
+}
