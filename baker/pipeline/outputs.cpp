@@ -30,6 +30,33 @@ std::vector<PendingFile> errorPageFiles(const BakeResult& result, const std::fil
   return files;
 }
 
+// Pages of an earlier bake into the same folder that this bake does not have (more pages, shadow masks).
+void removeStalePages(const BakeResult& result, const std::filesystem::path& outDir) {
+  namespace fs = std::filesystem;
+  // Pages of an earlier bake into the same folder that this bake does not have would be read as
+  // part of it (irbake diff, the viewer): remove them.
+  std::error_code removeError;
+  for (size_t page = result.maps.size();; ++page) {
+    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    if (!fs::exists(stale)) break;
+    fs::remove(stale, removeError);
+    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
+  }
+  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
+  for (size_t page = 0;; ++page) {
+    bool found = false;
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
+      if (!fs::exists(stale)) continue;
+      found = true;
+      if (page < result.shadowMask.rgb.size()) continue;
+      fs::remove(stale, removeError);
+      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
+    }
+    if (!found && page >= result.shadowMask.rgb.size()) break;
+  }
+}
+
 }  // namespace
 
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
@@ -129,28 +156,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     writeAllAtomically(files);
   }
 
-  // Pages of an earlier bake into the same folder that this bake does not have would be read as
-  // part of it (irbake diff, the viewer): remove them.
-  std::error_code removeError;
-  for (size_t page = result.maps.size();; ++page) {
-    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
-    if (!fs::exists(stale)) break;
-    fs::remove(stale, removeError);
-    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
-  }
-  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
-  for (size_t page = 0;; ++page) {
-    bool found = false;
-    for (const char* ext : {".exr", ".png"}) {
-      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
-      if (!fs::exists(stale)) continue;
-      found = true;
-      if (page < result.shadowMask.rgb.size()) continue;
-      fs::remove(stale, removeError);
-      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
-    }
-    if (!found && page >= result.shadowMask.rgb.size()) break;
-  }
+  removeStalePages(result, outDir);
   written.push_back(reportPath);
   return written;
 }
