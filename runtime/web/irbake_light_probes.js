@@ -148,10 +148,13 @@ export async function readProbeGrid(json, accessor) {
     if (def.componentType !== FLOAT || def.type !== type)
       fail(key, `accessor of componentType ${def.componentType} ${def.type}, expected ${FLOAT} ${type}`);
     if (def.count !== count) fail(key, `${def.count} elements, the grid needs ${count}`);
-    const view = json.bufferViews?.[def.bufferView];
-    const bytes = (def.byteOffset ?? 0) + 4 * COMPONENTS[type] * count;
-    if (!view || (view.byteStride === undefined && bytes > view.byteLength))
-      fail(key, `accessor ${index} needs ${bytes} bytes of its buffer view, which has ${view?.byteLength ?? 'none'}`);
+    // An accessor without a buffer view is zeros (glTF 2.0, 3.6.2.1), as optimisers write an all-zero one.
+    if (def.bufferView !== undefined) {
+      const view = json.bufferViews?.[def.bufferView];
+      const bytes = (def.byteOffset ?? 0) + 4 * COMPONENTS[type] * count;
+      if (!view || (view.byteStride === undefined && bytes > view.byteLength))
+        fail(key, `accessor ${index} needs ${bytes} bytes of its buffer view, which has ${view?.byteLength ?? 'none'}`);
+    }
     let attribute;
     try {
       attribute = await accessor(index);
