@@ -233,6 +233,30 @@ def t_slurm():
                   "bytes identical to one machine", "load average"], out)
 
 
+ESTIMATE_SCENES = {"cornell_sample": "Cornell sample", "mcguire_cornell": "McGuire Cornell", "corner": "corner (sample)",
+                   "contacts": "contacts (sample)", "sponza_sun_sky": "Sponza, sun + sky", "sibenik_lamp": "Sibenik, lamp"}
+
+
+def t_error_estimate():
+    rows = latest(read("error_estimate.csv"), lambda r: (r["scene"], r["our_options"], r["seed"]))
+    out = []
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        group = [r for r in rows if r["scene"] == scene]
+        for r in group:
+            opts = " ".join(t for t in r["our_options"].replace("--estimate-error true", "").split())
+            out.append([ESTIMATE_SCENES.get(scene, scene), f"`{opts}`" if opts else "default", r["seed"], f"`{r['commit']}`",
+                        f"{int(r['texels']) / 1e3:.0f}k", pct(r["est_vpls"]), pct(r["est_compensation_rays"]),
+                        pct(r["est_gather_rays"]), f"**{pct(r['estimated'])}**", pct(r["rel_rmse_4"]),
+                        pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**", num(r["ratio"], 2), r["ref_spp"]])
+        rms = lambda k: math.sqrt(sum(float(r[k]) ** 2 for r in group) / len(group))
+        out.append([ESTIMATE_SCENES.get(scene, scene), "RMS over seeds", len(group), "", "", "", "", "",
+                    f"**{pct(rms('estimated'))}**", "", "", f"**{pct(rms('rel_rmse_4_corrected'))}**",
+                    f"**{num(rms('estimated') / rms('rel_rmse_4_corrected'), 2)}**", ""])
+    return table(["scene", "options", "seed", "baker", "texels", "estimate: walk", "compensation rays",
+                  "final-gather rays (and the compensation's under it)", "estimate", "measured", "Cycles' noise", "measured, noise removed",
+                  "estimate / measured", "Cycles spp"], out)
+
+
 def t_vpl_blocks():
     rows = read("vpl_blocks.csv")
     out = []

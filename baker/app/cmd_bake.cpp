@@ -125,7 +125,8 @@ void probeArguments(const BakeArguments& a, ProbeOptions& o) {
 
 // The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
 const std::vector<std::string> kCommonOptions = {"SCENE", "output", "quality", "config", "sun", "sky", "env",
-                                                 "texels-per-unit", "directional", "probes", "seed", "threads", "report",
+                                                 "texels-per-unit", "directional", "probes", "seed", "target-error",
+                                                 "threads", "report",
                                                  "quiet", "portable", "help", "help-all"};
 const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroups = {
     {"Light paths and VPLs", {"paths", "bounces", "walk-split", "vpl-importance", "vpl-probes", "vpl-keep", "vpl-block"}},
@@ -139,6 +140,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
+    {"Estimated error", {"estimate-error", "max-time", "max-rounds", "error-map"}},
     {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams"}},
 };
 
@@ -361,6 +363,28 @@ void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   app->add_flag("--help-all", a.helpAll, "every option, grouped by stage");
 }
 
+// The bake's own error (stages/error_estimate) and the target that adds rounds until it is met.
+void addErrorOptions(CLI::App* app, BakeCommand& command) {
+  ErrorEstimateOptions& e = command.options.errorEstimate;
+  const ErrorEstimateOptions d;
+  app->add_flag("--estimate-error", e.enabled,
+                "walk the paths as two independent halves (seeds of their own) and\n"
+                "report the bake's estimated error (report.json estimatedError:\n"
+                "relative RMS on 4x4-texel bins, as bench/cycles/compare.py scores)");
+  app->add_option("--target-error", e.targetError,
+                  "add rounds of paths until the estimated error is at most E (e.g. 0.02)")
+      ->transform(cli::numberIn(1e-6, 1.0))->type_name("E");
+  app->add_option("--max-rounds", e.maxRounds,
+                  "--target-error: at most this many rounds (default " + shown(d.maxRounds) + ")")
+      ->transform(cli::integerIn(1, 4096))->type_name("N");
+  app->add_option("--max-time", e.maxSeconds,
+                  "--target-error: no round started that would end the VPL stage past\n"
+                  "this many seconds of bake (default 0: no cap; the result then depends on\nthe machine)")
+      ->transform(cli::numberIn(0.0, 1e9))->type_name("SECONDS");
+  app->add_flag("--error-map", e.errorMap,
+                "with the estimate: also each texel's standard error, OUTDIR/error_<page>.exr");
+}
+
 // Every option of `irbake bake`, with its range and help.
 std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   auto app = cli::makeApp("irbake bake",
@@ -370,6 +394,7 @@ std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
   addStageOptions(app.get(), command, a);
   addLightAndOutputOptions(app.get(), command, a);
   addRunOptions(app.get(), command, a);
+  addErrorOptions(app.get(), command);
   groupOptions(*app);
   return app;
 }
@@ -480,6 +505,10 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
     throw Error(ErrorCode::Usage, "", "--directional needs a VPL backend (gl, embree or auto), not reference");
   if (command.shardIndex > 0 && o.backend == BackendKind::Reference)
     throw Error(ErrorCode::Usage, "", "--shard splits the VPLs: the reference backend has none (use gl, embree or auto)");
+  if (o.errorEstimate.targetError > 0.0 || o.errorEstimate.errorMap) o.errorEstimate.enabled = true;
+  if (o.errorEstimate.enabled && (command.shardIndex > 0 || command.resume))
+    throw Error(ErrorCode::Usage, "", "--estimate-error and --target-error need the whole bake in one process "
+                                      "(the halves' sums are not in partials or checkpoints): drop --shard / --resume");
 }
 
 }  // namespace
@@ -855,8 +884,9 @@ int runBake(const Args& args) {
   }
 
   Stopwatch sinceCheckpoint;
+  const bool checkpoints = !c.options.errorEstimate.enabled;  // the halves' sums are not in a checkpoint
   staged.evaluateBlocks(next, end, sums, [&](size_t done) {
-    if (done >= end || sinceCheckpoint.seconds() < c.checkpointSeconds) return;
+    if (!checkpoints || done >= end || sinceCheckpoint.seconds() < c.checkpointSeconds) return;
     VplSumHeader h = header;
     h.kind = "checkpoint";
     h.endBlock = done;
@@ -880,6 +910,7 @@ int runBake(const Args& args) {
     return 0;
   }
 
+  staged.refineToTarget(sums);
   BakeResult result = staged.finish(std::move(sums));
   result.report["timings"]["seconds"]["load"] = loadSeconds;
   result.report["options"] = c.resultOptions;
@@ -887,6 +918,17 @@ int runBake(const Args& args) {
   if (!c.dumpConfig.empty()) writeDumpedConfig(c.dumpConfig, c.dumpText + automaticChoices(result.report));
   fs::remove(checkpoint, ec);
   return 0;
+}
+
+// ", estimated error 2.10%" (and what stopped --target-error) for the final log line; "" without an estimate.
+std::string estimatedErrorText(const nlohmann::json& report) {
+  if (!report.contains("estimatedError")) return "";
+  const nlohmann::json& e = report["estimatedError"];
+  char text[96];
+  std::snprintf(text, sizeof text, ", estimated error %.2f%%", 100.0 * e.value("relative", 0.0));
+  std::string line = text;
+  if (e.contains("stoppedBy")) line += " (stopped by " + e["stoppedBy"].get<std::string>() + ")";
+  return line;
 }
 
 void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress) {
@@ -904,7 +946,7 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   progress.finish();
   log::info("baked " + std::to_string(result.maps.size()) + " page(s) with " + result.report["backend"].get<std::string>() +
             " in " + std::to_string(result.report["timings"]["seconds"]["bake"].get<double>()) + " s (+ " +
-            std::to_string(writeTime.seconds()) + " s writing)");
+            std::to_string(writeTime.seconds()) + " s writing)" + estimatedErrorText(result.report));
   for (const auto& f : files) std::printf("%s\n", f.string().c_str());
 }
 }  // namespace irbake::app

@@ -26,6 +26,8 @@
 #include "pipeline/evaluator_factory.h"
 #include "post/post.h"
 #include "raytrace/ray_tracer.h"
+#include "sampling/sampling.h"
+#include "stages/error_estimate/error_estimate.h"
 
 namespace irbake {
 namespace {
@@ -74,10 +76,11 @@ VplEvalOptions directEval(const VplEvalOptions& eval) {
   return e;
 }
 
-// A contiguous range of one interleave class's VPLs.
+// A contiguous range of one interleave class's VPLs, of one replicate of the walk (0 without an error estimate).
 struct VplBlock {
   int vplClass = 0;
   size_t begin = 0, end = 0;
+  size_t replicate = 0;
 };
 
 }  // namespace
@@ -92,7 +95,18 @@ struct StagedBake::State {
   BakePlan plan;              // every automatic choice, settled once
   VplImportanceStats importanceStats;
   std::unique_ptr<GlContext> glContext;
-  std::vector<VplSet> classVpls;                    // per interleave class
+  std::vector<std::vector<VplSet>> classVpls;       // per replicate of the walk, per interleave class
+  // The error estimate (stages/error_estimate): the walk as independent replicates, each a whole estimate of
+  // the VPL light; the even ones form half A, the odd ones half B, and their spread is the estimate.
+  std::vector<VplSet> replicates;                   // empty without an estimate
+  ExactVplSums halfB;                               // the odd replicates' sum (the bake's sums hold them all)
+  std::array<std::vector<Lightmap>, 2> halves;      // both halves mixed like the map (finish)
+  float candidateBound = 0.0f;                      // the importance selection's bound, for every replicate
+  double gatherNoiseRatio = 0.0;                    // the final gather's noise over the mixed halves' (once)
+  std::vector<Lightmap> cachedDirect;               // the punctual lights' pages, made once for the rounds
+  nlohmann::json rounds = nlohmann::json::array();  // the estimate after each round
+  std::string stoppedBy;
+  nlohmann::json stageNoise = nlohmann::json::object();  // a stage's own ray noise (RMS on bins, map units)
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
   std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
@@ -145,7 +159,7 @@ struct StagedBake::State {
     plan.settle("texels-per-unit", atlas.stats.texelsPerUnit,
                 autoDensity ? "about one page at the preset's size, more for many triangles" : "asked for", autoDensity);
     timed("vpls", [&] {
-      WalkOptions o = plan.walk;
+      WalkOptions o = replicateWalk(0);
       o.progress = withProgress(o.progress);
       vpls = generateVpls(scene, *rayTracer, o);
       // Importance-driven selection: where the plain walk's VPLs matter unevenly (its pilot), the walk again
@@ -193,11 +207,13 @@ struct StagedBake::State {
         selection.keepFraction = options.vplImportance.keepShare / plan.importanceFactor;
         selection.clampBound = plan.clampDerived ? static_cast<float>(plan.eval.clampBound * selection.keepFraction)
                                                  : plan.eval.clampBound;
-        selection.seed = options.walk.seed;
+        selection.seed = estimating() ? replicateWalk(0).seed : options.walk.seed;
+        candidateBound = selection.clampBound;
         importanceStats.factor = plan.importanceFactor;
         selectVplsByImportance(scene, *rayTracer, texels, vpls, options.vplImportance, selection, &importanceStats);
       });
     settleClamp(plan, options, scene, vpls);
+    if (estimating()) timed("vpls", [&] { startReplicates(); });
     // The gather keeps a reference to its inputs, so they live as long as the bake.
     wholeInputs = std::make_unique<BakeInputs>(inputs(texels, vpls, plan.eval));
     surfaceFilters = std::make_unique<SurfaceFilterCache>(texels);
@@ -207,6 +223,221 @@ struct StagedBake::State {
       wholeInputs->footprintAlbedo = footprintAlbedo.get();
     }
     timed("backend", [&] { planBlocks(); });
+    if (estimating() && !blocks.empty()) halfB = zeroSums();
+    settleErrorEstimate();
+  }
+
+  // The estimate and its target in the plan, with their reasons.
+  void settleErrorEstimate() {
+    const ErrorEstimateOptions& e = options.errorEstimate;
+    if (!e.enabled) return;
+    plan.settle("error-estimate", estimating(),
+                estimating() ? (e.targetError > 0.0 ? "implied by --target-error" : "asked for")
+                             : "no VPLs to split into independent replicates (reference backend or no VPL light)",
+                false);
+    if (e.targetError > 0.0)
+      plan.settle("target-error", e.targetError,
+                  "asked for: rounds of " + std::to_string(replicateWalk(0).paths) + " + " +
+                      std::to_string(replicateWalk(1).paths) + " paths until the estimate is at most it, at most " +
+                      std::to_string(e.maxRounds) + " rounds" +
+                      (e.maxSeconds > 0.0 ? ", " + std::to_string(e.maxSeconds) + " s" : ""),
+                  false);
+  }
+
+  // Zero sums for every texel a backend can return valid (GL and Embree keep the samples' valid flags).
+  ExactVplSums zeroSums() const {
+    std::vector<std::vector<uint8_t>> receivers;
+    for (const TexelSamples& ts : texels)
+      receivers.push_back(ts.valid.size() == ts.layerSize() ? ts.valid : std::vector<uint8_t>(ts.layerSize(), 1));
+    return ExactVplSums::zeros(receivers, coefficients());
+  }
+
+  // Both halves' VPL sums (even and odd replicates), each scaled to a whole estimate, mixed like the map.
+  std::array<std::vector<Lightmap>, 2> mixedHalves(const ExactVplSums& sums) const {
+    std::array<std::vector<Lightmap>, 2> out;
+    const float scale = 2.0f / static_cast<float>(replicates.size());
+    for (size_t p = 0; p < texels.size(); ++p) {
+      for (auto& half : out) {
+        half.push_back(blankLightmap(texels[p]));
+        half.back().page = static_cast<int>(p);
+        if (half.back().valid.size() != half.back().size()) half.back().valid = texels[p].valid;
+      }
+      std::vector<glm::vec3> a(texels[p].layerSize()), b(texels[p].layerSize());
+      tbb::parallel_for(size_t(0), a.size(), [&](size_t t) {
+        const glm::vec3 odd = halfB.value(p, t);
+        a[t] = (sums.value(p, t) - odd) * scale;
+        b[t] = odd * scale;
+      });
+      addMixedClasses(texels[p], plan.interleave, {&a, &b}, sums.pages[p].valid, {&out[0][p], &out[1][p]},
+                      surfaceFilters.get());
+    }
+    return out;
+  }
+
+  // The halves through the final gather alone (no direct light, rays that escape bring nothing): the map's
+  // noise under the gather, since the gather is linear in the map it reads (emitters' Le cancels in the spread).
+  std::vector<std::vector<Lightmap>> gatheredHalves() const {
+    FinalGatherOptions g = plan.gather;
+    g.missRadiance = glm::vec3(0.0f);
+    std::vector<Lightmap> none = halves[0];
+    for (Lightmap& m : none) std::fill(m.texels.begin(), m.texels.end(), glm::vec3(0.0f));
+    std::vector<std::vector<Lightmap>> out = {halves[0], halves[1]};
+    for (auto& half : out) finalGather(*wholeInputs, none, half, g);
+    return out;
+  }
+
+  // The estimate between rounds: the mixed halves' spread (under the final gather scaled by the gather's
+  // noise ratio, measured once) over their mean plus the punctual lights. The sky and the compensation are
+  // left out of the normaliser, so it is at least the finished bake's figure.
+  double roundEstimate(const ExactVplSums& sums) {
+    halves = mixedHalves(sums);
+    if (cachedDirect.empty()) cachedDirect = directStage(nullptr);
+    std::vector<Lightmap> value = replicateMean({halves[0], halves[1]});
+    for (size_t p = 0; p < value.size() && p < cachedDirect.size(); ++p)
+      for (size_t t = 0; t < value[p].size() && t < cachedDirect[p].size(); ++t) value[p].texels[t] += cachedDirect[p].texels[t];
+    const int bin = options.errorEstimate.bin;
+    const BinnedError e = replicateError({halves[0], halves[1]}, &value, bin);
+    if (plan.finalGather && gatherNoiseRatio == 0.0)
+      gatherNoiseRatio = e.noiseRms > 0.0 ? replicateError(gatheredHalves(), nullptr, bin).noiseRms / e.noiseRms : 1.0;
+    return e.relative * (plan.finalGather ? gatherNoiseRatio : 1.0);
+  }
+
+  // A stage's own ray noise: the stage again with rays of another seed on the same input; one stage's
+  // variance per bin is half the two results' squared difference (twice replicateError's s²/2 of the pair).
+  double rayNoise(const std::vector<Lightmap>& once, const std::vector<Lightmap>& twice) const {
+    return std::sqrt(2.0) * replicateError({once, twice}, nullptr, options.errorEstimate.bin).noiseRms;
+  }
+  // before: the compensation's input, replaced by its second run's output.
+  void compensationRayNoise(std::vector<Lightmap>& before, const std::vector<Lightmap>& after) {
+    ClampCompensationOptions o = plan.compensation;
+    o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x636f6d70ull));  // "comp"
+    ClampGather(*wholeInputs, o).apply(before);
+    if (!plan.finalGather) stageNoise["compensationRays"] = rayNoise(after, before);
+  }
+  void gatherRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
+    FinalGatherOptions o = plan.gather;
+    o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x676174686572ull));  // "gather"
+    finalGather(*wholeInputs, directMaps, before, o);
+    stageNoise[plan.compensate ? "compensationAndGatherRays" : "finalGatherRays"] = rayNoise(after, before);
+  }
+
+  // The finished bake's estimate (before post, on the map as the stages left it) into the report.
+  std::vector<Lightmap> finalEstimate(const std::vector<Lightmap>& maps, nlohmann::json& report) const {
+    std::vector<std::vector<Lightmap>> reps = plan.finalGather ? gatheredHalves()
+                                                               : std::vector<std::vector<Lightmap>>{halves[0], halves[1]};
+    BinnedError e = replicateError(reps, &maps, options.errorEstimate.bin);
+    // The stages' own ray noise is independent of the walk's: the variances add.
+    nlohmann::json breakdown = {{"vpls", e.relative}};
+    double noise2 = e.noiseRms * e.noiseRms;
+    for (const auto& [stage, rms] : stageNoise.items()) {
+      noise2 += rms.get<double>() * rms.get<double>();
+      breakdown[stage] = e.signalRms > 0.0 ? rms.get<double>() / e.signalRms : 0.0;
+    }
+    e.noiseRms = std::sqrt(noise2);
+    e.relative = e.signalRms > 0.0 ? e.noiseRms / e.signalRms : 0.0;
+    nlohmann::json& j = report["estimatedError"] = e.toJson();
+    j["replicates"] = replicates.size();
+    j["breakdown"] = breakdown;
+    j["binTexels"] = options.errorEstimate.bin;
+    j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
+                  "compensation's and final gather's own ray noise (each run again with another seed)";
+    j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
+    j["rounds"] = rounds;
+    if (options.errorEstimate.targetError > 0.0) {
+      j["targetError"] = options.errorEstimate.targetError;
+      j["stoppedBy"] = stoppedBy;
+      report["stoppedBy"] = stoppedBy;
+    }
+    log::info("estimated error " + percent(e.relative) + " (relative RMS on " + std::to_string(options.errorEstimate.bin) +
+              "x" + std::to_string(options.errorEstimate.bin) + "-texel bins, " + std::to_string(replicates.size()) +
+              " replicates)");
+    return standardErrorPages(reps);
+  }
+
+  static std::string percent(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f%%", 100.0 * x);
+    return text;
+  }
+
+  bool estimating() const {
+    return options.errorEstimate.enabled && plan.backend != BackendKind::Reference && options.eval.includeVpls;
+  }
+
+  // The walk of replicate i: the plan's walk, or with an estimate half its paths and a seed of its own (an
+  // independent digit permutation of the Halton points), so that replicates are independent estimates.
+  WalkOptions replicateWalk(size_t i) const {
+    WalkOptions o = plan.walk;
+    if (!estimating()) return o;
+    o.paths = std::max(1, o.paths / 2);
+    o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x7265706c6963ull, i));  // "replic"
+    return o;
+  }
+
+  // Replicate i's VPLs, walked and selected as replicate 0's were (the same factor and bound).
+  VplSet walkReplicate(size_t i) {
+    WalkOptions o = replicateWalk(i);
+    o.progress = withProgress(o.progress);
+    if (plan.importanceFactor > 1.0)
+      o.paths = static_cast<int>(std::min(double(1 << 26), std::round(o.paths * plan.importanceFactor)));
+    VplSet set = generateVpls(scene, *rayTracer, o);
+    if (plan.importanceFactor > 1.0) {
+      VplSelection selection;
+      selection.keepFraction = options.vplImportance.keepShare / plan.importanceFactor;
+      selection.clampBound = candidateBound;
+      selection.seed = o.seed;
+      selectVplsByImportance(scene, *rayTracer, texels, set, options.vplImportance, selection);
+    }
+    return set;
+  }
+
+  // The walk so far as one set (the report's counts; powers as the mean of the replicates).
+  void combineReplicates() {
+    VplSet all = replicates[0];
+    all.vpls.clear();
+    const float share = 1.0f / static_cast<float>(replicates.size());
+    for (auto& power : all.powerPerBounce) power *= share;
+    for (size_t r = 0; r < replicates.size(); ++r) {
+      for (size_t b = 0; r > 0 && b < replicates[r].powerPerBounce.size(); ++b) {
+        if (b >= all.powerPerBounce.size()) all.powerPerBounce.resize(b + 1, glm::dvec3(0.0));
+        all.powerPerBounce[b] += replicates[r].powerPerBounce[b] * double(share);
+      }
+      for (Vpl v : replicates[r].vpls) {
+        v.power *= share;
+        all.vpls.push_back(v);
+      }
+      for (size_t b = 0; r > 0 && b < replicates[r].countPerBounce.size(); ++b) {
+        if (b >= all.countPerBounce.size()) all.countPerBounce.resize(b + 1, 0);
+        all.countPerBounce[b] += replicates[r].countPerBounce[b];
+      }
+    }
+    vpls = std::move(all);
+  }
+
+  // Replicate 0 is the walk just made (its clamp settled); replicate 1 pairs it.
+  void startReplicates() {
+    replicates = {vpls, walkReplicate(1)};
+    combineReplicates();
+  }
+
+  // One more round: a replicate for each half, its classes and blocks.
+  void addRound() {
+    timed("vpls", [&] {
+      for (int k = 0; k < 2; ++k) replicates.push_back(walkReplicate(replicates.size()));
+      combineReplicates();
+    });
+    for (size_t r = replicates.size() - 2; r < replicates.size(); ++r) appendBlocks(r);
+  }
+
+  // Replicate r's interleave classes and their fixed blocks.
+  void appendBlocks(size_t r) {
+    const VplSet& set = replicates.empty() ? vpls : replicates[r];
+    if (classVpls.size() <= r) classVpls.resize(r + 1);
+    classVpls[r] = classVplSubsets(set, plan.interleave);
+    const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
+    for (size_t c = 0; c < classVpls[r].size(); ++c)
+      for (size_t b0 = 0; b0 < classVpls[r][c].vpls.size(); b0 += blockSize)
+        blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[r][c].vpls.size(), b0 + blockSize), r});
   }
 
   // The plan (the GL context is made here where GL may run: its time counts to the backend).
@@ -239,12 +470,8 @@ struct StagedBake::State {
     if (plan.backend == BackendKind::Reference || !plan.eval.includeVpls || vpls.vpls.empty()) return;
     settleBlocks(plan, options, texels, surfaceFilters.get(),
                  [this](int c) -> const std::vector<TexelSamples>& { return pagesOf(c); }, vpls);
-    classVpls = classVplSubsets(vpls, plan.interleave);
-    const size_t blockSize = static_cast<size_t>(std::max(1, options.vplBlock));
-    for (size_t c = 0; c < classVpls.size(); ++c)
-      for (size_t b0 = 0; b0 < classVpls[c].vpls.size(); b0 += blockSize)
-        blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[c].vpls.size(), b0 + blockSize)});
-    interleaveStats.classes = static_cast<int>(classVpls.size());
+    for (size_t r = 0; r < std::max<size_t>(1, replicates.size()); ++r) appendBlocks(r);
+    interleaveStats.classes = static_cast<int>(classVpls[0].size());
   }
 
   // The texel samples of an interleave class as pages of their own (interleave 1: the pages themselves).
@@ -279,7 +506,7 @@ struct StagedBake::State {
 
   void evaluateBlock(size_t index, ExactVplSums& sums, ProgressCallback progress) {
     const VplBlock& block = blocks[index];
-    const VplSet& classSet = classVpls[static_cast<size_t>(block.vplClass)];
+    const VplSet& classSet = classVpls[block.replicate][static_cast<size_t>(block.vplClass)];
     VplSet set;
     set.meanReflectivity = classSet.meanReflectivity;
     set.bounces = classSet.bounces;
@@ -302,7 +529,7 @@ struct StagedBake::State {
           glm::vec3 value[ExactVplSums::kMaxCoefficients] = {m.texels[ct]};  // L0, then L1x, L1y, L1z
           if (plan.directional)
             for (int k = 0; k < 3; ++k) value[1 + k] = l1[k][p].texels[ct];
-          if (!sums.add(p, t, value))
+          if (!sums.add(p, t, value) || (block.replicate % 2 == 1 && !halfB.add(p, t, value)))
             throw Error(ErrorCode::NumericError, scene.sourcePath,
                         "VPL block " + std::to_string(index) + " gave a non-finite or absurd value (≥ 2^40) at page " +
                             std::to_string(p) + " texel " + std::to_string(t % fullWidth) + "," +
@@ -359,7 +586,9 @@ struct StagedBake::State {
   // once rounded: with four coefficients they are the largest thing alive here.
   std::vector<Lightmap> backendMaps(ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
     if (plan.backend == BackendKind::Reference) return referenceStage(report);
-    std::vector<Lightmap> maps = directStage(l1);
+    if (!replicates.empty() && !halfB.pages.empty()) halves = mixedHalves(sums);
+    std::vector<Lightmap> maps = cachedDirect.empty() || l1 ? directStage(l1) : std::move(cachedDirect);
+    cachedDirect = {};
     if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
       throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
                                                                 " pages for " + std::to_string(texels.size()));
@@ -382,10 +611,11 @@ struct StagedBake::State {
         pages.push_back(&map);
       }
       if (blocks.empty()) continue;
+      const float share = replicates.empty() ? 1.0f : 1.0f / static_cast<float>(replicates.size());  // their mean
       std::vector<std::vector<glm::vec3>> vplParts(coefficients, std::vector<glm::vec3>(texels[p].layerSize()));
       std::vector<const std::vector<glm::vec3>*> parts;
       for (int c = 0; c < coefficients; ++c) {
-        tbb::parallel_for(size_t(0), vplParts[c].size(), [&](size_t t) { vplParts[c][t] = sums.value(p, t, c); });
+        tbb::parallel_for(size_t(0), vplParts[c].size(), [&](size_t t) { vplParts[c][t] = sums.value(p, t, c) * share; });
         parts.push_back(&vplParts[c]);
       }
       std::vector<uint8_t> vplValid = std::move(sums.pages[p].valid);
@@ -417,11 +647,7 @@ size_t StagedBake::blockCount() const { return state_->blocks.size(); }
 BackendKind StagedBake::backend() const { return state_->plan.backend; }
 
 ExactVplSums StagedBake::emptySums() const {
-  // Receivers: the texels a backend can return valid (GL and Embree keep the samples' valid flags).
-  std::vector<std::vector<uint8_t>> receivers;
-  for (const TexelSamples& ts : state_->texels)
-    receivers.push_back(ts.valid.size() == ts.layerSize() ? ts.valid : std::vector<uint8_t>(ts.layerSize(), 1));
-  return ExactVplSums::zeros(receivers, state_->coefficients());
+  return state_->zeroSums();
 }
 
 void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
@@ -448,6 +674,30 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
   });
 }
 
+void StagedBake::refineToTarget(ExactVplSums& sums, const std::function<void(size_t next)>& afterBlock) {
+  State& s = *state_;
+  const ErrorEstimateOptions& o = s.options.errorEstimate;
+  if (!s.estimating() || s.halfB.pages.empty() || !(o.targetError > 0.0)) return;
+  double roundSeconds = s.seconds.value("backend", 0.0);  // the first round's: its blocks
+  for (int round = 1;; ++round) {
+    double estimate = 0.0;
+    s.timed("errorEstimate", [&] { estimate = s.roundEstimate(sums); });
+    s.rounds.push_back({{"round", round}, {"replicates", s.replicates.size()}, {"vpls", s.vpls.vpls.size()},
+                        {"estimatedError", estimate}});
+    log::info("round " + std::to_string(round) + ": " + std::to_string(s.replicates.size()) + " replicates, " +
+              std::to_string(s.vpls.vpls.size()) + " VPLs, estimated error " + State::percent(estimate));
+    if (estimate <= o.targetError) s.stoppedBy = "target";
+    else if (round >= o.maxRounds) s.stoppedBy = "max-rounds";
+    else if (o.maxSeconds > 0.0 && s.total.seconds() + roundSeconds > o.maxSeconds) s.stoppedBy = "max-time";
+    if (!s.stoppedBy.empty()) return;
+    Stopwatch watch;
+    const size_t begin = s.blocks.size();
+    s.addRound();
+    evaluateBlocks(begin, s.blocks.size(), sums, afterBlock);
+    roundSeconds = watch.seconds();
+  }
+}
+
 nlohmann::json StagedBake::backendCounts() const {
   nlohmann::json counts = state_->glStats.toJson();
   counts["texelsEvaluated"] = state_->glStats.texelsEvaluated;
@@ -470,8 +720,20 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   StageContext ctx = s.stageContext(report);
   L1Pages* l1 = s.plan.directional ? &r.directional : nullptr;
   skyStage(ctx, r.maps, s.directMaps);
+  const bool estimate = !s.halves[0].empty();
+  std::vector<Lightmap> beforeStage = estimate && s.plan.compensate ? r.maps : std::vector<Lightmap>{};
   compensationStage(ctx, r.maps, l1, s.gather.valid() ? s.gather.get() : nullptr);
+  // Under the final gather the map the gather reads is not written: the compensation's second run is
+  // gathered again (with another gather seed), so both stages' ray noise is measured where it shows.
+  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.compensationRayNoise(beforeStage, r.maps); });
+  if (estimate && s.plan.finalGather && beforeStage.empty()) beforeStage = r.maps;
   finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
+  if (s.plan.finalGather && !beforeStage.empty()) s.timed("errorEstimate", [&] { s.gatherRayNoise(std::move(beforeStage), r.maps); });
+  if (estimate) s.timed("errorEstimate", [&] {
+      std::vector<Lightmap> errorPages = s.finalEstimate(r.maps, report);
+      if (s.options.errorEstimate.errorMap) r.standardError = std::move(errorPages);
+    });
+  s.halves = {};
   leaveOutDirect(r.maps, s.leftOutDirect);
   s.leftOutDirect = {};
   r.shadowMask = shadowMaskStage(ctx);
@@ -505,6 +767,7 @@ BakeResult bake(Scene scene, const BakeOptions& options) {
   StagedBake staged(std::move(scene), options);
   ExactVplSums sums = staged.emptySums();
   staged.evaluateBlocks(0, staged.blockCount(), sums);
+  staged.refineToTarget(sums);
   return staged.finish(std::move(sums));
 }
 

@@ -36,6 +36,9 @@ struct BakeResult {
   ShadowMaskPages shadowMask;
   std::vector<LightMode> lightModes;   // per scene light, as settled (fallbacks applied)
   ShadowMaskChannels maskChannels;
+  // With an error estimate: per page, the standard error of each texel's value (the two halves' spread; the
+  // map's units, before post); empty otherwise.
+  std::vector<Lightmap> standardError;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 
@@ -62,6 +65,10 @@ class StagedBake {
   // Evaluates blocks [begin, end) in order into sums; afterBlock(next) runs after each (next = index + 1).
   void evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
                       const std::function<void(size_t next)>& afterBlock = {});
+  // With an error estimate and a target (BakeOptions::errorEstimate): rounds of two walk replicates added,
+  // their blocks evaluated into sums, until the estimate is at most the target or a cap stops it; the
+  // report's estimatedError says which. Deterministic for a seed unless the time cap stops it.
+  void refineToTarget(ExactVplSums& sums, const std::function<void(size_t next)>& afterBlock = {});
   // Backend counts of the blocks evaluated so far (report "gl"), for a partial to carry to the merge;
   // addBackendCounts adds a shard's.
   nlohmann::json backendCounts() const;

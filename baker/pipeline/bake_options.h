@@ -10,6 +10,7 @@
 #include "evaluators/bake_inputs.h"
 #include "evaluators/gl/gl_backend.h"
 #include "pipeline/backend_choice.h"
+#include "stages/error_estimate/error_estimate.h"
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/gather/final_gather.h"
 #include "stages/probes/light_probes.h"
@@ -96,6 +97,8 @@ struct BakeOptions {
   ShadowMaskOptions shadowMask;           // the shadow-mask lights' visibility pages (stages/shadow_mask)
   std::vector<LightModeRequest> lightModes;  // --light-mode in the order given (a name wins over "*", the last
                                             // of each over earlier ones; any over the glTF's extras.irbake.mode)
+  ErrorEstimateOptions errorEstimate;     // the bake's own error from independent replicates of the walk, and
+                                          // --target-error's rounds (off: one walk, the same bytes as before)
   ProgressCallback progress;
 };
 

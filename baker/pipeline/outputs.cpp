@@ -15,6 +15,50 @@
 
 namespace irbake {
 
+namespace {
+
+// With --error-map: each texel's standard error (BakeResult::standardError) as error_<page>.exr.
+std::vector<PendingFile> errorPageFiles(const BakeResult& result, const std::filesystem::path& outDir,
+                                        std::vector<std::filesystem::path>& written) {
+  std::vector<PendingFile> files;
+  for (const Lightmap& m : result.standardError) {
+    const std::filesystem::path path = outDir / ("error_" + std::to_string(m.page) + ".exr");
+    const Lightmap* map = &m;
+    files.push_back({path, [map, path](const std::filesystem::path& temp) { writeExrFile(*map, temp, path); }});
+    written.push_back(path);
+  }
+  return files;
+}
+
+// Pages of an earlier bake into the same folder that this bake does not have (more pages, shadow masks).
+void removeStalePages(const BakeResult& result, const std::filesystem::path& outDir) {
+  namespace fs = std::filesystem;
+  // Pages of an earlier bake into the same folder that this bake does not have would be read as
+  // part of it (irbake diff, the viewer): remove them.
+  std::error_code removeError;
+  for (size_t page = result.maps.size();; ++page) {
+    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    if (!fs::exists(stale)) break;
+    fs::remove(stale, removeError);
+    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
+  }
+  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
+  for (size_t page = 0;; ++page) {
+    bool found = false;
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
+      if (!fs::exists(stale)) continue;
+      found = true;
+      if (page < result.shadowMask.rgb.size()) continue;
+      fs::remove(stale, removeError);
+      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
+    }
+    if (!found && page >= result.shadowMask.rgb.size()) break;
+  }
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
   namespace fs = std::filesystem;
   // -o OUT.glb / OUT.gltf names the glTF itself (a GLB embeds its images); its folder takes the rest.
@@ -47,6 +91,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
+  const std::vector<PendingFile> errorPages = errorPageFiles(result, outDir, written);
   // The portable GLB is built now (its report entry says how), written with the rest.
   std::vector<PendingFile> portable;
   nlohmann::json portableSummary;
@@ -81,6 +126,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.exrPrefix = "lightmap";
     ex.alsoWrite = {reportFile};
     ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
+    ex.alsoWrite.insert(ex.alsoWrite.end(), errorPages.begin(), errorPages.end());
     ex.inputs = options.inputs;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
@@ -105,32 +151,12 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     }
     files.push_back(reportFile);
     files.insert(files.end(), portable.begin(), portable.end());
+    files.insert(files.end(), errorPages.begin(), errorPages.end());
     refuseOverwritingInputs(files, options.inputs);
     writeAllAtomically(files);
   }
 
-  // Pages of an earlier bake into the same folder that this bake does not have would be read as
-  // part of it (irbake diff, the viewer): remove them.
-  std::error_code removeError;
-  for (size_t page = result.maps.size();; ++page) {
-    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
-    if (!fs::exists(stale)) break;
-    fs::remove(stale, removeError);
-    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
-  }
-  // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
-  for (size_t page = 0;; ++page) {
-    bool found = false;
-    for (const char* ext : {".exr", ".png"}) {
-      const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
-      if (!fs::exists(stale)) continue;
-      found = true;
-      if (page < result.shadowMask.rgb.size()) continue;
-      fs::remove(stale, removeError);
-      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
-    }
-    if (!found && page >= result.shadowMask.rgb.size()) break;
-  }
+  removeStalePages(result, outDir);
   written.push_back(reportPath);
   return written;
 }

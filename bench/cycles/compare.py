@@ -130,11 +130,17 @@ def export_key_file(scene, workdir):
     with the same atlas share one Cycles map bake, whatever their VPL options."""
     doc, bufs = load_gltf(scene)
     h = hashlib.sha256()
+    # The irradiance probes (IRBAKE_light_probes: its JSON and accessors) are read from the map, Cycles never
+    # sees them: left out, so bakes of other seeds share the reference.
+    probes = doc.get("extensions", {}).get("IRBAKE_light_probes", {})
+    probe_accessors = {probes.get(k) for k in ("coefficients", "offsets", "valid")} - {None}
 
     def view_bytes(i):
         v = doc["bufferViews"][i]
         return bufs[v.get("buffer", 0)][v.get("byteOffset", 0):v.get("byteOffset", 0) + v["byteLength"]]
-    for a in doc.get("accessors", []):
+    for i, a in enumerate(doc.get("accessors", [])):
+        if i in probe_accessors:
+            continue
         h.update(json.dumps(a, sort_keys=True).encode())
         if "bufferView" in a:
             h.update(view_bytes(a["bufferView"]))
@@ -148,7 +154,8 @@ def export_key_file(scene, workdir):
     mats = json.loads(json.dumps(doc.get("materials", [])))
     for m in mats:
         m.get("extensions", {}).pop("MOZ_lightmap", None)
-    h.update(json.dumps([mats, doc.get("meshes"), doc.get("nodes"), doc.get("extensions"), doc.get("cameras")],
+    extensions = {k: v for k, v in doc.get("extensions", {}).items() if k != "IRBAKE_light_probes"}
+    h.update(json.dumps([mats, doc.get("meshes"), doc.get("nodes"), extensions, doc.get("cameras")],
                         sort_keys=True).encode())
     key = os.path.join(workdir, "export.key")
     with open(key, "w") as f:
@@ -266,6 +273,8 @@ def map_mode(args, out, rep, row, rows):
     base = ["--uv", "UVMap.001", "--width", str(w), "--height", str(h), "--max-bounces", str(args.max_bounces)]
     if args.bake_lights:
         base += ["--cycles-dir", args.cycles_dir]
+        if args.sky:  # the world gets the sky's radiance (cycles_bake_lights.py --sky)
+            base += ["--sky", args.sky]
     half = max(1, args.map_spp // 2)
     kf = [export_key_file(scene, out)]
     refs = [cycles_cached(args, args.bake_script, scene, base + ["--spp", str(half), "--seed", str(s)], "map.exr", kf)
@@ -394,8 +403,8 @@ def main():
     ap.add_argument("--emitter-cut", type=float, default=3.0, help="radiance above which a pixel is an emitter")
     ap.add_argument("--hidden-cut", type=float, default=0.02,
                     help="maps: covered texels darker than this fraction of the mean in Cycles are hidden (left out)")
-    ap.add_argument("--sky", default="", help="views: Cycles' world = this uniform radiance R,G,B (as irbake "
-                    "--sky; put --sky in --opts too); sky pixels are left out as background")
+    ap.add_argument("--sky", default="", help="views (and maps with --bake-lights): Cycles' world = this uniform "
+                    "radiance R,G,B (as irbake --sky; put --sky in --opts too); sky pixels are left out as background")
     ap.add_argument("--save-diff", action="store_true", help="write view<i>_ratio.exr (ours/Cycles) beside our bake")
     ap.add_argument("--csv", help="append rows here (default bench/results/cycles_NAME.csv)")
     args = ap.parse_args()

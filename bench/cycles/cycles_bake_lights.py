@@ -7,7 +7,8 @@ usage: blender -b --factory-startup --python bench/cycles/cycles_bake_lights.py 
 The shared script is loaded as a module and run unchanged, except that after its glTF import the LIGHT objects
 survive its clean-up, and they are set up as cycles_render.py sets them: suns re-oriented from the glTF JSON
 (the importer's orientation of a tilted sun is not trusted there), sun angle 0, point and spot radius 0, COMPAT
-units (the bake's importer already uses them). compare.py --maps --bake-lights runs it.
+units (the bake's importer already uses them). compare.py --maps --bake-lights runs it. With --sky R,G,B the
+world (black there) gets that uniform radiance, as `irbake bake --sky R,G,B` (compare.py --maps --sky).
 """
 import importlib.util
 import os
@@ -66,9 +67,12 @@ class _Bpy:
 def main():
     import bpy
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    cycles_dir, rest, i = None, [], 0
+    cycles_dir, sky, rest, i = None, None, [], 0
     while i < len(argv):
-        if argv[i] == "--cycles-dir":
+        if argv[i] == "--sky":
+            sky = [float(x) for x in argv[i + 1].split(",")]
+            i += 2
+        elif argv[i] == "--cycles-dir":
             cycles_dir = argv[i + 1]
             i += 2
         else:
@@ -96,6 +100,17 @@ def main():
         print("LIGHTS KEPT %d: %s" % (len(lights), ", ".join(lights)))
 
     bake.import_gltf = import_keeping_lights
+    if sky is not None:
+        setup_cycles = bake.setup_cycles
+
+        def setup_cycles_with_sky(scene, args):
+            setup_cycles(scene, args)
+            background = scene.world.node_tree.nodes.get("Background")
+            background.inputs["Color"].default_value = (sky[0], sky[1], sky[2], 1.0)
+            background.inputs["Strength"].default_value = 1.0
+            print("SKY %.6g %.6g %.6g" % tuple(sky))
+
+        bake.setup_cycles = setup_cycles_with_sky
     bake.main()
 
 

@@ -1,0 +1,115 @@
+// The bake's estimated error against its measured error (a bake of 16× the paths as the reference), and
+// --target-error's rounds: tighter targets give smaller errors, the estimate falls, the same seed gives the
+// same bytes.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/bake.h"
+#include "samples/sample_scenes.h"
+#include "stages/error_estimate/error_estimate.h"
+
+namespace irbake {
+namespace {
+
+// The Cornell box, small pages, Embree, a fixed clamp without its compensation (so that a bake and its
+// reference share the clamp's bias: the derived bound follows the VPL count, and the compensation's own ray
+// noise, which more VPLs do not lower, would blur what these tests hold), interleave off.
+BakeOptions cornellBake(int paths, uint32_t seed) {
+  BakeOptions o;
+  o.backend = BackendKind::Embree;
+  o.atlas.texelsPerUnit = 48.0f;
+  o.walk.paths = paths;
+  o.walk.seed = seed;
+  o.clamp = ClampMode::Fixed;
+  o.clampBound = 4.0f;
+  o.eval.biasCompensation = false;
+  o.interleave = 1;
+  return o;
+}
+
+// rel_rmse_4 of bench/cycles/compare.py: RMS over 4×4 bins (at least half valid) and channels of the bin
+// means' difference, over the RMS of the reference's bin means. replicateError on {a, b} gives
+// s²/2 = (a − b)²/4 per bin, so twice its noise is the RMS difference.
+double measuredError(const std::vector<Lightmap>& maps, const std::vector<Lightmap>& reference) {
+  const BinnedError e = replicateError({maps, reference}, &reference);
+  return 2.0 * e.relative;
+}
+
+// 16× the paths of the 256-path bakes: its own noise a quarter of theirs (adds 3% to their measured error).
+const std::vector<Lightmap>& referenceMaps() {
+  static const std::vector<Lightmap> maps = bake(samples::makeCornellBox(), cornellBake(4096, 99)).maps;
+  return maps;
+}
+
+// The estimate against the error measured on the reference: their RMS over eight seeds within ±30% (the
+// reference shares the clamp's bias, so both are the walk's noise; measured 1.17 on 8 seeds, 1.09 on 12),
+// each seed within 0.4–2.5× (two halves of a few hundred VPLs: one bake's estimate is itself noisy).
+TEST(ErrorEstimateBake, EstimateMatchesTheMeasuredErrorWithin30Percent) {
+  double estimates2 = 0.0, measured2 = 0.0;
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    BakeOptions o = cornellBake(256, seed);
+    o.errorEstimate.enabled = true;
+    const BakeResult r = bake(samples::makeCornellBox(), o);
+    ASSERT_TRUE(r.report.contains("estimatedError"));
+    const double estimate = r.report["estimatedError"]["relative"].get<double>();
+    const double measured = measuredError(r.maps, referenceMaps());
+    EXPECT_GT(estimate, 0.0);
+    EXPECT_GT(estimate / measured, 0.4) << "seed " << seed;
+    EXPECT_LT(estimate / measured, 2.5) << "seed " << seed << ": estimate " << estimate << ", measured " << measured;
+    estimates2 += estimate * estimate;
+    measured2 += measured * measured;
+  }
+  EXPECT_NEAR(std::sqrt(estimates2 / measured2), 1.0, 0.3);
+}
+
+// Tighter targets: more rounds, a smaller measured error, the target met; the estimate falls round by
+// round (within 25%: it is itself an estimate); the same seed gives the same bytes.
+TEST(ErrorEstimateBake, TargetErrorAddsRoundsUntilMet) {
+  std::vector<double> measured;
+  size_t lastRounds = 0;
+  for (double target : {0.04, 0.015}) {
+    BakeOptions o = cornellBake(128, 5);
+    o.errorEstimate.targetError = target;
+    o.errorEstimate.enabled = true;
+    const BakeResult r = bake(samples::makeCornellBox(), o);
+    const nlohmann::json& e = r.report["estimatedError"];
+    EXPECT_EQ(e["stoppedBy"], "target") << target;
+    EXPECT_LE(e["rounds"].back()["estimatedError"].get<double>(), target);
+    // The finished map's walk part (its normaliser has the compensation's light too: no larger).
+    EXPECT_LE(e["breakdown"]["vpls"].get<double>(), target * 1.05);
+    for (size_t k = 1; k < e["rounds"].size(); ++k)  // falls about as 1/√rounds, give or take its own noise
+      EXPECT_LT(e["rounds"][k]["estimatedError"].get<double>(), 1.25 * e["rounds"][k - 1]["estimatedError"].get<double>());
+    if (e["rounds"].size() > 2)
+      EXPECT_LT(e["rounds"].back()["estimatedError"].get<double>(), 0.8 * e["rounds"][0]["estimatedError"].get<double>());
+    EXPECT_GE(e["rounds"].size(), lastRounds);
+    lastRounds = e["rounds"].size();
+    measured.push_back(measuredError(r.maps, referenceMaps()));
+    if (target < 0.02) {
+      const BakeResult again = bake(samples::makeCornellBox(), o);
+      ASSERT_EQ(again.maps.size(), r.maps.size());
+      for (size_t p = 0; p < r.maps.size(); ++p) EXPECT_TRUE(again.maps[p].texels == r.maps[p].texels);
+      EXPECT_EQ(again.report["estimatedError"], e);
+    }
+  }
+  EXPECT_GT(lastRounds, 1u);
+  EXPECT_LT(measured[1], 0.75 * measured[0]);
+  EXPECT_LT(measured[1], 0.015 * 2.0);  // the target holds against the reference too, within one estimate's scatter
+}
+
+// A cap stops the rounds and says so; the bake without an estimate has no figure.
+TEST(ErrorEstimateBake, CapsStopTheRoundsAndSaySo) {
+  BakeOptions o = cornellBake(64, 5);
+  o.errorEstimate.enabled = true;
+  o.errorEstimate.targetError = 1e-5;
+  o.errorEstimate.maxRounds = 2;
+  const BakeResult r = bake(samples::makeCornellBox(), o);
+  EXPECT_EQ(r.report["estimatedError"]["stoppedBy"], "max-rounds");
+  EXPECT_EQ(r.report["estimatedError"]["rounds"].size(), 2u);
+  EXPECT_EQ(r.report["estimatedError"]["replicates"], 4);
+  EXPECT_FALSE(bake(samples::makeCornellBox(), cornellBake(64, 5)).report.contains("estimatedError"));
+}
+
+}  // namespace
+}  // namespace irbake
