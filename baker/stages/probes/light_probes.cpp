@@ -7,14 +7,16 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "common/progress.h"
 #include "sampling/sampling.h"
 #include "transport/geometry_term.h"
+#include "vpl/light_sources.h"
 
 namespace irbake {
 namespace {
 
-constexpr uint64_t kProbeStream = 0x9b;  // the probes' lattice rotations
+constexpr uint64_t kProbeStream = 0x9b;  // the probes' lattice rotations and emitter-sample offsets
 constexpr double kGoldenRatio = 1.6180339887498949;
 constexpr double kAutoProbes = 1024.0;   // about this many probes at the automatic spacing, whatever the scale
 
@@ -26,6 +28,29 @@ struct ProbeTrace {
   glm::vec3 nearestBackDir{0.0f};
 };
 
+// The emissive triangles' direct light by next-event estimation: K points per probe, picked by power, each
+// combined with the lattice by the power heuristic (Veach 1997). The lattice samples directions with density
+// a = N/(4π), the emitter samples with b = K p(ω), p(ω) = p_A r²/cosθ_y; weighted a²/(a² + b²) and b²/(a² + b²),
+// an emitter's direction ω counts Le a/(a² + b²) per lattice ray and Le b/(a² + b²) per shadow ray: a small
+// emitter is nearly all shadow rays, a wall nearly all lattice, and no direction is counted twice.
+struct EmitterSampler {
+  LightSources sources;
+  int samples = 0;              // K
+  double latticeDensity = 0.0;  // N/(4π)
+  EmitterSampler(const Scene& scene, int k, int rays) : sources(collectLightSources(scene)), latticeDensity(rays / (4.0 * kPi)) {
+    const bool any = !sources.triangles.empty() && sources.areaOnly.total() > 0.0;
+    samples = any ? std::max(0, k) : 0;
+  }
+  // The weight of a lattice ray's front-face hit on an emitter (1 where no shadow ray could find it).
+  double latticeWeight(const RayHit& hit, const glm::vec3& dir) const {
+    if (samples == 0) return 1.0;
+    const double pA = sources.areaPdf(hit.primitive, hit.triangle), cosY = -glm::dot(hit.geometricNormal, dir);
+    if (!(pA > 0.0) || !(cosY > 0.0)) return 1.0;
+    const double a = latticeDensity, b = samples * pA * double(hit.t) * hit.t / cosY;
+    return a * a / (a * a + b * b);
+  }
+};
+
 // The finished maps, packed once for the rays' reads (M; ρ is read at the hit).
 struct MapReader {
   const BakeInputs& in;
@@ -35,10 +60,11 @@ struct MapReader {
     packed.reserve(maps.size());
     for (const Lightmap& m : maps) packed.emplace_back(m, m.texels);
   }
-  // Outgoing radiance of a front-face hit: Le + ρ M.
-  glm::vec3 radiance(const RayHit& hit) const {
+  // Outgoing radiance of a front-face hit: w Le + ρ M, w the lattice's balance weight of the emission.
+  glm::vec3 radiance(const RayHit& hit, double emissionWeight) const {
     const Primitive& prim = in.scene.primitives[hit.primitive];
     glm::vec3 L = in.scene.emissionAt(prim, hit.triangle, hit.barycentric);
+    if (L != glm::vec3(0.0f)) L *= static_cast<float>(emissionWeight);
     const MapPoint point = mapPointOf(in.scene, mapOfPage, in.texels, hit);
     if (point.map >= 0 && static_cast<size_t>(point.map) < packed.size())
       L += in.albedoAtHit(hit) * packed[point.map].read(point.texel);
@@ -52,7 +78,8 @@ bool doubleSided(const Scene& scene, uint32_t primitive) {
   return m >= 0 && m < static_cast<int>(scene.materials.size()) && scene.materials[m].doubleSided;
 }
 
-ProbeTrace traceProbe(const MapReader& reader, const glm::vec3& p, int rays, double r1, double r2) {
+ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, const glm::vec3& p, int rays, double r1,
+                      double r2) {
   const Scene& scene = reader.in.scene;
   const RayTracer& rt = reader.in.rayTracer;
   ProbeTrace out;
@@ -78,7 +105,7 @@ ProbeTrace traceProbe(const MapReader& reader, const glm::vec3& p, int rays, dou
           if (hit.t < out.nearestBack) out.nearestBack = hit.t, out.nearestBackDir = dirs[k];
         }
       } else {
-        L = reader.radiance(hit);
+        L = reader.radiance(hit, emitters.latticeWeight(hit, dirs[k]));
       }
       if (L != glm::vec3(0.0f)) shAddDirectional(out.sh, dirs[k], L);
     }
@@ -100,6 +127,41 @@ size_t addPunctualLights(const BakeInputs& in, const glm::vec3& p, ShCoefficient
     ++traced;
     if (in.rayTracer.occluded(p, c.toLight, 0.0f, c.distance)) continue;
     shAddDirectional(sh, c.toLight, c.mapValue * in.rayTracer.transmittance(p, c.toLight, 0.0f, c.distance));
+  }
+  return traced;
+}
+
+// The emitters' share by K shadow rays to points on a rotated 2D Fibonacci lattice (the first coordinate picks the
+// triangle by power and, rescaled, stays stratified within it); returns the shadow rays traced.
+size_t addEmitters(const BakeInputs& in, const EmitterSampler& emitters, const glm::vec3& p, double r3, double r4,
+                   ShCoefficients& sh) {
+  const RayTracer& rt = in.rayTracer;
+  const int K = emitters.samples;
+  size_t traced = 0;
+  for (int j = 0; j < K; ++j) {
+    const double u = (j + 0.5) / K + r3, v = j / kGoldenRatio + r4;
+    double residual = 0.0;
+    const size_t k = emitters.sources.areaOnly.sample(u - std::floor(u), &residual);
+    const EmitterTriangle& e = emitters.sources.triangles[k];
+    const Primitive& prim = in.scene.primitives[e.primitive];
+    const glm::vec2 b = uniformTriangle(residual, v - std::floor(v));
+    const uint32_t* idx = &prim.indices[3 * e.triangle];
+    const glm::vec3 y = prim.positions[idx[0]] * (1.0f - b.x - b.y) + prim.positions[idx[1]] * b.x + prim.positions[idx[2]] * b.y;
+    const glm::vec3 d = y - p;
+    const float r2 = glm::dot(d, d);
+    if (!(r2 > 0.0f)) continue;
+    const float r = std::sqrt(r2);
+    const glm::vec3 w = d / r;
+    const float cosY = -glm::dot(e.normal, w);  // emission leaves the front face only
+    if (!(cosY > 0.0f)) continue;
+    glm::vec3 Le = in.scene.emissionAt(prim, e.triangle, b);
+    if (Le == glm::vec3(0.0f)) continue;
+    ++traced;
+    const float tmax = r - 2.0f * rt.epsilon();
+    if (tmax > 0.0f && rt.occluded(p, w, 0.0f, tmax)) continue;
+    if (rt.hasTransmission() && tmax > 0.0f) Le *= rt.transmittance(p, w, 0.0f, tmax);
+    const double da = emitters.latticeDensity, db = K * emitters.sources.areaOnly.pdf(k) / e.area * r2 / cosY;
+    shAddDirectional(sh, w, Le * static_cast<float>(db / (kPi * (da * da + db * db))));  // 1/π: map units
   }
   return traced;
 }
@@ -143,13 +205,14 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
   grid.valid.assign(n, 0);
   const MapReader reader(in, maps);
   const int rays = std::max(16, options.rays);
+  const EmitterSampler emitters(in.scene, options.emitterSamples, rays);
   const int tooManyBack = static_cast<int>(std::floor(options.maxBackFaceShare * rays));
   std::atomic<size_t> traced{0}, moved{0};
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
     Rng rng(hashSeed(options.seed, kProbeStream, i));
-    const double r1 = rng.uniform(), r2 = rng.uniform();
+    const double r1 = rng.uniform(), r2 = rng.uniform(), r3 = rng.uniform(), r4 = rng.uniform();
     const glm::vec3 at = grid.position(i);
-    ProbeTrace t = traceProbe(reader, at, rays, r1, r2);
+    ProbeTrace t = traceProbe(reader, emitters, at, rays, r1, r2);
     size_t count = static_cast<size_t>(rays);
     glm::vec3 offset(0.0f);
     if (t.backFaces > tooManyBack) {
@@ -157,13 +220,14 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
       const float step = t.nearestBack + 0.05f * grid.spacing;
       if (step <= 0.5f * grid.spacing) {
         offset = t.nearestBackDir * step;
-        t = traceProbe(reader, at + offset, rays, r1, r2);
+        t = traceProbe(reader, emitters, at + offset, rays, r1, r2);
         count += static_cast<size_t>(rays);
         if (t.backFaces <= tooManyBack) ++moved;
       }
     }
     if (t.backFaces <= tooManyBack) {
       count += addPunctualLights(in, at + offset, t.sh);
+      count += addEmitters(in, emitters, at + offset, r3, r4, t.sh);
       grid.coefficients[i] = t.sh;
       grid.offsets[i] = offset;
       grid.valid[i] = 1;

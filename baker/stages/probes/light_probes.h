@@ -1,10 +1,16 @@
 // Irradiance probes for moving objects: a regular grid over the scene (or a box), each probe the light arriving
 // there from every direction as L2 spherical harmonics (lightmap/probe_grid.h), from the same light as the maps:
 //   punctual lights exact (a shadow ray each, their map value at normal incidence projected as a delta);
+//   emissive triangles by next-event estimation: K shadow rays to points picked by power, on a rotated 2D
+//   Fibonacci lattice, each direction's Le projected with its solid-angle density p(ω) = p_A r²/cosθ_y (front
+//   faces only);
 //   every other direction by N rays on a rotated spherical Fibonacci lattice, c_k = (4π/N)(1/π) Σ L_i Y_k(ω_i):
 //   a ray that escapes brings the sky's radiance, one that hits a front face the surface's outgoing radiance
-//   Le + ρ M read from the finished map (M = E/π, so ρ M is the radiance a Lambertian surface sends; docs/units.md),
-//   one that hits a back face nothing.
+//   ρ M read from the finished map (M = E/π, so ρ M is the radiance a Lambertian surface sends; docs/units.md)
+//   plus its Le, one that hits a back face nothing.
+// An emitter's Le is found by both: they are combined by the power heuristic (weights a²/(a² + b²), b²/(a² + b²)
+// for the densities a = N/(4π), b = K p(ω)), so a small light (few lattice rays find it) comes from the shadow
+// rays and a large emissive wall from the lattice, and nothing is counted twice.
 // A probe whose rays meet back faces in more than maxBackFaceShare of the directions is inside geometry: moved
 // through the nearest back face (at most half a spacing), else left invalid. Walls between a point and a probe
 // are the reader's to test (interpolateProbes' visibility), so no light crosses them.
@@ -33,7 +39,8 @@ struct ProbeOptions {
                                       // probe beside a wall of two coincident opposite quads meets (makeThinWall:
                                       // the ray finds either), lost 104 of its 1024 valid lit-side probes
   size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
-  uint32_t seed = 0;                  // turns each probe's lattice
+  int emitterSamples = 128;           // shadow rays per probe to the emissive triangles (0: the lattice alone)
+  uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
 };
 
 struct ProbeStats {
