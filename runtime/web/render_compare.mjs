@@ -14,7 +14,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { createRequire } from 'node:module';
 import { fileURLToPath } from 'node:url';
-import { serve } from './serve.mjs';
+import { openTab, serve } from './serve.mjs';
 
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
 const fail = msg => { console.error(`render_compare: ${msg}`); process.exit(2); };
@@ -41,20 +41,9 @@ const server = await serve({
   ref: path.dirname(path.resolve(args.reference)),
 });
 const port = server.address().port;
-const browser = await puppeteer.launch({
-  executablePath: args.chromium ?? '/usr/bin/chromium',
-  headless: true,
-  // WebGL without a GPU: ANGLE on SwiftShader (software Vulkan/GL inside Chromium).
-  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist',
-         '--force-color-profile=srgb', `--window-size=${width},${height}`],
-});
+const { browser, tab, log } = await openTab(puppeteer, { chromium: args.chromium, width, height });
 let code = 0;
 try {
-  const tab = await browser.newPage();
-  const log = [];
-  tab.on('console', m => log.push(`${m.type()}: ${m.text()}`));
-  tab.on('pageerror', e => log.push(`pageerror: ${e.message}`));
-  await tab.setViewport({ width, height, deviceScaleFactor: 1 });
   const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height,
                                   lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz' });
   await tab.goto(`http://127.0.0.1:${port}/web/${page.html}?${q}`);

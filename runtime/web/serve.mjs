@@ -24,6 +24,23 @@ export function serve(roots) {
   return new Promise(resolve => server.listen(0, '127.0.0.1', () => resolve(server)));
 }
 
+// Headless Chromium with WebGL on SwiftShader (no GPU), one tab of width × height whose console and page errors
+// are collected in `log`. puppeteer: the caller's puppeteer-core (it lives in the build's node_modules).
+export async function openTab(puppeteer, { chromium, width, height }) {
+  const browser = await puppeteer.launch({
+    executablePath: chromium ?? '/usr/bin/chromium',
+    headless: true,
+    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist',
+           '--force-color-profile=srgb', `--window-size=${width},${height}`],
+  });
+  const tab = await browser.newPage();
+  const log = [];
+  tab.on('console', m => log.push(`${m.type()}: ${m.text()}`));
+  tab.on('pageerror', e => log.push(`pageerror: ${e.message}`));
+  await tab.setViewport({ width, height, deviceScaleFactor: 1 });
+  return { browser, tab, log };
+}
+
 // Run directly to look at a bake in a browser:
 //   node runtime/web/serve.mjs --modules build/web --scene out/scene.gltf [--port 8080]
 // then open the printed URL (camera 0; add &camera=N&width=W&height=H).
