@@ -7,27 +7,9 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "view_renderer.h"
 
 namespace irbake::view {
-
-namespace {
-
-// A mask page: half float RGBA (the 8-bit values exactly), bilinear, no mipmaps (a coarser level would mix
-// in the padding between charts), clamped at the page edge, as the light map is.
-GLuint uploadMask(int width, int height, const void* rgba) {
-  GLuint tex = 0;
-  glGenTextures(1, &tex);
-  glBindTexture(GL_TEXTURE_2D, tex);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, width, height, 0, GL_RGBA, GL_FLOAT, rgba);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return tex;
-}
-
-}  // namespace
 
 glm::vec3 runtimeLightIrradiance(const Light& light, const glm::vec3& p, const glm::vec3& n) {
   if (light.type == LightType::Directional)
@@ -51,7 +33,7 @@ MixedLights::MixedLights(const ViewerScene& v) : scene_(v), lights_(v.scene.runt
     if (t.width <= 0 || t.height <= 0 || t.texels.size() != static_cast<size_t>(t.width) * t.height)
       throw Error(ErrorCode::InvalidData, where,
                   "material '" + m.name + "': IRBAKE_shadowmask image '" + t.name + "' could not be decoded");
-    masks_[m.shadowMaskTexture] = uploadMask(t.width, t.height, t.texels.data());
+    masks_[m.shadowMaskTexture] = uploadLightmap(t.width, t.height, GL_RGBA, t.texels.data());
   }
 }
 
@@ -66,7 +48,7 @@ unsigned MixedLights::maskTexture(int material) {
   if (it != masks_.end()) return it->second;
   if (!white_) {
     const glm::vec4 one(1.0f);
-    white_ = uploadMask(1, 1, &one);
+    white_ = uploadLightmap(1, 1, GL_RGBA, &one);
   }
   return white_;
 }

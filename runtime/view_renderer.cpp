@@ -51,23 +51,6 @@ GLuint uploadColorTexture(const Texture& t) {
   return tex;
 }
 
-// Light maps: half float (range to 65504, 11-bit mantissa: 0.05% relative, far below what a display
-// shows) — llvmpipe filters RGBA16F markedly faster than RGB32F (docs/validation.md, "Viewer");
-// bilinear, no mipmaps (a coarser level would mix in the padding between charts), clamped at the page edge.
-GLuint uploadLightmap(int width, int height, GLenum format, const void* data) {
-  GLuint tex = 0;
-  glGenTextures(1, &tex);
-  glBindTexture(GL_TEXTURE_2D, tex);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  GLenum internal = GL_RGBA16F;
-  glTexImage2D(GL_TEXTURE_2D, 0, internal, width, height, 0, format, GL_FLOAT, data);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return tex;
-}
-
 // An environment map (Environment::texels, rows top to bottom) as RGB32F: the sky shader reads it with
 // texelFetch, so screenshots hold the map's radiance exactly.
 GLuint uploadEnvironment(const Environment& env) {
@@ -90,6 +73,23 @@ struct Vertex {
 };
 
 }  // namespace
+
+// Light maps: half float (range to 65504, 11-bit mantissa: 0.05% relative, far below what a display
+// shows) — llvmpipe filters RGBA16F markedly faster than RGB32F (docs/validation.md, "Viewer");
+// bilinear, no mipmaps (a coarser level would mix in the padding between charts), clamped at the page edge.
+unsigned uploadLightmap(int width, int height, unsigned format, const void* data) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  GLenum internal = GL_RGBA16F;
+  glTexImage2D(GL_TEXTURE_2D, 0, internal, width, height, 0, format, GL_FLOAT, data);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
 
 const char* toString(ViewMode mode) {
   switch (mode) {

@@ -14,6 +14,10 @@
 
 namespace irbake::view {
 
+// A light-map-like page (format GL_RGB or GL_RGBA, float texels) as an RGBA16F texture: bilinear, no mipmaps,
+// clamped at the edge (the maps, directional maps and shadow masks).
+unsigned uploadLightmap(int width, int height, unsigned format, const void* data);
+
 enum class ViewMode { Lit, Lightmap, Albedo, Charts, TexelDensity, Wireframe };
 const char* toString(ViewMode mode);
 // "lit", "lightmap", "albedo", "charts", "density", "wireframe"; throws Error(Usage) otherwise.
