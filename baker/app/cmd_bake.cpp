@@ -136,7 +136,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays"}},
+    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -315,6 +315,10 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
   app->add_option("--probe-rays", o.probes.rays, "rays per probe (default 1024)")
       ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
+  app->add_option("--probe-light-fit", o.probes.lightFitSamples,
+                  "the punctual lights' visibility at the probes fitted over S×S×S points per probe\n"
+                  "(default " + std::to_string(ProbeOptions{}.lightFitSamples) + "; 0: each probe's own shadow ray)")
+      ->transform(cli::integerIn(0, 8))->type_name("S");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");

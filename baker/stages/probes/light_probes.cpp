@@ -11,6 +11,7 @@
 #include "common/progress.h"
 #include "sampling/sampling.h"
 #include "transport/geometry_term.h"
+#include "stages/probes/light_visibility_fit.h"
 #include "vpl/light_sources.h"
 
 namespace irbake {
@@ -115,20 +116,22 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
   return out;
 }
 
-// Every punctual light as a delta from its direction, shadowed; returns the shadow rays traced.
-size_t addPunctualLights(const BakeInputs& in, const glm::vec3& p, ShCoefficients& sh) {
-  size_t traced = 0;
-  for (const Light& light : in.scene.lights) {
+// Every punctual light as a delta from its direction, times its visibility at the probe (`visibility`, one per
+// light: the fitted value, light_visibility_fit.h) and the colour of the see-through surfaces on the way.
+void addPunctualLights(const BakeInputs& in, const glm::vec3& p, const float* visibility, ShCoefficients& sh) {
+  for (size_t l = 0; l < in.scene.lights.size(); ++l) {
+    const Light& light = in.scene.lights[l];
     const glm::vec3 toward = light.type == LightType::Directional ? -glm::normalize(light.direction)
                                                                   : light.position - p;
-    if (!(glm::dot(toward, toward) > 0.0f)) continue;
+    if (!(glm::dot(toward, toward) > 0.0f) || !(visibility[l] > 0.0f)) continue;
     const PunctualContribution c = punctualDirect(light, p, glm::normalize(toward));  // at normal incidence
     if (c.mapValue == glm::vec3(0.0f)) continue;
-    ++traced;
-    if (in.rayTracer.occluded(p, c.toLight, 0.0f, c.distance)) continue;
-    shAddDirectional(sh, c.toLight, c.mapValue * in.rayTracer.transmittance(p, c.toLight, 0.0f, c.distance));
+    glm::vec3 colour(1.0f);
+    const float own = punctualVisibility(in, light, p, &colour);
+    if (!(own > 0.0f)) colour = glm::vec3(1.0f);  // shadowed here, lit in the fit: the light's own colour
+    else colour /= own;                           // the transmittance's hue; its strength is the fit's
+    shAddDirectional(sh, c.toLight, c.mapValue * colour * visibility[l]);
   }
-  return traced;
 }
 
 // The emitters' share by K shadow rays to points on a rotated 2D Fibonacci lattice (the first coordinate picks the
@@ -226,7 +229,6 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
       }
     }
     if (t.backFaces <= tooManyBack) {
-      count += addPunctualLights(in, at + offset, t.sh);
       count += addEmitters(in, emitters, at + offset, r3, r4, t.sh);
       grid.coefficients[i] = t.sh;
       grid.offsets[i] = offset;
@@ -234,12 +236,21 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     }
     traced += count;
   });
+  // The punctual lights once every probe's validity is known: their visibility is fitted over the blend.
+  const LightVisibilityFit fit = fitLightVisibility(in, grid, options.lightFitSamples, options.seed);
+  if (fit.lights > 0)
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+      if (grid.valid[i]) addPunctualLights(in, grid.position(i), &fit.visibility[i * fit.lights], grid.coefficients[i]);
+    });
+  traced += fit.rays;
   if (stats) {
     stats->count = n;
     stats->valid = static_cast<size_t>(std::count(grid.valid.begin(), grid.valid.end(), uint8_t(1)));
     stats->moved = moved;
     stats->spacing = grid.spacing;
     stats->rays = traced;
+    stats->lightFitSamples = fit.samples;
+    stats->lightFitSweeps = fit.sweeps;
     stats->seconds = watch.seconds();
   }
 }

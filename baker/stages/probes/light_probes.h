@@ -1,6 +1,7 @@
 // Irradiance probes for moving objects: a regular grid over the scene (or a box), each probe the light arriving
 // there from every direction as L2 spherical harmonics (lightmap/probe_grid.h), from the same light as the maps:
-//   punctual lights exact (a shadow ray each, their map value at normal incidence projected as a delta);
+//   punctual lights exact (their map value at normal incidence projected as a delta), times their visibility
+//   fitted over the volume the probe blends (light_visibility_fit.h);
 //   emissive triangles by next-event estimation: K shadow rays to points picked by power, on a rotated 2D
 //   Fibonacci lattice, each direction's Le projected with its solid-angle density p(ω) = p_A r²/cosθ_y (front
 //   faces only);
@@ -41,15 +42,20 @@ struct ProbeOptions {
   size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
   int emitterSamples = 128;           // shadow rays per probe to the emissive triangles (0: the lattice alone)
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
+  int lightFitSamples = 3;            // S: the punctual lights' visibility fitted over S³ points per probe
+                                      // (light_visibility_fit.h); 0: each probe's own shadow ray
 };
 
 struct ProbeStats {
   size_t count = 0, valid = 0, moved = 0;
   float spacing = 0.0f;
-  size_t rays = 0;  // lattice and shadow rays, relocation tests included
+  size_t rays = 0;  // lattice and shadow rays, relocation tests and the visibility fit's included
+  size_t lightFitSamples = 0;  // volume samples the punctual lights' visibility was fitted to
+  int lightFitSweeps = 0;      // the fit's Gauss–Seidel sweeps
   double seconds = 0.0;
   nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
-    return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays}};
+    return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays},
+            {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps}};
   }
 };
 
