@@ -160,13 +160,18 @@ void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options
   if (!plan.probes.enabled) return;
   const Bounds3 volume = options.probes.box ? *options.probes.box : scene.bounds();
   const bool automatic = !options.probes.spacing;
-  const float spacing = automatic ? chooseProbeSpacing(volume) : *options.probes.spacing;
+  const double count = autoProbeCount(options.probes, scene.lights);
+  const float spacing = automatic ? chooseProbeSpacing(volume, count) : *options.probes.spacing;
   const LightProbeGrid grid = probeGridOver(volume, spacing, plan.probes.maxProbes);
   plan.probes.spacing = spacing;
   plan.probes.box = volume;
+  const std::string n = std::to_string(static_cast<long>(count));
+  const std::string why = !automatic ? "asked for"
+                          : "about " + n + " probes over the volume" +
+                                (count == options.probes.autoProbesSun ? " (a directional light's shadows)" : "") +
+                                ": cbrt(volume / " + n + ")";
   plan.settle("probe-spacing", spacing,
-              std::string(automatic ? "about 1024 probes over the volume: cbrt(volume / 1024)" : "asked for") + ": " +
-                  std::to_string(grid.counts.x) + " x " + std::to_string(grid.counts.y) + " x " +
+              why + ": " + std::to_string(grid.counts.x) + " x " + std::to_string(grid.counts.y) + " x " +
                   std::to_string(grid.counts.z) + " probes",
               automatic);
 }

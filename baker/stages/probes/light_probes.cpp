@@ -19,7 +19,6 @@ namespace {
 
 constexpr uint64_t kProbeStream = 0x9b;  // the probes' lattice rotations and emitter-sample offsets
 constexpr double kGoldenRatio = 1.6180339887498949;
-constexpr double kAutoProbes = 1024.0;   // about this many probes at the automatic spacing, whatever the scale
 
 // What one probe's lattice rays found.
 struct ProbeTrace {
@@ -171,11 +170,11 @@ size_t addEmitters(const BakeInputs& in, const EmitterSampler& emitters, const g
 
 }  // namespace
 
-float chooseProbeSpacing(const Bounds3& volume) {
+float chooseProbeSpacing(const Bounds3& volume, double probes) {
   const glm::vec3 e = volume.extent();
   const double longest = std::max({e.x, e.y, e.z}), shortest = longest / 16.0;
   const double v = std::max<double>(e.x, shortest) * std::max<double>(e.y, shortest) * std::max<double>(e.z, shortest);
-  return std::max(0.01f, static_cast<float>(std::cbrt(v / kAutoProbes)));
+  return std::max(0.01f, static_cast<float>(std::cbrt(v / std::max(1.0, probes))));
 }
 
 LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes) {

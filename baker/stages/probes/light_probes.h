@@ -32,6 +32,10 @@ namespace irbake {
 struct ProbeOptions {
   bool enabled = true;                // --probes off: no probes, no extension, nothing else changes
   std::optional<float> spacing;       // metres; unset: automatic (chooseProbeSpacing)
+  double autoProbes = 1024;           // about this many probes at the automatic spacing, whatever the scale
+  double autoProbesSun = 2048;        // with a directional light: its shadows are sharp and cross the whole
+                                      // scene, and a blend of probes 2 m apart smears them (docs/validation.md,
+                                      // "Probes against Cycles": Sponza's sunlit court read 0.86 of Cycles)
   std::optional<Bounds3> box;         // the volume the grid fills; unset: the scene's bounds
   int rays = 1024;                    // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
                                       // for independent rays, far less on the lattice)
@@ -59,11 +63,18 @@ struct ProbeStats {
   }
 };
 
-// The automatic spacing: about 1024 probes over the volume, cbrt(V / 1024) with each side of V held to at least
-// 1/16 of the longest (a flat scene keeps two layers), never below 1 cm. A fixed count follows the scene's scale
-// and keeps the cost small beside the bake: the longest side / 16 gave a cube 4096 probes, 21% of a
-// DamagedHelmet bake's time (Sponza: 2.0 m, 18 × 8 × 8).
-float chooseProbeSpacing(const Bounds3& volume);
+// The automatic spacing: about `probes` probes over the volume (autoProbeCount), cbrt(V / probes) with each side
+// of V held to at least 1/16 of the longest (a flat scene keeps two layers), never below 1 cm. A fixed count
+// follows the scene's scale and keeps the cost small beside the bake: the longest side / 16 gave a cube 4096
+// probes, 21% of a DamagedHelmet bake's time.
+float chooseProbeSpacing(const Bounds3& volume, double probes);
+
+// The automatic count: ProbeOptions::autoProbes, or autoProbesSun when the scene has a directional light.
+inline double autoProbeCount(const ProbeOptions& o, const std::vector<Light>& lights) {
+  for (const Light& l : lights)
+    if (l.type == LightType::Directional) return o.autoProbesSun;
+  return o.autoProbes;
+}
 
 // The grid over `volume` at `spacing`: ceil(extent / spacing) probes per axis (at least 1), centred in the
 // volume, so probes sit half a step in from its faces rather than on walls and floors at its border.

@@ -280,7 +280,7 @@ TEST(LightProbes, GridFollowsTheVolumeAndRefusesTooManyProbes) {
   Bounds3 b;
   b.extend(glm::vec3(-1, 0, 0));
   b.extend(glm::vec3(3, 1, 0.5f));
-  EXPECT_FLOAT_EQ(chooseProbeSpacing(b), 0.125f);  // cbrt(4 · 1 · 0.5 / 1024)
+  EXPECT_FLOAT_EQ(chooseProbeSpacing(b, 1024), 0.125f);  // cbrt(4 · 1 · 0.5 / 1024)
   const LightProbeGrid g = probeGridOver(b, 0.25f, 1000);
   EXPECT_EQ(g.counts, glm::ivec3(16, 4, 2));
   EXPECT_NEAR(g.origin.x, -0.875f, 1e-6f);  // half a step in from the face
@@ -288,9 +288,25 @@ TEST(LightProbes, GridFollowsTheVolumeAndRefusesTooManyProbes) {
   Bounds3 flat;  // a 10 × 10 m plane: its thickness held to 10/16 m
   flat.extend(glm::vec3(-5, 0, -5));
   flat.extend(glm::vec3(5, 0, 5));
-  EXPECT_NEAR(chooseProbeSpacing(flat), std::cbrt(62.5 / 1024.0), 1e-6);
+  EXPECT_NEAR(chooseProbeSpacing(flat, 1024), std::cbrt(62.5 / 1024.0), 1e-6);
+  EXPECT_NEAR(chooseProbeSpacing(flat, 2048), std::cbrt(62.5 / 2048.0), 1e-6);
   EXPECT_THROW(probeGridOver(b, 0.01f, 1000), Error);
   EXPECT_THROW(probeGridOver(b, 0.0f, 1000), Error);
+}
+
+TEST(LightProbes, AutomaticCountDoublesForADirectionalLightsShadows) {
+  const ProbeOptions o;
+  std::vector<Light> lights;
+  EXPECT_EQ(autoProbeCount(o, lights), 1024.0);
+  lights.push_back(pointLight(glm::vec3(0, 2, 0), 10.0f));
+  EXPECT_EQ(autoProbeCount(o, lights), 1024.0);  // a point light's shadows stay near it
+  lights.push_back(directionalLight(glm::vec3(0.35f, -1, 0.2f), 5.0f));
+  EXPECT_EQ(autoProbeCount(o, lights), 2048.0);
+  Bounds3 sponza;  // Sponza's bounds: 17 × 9 × 8 probes at 2.06 m without a sun, 22 × 11 × 10 at 1.64 m with one
+  sponza.extend(glm::vec3(-17.4028f, -0.906689f, -7.79851f));
+  sponza.extend(glm::vec3(17.4172f, 15.6533f, 7.80149f));
+  EXPECT_EQ(probeGridOver(sponza, chooseProbeSpacing(sponza, 1024), 1 << 20).counts, glm::ivec3(17, 9, 8));
+  EXPECT_EQ(probeGridOver(sponza, chooseProbeSpacing(sponza, 2048), 1 << 20).counts, glm::ivec3(22, 11, 10));
 }
 
 }  // namespace
