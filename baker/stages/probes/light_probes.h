@@ -46,7 +46,7 @@ struct ProbeOptions {
   size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
   int emitterSamples = 128;           // shadow rays per probe to the emissive triangles (0: the lattice alone)
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
-  int lightFitSamples = 3;            // S: the punctual lights' visibility fitted over S³ points per probe
+  int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
 };
 

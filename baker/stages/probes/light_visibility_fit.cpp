@@ -152,13 +152,18 @@ LightVisibilityFit fitLightVisibility(const BakeInputs& in, const LightProbeGrid
       const glm::vec3 cell(static_cast<float>(s % S), static_cast<float>(s / S % S), static_cast<float>(s / (S * S)));
       const glm::vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
       const glm::vec3 x = corner + g.spacing * (cell + jitter) / static_cast<float>(S);
-      traced += 8;
-      if (insideGeometry(in, x)) continue;
-      out.corners = blendWeights(g, x, out.probe, out.weight);
-      if (out.corners == 0) continue;
       out.firstTarget = (i * perProbe + s) * m;
-      for (size_t l = 0; l < m; ++l) targets[out.firstTarget + l] = punctualVisibility(in, lights[l], x);
+      bool seesALight = false;
+      for (size_t l = 0; l < m; ++l) {
+        targets[out.firstTarget + l] = punctualVisibility(in, lights[l], x);
+        seesALight = seesALight || targets[out.firstTarget + l] > 0.0f;
+      }
       traced += m;
+      if (!seesALight) {  // a point that sees a light is not inside closed geometry: only the others are tested
+        traced += 8;
+        if (insideGeometry(in, x)) continue;
+      }
+      out.corners = blendWeights(g, x, out.probe, out.weight);
     }
     rays += traced;
   });
