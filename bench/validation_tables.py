@@ -286,7 +286,7 @@ def t_probe_spheres():
     rows = latest(read("probe_spheres.csv"), lambda r: (r["scene"], r["place"], r["our_seed"], r["ours"],
                                                              r["cycles_sphere"], r["our_options"]))
     out = []
-    for r in sorted(rows, key=lambda r: (r["scene"], r["cycles_sphere"] != "scene", r["our_options"],
+    for r in sorted(rows, key=lambda r: (r["scene"], r["cycles_sphere"] != "camera", r["our_options"],
                                          int(r["our_seed"]), r["ours"])):
         quarters = " / ".join(num(r[q], 3) for q in ("q_upper_left", "q_upper_right", "q_lower_left", "q_lower_right"))
         ok = abs(float(r["ratio"]) - 1) <= 0.03 and float(r["worst_quarter"]) <= 0.05

@@ -3,15 +3,17 @@
 
 usage (from the repository root; Debian's /usr/bin/python3 with python3-numpy and python3-openimageio):
   /usr/bin/python3 bench/cycles/probe_spheres.py [--scenes cornell,sponza] [--seeds 0,1,2,3,4]
-      [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere scene|camera] [--bake-opts "--probes 1"]
+      [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere camera|scene] [--bake-opts "--probes 1"]
       [--irbake build/baker/irbake --irview build/runtime/irview]
 
 For each scene (build/cycles-scenes from scenes.py: the McGuire Cornell box; Sponza with its sun and the sky
 0.4,0.5,0.7) and each place (PLACES: a centre and radius R, away from walls, and a camera framing it):
   Cycles  a copy of the scene with one more node, a UV sphere (SPHERE_SEGMENTS x SPHERE_RINGS, smooth
-          normals, baseColorFactor 1, metallic 0, roughness 1) at the place, rendered by cycles_render.py
-          (with the sky: cycles_render_sky.py) from the place's camera at SIZE x SIZE, two halves of spp/2
-          (seeds 1, 2), cached by input checksum like compare.py.
+          normals, baseColorFactor 1, metallic 0, roughness 1) at the place, seen by camera rays only
+          (cycles_render_probe_object.py: what a probe-lit object is; --cycles-sphere scene: part of the scene,
+          rendered by cycles_render.py or, with the sky, cycles_render_sky.py) from the place's camera at
+          SIZE x SIZE, two halves of spp/2 (seeds 1, 2), cached by input checksum like compare.py (the key holds
+          --cycles-dir as given: pass the path the cached renders were made with to reuse them).
   ours    `irbake bake SCENE --seed K` without the sphere (default options: probes auto), then
           `irview OUT/scene.gltf --probe-object X,Y,Z,R` from the same camera at 4x the size, averaged 4x4
           down (Cycles' pixels average their area). With --ours probe: the same sphere shaded from
@@ -25,7 +27,8 @@ disc (split at the projected centre, which is the image centre: the camera targe
 `worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone (the sun,
 times the sphere's sunlit share, and the emitters seen from the centre, as exact clamped cosines in place of
 their L2 parts): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
-probes around the centre that see the sun (a sun shadow edge between probes shows as a share below `sunlit`). Rows are appended to bench/results/probe_spheres.csv.
+probes around the centre whose own point sees the sun (a sun shadow edge between probes shows as a share below
+`sunlit`; the bake fits each probe's sun over its cube, docs/units.md, so the blended sun may differ). Rows are appended to bench/results/probe_spheres.csv.
 Every process runs under `nice -n 15`; Cycles with --threads 2.
 """
 import argparse
@@ -541,9 +544,10 @@ def main():
     ap.add_argument("--spp", type=int, default=1024, help="Cycles samples per pixel (two halves)")
     ap.add_argument("--size", type=int, default=96, help="image width and height (pixels)")
     ap.add_argument("--ours", choices=["irview", "probe"], default="irview")
-    ap.add_argument("--cycles-sphere", choices=["scene", "camera"], default="scene",
-                    help="Cycles' sphere: part of the scene (it shadows and lights its surroundings), or seen by "
-                         "camera rays only (cycles_render_probe_object.py), as a probe-lit object is")
+    ap.add_argument("--cycles-sphere", choices=["scene", "camera"], default="camera",
+                    help="Cycles' sphere: seen by camera rays only (cycles_render_probe_object.py; the default: a "
+                         "probe-lit object neither shadows the scene nor gets its own light back), or part of the "
+                         "scene (it shadows and lights its surroundings)")
     ap.add_argument("--bake-opts", default="", help='more irbake bake options, e.g. "--probes 1" (own work folder)')
     ap.add_argument("--cycles-only", action="store_true", help="only the Cycles renders (to fill the cache)")
     ap.add_argument("--reuse-bakes", action="store_true", help="keep our bakes already in --work")
