@@ -53,23 +53,12 @@ int blendWeights(const LightProbeGrid& g, const glm::vec3& p, std::array<uint32_
   return n;
 }
 
-bool doubleSidedHit(const Scene& scene, uint32_t primitive) {
-  if (primitive >= scene.primitives.size()) return false;
-  const int m = scene.primitives[primitive].material;
-  return m >= 0 && m < static_cast<int>(scene.materials.size()) && scene.materials[m].doubleSided;
-}
-
-// Inside geometry: more than half of 8 diagonal rays (off the axes, so that none grazes an axis-aligned wall)
-// meet a single-sided back face, the probes' own test (light_probes.h) with fewer rays.
-bool insideGeometry(const BakeInputs& in, const glm::vec3& x) {
-  static const float k = 1.0f / std::sqrt(3.0f);
-  glm::vec3 dirs[8];
-  for (int c = 0; c < 8; ++c) dirs[c] = k * glm::vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1);
-  RayHit hits[8];
-  in.rayTracer.intersectPackets(x, dirs, 8, hits, RayTracer::HitDetail::Surface);
-  int back = 0;
-  for (const RayHit& h : hits) back += h.hit && h.backFace && !doubleSidedHit(in.scene, h.primitive);
-  return back > 4;
+// Whether the probe at p sees x: the fit's samples are the free volume around the probe that it sees, not the
+// space under a floor or behind a wall at the grid's border (dark to every light, they would drag it down).
+bool probeSees(const BakeInputs& in, const glm::vec3& p, const glm::vec3& x) {
+  const glm::vec3 d = x - p;
+  const float r = std::sqrt(glm::dot(d, d));
+  return !(r > 0.0f) || !in.rayTracer.occluded(p, d / r, 0.0f, r);
 }
 
 // The normal equations' 27-point stencil slot of neighbour j of probe i (both within one step on every axis).
@@ -152,17 +141,11 @@ LightVisibilityFit fitLightVisibility(const BakeInputs& in, const LightProbeGrid
       const glm::vec3 cell(static_cast<float>(s % S), static_cast<float>(s / S % S), static_cast<float>(s / (S * S)));
       const glm::vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
       const glm::vec3 x = corner + g.spacing * (cell + jitter) / static_cast<float>(S);
+      ++traced;
+      if (!probeSees(in, g.position(i), x)) continue;
       out.firstTarget = (i * perProbe + s) * m;
-      bool seesALight = false;
-      for (size_t l = 0; l < m; ++l) {
-        targets[out.firstTarget + l] = punctualVisibility(in, lights[l], x);
-        seesALight = seesALight || targets[out.firstTarget + l] > 0.0f;
-      }
+      for (size_t l = 0; l < m; ++l) targets[out.firstTarget + l] = punctualVisibility(in, lights[l], x);
       traced += m;
-      if (!seesALight) {  // a point that sees a light is not inside closed geometry: only the others are tested
-        traced += 8;
-        if (insideGeometry(in, x)) continue;
-      }
       out.corners = blendWeights(g, x, out.probe, out.weight);
     }
     rays += traced;

@@ -5,8 +5,8 @@
 // between a sunlit and a shaded probe gets half the sun. Here each probe's visibility v_i ∈ [0, 1] of each light
 // is the one whose blend best matches the light's visibility over the free volume:
 //   minimise Σ_s (Σ_i a_si v_i − f_s)² + Σ_i (v_i − f(p_i))²
-// over S³ jittered points s per probe (its cube of one spacing around the grid point; points that see no light
-// and where most of 8 diagonal rays meet back faces are inside geometry, left out), a_si the blend's weights at s, f_s the light's
+// over S³ jittered points s per probe (its cube of one spacing around the grid point; only the points the probe
+// sees: not under a floor, behind a wall or inside geometry), a_si the blend's weights at s, f_s the light's
 // visibility there (0 or the see-through transmittance's mean), and each probe's own point p_i as one more
 // sample; solved by projected Gauss–Seidel on the normal equations (27-point stencil), bounded to [0, 1] so
 // that a probe never holds more of a light than reaches it unoccluded, nor less than none.
@@ -24,8 +24,8 @@ struct LightVisibilityFit {
   size_t lights = 0;             // the scene's punctual lights, in order
   std::vector<float> visibility;  // [probe × lights + light]: the fitted visibility (0 for invalid probes)
   std::vector<float> pointVisibility;  // the same at each probe's baked position alone (one shadow ray)
-  size_t samples = 0;            // volume samples kept (outside geometry, near a valid probe)
-  size_t rays = 0;               // shadow and inside-geometry rays traced
+  size_t samples = 0;            // volume samples kept (seen by their probe, near a valid probe)
+  size_t rays = 0;               // shadow rays traced (to the lights and from each probe to its samples)
   int sweeps = 0;                // Gauss–Seidel sweeps run
 };
 
