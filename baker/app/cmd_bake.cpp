@@ -308,9 +308,8 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_option("--probes", a.probes,
-                  "irradiance probes for moving objects (IRBAKE_light_probes): auto (default:\n"
-                  "about 1024 probes on a grid over the scene, 2048 with a directional light),\n"
-                  "off, or a spacing in metres")
+                  "irradiance probes for moving objects (IRBAKE_light_probes): auto (default: about\n"
+                  "1024 probes over the scene, 2048 with a sun), off, or a spacing in metres")
       ->type_name("auto|off|M");
   app->add_option("--probe-box", a.probeBox, "the probes fill this box instead of the scene's bounds")
       ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
