@@ -24,13 +24,13 @@ SP="$S/dabrovic_sponza/sponza.glb --sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7"
 SB="$S/sibenik/sibenik_lamp.glb --sky 1,1,1"
 echo "idle gpu_mem_mib=$(nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits)" | tee $R/gpumem.txt
 for i in 1 2 3; do
-  gbake cornell_gl_$i 60 $B bake $CO --backend gl
-  gbake sponza_gl_$i 120 $B bake $SP --backend gl
+  gbake cornell_gl_$i 60 $B bake $CO --backend gl --gpu-timers
+  gbake sponza_gl_$i 120 $B bake $SP --backend gl --gpu-timers
 done
 gbake cornell_embree_1 60 $B bake $CO --backend embree
 gbake sponza_embree_1 120 $B bake $SP --backend embree
 gbake sponza_auto_1 120 $B bake $SP
-for i in 1 2; do gbake sibenik_gl_$i 120 $B bake $SB --backend gl; done
+for i in 1 2; do gbake sibenik_gl_$i 120 $B bake $SB --backend gl --gpu-timers; done
 gbake sibenik_embree_1 120 $B bake $SB --backend embree
 ${PROFILE_EXTRA:-true}
 rm -f $R/*/*.exr $R/*/*.png $R/*/*.bin $R/*/*.glb $R/*/*.jpg $R/*/*.gltf

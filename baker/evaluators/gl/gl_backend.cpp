@@ -65,7 +65,8 @@ class GlBaker {
  public:
   GlBaker(const BakeInputs& in, const GlBackendOptions& opt, const EvaluationRequest& request, GlBakeStats& stats,
           const GlContext& context)
-      : in_(in), opt_(opt), request_(request), stats_(stats), context_(context), programs_(context.programs()) {}
+      : in_(in), opt_(opt), request_(request), stats_(stats), context_(context), programs_(context.programs()),
+        gpuTimer_(opt.gpuTimers) {}
 
   // The maps, and with EvaluationRequest::directional their L1 pages.
   std::vector<Lightmap> run();

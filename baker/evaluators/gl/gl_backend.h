@@ -26,7 +26,7 @@ struct GlBakeStats {
   double foldSeconds = 0.0;      // read-backs into the double accumulators
   double geometrySeconds = 0.0;  // scene geometry sorted, clustered and uploaded (once per context and scene)
   double readSeconds = 0.0;      // the double sums turned into maps
-  // GPU elapsed time (GL_TIME_ELAPSED) of the same stages' commands: what the GPU itself spends.
+  // GPU elapsed time (GL_TIME_ELAPSED) of the same stages' commands, with GlBackendOptions::gpuTimers.
   double gpuShadowSeconds = 0.0;
   double gpuAccumulateSeconds = 0.0;
   double gpuFoldSeconds = 0.0;
@@ -123,6 +123,7 @@ struct GlBackendOptions {
   bool resolveContacts = true;
   float contactLeakFraction = 0.01f;
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
+  bool gpuTimers = false;        // GL_TIME_ELAPSED queries per pass kind (GlBakeStats::gpu*Seconds)
   const GlContext* context = nullptr;  // an existing context, made current per call; null: one made per call
   GlBakeStats* stats = nullptr;  // where every call's figures are added (null: the evaluator keeps its own)
 };
