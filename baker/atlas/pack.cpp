@@ -343,9 +343,9 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
   const int pad = std::max(0, options.padding);
   const int limit = std::max(8, options.maxPageSize);
   std::vector<std::array<Mask, 4>> masks(charts.size());
-  double paddedArea = 0.0;
-  int widest = 1;
-  for (size_t i = 0; i < charts.size(); ++i) {
+  std::vector<double> scaledFrom(charts.size(), 0.0);  // a chart's longest side before it was scaled to fit a page
+  // Per chart, then per (chart, turn): each writes its own slot, so the masks do not depend on the thread count.
+  tbb::parallel_for(size_t(0), charts.size(), [&](size_t i) {
     ChartUv& chart = charts[i];
     for (glm::dvec2& p : chart.uv) p *= options.texelsPerUnit;
     rotateToMinimumBox(chart);
@@ -355,10 +355,18 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
     if (longest > limit - 2) {  // keep the chart whole: scale it to fit a page
       const double s = (limit - 2) / longest;
       for (glm::dvec2& p : chart.uv) p = lo + (p - lo) * s;
-      result.warnings.push_back("a chart of " + std::to_string(int(std::ceil(longest))) + " texels was scaled by " +
-                                std::to_string(s) + " to fit a " + std::to_string(limit) + "-texel page");
+      scaledFrom[i] = longest;
     }
-    for (int t = 0; t < 4; ++t) masks[i][size_t(t)] = buildMask(chart, t, pad);
+  });
+  tbb::parallel_for(size_t(0), 4 * charts.size(), [&](size_t k) {
+    masks[k / 4][k % 4] = buildMask(charts[k / 4], int(k % 4), pad);
+  });
+  double paddedArea = 0.0;
+  int widest = 1;
+  for (size_t i = 0; i < charts.size(); ++i) {
+    if (scaledFrom[i] > 0.0)
+      result.warnings.push_back("a chart of " + std::to_string(int(std::ceil(scaledFrom[i]))) + " texels was scaled by " +
+                                std::to_string((limit - 2) / scaledFrom[i]) + " to fit a " + std::to_string(limit) + "-texel page");
     const Mask& m = masks[i][0];
     paddedArea += double(m.w + pad) * double(m.h + pad);
     widest = std::max(widest, std::min(m.w, m.h));
