@@ -40,7 +40,8 @@ nlohmann::json reportJson(const std::string& input, const AtlasResult& r) {
       {"degenerate_faces", s.degenerateFaces},
       {"non_manifold_faces", s.nonManifoldFaces},
       {"seconds", {{"mesh", s.secondsMesh}, {"charts", s.secondsCharts}, {"parameterise", s.secondsParam},
-                   {"pack", s.secondsPack}, {"output", s.secondsOutput}, {"stats", s.secondsStats}}},
+                   {"pack", s.secondsPack}, {"output", s.secondsOutput}, {"stats", s.secondsStats},
+                   {"total", s.secondsTotal}}},
       {"warnings", s.warnings},
   };
 }

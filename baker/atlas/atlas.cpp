@@ -392,6 +392,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
   if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
   checkTexelEstimate(scene, options);
+  const Stopwatch total;
   AtlasResult result;
   AtlasStats& stats = result.stats;
   auto progress = [&](double f) {
@@ -420,10 +421,13 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   progress(0.85);
 
   clock.reset();
+  std::vector<std::vector<Primitive>> split(scene.primitives.size());
+  tbb::parallel_for(size_t(0), scene.primitives.size(),
+                    [&](size_t p) { emitOnPages(scene.primitives[p], prims[p], charts, packed, result.pages, split[p]); });
   std::vector<Primitive> out;
   out.reserve(scene.primitives.size());
-  for (size_t p = 0; p < scene.primitives.size(); ++p)
-    emitOnPages(scene.primitives[p], prims[p], charts, packed, result.pages, out);
+  for (std::vector<Primitive>& pieces : split)
+    for (Primitive& piece : pieces) out.push_back(std::move(piece));
   scene.primitives = std::move(out);
   stats.secondsOutput = clock.seconds();
   progress(0.95);
@@ -435,6 +439,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   stats.secondsStats = clock.seconds();
   if (stats.degenerateFaces) stats.warnings.push_back(std::to_string(stats.degenerateFaces) + " degenerate faces mapped to a point");
   if (stats.nonManifoldFaces) stats.warnings.push_back(std::to_string(stats.nonManifoldFaces) + " non-manifold faces split off");
+  stats.secondsTotal = total.seconds();
   progress(1.0);
   return result;
 }
