@@ -1,4 +1,5 @@
 #include "atlas/atlas.h"
+#include "scene/triangle_area.h"
 
 #include <algorithm>
 #include <cmath>
@@ -108,10 +109,7 @@ void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
   if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
   double area = 0.0;
   for (const Primitive& p : scene.primitives)
-    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-      const glm::dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]), c(p.positions[p.indices[t + 2]]);
-      area += 0.5 * glm::length(glm::cross(b - a, c - a));
-    }
+    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
   const double density = options.texelsPerUnit;
   const double estimate = area * density * density / kTypicalFill;
   if (estimate > double(options.maxTexels))
