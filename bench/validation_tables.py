@@ -319,6 +319,17 @@ def t_atlas():
                   "flipped", "median (s)", "xatlas charts", "xatlas utilisation", "xatlas (s)", "target"], out)
 
 
+def t_atlas_threads():
+    """The atlas stage by thread count (bench/atlas_threads.py): the latest row of each machine, baker, scene and
+    thread count."""
+    rows = latest(read("atlas_threads.csv"), lambda r: (r["machine"], r["baker"], r["scene"], r["threads"]))
+    out = [[r["machine"], f"`{r['baker']}`", r["scene"], r["charts"], r["threads"], r["runs"], num(r["median_atlas_s"], 2),
+            num(r["median_pack_s"], 2), num(r["median_cpu_s"], 2), r["load_average"], f"`{r['output_md5']}`"]
+           for r in rows]
+    return table(["machine", "baker", "scene", "charts", "threads", "runs", "atlas median (s)", "of it packing (s)",
+                  "process CPU (s)", "load (1 min)", "unwrapped file (md5)"], out)
+
+
 def t_viewer():
     with open(os.path.join(RESULTS, "viewer_bench.csv")) as f:
         lines = f.read().splitlines()

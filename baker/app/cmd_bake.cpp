@@ -141,7 +141,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
     {"Estimated error", {"estimate-error", "max-time", "max-rounds", "error-map"}},
-    {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams"}},
+    {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams", "gpu-timers"}},
 };
 
 void groupOptions(CLI::App& app) {
@@ -340,6 +340,9 @@ void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   app->add_flag("--no-leak-control", a.noLeakControl, "diagnostics: texel samples may sit behind walls");
   app->add_flag("--no-dilate", a.noDilate, "diagnostics: no dilation into the padding");
   app->add_flag("--no-seams", a.noSeams, "diagnostics: no seam stitching");
+  app->add_flag("--gpu-timers", o.gl.gpuTimers,
+                "diagnostics: the GL passes' GPU time in the report (timings.gl.gpu*Seconds;\n"
+                "timer queries, which some drivers serialise)");
   app->add_option("--threads", command.threads, "worker threads (default 0: every core; same bytes for any count)")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", command.quiet, "warnings and errors only, no progress bars");

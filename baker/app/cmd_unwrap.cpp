@@ -4,7 +4,10 @@
 #include <fstream>
 #include <string>
 
+#include <memory>
+
 #include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
 
 #include "app/commands.h"
 #include "atlas/atlas.h"
@@ -37,7 +40,8 @@ nlohmann::json reportJson(const std::string& input, const AtlasResult& r) {
       {"degenerate_faces", s.degenerateFaces},
       {"non_manifold_faces", s.nonManifoldFaces},
       {"seconds", {{"mesh", s.secondsMesh}, {"charts", s.secondsCharts}, {"parameterise", s.secondsParam},
-                   {"pack", s.secondsPack}, {"output", s.secondsOutput}, {"stats", s.secondsStats}}},
+                   {"pack", s.secondsPack}, {"output", s.secondsOutput}, {"stats", s.secondsStats},
+                   {"total", s.secondsTotal}}},
       {"warnings", s.warnings},
   };
 }
@@ -48,6 +52,7 @@ int runUnwrap(const Args& args) {
   std::vector<std::string> inputs;
   std::string output, report;
   double tpu = 0.0;
+  int threads = 0;
   AtlasOptions options;
   auto app = cli::makeApp("irbake unwrap",
                               "Adds a lightmap UV set (TEXCOORD_1) and extras.lightmap {page, width, height} per "
@@ -66,7 +71,12 @@ int runUnwrap(const Args& args) {
       ->transform(cli::integerIn(16, 16384))->type_name("S");
   app->add_flag("--keep-uv1", options.keepUv1, "keep an input TEXCOORD_1 and only repack its islands");
   app->add_option("--report", report, "write the atlas statistics")->type_name("R.json");
+  app->add_option("--threads", threads, "worker threads (default 0: every core; same bytes for any count)")
+      ->transform(cli::integerIn(0, 1024))->type_name("N");
   if (!cli::parse(*app, args)) return 0;
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (threads > 0)
+    threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   if (inputs.size() != 1) throw Error(ErrorCode::Usage, "", "unwrap takes exactly one input scene");
   if (output.empty()) throw Error(ErrorCode::Usage, "", "unwrap needs -o OUT.gltf");
   const std::string input = inputs[0];

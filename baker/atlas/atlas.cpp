@@ -1,12 +1,16 @@
 #include "atlas/atlas.h"
+#include "scene/triangle_area.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 #include "atlas/atlas_mesh.h"
 #include "atlas/atlas_stats.h"
@@ -105,10 +109,7 @@ void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
   if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
   double area = 0.0;
   for (const Primitive& p : scene.primitives)
-    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-      const glm::dvec3 a(p.positions[p.indices[t]]), b(p.positions[p.indices[t + 1]]), c(p.positions[p.indices[t + 2]]);
-      area += 0.5 * glm::length(glm::cross(b - a, c - a));
-    }
+    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
   const double density = options.texelsPerUnit;
   const double estimate = area * density * density / kTypicalFill;
   if (estimate > double(options.maxTexels))
@@ -193,26 +194,75 @@ size_t parameterizeWithBisection(const AtlasMesh& mesh, std::vector<atlas::Chart
   return fallbackFaces;
 }
 
-// The charts of one primitive, appended to charts: its TEXCOORD_1 islands (keepUv1) or segmented and
-// parameterised here.
-void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOptions& options, AtlasStats& stats,
-                    std::vector<ChartUv>& charts) {
+// One primitive's share of the atlas: its half-edge mesh and charts, with the stats it adds. Primitives are
+// unwrapped in parallel, each into its own slot, and joined in scene order so any thread count gives the same bytes.
+struct PrimitiveWork {
+  std::vector<ChartUv> charts;
+  AtlasStats stats;  // the counts, seconds and warnings this primitive adds
+};
+
+// The charts of one primitive: its TEXCOORD_1 islands (keepUv1) or segmented and parameterised here.
+void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOptions& options, PrimitiveWork& work) {
+  AtlasStats& stats = work.stats;
+  std::vector<ChartUv>& charts = work.charts;
   Stopwatch clock;
   if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
-    for (ChartUv& c : chartsFromUv1(prim, mesh)) charts.push_back(std::move(c));
+    charts = chartsFromUv1(prim, mesh);
     stats.secondsParam += clock.seconds();
     return;
   }
-  std::vector<atlas::ChartFaces> work = atlas::segmentCharts(mesh);
+  std::vector<atlas::ChartFaces> faces = atlas::segmentCharts(mesh);
   stats.secondsCharts += clock.seconds();
   clock.reset();
-  const size_t fallbackFaces = parameterizeWithBisection(mesh, std::move(work), options, stats, charts);
+  const size_t fallbackFaces = parameterizeWithBisection(mesh, std::move(faces), options, stats, charts);
   stats.secondsParam += clock.seconds();
-  if (fallbackFaces) {
-    const std::string w = std::to_string(fallbackFaces) + " faces of \"" + prim.name + "\" still failed the chart checks after " +
-                          std::to_string(options.maxSplitDepth) + " bisections: mapped as one planar chart per face";
-    log::warn("atlas: " + w);
-    stats.warnings.push_back(w);
+  if (fallbackFaces)
+    stats.warnings.push_back(std::to_string(fallbackFaces) + " faces of \"" + prim.name + "\" still failed the chart checks after " +
+                             std::to_string(options.maxSplitDepth) + " bisections: mapped as one planar chart per face");
+}
+
+// Meshes and charts of every primitive (in parallel), joined in scene order into `charts`.
+void chartAllPrimitives(const Scene& scene, const AtlasOptions& options, std::vector<PrimitiveCharts>& prims,
+                        std::vector<ChartUv>& charts, AtlasStats& stats) {
+  const size_t count = scene.primitives.size();
+  std::vector<PrimitiveWork> work(count);
+  std::mutex progressLock;
+  size_t finished = 0;
+  // Largest primitives first, so one big mesh does not start last and run alone.
+  std::vector<size_t> order(count);
+  for (size_t p = 0; p < count; ++p) order[p] = p;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return scene.primitives[a].triangleCount() > scene.primitives[b].triangleCount();
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const size_t p = order[i];
+      Stopwatch clock;
+      prims[p].mesh = atlas::buildAtlasMesh(scene.primitives[p]);
+      work[p].stats.secondsMesh = clock.seconds();
+      chartPrimitive(scene.primitives[p], prims[p].mesh, options, work[p]);
+      if (options.progress) {
+        std::lock_guard<std::mutex> lock(progressLock);
+        options.progress("atlas", 0.6 * double(++finished) / double(count));
+      }
+    }
+  }, tbb::simple_partitioner());
+  for (size_t p = 0; p < count; ++p) {
+    const AtlasMesh& mesh = prims[p].mesh;
+    const AtlasStats& s = work[p].stats;
+    stats.degenerateFaces += mesh.degenerateFaces;
+    stats.nonManifoldFaces += mesh.nonManifoldFaces;
+    stats.secondsMesh += s.secondsMesh;
+    stats.secondsCharts += s.secondsCharts;
+    stats.secondsParam += s.secondsParam;
+    stats.chartsSplit += s.chartsSplit;
+    for (const std::string& w : s.warnings) {
+      log::warn("atlas: " + w);
+      stats.warnings.push_back(w);
+    }
+    prims[p].firstChart = charts.size();
+    prims[p].chartCount = work[p].charts.size();
+    for (ChartUv& c : work[p].charts) charts.push_back(std::move(c));
   }
 }
 
@@ -339,6 +389,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
   if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
   checkTexelEstimate(scene, options);
+  const Stopwatch total;
   AtlasResult result;
   AtlasStats& stats = result.stats;
   auto progress = [&](double f) {
@@ -347,18 +398,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   Stopwatch clock;
   std::vector<PrimitiveCharts> prims(scene.primitives.size());
   std::vector<ChartUv> charts;
-  for (size_t p = 0; p < scene.primitives.size(); ++p) {
-    clock.reset();
-    prims[p].mesh = atlas::buildAtlasMesh(scene.primitives[p]);
-    const AtlasMesh& mesh = prims[p].mesh;
-    stats.degenerateFaces += mesh.degenerateFaces;
-    stats.nonManifoldFaces += mesh.nonManifoldFaces;
-    stats.secondsMesh += clock.seconds();
-    prims[p].firstChart = charts.size();
-    chartPrimitive(scene.primitives[p], mesh, options, stats, charts);
-    prims[p].chartCount = charts.size() - prims[p].firstChart;
-    progress(0.6 * double(p + 1) / double(scene.primitives.size()));
-  }
+  chartAllPrimitives(scene, options, prims, charts, stats);
   for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
   stats.texelsPerUnit = chooseDensity(charts, options, scene);
 
@@ -378,10 +418,13 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   progress(0.85);
 
   clock.reset();
+  std::vector<std::vector<Primitive>> split(scene.primitives.size());
+  tbb::parallel_for(size_t(0), scene.primitives.size(),
+                    [&](size_t p) { emitOnPages(scene.primitives[p], prims[p], charts, packed, result.pages, split[p]); });
   std::vector<Primitive> out;
   out.reserve(scene.primitives.size());
-  for (size_t p = 0; p < scene.primitives.size(); ++p)
-    emitOnPages(scene.primitives[p], prims[p], charts, packed, result.pages, out);
+  for (std::vector<Primitive>& pieces : split)
+    for (Primitive& piece : pieces) out.push_back(std::move(piece));
   scene.primitives = std::move(out);
   stats.secondsOutput = clock.seconds();
   progress(0.95);
@@ -393,6 +436,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   stats.secondsStats = clock.seconds();
   if (stats.degenerateFaces) stats.warnings.push_back(std::to_string(stats.degenerateFaces) + " degenerate faces mapped to a point");
   if (stats.nonManifoldFaces) stats.warnings.push_back(std::to_string(stats.nonManifoldFaces) + " non-manifold faces split off");
+  stats.secondsTotal = total.seconds();
   progress(1.0);
   return result;
 }

@@ -41,10 +41,12 @@ struct AtlasStats {
   double areaStretchP5 = 0.0, areaStretchP50 = 0.0, areaStretchP95 = 0.0;
   double l2Stretch = 0.0;
   double texelsPerUnit = 0.0;      // the density used
+  // Mesh, charts and parameterisation are summed over primitives (which run in parallel); the others are wall.
   double secondsMesh = 0.0, secondsCharts = 0.0, secondsParam = 0.0, secondsPack = 0.0;
   size_t nonManifoldFaces = 0;     // faces given their own vertex copies so the half-edge mesh accepts them
   size_t chartsSplit = 0;          // charts that failed a check (flip, zero area, overlap, stretch) and were bisected
   double secondsOutput = 0.0, secondsStats = 0.0;
+  double secondsTotal = 0.0;       // wall clock of buildAtlas
   std::vector<std::string> warnings;
 };
 

@@ -93,7 +93,10 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
   for (const glm::dvec3& p : mesh.vertexPos) om.add_vertex(OmMesh::Point(float(p.x), float(p.y), float(p.z)));
   std::vector<uint32_t> faceOfOm;
   faceOfOm.reserve(faces);
-  omerr().disable();
+  // Refused faces are handled here; OpenMesh's message about each is noise. Switched off once for the
+  // process: meshes are built on several threads, and toggling the shared stream per mesh would race.
+  static const bool quiet = (omerr().disable(), true);
+  (void)quiet;
   for (size_t f = 0; f < faces; ++f) {
     if (mesh.degenerate[f]) continue;
     auto& v = mesh.faceVertex[f];
@@ -113,7 +116,6 @@ AtlasMesh buildAtlasMesh(const Primitive& prim, const MeshOptions& options) {
     if (size_t(fh.idx()) != faceOfOm.size()) faceOfOm.resize(size_t(fh.idx()));
     faceOfOm.push_back(uint32_t(f));
   }
-  omerr().enable();
 
   // Normal breaks are seams only when authored: flat normals the loader computed break at every edge.
   const bool hasNormals = prim.normals.size() == prim.positions.size() && !prim.normalsComputed;

@@ -9,6 +9,10 @@
 #include <functional>
 #include <map>
 #include <numeric>
+#include <cstring>
+
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "atlas/atlas.h"
 #include "atlas/atlas_mesh.h"
@@ -544,6 +548,62 @@ TEST(Atlas, SameInputGivesIdenticalUv1) {
   for (int run = 1; run < 3; ++run) {
     ASSERT_EQ(runs[run].size(), runs[0].size());
     EXPECT_TRUE(std::equal(runs[run].begin(), runs[run].end(), runs[0].begin())) << "run " << run << " differs";
+  }
+}
+
+// Primitives, charts, masks, page rows and measures run in parallel: 1, 2 and 8 threads give the same atlas
+// (every vertex, index and uv1 bit, the pages, the measured figures), on one page and over several.
+TEST(Atlas, SameAtlasForAnyThreadCount) {
+  struct Atlas {
+    std::vector<AtlasPage> pages;
+    std::vector<Primitive> primitives;
+    AtlasStats stats;
+  };
+  auto unwrapWith = [](int threads, int maxPage) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    tbb::task_arena arena(threads);
+    Atlas out;
+    arena.execute([&] {
+      Primitive boxes;  // many small planar charts of a few sizes: the packer's rows compete
+      for (int i = 0; i < 24; ++i) {
+        Primitive c = cube(0.05f + 0.015f * float(i * 7 % 17), 1 + i % 2);
+        const uint32_t base = uint32_t(boxes.positions.size());
+        for (glm::vec3 q : c.positions) boxes.positions.push_back(q + glm::vec3(float(i % 8), float(i / 8), 4.0f));
+        boxes.normals.insert(boxes.normals.end(), c.normals.begin(), c.normals.end());
+        for (uint32_t k : c.indices) boxes.indices.push_back(base + k);
+      }
+      Scene s = sceneOf({crumpledSheet(12), uvSphere(0.5f, 24, 12), torus(1.0f, 0.3f, 24, 8), boxes, cylinder(0.3f, 1.0f, 16)});
+      const AtlasResult r = unwrap(s, 64, 2, maxPage);
+      expectValid(s, r, 2);
+      out = {r.pages, s.primitives, r.stats};
+    });
+    return out;
+  };
+  for (int maxPage : {2048, 128}) {
+    const Atlas one = unwrapWith(1, maxPage);
+    if (maxPage == 128) EXPECT_GE(one.pages.size(), 2u);
+    for (int threads : {2, 8}) {
+      const Atlas many = unwrapWith(threads, maxPage);
+      ASSERT_EQ(many.pages.size(), one.pages.size()) << threads << " threads";
+      for (size_t p = 0; p < one.pages.size(); ++p) {
+        EXPECT_EQ(many.pages[p].width, one.pages[p].width);
+        EXPECT_EQ(many.pages[p].height, one.pages[p].height);
+      }
+      ASSERT_EQ(many.primitives.size(), one.primitives.size());
+      for (size_t p = 0; p < one.primitives.size(); ++p) {
+        const Primitive &a = one.primitives[p], &b = many.primitives[p];
+        EXPECT_EQ(b.lightmap.page, a.lightmap.page);
+        EXPECT_EQ(b.indices, a.indices) << "primitive " << p << ", " << threads << " threads";
+        EXPECT_EQ(b.sourceVertex, a.sourceVertex);
+        ASSERT_EQ(b.uv1.size(), a.uv1.size());
+        EXPECT_EQ(0, std::memcmp(b.uv1.data(), a.uv1.data(), a.uv1.size() * sizeof(glm::vec2)))
+            << "primitive " << p << ", " << threads << " threads";
+      }
+      EXPECT_EQ(many.stats.charts, one.stats.charts);
+      EXPECT_EQ(many.stats.centreUtilisation, one.stats.centreUtilisation);
+      EXPECT_EQ(many.stats.l2Stretch, one.stats.l2Stretch);
+      EXPECT_EQ(many.stats.areaStretchP95, one.stats.areaStretchP95);
+    }
   }
 }
 

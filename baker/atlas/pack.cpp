@@ -9,8 +9,11 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <unordered_map>
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace irbake::atlas {
 namespace {
@@ -175,52 +178,45 @@ class PageGrid {
     bits_[size_t(y) * words_ + (x >> 6)] |= uint64_t(1) << (x & 63);
   }
 
-  // Lowest-leftmost position whose padded mask overlaps nothing, with the chart's top at most maxTop.
-  bool firstFit(const Mask& m, int padding, int minY, int maxTop, int& outX, int& outY) const {
-    const int lastY = std::min(maxHeight_ - m.h, maxTop - m.h);
-    size_t hint = size_t(padding);
+  // Rows of the mask tested first: the one that last failed (a page row that is full stays full nearby).
+  struct RowHints {
+    size_t run = 0, gap = 0;  // padded rows tested first by the run scan and by the gap rejection
+  };
+  static RowHints hintsFor(const Mask& m, int padding) { return {size_t(padding), size_t(m.widestRow)}; }
+
+  // Leftmost x where the padded mask with its chart's bottom row at page row y overlaps nothing, or -1.
+  int fitInRow(const Mask& m, int padding, int y, RowHints& hints) const {
+    // Cheap rejection: each padded row needs a free gap as long as its longest run somewhere in its page row
+    // (runs that reach past the page edges are clipped, so only rows fully inside the page are tested).
     const int ph = int(m.paddedRuns.size());
-    size_t gapHint = size_t(m.widestRow);
-    for (int y = std::max(0, minY); y <= lastY; ++y) {
-      // Cheap rejection: each padded row needs a free gap as long as its longest run somewhere in its page row
-      // (runs that reach past the page edges are clipped, so only rows fully inside the page are tested).
-      bool possible = true;
-      for (int i = 0; i < ph && possible; ++i) {
-        const size_t j = i == 0 ? gapHint : (i == int(gapHint) ? 0 : size_t(i));
-        const int row = y - padding + int(j);
-        if (row < 0 || size_t(row) >= rowsUsed_) continue;
-        if (freeGap_[size_t(row)] < std::min(m.longestRun[j] - 2 * padding, width_)) {
-          possible = false;
-          gapHint = j;
-        }
-      }
-      if (!possible) continue;
-      int x = 0;
-      for (;;) {
-        if (x + m.w > width_) break;
-        bool clear = true;
-        for (size_t i = 0; i < m.paddedRuns.size() && clear; ++i) {
-          const size_t j = i == 0 ? hint : (i == hint ? 0 : i);
-          const int row = y - padding + int(j);
-          for (const auto& [a, b] : m.paddedRuns[j]) {
-            const int q = lastSet(row, std::max(0, x + a), std::min(width_ - 1, x + b));
-            if (q >= 0) {
-              // Every x whose run still reaches q fails; jump to where this run finds a long-enough gap.
-              x = nextFreeStretch(row, q + 1, b - a + 1) - a;
-              hint = j;
-              clear = false;
-              break;
-            }
-          }
-        }
-        if (clear) {
-          outX = x;
-          outY = y;
-          return true;
-        }
+    for (int i = 0; i < ph; ++i) {
+      const size_t j = i == 0 ? hints.gap : (i == int(hints.gap) ? 0 : size_t(i));
+      const int row = y - padding + int(j);
+      if (row < 0 || size_t(row) >= rowsUsed_) continue;
+      if (freeGap_[size_t(row)] < std::min(m.longestRun[j] - 2 * padding, width_)) {
+        hints.gap = j;
+        return -1;
       }
     }
-    return false;
+    for (int x = 0; x + m.w <= width_;) {
+      bool clear = true;
+      for (size_t i = 0; i < m.paddedRuns.size() && clear; ++i) {
+        const size_t j = i == 0 ? hints.run : (i == hints.run ? 0 : i);
+        const int row = y - padding + int(j);
+        for (const auto& [a, b] : m.paddedRuns[j]) {
+          const int q = lastSet(row, std::max(0, x + a), std::min(width_ - 1, x + b));
+          if (q >= 0) {
+            // Every x whose run still reaches q fails; jump to where this run finds a long-enough gap.
+            x = nextFreeStretch(row, q + 1, b - a + 1) - a;
+            hints.run = j;
+            clear = false;
+            break;
+          }
+        }
+      }
+      if (clear) return x;
+    }
+    return -1;
   }
   // Where to start looking: an earlier chart about as large (both box sides ≥ 90% of it) found no room
   // below its row, so this one starts there. A heuristic (shapes differ): it costs a little density and
@@ -233,7 +229,11 @@ class PageGrid {
     return y;
   }
   void place(const Mask& m, int x0, int y0) {
-    placedRows_.push_back({std::min(m.w, m.h), std::max(m.w, m.h), y0});
+    // One entry per box size (the highest row): many charts share a size, and searchStart reads them all.
+    const uint64_t size = uint64_t(std::min(m.w, m.h)) << 32 | uint32_t(std::max(m.w, m.h));
+    auto [it, added] = rowOfSize_.try_emplace(size, placedRows_.size());
+    if (added) placedRows_.push_back({std::min(m.w, m.h), std::max(m.w, m.h), y0});
+    else placedRows_[it->second][2] = std::max(placedRows_[it->second][2], y0);
     for (int y = 0; y < m.h; ++y)
       for (int x = 0; x < m.w; ++x)
         if (m.bits[size_t(y) * m.w + x]) set(x0 + x, y0 + y);
@@ -263,7 +263,8 @@ class PageGrid {
     }
     return best;
   }
-  std::vector<std::array<int, 3>> placedRows_;  // (short side, long side, row) of every placed chart
+  std::vector<std::array<int, 3>> placedRows_;  // (short side, long side, highest row) of the placed box sizes
+  std::unordered_map<uint64_t, size_t> rowOfSize_;  // box size -> its entry in placedRows_
   std::vector<int> freeGap_;  // per used row: its longest run of free columns
   int width_, maxHeight_, words_;
   size_t rowsUsed_ = 0;
@@ -277,36 +278,79 @@ struct Placement {
   int page = -1, quarterTurns = 0, x = 0, y = 0;
 };
 
+// The place of one chart on a page: of the turns, the one whose lowest fit has the lowest top (the earliest
+// turn on a tie), at its leftmost position. Rows are tested in order of (top, turn), in waves of `wave` tops
+// whose rows are tested in parallel; the first wave with a fit holds the answer, so any wave size (and thread
+// count) gives the same place.
+bool placeOnPage(const std::array<Mask, 4>& masks, const PageGrid& grid, int width, int maxPage, int padding, int wave,
+                 Placement& out) {
+  const int startY = grid.searchStart(masks[0]);
+  std::array<bool, 4> usable{};
+  std::array<PageGrid::RowHints, 4> hints{};
+  int lowTop = maxPage + 1;
+  for (size_t t = 0; t < 4; ++t) {
+    usable[t] = masks[t].w <= width && masks[t].h <= maxPage;
+    hints[t] = PageGrid::hintsFor(masks[t], padding);
+    if (usable[t]) lowTop = std::min(lowTop, startY + masks[t].h);
+  }
+  std::vector<int> fitX;
+  for (int firstTop = lowTop, size = 1; firstTop <= maxPage; firstTop += size, size = std::min(2 * size, wave)) {
+    const int tops = std::min(size, maxPage - firstTop + 1), items = 4 * tops;
+    std::atomic<int> best{items};  // the first item (in (top, turn) order) that fits
+    fitX.assign(size_t(items), -1);
+    auto test = [&](int i, PageGrid::RowHints& h) {
+      const size_t t = size_t(i % 4);
+      const int y = firstTop + i / 4 - masks[t].h;
+      if (!usable[t] || y < startY || i > best.load(std::memory_order_relaxed)) return false;
+      fitX[size_t(i)] = grid.fitInRow(masks[t], padding, y, h);
+      if (fitX[size_t(i)] < 0) return false;
+      for (int seen = best.load(std::memory_order_relaxed); i < seen && !best.compare_exchange_weak(seen, i);) {
+      }
+      return true;
+    };
+    if (items <= 4) {  // one top: in order, keeping each turn's hints from row to row
+      for (int i = 0; i < items; ++i)
+        if (test(i, hints[size_t(i % 4)])) break;
+    } else {
+      tbb::parallel_for(0, items, [&](int i) {
+        PageGrid::RowHints h = hints[size_t(i % 4)];
+        test(i, h);
+      });
+    }
+    const int i = best.load();
+    if (i < items) {
+      const size_t t = size_t(i % 4);
+      out.quarterTurns = int(t);
+      out.x = fitX[size_t(i)];
+      out.y = firstTop + i / 4 - masks[t].h;
+      return true;
+    }
+  }
+  return false;
+}
+
 // Packs masks (in order) into pages of the given width; returns the total page area.
 double packAll(const std::vector<std::array<Mask, 4>>& masks, const std::vector<size_t>& order, int width, int maxPage,
                int padding, const std::atomic<double>& giveUp, std::vector<Placement>& placement,
                std::vector<PageGrid>& pages) {
   pages.clear();
   placement.assign(masks.size(), Placement{});
+  // Tops tested at once: enough rows to keep the threads busy, one at a time on one thread.
+  const int threads = std::min(tbb::this_task_arena::max_concurrency(),
+                               int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const int wave = threads > 1 ? std::max(2, threads / 2) : 1;
   for (size_t c : order) {
     for (int p = 0;; ++p) {
       if (p == int(pages.size())) pages.emplace_back(width, maxPage);
-      int bestTop = maxPage + 1, bestX = 0, bestY = 0, bestTurn = -1;
-      const int startY = pages[size_t(p)].searchStart(masks[c][0]);
-      for (int t = 0; t < 4; ++t) {
-        const Mask& m = masks[c][size_t(t)];
-        int x, y;
-        if (m.w > width || m.h > maxPage) continue;
-        // Prune: only positions whose top is below the best found so far.
-        if (pages[size_t(p)].firstFit(m, padding, startY, bestTop - 1, x, y) && (y + m.h < bestTop || (y + m.h == bestTop && x < bestX))) {
-          bestTop = y + m.h;
-          bestX = x;
-          bestY = y;
-          bestTurn = t;
-        }
-      }
-      if (bestTurn < 0 && pages[size_t(p)].usedHeight() == 0)  // cannot happen: charts are scaled to fit a page
-        throw Error(ErrorCode::InvalidData, "", "atlas: a chart does not fit an empty page");
-      if (bestTurn >= 0) {
-        pages[size_t(p)].place(masks[c][size_t(bestTurn)], bestX, bestY);
-        placement[c] = {p, bestTurn, bestX, bestY};
+      Placement where;
+      if (placeOnPage(masks[c], pages[size_t(p)], width, maxPage, padding, wave, where)) {
+        where.page = p;
+        pages[size_t(p)].place(masks[c][size_t(where.quarterTurns)], where.x, where.y);
+        placement[c] = where;
         break;
       }
+      if (pages[size_t(p)].usedHeight() == 0)  // cannot happen: charts are scaled to fit a page
+        throw Error(ErrorCode::InvalidData, "", "atlas: a chart does not fit an empty page");
     }
     // Pages only grow: once this trial is larger than a finished one it cannot win (strictly larger: an equal
     // area may still win the tie, which goes to the narrower width whatever order the trials finish in).
@@ -343,9 +387,9 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
   const int pad = std::max(0, options.padding);
   const int limit = std::max(8, options.maxPageSize);
   std::vector<std::array<Mask, 4>> masks(charts.size());
-  double paddedArea = 0.0;
-  int widest = 1;
-  for (size_t i = 0; i < charts.size(); ++i) {
+  std::vector<double> scaledFrom(charts.size(), 0.0);  // a chart's longest side before it was scaled to fit a page
+  // Per chart, then per (chart, turn): each writes its own slot, so the masks do not depend on the thread count.
+  tbb::parallel_for(size_t(0), charts.size(), [&](size_t i) {
     ChartUv& chart = charts[i];
     for (glm::dvec2& p : chart.uv) p *= options.texelsPerUnit;
     rotateToMinimumBox(chart);
@@ -355,10 +399,18 @@ PackResult packCharts(std::vector<ChartUv>& charts, const PackOptions& options) 
     if (longest > limit - 2) {  // keep the chart whole: scale it to fit a page
       const double s = (limit - 2) / longest;
       for (glm::dvec2& p : chart.uv) p = lo + (p - lo) * s;
-      result.warnings.push_back("a chart of " + std::to_string(int(std::ceil(longest))) + " texels was scaled by " +
-                                std::to_string(s) + " to fit a " + std::to_string(limit) + "-texel page");
+      scaledFrom[i] = longest;
     }
-    for (int t = 0; t < 4; ++t) masks[i][size_t(t)] = buildMask(chart, t, pad);
+  });
+  tbb::parallel_for(size_t(0), 4 * charts.size(), [&](size_t k) {
+    masks[k / 4][k % 4] = buildMask(charts[k / 4], int(k % 4), pad);
+  });
+  double paddedArea = 0.0;
+  int widest = 1;
+  for (size_t i = 0; i < charts.size(); ++i) {
+    if (scaledFrom[i] > 0.0)
+      result.warnings.push_back("a chart of " + std::to_string(int(std::ceil(scaledFrom[i]))) + " texels was scaled by " +
+                                std::to_string((limit - 2) / scaledFrom[i]) + " to fit a " + std::to_string(limit) + "-texel page");
     const Mask& m = masks[i][0];
     paddedArea += double(m.w + pad) * double(m.h + pad);
     widest = std::max(widest, std::min(m.w, m.h));

@@ -5,6 +5,7 @@
 #include <epoxy/gl.h>
 
 #include <atomic>
+#include <map>
 #include <cstdio>
 #include <cstring>
 
@@ -48,6 +49,7 @@ struct GlContext::Impl {
   std::string renderer, version, vendor;
   std::atomic<int> messages{0}, errors{0};
   std::unique_ptr<GlProgramCache> programs = std::make_unique<GlProgramCache>();
+  std::map<std::string, std::shared_ptr<void>> resources;
 
   static void GLAPIENTRY onDebug(GLenum /*source*/, GLenum type, GLuint id, GLenum severity, GLsizei length,
                                  const GLchar* message, const void* user) {
@@ -181,12 +183,14 @@ GlContext::GlContext(const GlContextOptions& options) : impl_(std::make_unique<I
 
 GlContext::~GlContext() {
   if (!impl_ || impl_->display == EGL_NO_DISPLAY) return;
-  if (impl_->programs && impl_->programs->size() > 0 && impl_->context != EGL_NO_CONTEXT) {
-    // Programs are deleted on this context; whatever context the thread had current is restored.
+  if (((impl_->programs && impl_->programs->size() > 0) || !impl_->resources.empty()) &&
+      impl_->context != EGL_NO_CONTEXT) {
+    // Resources and programs are deleted on this context; whatever context the thread had current is restored.
     const EGLContext previous = eglGetCurrentContext();
     const EGLDisplay previousDisplay = eglGetCurrentDisplay();
     const EGLSurface draw = eglGetCurrentSurface(EGL_DRAW), read = eglGetCurrentSurface(EGL_READ);
     if (previous != impl_->context) eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context);
+    impl_->resources.clear();
     impl_->programs.reset();
     if (previous != impl_->context && previous != EGL_NO_CONTEXT) eglMakeCurrent(previousDisplay, draw, read, previous);
   }
@@ -200,6 +204,8 @@ GlContext::~GlContext() {
 }
 
 GlProgramCache& GlContext::programs() const { return *impl_->programs; }
+
+std::shared_ptr<void>& GlContext::resource(const std::string& key) const { return impl_->resources[key]; }
 
 void GlContext::makeCurrent() const {
   if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))

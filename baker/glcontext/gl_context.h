@@ -37,6 +37,9 @@ class GlContext {
   bool softwareRenderer() const;        // llvmpipe / softpipe / swrast
   // Programs built on this context, reused across calls (use with this context current).
   GlProgramCache& programs() const;
+  // A caller's objects kept for the context's life under `key` (e.g. the GL backend's scene geometry across
+  // its calls in one bake), released before the programs, with this context current.
+  std::shared_ptr<void>& resource(const std::string& key) const;
   // KHR_debug messages received so far (all severities), for tests and reports.
   int debugMessageCount() const;
   int debugErrorCount() const;  // messages of type GL_DEBUG_TYPE_ERROR

@@ -123,6 +123,7 @@ struct StagedBake::State {
                                                     // in every stage's map, taken out of what is written
   L1Pages directL1;                                 // with --directional: D's L1 pages
   nlohmann::json seconds = nlohmann::json::object();
+  nlohmann::json backendParts = nlohmann::json::object();  // the backend stage's split (report timings.backendParts)
   Stopwatch total;
 
   ProgressCallback withProgress(ProgressCallback cb) const { return cb ? cb : options.progress; }
@@ -137,6 +138,14 @@ struct StagedBake::State {
     Stopwatch watch;
     stage();
     seconds[name] = seconds.value(name, 0.0) + watch.seconds();
+  }
+  // A part of the backend stage (inside its timed call): the GL context, the blocks' plan, the evaluator
+  // calls, the maps (the punctual lights' "direct" call, their shadow edges and the classes' mix).
+  template <class Part>
+  void part(const char* name, Part&& work) {
+    Stopwatch watch;
+    work();
+    backendParts[name] = backendParts.value(name, 0.0) + watch.seconds();
   }
 
   void prepare() {
@@ -222,7 +231,7 @@ struct StagedBake::State {
       footprintAlbedo = std::make_unique<FootprintAlbedo>(scene);
       wholeInputs->footprintAlbedo = footprintAlbedo.get();
     }
-    timed("backend", [&] { planBlocks(); });
+    timed("backend", [&] { part("blocks", [&] { planBlocks(); }); });
     if (estimating() && !blocks.empty()) halfB = zeroSums();
     settleErrorEstimate();
   }
@@ -442,11 +451,11 @@ struct StagedBake::State {
 
   // The plan (the GL context is made here where GL may run: its time counts to the backend).
   void chooseBackend() {
-    if (options.backend == BackendKind::Gl) glContext = std::make_unique<GlContext>();
+    if (options.backend == BackendKind::Gl) part("context", [&] { glContext = std::make_unique<GlContext>(); });
     plan = planBake(scene, *rayTracer, options, [&] {
       GlProbe probe;
       try {
-        if (!glContext) glContext = std::make_unique<GlContext>();
+        if (!glContext) part("context", [&] { glContext = std::make_unique<GlContext>(); });
         probe.softwareRenderer = glContext->softwareRenderer();
       } catch (const Error& e) {
         probe.error = e.what();
@@ -587,7 +596,8 @@ struct StagedBake::State {
   std::vector<Lightmap> backendMaps(ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
     if (plan.backend == BackendKind::Reference) return referenceStage(report);
     if (!replicates.empty() && !halfB.pages.empty()) halves = mixedHalves(sums);
-    std::vector<Lightmap> maps = cachedDirect.empty() || l1 ? directStage(l1) : std::move(cachedDirect);
+    std::vector<Lightmap> maps;
+    part("direct", [&] { maps = cachedDirect.empty() || l1 ? directStage(l1) : std::move(cachedDirect); });
     cachedDirect = {};
     if (maps.size() != texels.size() || (l1 && (*l1)[0].size() != texels.size()))
       throw Error(ErrorCode::InvalidData, scene.sourcePath, "the backend returned " + std::to_string(maps.size()) +
@@ -668,7 +678,7 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
           s.options.progress(stage, (static_cast<double>(b - begin) + std::clamp(f, 0.0, 1.0)) / count);
         };
       }
-      s.evaluateBlock(b, sums, progress);
+      s.part("evaluate", [&] { s.evaluateBlock(b, sums, progress); });
       if (afterBlock) afterBlock(b + 1);
     }
   });
@@ -715,7 +725,9 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   BakeResult r;
   nlohmann::json& report = r.report;
   s.classPages = {};
-  s.timed("backend", [&] { r.maps = s.backendMaps(sums, report, s.plan.directional ? &r.directional : nullptr); });
+  s.timed("backend", [&] {
+    s.part("maps", [&] { r.maps = s.backendMaps(sums, report, s.plan.directional ? &r.directional : nullptr); });
+  });
   sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
   StageContext ctx = s.stageContext(report);
   L1Pages* l1 = s.plan.directional ? &r.directional : nullptr;
@@ -753,6 +765,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,
   // the GL stage split, peak memory); the rest of the report is the same bytes every time.
   report["timings"]["seconds"] = s.seconds;
+  report["timings"]["backendParts"] = s.backendParts;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);

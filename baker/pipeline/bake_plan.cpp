@@ -1,5 +1,6 @@
 // The bake plan: each automatic choice and cross-stage rule, with its reason.
 #include "pipeline/bake_plan.h"
+#include "scene/triangle_area.h"
 
 #include <algorithm>
 
@@ -61,9 +62,7 @@ double emissiveAreaShare(const Scene& scene) {
   for (const Primitive& p : scene.primitives) {
     const bool emits = scene.materials[p.material].isEmissive();
     for (uint32_t t = 0; t < p.triangleCount(); ++t) {
-      const glm::dvec3 a(p.positions[p.indices[3 * t]]), b(p.positions[p.indices[3 * t + 1]]),
-          c(p.positions[p.indices[3 * t + 2]]);
-      const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+      const double area = triangleArea(p, t);
       all += area;
       if (emits) emitting += area;
     }

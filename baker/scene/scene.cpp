@@ -1,4 +1,5 @@
 #include "scene/scene.h"
+#include "scene/triangle_area.h"
 
 #include <algorithm>
 #include <cmath>
@@ -118,10 +119,7 @@ glm::vec3 Scene::emitterPower() const {
     const Material& m = materials[p.material];
     if (!m.isEmissive()) continue;
     for (uint32_t t = 0; t < p.triangleCount(); ++t) {
-      const glm::vec3& a = p.positions[p.indices[3 * t]];
-      const glm::vec3& b = p.positions[p.indices[3 * t + 1]];
-      const glm::vec3& c = p.positions[p.indices[3 * t + 2]];
-      double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+      const double area = triangleArea(p, t);
       glm::vec3 Le = emissionAt(p, t, glm::vec2(1.0f / 3.0f));  // texture at the centroid
       total += glm::dvec3(Le) * (kPiF * area);
     }

@@ -1,4 +1,5 @@
 #include "transport/geometry_term.h"
+#include "scene/triangle_area.h"
 
 #include <cmath>
 #include <limits>
@@ -35,10 +36,7 @@ float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMea
     if (v.power.x > 0.0f || v.power.y > 0.0f || v.power.z > 0.0f) ++n;
   double area = 0.0;
   for (const Primitive& p : scene.primitives)
-    for (size_t t = 0; t < p.triangleCount(); ++t) {
-      const glm::vec3& a = p.positions[p.indices[3 * t]];
-      area += 0.5 * glm::length(glm::cross(p.positions[p.indices[3 * t + 1]] - a, p.positions[p.indices[3 * t + 2]] - a));
-    }
+    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
   if (n == 0 || area <= 0.0) return 0.0f;
   return static_cast<float>(kPi * static_cast<double>(n) / (vplsPerMean * area));
 }

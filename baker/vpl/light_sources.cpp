@@ -1,4 +1,5 @@
 #include "vpl/light_sources.h"
+#include "scene/triangle_area.h"
 
 #include <algorithm>
 #include <cmath>
@@ -72,8 +73,7 @@ double meanReflectivity(const Scene& scene) {
   double weighted = 0.0, area = 0.0;
   for (const Primitive& prim : scene.primitives) {
     for (uint32_t t = 0; t < prim.triangleCount(); ++t) {
-      const glm::vec3& a = prim.positions[prim.indices[3 * t]];
-      double A = 0.5 * glm::length(glm::cross(prim.positions[prim.indices[3 * t + 1]] - a, prim.positions[prim.indices[3 * t + 2]] - a));
+      const double A = triangleArea(prim, t);
       double rho = 0.0;
       for (const glm::vec2& p : kPoints) {
         glm::vec3 a(scene.baseColorAt(prim, t, p));

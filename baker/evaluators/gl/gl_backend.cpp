@@ -11,6 +11,8 @@
 #include <time.h>
 
 #include "evaluators/gl/gl_resources.h"
+#include "evaluators/gl/gpu_timer.h"
+#include "common/checksum.h"
 #include "bake_interface.glsl"  // texture units and light codes, shared with the shaders
 #include "evaluators/gl/shadow_views.h"
 #include "common/error.h"
@@ -62,8 +64,9 @@ struct StageClock {
 class GlBaker {
  public:
   GlBaker(const BakeInputs& in, const GlBackendOptions& opt, const EvaluationRequest& request, GlBakeStats& stats,
-          GlProgramCache& programs)
-      : in_(in), opt_(opt), request_(request), stats_(stats), programs_(programs) {}
+          const GlContext& context)
+      : in_(in), opt_(opt), request_(request), stats_(stats), context_(context), programs_(context.programs()),
+        gpuTimer_(opt.gpuTimers) {}
 
   // The maps, and with EvaluationRequest::directional their L1 pages.
   std::vector<Lightmap> run();
@@ -90,15 +93,18 @@ class GlBaker {
     return !subset || (page < subset->size() && texel < (*subset)[page].size() && (*subset)[page][texel] != 0);
   }
   void finishStage(double& seconds, StageClock& sw, double* cpuSeconds = nullptr) const;
+  std::shared_ptr<GpuGeometry> sharedGeometry(bool seeThroughOnly);
 
   const BakeInputs& in_;
   const GlBackendOptions& opt_;
   const EvaluationRequest& request_;
   GlBakeStats& stats_;
+  const GlContext& context_;
   GlProgramCache& programs_;  // the context's: programs outlive this call, so later calls skip compiling
   ShadowScale scale_;
-  std::unique_ptr<GpuGeometry> geometry_;            // opaque primitives
-  std::unique_ptr<GpuGeometry> seeThroughGeometry_;  // MASK / BLEND / transmissive primitives (null: none)
+  std::shared_ptr<GpuGeometry> geometry_;            // opaque primitives (the context's, see sharedGeometry)
+  std::shared_ptr<GpuGeometry> seeThroughGeometry_;  // MASK / BLEND / transmissive primitives (null: none)
+  GpuTimer gpuTimer_;
   const GpuGeometry* drawing_ = nullptr;             // what drawCulled draws
   std::vector<std::unique_ptr<GpuPage>> pages_;
   const GlProgram* depthProgram_ = nullptr;
@@ -119,6 +125,29 @@ void GlBaker::finishStage(double& seconds, StageClock& sw, double* cpuSeconds) c
   seconds += sw.wall.seconds();
   if (cpuSeconds) *cpuSeconds += processCpuSeconds() - sw.cpuStart;
   sw.reset();
+}
+
+// The scene's geometry on this context: uploaded by a bake's first call and reused by the next ones
+// (interleaved sampling calls the backend n² + 1 times). Keyed by the scene's address and a checksum of its
+// positions and indices, so another scene at the same address uploads its own.
+std::shared_ptr<GpuGeometry> GlBaker::sharedGeometry(bool seeThroughOnly) {
+  Checksum64 sum;
+  for (const Primitive& p : in_.scene.primitives) {
+    sum.add(p.positions.data(), p.positions.size() * sizeof(glm::vec3));
+    sum.add(p.indices.data(), p.indices.size() * sizeof(uint32_t));
+  }
+  char key[96];
+  std::snprintf(key, sizeof key, "gl.geometry.%p.%s.%d.%s", static_cast<const void*>(&in_.scene), sum.hex().c_str(),
+                opt_.clusterTriangles, seeThroughOnly ? "see-through" : "opaque");
+  std::shared_ptr<void>& slot = context_.resource(key);
+  if (!slot) {
+    Stopwatch watch;
+    auto g = std::make_shared<GpuGeometry>();
+    uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *g, seeThroughOnly);
+    slot = g;
+    stats_.geometrySeconds += watch.seconds();
+  }
+  return std::static_pointer_cast<GpuGeometry>(slot);
 }
 
 // Depth-only views: depth test and writes, no blending (punctual maps scissor in drawView; VPL faces clip).
@@ -291,6 +320,7 @@ void GlBaker::bakeDirect(const Light& light) {
   depthProgram_->use();
   glBindVertexArray(geometry_->vao);
   shadowPassState();
+  gpuTimer_.begin(&stats_.gpuShadowSeconds);
   if (cube) {
     maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D_ARRAY, opt_.pointFaceSize, kFaces);
     const VplFrame identity{glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
@@ -332,6 +362,7 @@ void GlBaker::bakeDirect(const Light& light) {
   }
   finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
 
+  gpuTimer_.begin(&stats_.gpuAccumulateSeconds);
   lightMapPassState();  // blended: added to the VPL partial sums not yet folded
   directProgram_->use();
   const GlProgram& p = *directProgram_;
@@ -363,6 +394,7 @@ void GlBaker::bakeDirect(const Light& light) {
     glUniform1i(p.uniform("layers"), page->samples->supersample * page->samples->supersample);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
+  gpuTimer_.end();
   finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
 }
 
@@ -419,14 +451,11 @@ std::vector<Lightmap> GlBaker::run() {
   scale_.constantBias = opt_.constantBiasScale * diagonal;
   scale_.originOffset = std::max(in_.rayTracer.epsilon(), scale_.constantBias);
 
-  geometry_ = std::make_unique<GpuGeometry>();
-  uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *geometry_);
+  geometry_ = sharedGeometry(false);
   drawing_ = geometry_.get();
   if (contactFlags() && std::any_of(in_.scene.primitives.begin(), in_.scene.primitives.end(),
-                                    [&](const Primitive& p) { return seeThrough(in_.scene, p); })) {
-    seeThroughGeometry_ = std::make_unique<GpuGeometry>();
-    uploadGeometry(in_.scene, std::max(1, opt_.clusterTriangles), *seeThroughGeometry_, true);
-  }
+                                    [&](const Primitive& p) { return seeThrough(in_.scene, p); }))
+    seeThroughGeometry_ = sharedGeometry(true);
   for (const TexelSamples& s : in_.texels)
     pages_.push_back(std::make_unique<GpuPage>(s, in_.scene, opt_.skipInvalidTexels, directional()));
 
@@ -494,15 +523,20 @@ std::vector<Lightmap> GlBaker::run() {
     for (size_t first = 0; first < vplCount; first += vplsPerPass) {
       const size_t count = std::min<size_t>(vplsPerPass, vplCount - first);
       shadowPassState();
+      gpuTimer_.begin(&stats_.gpuShadowSeconds);
       renderVplBatch(first, count, atlas);
       finishStage(stats_.shadowSeconds, sw, &stats_.shadowCpuSeconds);
       lightMapPassState();
+      gpuTimer_.begin(&stats_.gpuAccumulateSeconds);
       accumulateVplBatch(first, count, atlas);
+      gpuTimer_.end();
       finishStage(stats_.accumulateSeconds, sw, &stats_.accumulateCpuSeconds);
       ++stats_.passes;
       stats_.vpls += count;
       if (++passesSinceFold >= std::max(1, opt_.foldEveryPasses)) {
+        gpuTimer_.begin(&stats_.gpuFoldSeconds);
         for (auto& page : pages_) page->fold();
+        gpuTimer_.end();
         passesSinceFold = 0;
         finishStage(stats_.foldSeconds, sw);
       }
@@ -515,11 +549,16 @@ std::vector<Lightmap> GlBaker::run() {
     if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * vplsPerPass) / std::max<size_t>(1, totalWork));
   }
   sw.reset();
+  gpuTimer_.begin(&stats_.gpuFoldSeconds);
   for (auto& page : pages_) page->fold();
+  gpuTimer_.end();
   checkGlError("GL backend passes");
   finishStage(stats_.foldSeconds, sw);
+  gpuTimer_.resolve();
 
+  Stopwatch readWatch;
   std::vector<Lightmap> maps = readMaps();
+  stats_.readSeconds += readWatch.seconds();
   if (in_.progress) in_.progress("gl", 1.0);
   return maps;
 }
@@ -572,11 +611,12 @@ std::vector<Lightmap> GlEvaluator::evaluate(const BakeInputs& inputs, const Eval
   std::vector<Lightmap> maps;
   std::vector<std::vector<uint8_t>> contact;
   {
-    GlBaker baker(inputs, options_, request, stats, ctx->programs());
+    GlBaker baker(inputs, options_, request, stats, *ctx);
     maps = baker.run();
     contact = baker.contactTexels();
   }
   stats.setupSeconds += contextSeconds;
+  ++stats.calls;
   if (options_.resolveContacts) resolveContactTexels(*contacts_, inputs, contact, maps, request.directional, stats);
   stats_->add(stats);
   return maps;

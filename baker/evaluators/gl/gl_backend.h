@@ -24,6 +24,13 @@ struct GlBakeStats {
   double shadowSeconds = 0.0;    // VPL depth cubes and punctual shadow maps
   double accumulateSeconds = 0.0;// accumulation passes (VPLs and direct lights)
   double foldSeconds = 0.0;      // read-backs into the double accumulators
+  double geometrySeconds = 0.0;  // scene geometry sorted, clustered and uploaded (once per context and scene)
+  double readSeconds = 0.0;      // the double sums turned into maps
+  // GPU elapsed time (GL_TIME_ELAPSED) of the same stages' commands, with GlBackendOptions::gpuTimers.
+  double gpuShadowSeconds = 0.0;
+  double gpuAccumulateSeconds = 0.0;
+  double gpuFoldSeconds = 0.0;
+  size_t calls = 0;              // evaluator calls (interleaved sampling makes n² + 1)
   double shadowCpuSeconds = 0.0;     // process CPU time (all llvmpipe threads) in the shadow stage
   double accumulateCpuSeconds = 0.0; // process CPU time in the accumulation stage (load-independent figures)
   int cubeFaceSize = 0;          // VPL depth-cube face size used (the largest over calls after add)
@@ -47,7 +54,10 @@ struct GlBakeStats {
   nlohmann::json timingsJson() const {
     return {{"setupSeconds", setupSeconds},           {"shadowSeconds", shadowSeconds},
             {"accumulateSeconds", accumulateSeconds}, {"foldSeconds", foldSeconds},
-            {"contactSeconds", contactSeconds}};
+            {"contactSeconds", contactSeconds},       {"geometrySeconds", geometrySeconds},
+            {"readSeconds", readSeconds},             {"gpuShadowSeconds", gpuShadowSeconds},
+            {"gpuAccumulateSeconds", gpuAccumulateSeconds}, {"gpuFoldSeconds", gpuFoldSeconds},
+            {"calls", calls}};
   }
   // The counts toJson() reports back from a partial (a merge adds its shards' counts).
   void addCounts(const nlohmann::json& j) {
@@ -65,6 +75,12 @@ struct GlBakeStats {
     shadowSeconds += o.shadowSeconds;
     accumulateSeconds += o.accumulateSeconds;
     foldSeconds += o.foldSeconds;
+    geometrySeconds += o.geometrySeconds;
+    readSeconds += o.readSeconds;
+    gpuShadowSeconds += o.gpuShadowSeconds;
+    gpuAccumulateSeconds += o.gpuAccumulateSeconds;
+    gpuFoldSeconds += o.gpuFoldSeconds;
+    calls += o.calls;
     shadowCpuSeconds += o.shadowCpuSeconds;
     accumulateCpuSeconds += o.accumulateCpuSeconds;
     cubeFaceSize = std::max(cubeFaceSize, o.cubeFaceSize);
@@ -107,6 +123,7 @@ struct GlBackendOptions {
   bool resolveContacts = true;
   float contactLeakFraction = 0.01f;
   bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
+  bool gpuTimers = false;        // GL_TIME_ELAPSED queries per pass kind (GlBakeStats::gpu*Seconds)
   const GlContext* context = nullptr;  // an existing context, made current per call; null: one made per call
   GlBakeStats* stats = nullptr;  // where every call's figures are added (null: the evaluator keeps its own)
 };
