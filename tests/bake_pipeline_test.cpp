@@ -155,27 +155,35 @@ TEST(BakePipeline, HighAlbedoFurnacesWithDefaultOptionsOnBothBackends) {
 }
 
 // Corners and edges of the white furnace (ρ = 0.9, Le = 0.1: map 1 everywhere) at the command's defaults, the
-// final gather included (auto: emitters cover the surface), on both backends: the texels along edges and in
-// corners, where the VPL sum is grainiest, stay close to 1.
+// final gather included (auto: emitters cover the surface), on both backends: every texel, those along the
+// edges and in the corners included, within 3% of 1 and the 99th percentile within 1.5%. The default bake's
+// proportions on a budget of seconds: its 3072 paths and one 1024² page become 512 paths and a 418² page (1/6
+// of each), which keeps the texel spacing against the clamp radius, and with it the automatic 4×4 interleave,
+// whose class mix is one-sided at the chart borders where the clamped VPL sum rises steeply off each edge (the
+// compensation's residual, mixed alike, makes it up: ClampCompensationOptions::classMix).
 TEST(BakePipeline, FurnaceCornersAndEdgesAtDefaults) {
   for (BackendKind backend : {BackendKind::Gl, BackendKind::Embree}) {
     BakeOptions o;
     o.backend = backend;
     o.finalGather = FinalGatherMode::Auto;
-    o.atlas.texelsPerUnit = 24.0f;
+    o.walk.paths = 512;
+    o.atlas.targetPageSize = 418;  // texelsPerUnit left automatic
     BakeResult r = bake(samples::makeFurnace(0.9f, 0.1f), o);
     ASSERT_TRUE(r.report.contains("finalGather"));
+    EXPECT_EQ(r.report["plan"]["interleave"]["value"].get<int>(), 4) << toString(backend);
     std::vector<double> deviation;
     for (const auto& m : r.maps)
       for (size_t i = 0; i < m.size(); ++i)
         if (m.valid[i]) deviation.push_back(std::abs(channelMean(m.texels[i]) - 1.0));
-    ASSERT_GT(deviation.size(), 1000u);
+    ASSERT_GT(deviation.size(), 100000u);
     std::sort(deviation.begin(), deviation.end());
     const double p99 = deviation[deviation.size() * 99 / 100], worst = deviation.back();
-    std::printf("[ figure ] furnace rho 0.9 %s, defaults: %zu texels, p99 |map - 1| %.2f%%, worst %.2f%%\n",
-                toString(backend), deviation.size(), 100 * p99, 100 * worst);
-    EXPECT_LT(p99, 0.015) << toString(backend);
-    EXPECT_LT(worst, 0.03) << toString(backend);
+    std::printf("[ figure ] furnace rho 0.9 %s, defaults at 1/6 scale: %zu texels, %.1f texels/m, p99 |map - 1| %.2f%%, "
+                "worst %.2f%%\n",
+                toString(backend), deviation.size(), r.report["plan"]["texels-per-unit"]["value"].get<double>(), 100 * p99,
+                100 * worst);
+    EXPECT_LE(p99, 0.015) << toString(backend);
+    EXPECT_LE(worst, 0.03) << toString(backend);
   }
 }
 

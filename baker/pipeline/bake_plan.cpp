@@ -225,6 +225,7 @@ void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<
   plan.interleave = options.interleave ? *options.interleave : chooseInterleave(texels, plan.eval.clampBound, filters);
   plan.settle("interleave", plan.interleave,
               options.interleave ? "asked for" : "from the texel spacing and the clamp radius", !options.interleave);
+  plan.compensation.classMix = plan.interleave;  // the residual mixed like the classes' VPL sum it completes
   if (plan.backend != BackendKind::Gl || plan.gl.cubeFaceSize) return;
   // Once for every block, from the first class's pages.
   plan.gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), plan.eval.clampBound, plan.gl.cubeFootprintPerTexel,

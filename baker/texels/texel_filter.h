@@ -26,6 +26,18 @@ struct TexelFilterOptions {
                                 // texel class (x mod n, y mod n) gets the same total weight
 };
 
+// The interleave's class mix (n×n texel classes, stages/interleave): a tent of half-width n (radius n − 1), not
+// symmetric, so that every class keeps its share of the window where a chart border cuts it. The clamp
+// compensation's residual, the complement of the clamped VPL sum, gets the same window (the sum they make is
+// smooth where each alone is steep: near concave edges and contacts). n ≤ 1: radius 0 (no mix).
+inline TexelFilterOptions classMixFilter(int n) {
+  TexelFilterOptions o;
+  o.radius = n > 1 ? n - 1 : 0;
+  o.tent = true;
+  o.symmetric = false;
+  return o;
+}
+
 // The filter over one page: each texel's mean position and normal (over its S×S samples) and the page's
 // texel spacing, computed once, so one page can be filtered many times (the compensation's sweeps).
 class SurfaceFilter {

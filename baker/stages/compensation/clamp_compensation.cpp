@@ -290,6 +290,16 @@ void gatherSlotResiduals(const std::vector<Tile>& tiles, const std::vector<Packe
   });
 }
 
+// A sweep's residual per texel as the map adds it: filtered (radius 0: not), then mixed like the interleave's
+// classes (classMix > 1).
+std::vector<glm::vec3> filteredResidual(SurfaceFilterCache& filters, const TexelSamples& ts,
+                                        const std::vector<glm::vec3>& residual, const std::vector<uint8_t>& valid,
+                                        const TexelFilterOptions& filter, int classMix) {
+  std::vector<glm::vec3> out = filter.radius > 0 ? filters.apply(ts, residual, valid, filter) : residual;
+  if (classMix > 1) out = filters.apply(ts, out, valid, classMixFilter(classMix));
+  return out;
+}
+
 // current = map + filter(current − map) on the valid texels: the residual filtered once, after the sweeps.
 void filterResidual(const Lightmap& map, std::vector<glm::vec3>& current, SurfaceFilterCache& filters,
                     const TexelSamples& texels, const TexelFilterOptions& options) {
@@ -373,10 +383,9 @@ void ClampGather::apply(std::vector<Lightmap>& maps, ClampCompensationStats* sta
       tbb::parallel_for(size_t(0), layer, [&](size_t t) {
         if (t < m.valid.size() && m.valid[t]) texelMean(ts, t, [&](size_t s) { return slotResidual[p][s]; }, residual[t]);
       });
-      std::vector<glm::vec3> filtered;
-      const bool filterNow = radii[p] > 0 && options.filterEachSweep;
-      if (filterNow) filtered = g.filters()->apply(ts, residual, m.valid, filterOptions[p]);
-      const std::vector<glm::vec3>& residualUsed = filterNow ? filtered : residual;
+      const TexelFilterOptions noFilter{0};
+      const std::vector<glm::vec3> residualUsed = filteredResidual(
+          *g.filters(), ts, residual, m.valid, options.filterEachSweep ? filterOptions[p] : noFilter, options.classMix);
       const std::vector<glm::vec3>& baseMap = base(p);
       for (size_t t = 0; t < layer; ++t) {
         if (t < m.valid.size() && m.valid[t]) {
@@ -475,11 +484,12 @@ void ClampGather::applyDirectional(const std::vector<Lightmap>& maps, L1Pages& a
           texelMean(ts, t, [&](size_t s) { return slotVector[k][p][s]; }, texelVector[k][t]);
       });
     }
-    if (g.radii[p] > 0) {  // the residual's filter, all three axes in one pass
-      TexelFilterOptions fo;
-      fo.radius = g.radii[p];
+    TexelFilterOptions fo;
+    fo.radius = g.radii[p];
+    for (const TexelFilterOptions& f : {fo, classMixFilter(g.options.classMix)}) {  // the map's filter, then its mix
+      if (f.radius <= 0) continue;
       std::vector<std::vector<glm::vec3>> filtered =
-          g.filters()->apply(in.texels[p], {&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, fo);
+          g.filters()->apply(in.texels[p], {&texelVector[0], &texelVector[1], &texelVector[2]}, m.valid, f);
       for (int k = 0; k < 3; ++k) texelVector[k] = std::move(filtered[k]);
     }
     for (int k = 0; k < 3; ++k) {

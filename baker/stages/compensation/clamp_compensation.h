@@ -53,6 +53,9 @@ struct ClampCompensationOptions {
   bool extrapolateTail = true;   // once the sweeps' ratio settles, add the remaining sweeps as a geometric tail
   bool filterEachSweep = true;   // false: the summed residual filtered once, after the last sweep (the pipeline's
                                  // choice with the final gather, whose rays and windows average this map again)
+  int classMix = 1;            // the interleave's n: each sweep's residual mixed like the n×n classes' VPL sum
+                               // (texel_filter.h, classMixFilter), so a border texel's one-sided window averages the
+                               // smooth sum of both, not the clamped part's steep rise off a concave edge; 1: none
   uint32_t seed = 0;           // rotates the per-sample ray lattices (deterministic per seed)
   bool directional = false;    // keep each kept hit's direction for applyDirectional (12 bytes a hit)
 };

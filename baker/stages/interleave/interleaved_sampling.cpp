@@ -104,12 +104,10 @@ void addMixedClasses(const TexelSamples& page, int n, const std::vector<const st
                      SurfaceFilterCache* filters) {
   std::vector<std::vector<glm::vec3>> mixed;
   if (n > 1) {
-    TexelFilterOptions fo;
-    fo.radius = n - 1;
-    fo.tent = true;
-    fo.symmetric = false;  // here every class must keep its share of the window, which mirror pairs do not
-                           // (they bias the page border)
-    mixed = filterOnSurface(filters, page, vplParts, vplValid, fo);
+    // Every class must keep its share of the window, which mirror pairs do not (they bias the page border); the
+    // one-sided window this leaves at a border reads the clamped sum's inner side, which the compensation's
+    // residual, mixed alike, makes up (ClampCompensationOptions::classMix).
+    mixed = filterOnSurface(filters, page, vplParts, vplValid, classMixFilter(n));
   }
   for (size_t c = 0; c < maps.size() && c < vplParts.size(); ++c) {
     const std::vector<glm::vec3>& added = n > 1 ? mixed[c] : *vplParts[c];
