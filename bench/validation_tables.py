@@ -71,6 +71,7 @@ def latest(rows, key):
 
 
 SCENES = {
+    "cycles_cornell_published.csv": "Cornell published",
     "cycles_cornell_sample.csv": "Cornell sample",
     "cycles_mcguire_cornell.csv": "McGuire Cornell",
     "cycles_sponza_sun_x4.csv": "Sponza, sun",
@@ -82,6 +83,8 @@ SCENES = {
 def cycles_rows(files, modes=("map", "view")):
     out = []
     for name in files:
+        if not os.path.isfile(os.path.join(RESULTS, name)):  # a scene not yet measured
+            continue
         rows = [r for r in read(name) if r["mode"] in modes and default_options(r["our_options"])]
         current = latest(rows, lambda r: (r["mode"], r["view"], seed_of(r["our_options"])))
         for r in sorted(current, key=lambda r: (int(seed_of(r["our_options"])), r["mode"], r["view"])):
@@ -96,7 +99,24 @@ def cycles_rows(files, modes=("map", "view")):
 
 
 def t_cycles_cornell():
-    return cycles_rows(["cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv"])
+    return cycles_rows(["cycles_cornell_published.csv", "cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv"])
+
+
+def t_seed_spread():
+    """bench/seed_spread.py: per scene and options, the latest run's seeds against each other."""
+    rows = read("seed_spread.csv")
+    summaries = latest([r for r in rows if r["seed"] == "all"], lambda r: (r["scene"], r["options"]))
+    out = []
+    for sm in summaries:
+        per = [r for r in rows if r["seed"] != "all" and r["date"] == sm["date"] and r["scene"] == sm["scene"]
+               and r["options"] == sm["options"]]
+        ratios = [float(r["total_ratio"]) for r in per]
+        noise = [float(r["seed_noise_4"]) for r in per]
+        out.append([sm["scene"], f"`{sm['options']}`" if sm["options"] else "default", f"`{sm['commit']}`", len(per),
+                    f"{min(ratios):.4f} … {max(ratios):.4f}", f"**{pct(sm['spread'])}**", pct(sm["noise_rms"]),
+                    pct(max(noise)), num(sm["wall_s"], 1), num(sm["load_1min"], 1)])
+    return table(["scene", "options", "baker", "seeds", "total / seeds' mean", "spread of the total",
+                  "seed noise 4×4, RMS", "worst seed", "median wall (s)", "1-min load (largest)"], out)
 
 
 def t_cycles_sponza():

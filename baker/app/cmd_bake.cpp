@@ -168,8 +168,9 @@ void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
                   "else embree; embree: ray-traced; reference: path traced)")
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
   app->add_option("--paths,--vpls", a.paths,
-                  "light paths of the quasi-random walk (default auto: by --quality;\n" + shown(q.paths) + ", or " +
-                      shown(q.pathsUnderGather) + " where the final gather runs, which reads their map averaged)")
+                  "light paths of the quasi-random walk (default auto: by --quality;\n" + shown(q.pathsUnderGather) +
+                      " (the final gather reads their map averaged; without it they fork past bounce 1),\n" +
+                      "or " + shown(q.paths) + " with --walk-split N and no final gather)")
       ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
       ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
@@ -177,7 +178,8 @@ void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
                   "paths fork into N where they leave bounce 1, each child carrying 1/N\n"
                   "(default auto: 1/(share of that light meeting the scene again), at most " +
                       shown(d.walk.maxAutoSplit) + ";\n"
-                  "1 in closed scenes; 1 = Keller's plain walk)")
+                  "1 in closed scenes, but at least 4 where the final gather does not run;\n"
+                  "1 = Keller's plain walk)")
       ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
   app->add_option("--vpl-importance", a.vplImportance,
                   "importance-driven VPLs: the walk places F times the VPLs and --vpl-keep of\n"

@@ -206,7 +206,10 @@ struct StagedBake::State {
                   options.walk.maxBounces ? "asked for" : "until the light not yet placed is negligible, the rest added as a tail",
                   !options.walk.maxBounces);
       plan.settle("walk-split", vpls.split,
-                  options.walk.split ? "asked for" : "from the share of bounce-1 light that meets the scene again",
+                  options.walk.split ? "asked for"
+                  : plan.walk.minAutoSplit > 1 && vpls.split == plan.walk.minAutoSplit
+                      ? "at least " + std::to_string(plan.walk.minAutoSplit) + " without the final gather: the deep bounces' carriers"
+                      : std::string("from the share of bounce-1 light that meets the scene again"),
                   !options.walk.split);
     }
     if (plan.importanceFactor > 1.0)

@@ -90,16 +90,27 @@ void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& op
   plan.settle("final-gather", onOff(plan.finalGather), reason, options.finalGather == FinalGatherMode::Auto);
 }
 
+// The auto walk split's least children per path where the final gather does not run (docs/units.md, "The
+// walk's random numbers and the split past bounce 1"); the paths are then the preset's reduced ones, as under
+// the gather, so the VPL count (and with it the clamp and the interleave) stays near the plain walk's.
+constexpr int kMinSplitWithoutGather = 4;
+
 // The walk's paths: finalGatherPaths where the final gather runs (it reads their map averaged).
 void settleWalk(BakePlan& plan, const BakeOptions& options) {
   plan.walk = options.walk;
-  const bool underGather = plan.finalGather && options.finalGatherPaths;
-  if (underGather) plan.walk.paths = *options.finalGatherPaths;
+  // Without the final gather the VPL sum is the map's bounced light, and its seed-to-seed noise is the deep
+  // bounces' few carriers (M_j = N ρ̄^j paths): they fork past bounce 1 even in a closed scene.
+  const bool splitDeep = !plan.finalGather && !options.walk.split;
+  if (splitDeep) plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
   // finalGatherPaths is set where the paths were left to the quality preset.
   const bool automatic = options.finalGatherPaths.has_value();
+  const bool underGather = plan.finalGather && automatic;
+  if (automatic && (underGather || splitDeep)) plan.walk.paths = *options.finalGatherPaths;
   plan.settle("paths", plan.walk.paths,
               !automatic   ? "asked for"
               : underGather ? "the preset's paths under the final gather, which reads their map averaged"
+              : splitDeep   ? "the preset's reduced paths: past bounce 1 each forks into at least " +
+                                std::to_string(kMinSplitWithoutGather)
                             : "the preset's paths",
               automatic);
 }

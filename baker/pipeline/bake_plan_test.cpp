@@ -28,15 +28,17 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
   const RayTracer rtEmissive(emissive);
   const BakePlan withEmitter = planBake(emissive, rtEmissive, autoOptions(), softwareGl);
   EXPECT_FALSE(withEmitter.finalGather);
-  EXPECT_EQ(withEmitter.walk.paths, 4096);
+  EXPECT_EQ(withEmitter.walk.paths, 3072);  // the preset's reduced paths: the deep bounces fork 4 ways instead
   EXPECT_EQ(withEmitter.compensation.refineRays, autoOptions().compensation.refineRays);
   EXPECT_EQ(withEmitter.backend, BackendKind::Gl);  // 32 triangles, no see-through material
+  EXPECT_EQ(withEmitter.walk.minAutoSplit, 4);  // the VPL sum is the map's bounced light: deep bounces fork
 
   const Scene lamp = makeCorner();  // a spot light, no emitter
   const RayTracer rtLamp(lamp);
   const BakePlan gathered = planBake(lamp, rtLamp, autoOptions(), softwareGl);
   EXPECT_TRUE(gathered.finalGather);
   EXPECT_EQ(gathered.walk.paths, 3072);         // the preset's paths under the gather
+  EXPECT_EQ(gathered.walk.minAutoSplit, 1);     // the gather reads their map averaged: the walk's own split rule
   EXPECT_EQ(gathered.compensation.refineRays, 0);  // the gather replaces the residual at the texel
   EXPECT_LE(gathered.compensation.minRays, 2);
   EXPECT_FALSE(gathered.compensation.filterEachSweep);

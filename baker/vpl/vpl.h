@@ -32,6 +32,8 @@ struct WalkOptions {
   std::optional<int> split;      // paths fork into this many where they leave bounce 1 (unset: auto, from the
                                  // share of bounce-1 light that meets the scene again; 1 = Keller's walk)
   int maxAutoSplit = 4;          // auto: at most this many children per path (more cost time for no less error)
+  int minAutoSplit = 1;          // auto: at least this many (the bake plan raises it where the VPL sum is the map's
+                                 // bounced light: the deep bounces' few carriers are the seed-to-seed noise there)
   uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };

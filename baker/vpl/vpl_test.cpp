@@ -300,6 +300,16 @@ TEST(Walk, SplitPathsKeepEveryBouncesEnergyExact) {
   const VplSet autoSet = generateVpls(s, rt, o);
   EXPECT_EQ(autoSet.split, 1);
   EXPECT_NEAR(autoSet.rehitFraction, 1.0, 0.02);
+  // A least auto split (the bake plan's without the final gather) forks the closed room's paths too, with
+  // every bounce's energy still exact.
+  o.minAutoSplit = 2;
+  const VplSet least = generateVpls(s, rt, o);
+  EXPECT_EQ(least.split, 2);
+  for (int j = 0; j <= least.bounces && j <= 5; ++j) {
+    const size_t m = static_cast<size_t>(std::floor(1000 * std::pow(0.6, j) + 1e-9));
+    EXPECT_EQ(least.countPerBounce[j], j >= 2 ? 2 * m : m) << "bounce " << j;
+    EXPECT_NEAR(least.powerPerBounce[j].x, Phi * std::pow(0.6, j), 1e-5 * Phi) << "bounce " << j;
+  }
 }
 
 // In an open court the auto split is 1 / (share of bounce-1 light meeting the scene again), and the split

@@ -408,7 +408,9 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
     out.rehitFraction = v1 > 0 ? (static_cast<double>(v2) * static_cast<double>(survivors[1])) /
                                      (static_cast<double>(v1) * static_cast<double>(survivors[2]))
                                : 1.0;
-    split = std::clamp(static_cast<int>(std::floor(1.0 / std::max(out.rehitFraction, 1e-6))), 1, options.maxAutoSplit);
+    const int least = std::max(1, options.minAutoSplit);
+    split = std::clamp(static_cast<int>(std::floor(1.0 / std::max(out.rehitFraction, 1e-6))), least,
+                       std::max(least, options.maxAutoSplit));
     if (split > 1) walk(split, true);
   }
   out.split = split;

@@ -3,6 +3,7 @@
 
 usage (from the repository root):
   /usr/bin/python3 bench/cycles/scenes.py mcguire OUTDIR   -> OUTDIR/mcguire_cornell.gltf + .bin
+  /usr/bin/python3 bench/cycles/scenes.py cornell_published OUTDIR -> OUTDIR/cornell_published.gltf + .bin
   /usr/bin/python3 bench/cycles/scenes.py sponza  OUTDIR   -> OUTDIR/sponza_sun.glb (+ OUTDIR/textures link)
                                                            and OUTDIR/sponza_sun_x4.glb (+ OUTDIR/textures_x4/)
   /usr/bin/python3 bench/cycles/scenes.py sibenik OUTDIR   -> OUTDIR/sibenik/sibenik_lamp.glb (+ its textures link)
@@ -18,6 +19,9 @@ mcguire: CornellBox-Original.obj/.mtl (McGuire archive) -> one glTF material per
   are split into two triangles (fan 0-1-2, 0-2-3; the OBJ's winding is kept, so the light faces down), no
   NORMAL (flat). Camera: the classic view into the open side, eye (0, 1, 3.94), target (0, 1, 0),
   yfov 39.3 degrees, aspect 1.
+cornell_published: the Cornell box from the Cornell University Program of Computer Graphics' published data
+  (geometry, reflectance and emission spectra; no input file: the data are in cornell_published.py, which
+  states the source and the spectrum -> RGB conversion). Light 0.1 mm under the ceiling, facing down.
 sponza: dabrovic_sponza/sponza.glb with KHR_materials_pbrSpecularGlossiness stripped (Blender 3.4 would
   build node trees from it that cycles_render.py cannot turn into Lambert; irbake ignores it), plus a
   KHR_lights_punctual directional light travelling along (0.35, -1, 0.2) normalised with intensity 5
@@ -132,6 +136,67 @@ def write_atomic(path, data):
     os.replace(tmp, path)
 
 
+def lambert_material(name, kd, ke=(0, 0, 0), note=None):
+    """A glTF material: base colour kd; an emitter when ke > 0 (factor ke / max(ke), strength max(ke))."""
+    mat = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(kd) + [1.0], "metallicFactor": 0.0,
+                                                   "roughnessFactor": 1.0}}
+    if note:
+        mat["extras"] = {"note": note}
+    if max(ke) > 0:
+        s = max(ke)
+        mat["emissiveFactor"] = [k / s for k in ke]
+        mat["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": s}}
+    return mat
+
+
+def write_polygon_scene(out, stem, groups, materials, camera, generator):
+    """OUT/stem.gltf + .bin: one mesh per (name, polygons, material index) group, each polygon a triangle
+    fan over its own corners (its winding kept, no NORMAL: flat); camera = (eye, target, yfov degrees)."""
+    blob, accessors, views, meshes, nodes = bytearray(), [], [], [], []
+    for name, polys, mat in groups:
+        pos, ind = [], []
+        for poly in polys:
+            b = len(pos)
+            pos += poly
+            for k in range(1, len(poly) - 1):
+                ind += [b, b + k, b + k + 1]
+        off = len(blob)
+        for p in pos:
+            blob += struct.pack("<3f", *p)
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": 12 * len(pos), "target": 34962})
+        lo = [min(p[i] for p in pos) for i in range(3)]
+        hi = [max(p[i] for p in pos) for i in range(3)]
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": len(pos), "type": "VEC3",
+                          "min": lo, "max": hi})
+        off = len(blob)
+        for j in ind:
+            blob += struct.pack("<H", j)
+        blob += b"\0" * ((4 - len(blob) % 4) % 4)
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": 2 * len(ind), "target": 34963})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5123, "count": len(ind), "type": "SCALAR"})
+        meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                                     "indices": len(accessors) - 1, "material": mat, "mode": 4}]})
+        nodes.append({"name": name, "mesh": len(meshes) - 1})
+    eye, target, yfov = camera
+    nodes.append({"name": "camera", "camera": 0, "translation": list(eye), "rotation": list(look_at_quat(eye, target))})
+    doc = {
+        "asset": {"version": "2.0", "generator": generator},
+        "extensionsUsed": ["KHR_materials_emissive_strength"],
+        "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
+        "materials": materials, "accessors": accessors, "bufferViews": views,
+        "buffers": [{"uri": stem + ".bin", "byteLength": len(blob)}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": math.radians(yfov), "aspectRatio": 1.0,
+                                                             "znear": 0.01, "zfar": 100.0}}],
+    }
+    os.makedirs(out, exist_ok=True)
+    write_atomic(os.path.join(out, stem + ".bin"), bytes(blob))
+    path = os.path.join(out, stem + ".gltf")
+    write_atomic(path, json.dumps(doc, indent=1).encode())
+    print("wrote", path, "(%d triangles, %d materials)" % (sum(len(p) - 2 for _, g, _ in groups for p in g),
+                                                          len(materials)))
+    return path
+
+
 def parse_mtl(path):
     mats, cur = {}, None
     for line in open(path):
@@ -168,7 +233,7 @@ def build_mcguire(shared, out):
             idx = [int(x.split("/")[0]) for x in t[1:]]
             idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
             groups[cur].append([verts[i] for i in idx])  # one polygon, its corners shared by its triangles
-    blob, accessors, views, meshes, materials, nodes = bytearray(), [], [], [], [], []
+    materials = []
     for name in order:
         m = mats.get(name)
         if m is None:
@@ -177,57 +242,10 @@ def build_mcguire(shared, out):
         note = None
         if max(kd) == 0 and max(m.get("Ks", (0, 0, 0))) > 0:
             kd, note = m["Ks"], "MTL Kd = 0, Ks = %s: made diffuse with the Ks white" % (m["Ks"],)
-        mat = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(kd) + [1.0], "metallicFactor": 0.0,
-                                                       "roughnessFactor": 1.0}}
-        if note:
-            mat["extras"] = {"note": note}
-        ke = m.get("Ke", (0, 0, 0))
-        if max(ke) > 0:
-            s = max(ke)
-            mat["emissiveFactor"] = [k / s for k in ke]
-            mat["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": s}}
-        materials.append(mat)
-        pos, ind = [], []
-        for poly in groups[name]:
-            b = len(pos)
-            pos += poly
-            for k in range(1, len(poly) - 1):
-                ind += [b, b + k, b + k + 1]
-        off = len(blob)
-        for p in pos:
-            blob += struct.pack("<3f", *p)
-        views.append({"buffer": 0, "byteOffset": off, "byteLength": 12 * len(pos), "target": 34962})
-        lo = [min(p[i] for p in pos) for i in range(3)]
-        hi = [max(p[i] for p in pos) for i in range(3)]
-        accessors.append({"bufferView": len(views) - 1, "componentType": 5126, "count": len(pos), "type": "VEC3",
-                          "min": lo, "max": hi})
-        off = len(blob)
-        for i in ind:
-            blob += struct.pack("<H", i)
-        blob += b"\0" * ((4 - len(blob) % 4) % 4)
-        views.append({"buffer": 0, "byteOffset": off, "byteLength": 2 * len(ind), "target": 34963})
-        accessors.append({"bufferView": len(views) - 1, "componentType": 5123, "count": len(ind), "type": "SCALAR"})
-        meshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 2},
-                                                     "indices": len(accessors) - 1,
-                                                     "material": len(materials) - 1, "mode": 4}]})
-        nodes.append({"name": name, "mesh": len(meshes) - 1})
-    eye, target = (0.0, 1.0, 3.94), (0.0, 1.0, 0.0)
-    nodes.append({"name": "camera", "camera": 0, "translation": list(eye), "rotation": list(look_at_quat(eye, target))})
-    doc = {
-        "asset": {"version": "2.0", "generator": "irbake bench/cycles/scenes.py (from CornellBox-Original.obj)"},
-        "extensionsUsed": ["KHR_materials_emissive_strength"],
-        "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
-        "materials": materials, "accessors": accessors, "bufferViews": views,
-        "buffers": [{"uri": "mcguire_cornell.bin", "byteLength": len(blob)}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": math.radians(39.3), "aspectRatio": 1.0,
-                                                             "znear": 0.01, "zfar": 100.0}}],
-    }
-    os.makedirs(out, exist_ok=True)
-    write_atomic(os.path.join(out, "mcguire_cornell.bin"), bytes(blob))
-    path = os.path.join(out, "mcguire_cornell.gltf")
-    write_atomic(path, json.dumps(doc, indent=1).encode())
-    print("wrote", path, "(%d triangles, %d materials)" % (sum(len(p) - 2 for g in groups.values() for p in g),
-                                                          len(materials)))
+        materials.append(lambert_material(name, kd, m.get("Ke", (0, 0, 0)), note))
+    path = write_polygon_scene(out, "mcguire_cornell", [(name, groups[name], i) for i, name in enumerate(order)], materials,
+                               ((0.0, 1.0, 3.94), (0.0, 1.0, 0.0), 39.3),
+                               "irbake bench/cycles/scenes.py (from CornellBox-Original.obj)")
     return path
 
 
@@ -327,6 +345,19 @@ def upsample_textures(src, out, doc, scale, folder):
         img.pop("mimeType", None)
 
 
+def build_cornell_published(out):
+    import cornell_published as cp  # the published data and its RGB conversion
+    parts, mats = cp.scene_parts()
+    names = list(dict.fromkeys(m for _, m, _ in parts))
+    materials = [lambert_material(m, mats[m][0], mats[m][1]) for m in names]
+    for m in materials:
+        m["extras"] = {"note": "Cornell Box Data spectra -> linear sRGB (bench/cycles/cornell_published.py)"}
+    groups = [(name, polys, names.index(m)) for name, m, polys in parts]
+    path = write_polygon_scene(out, "cornell_published", groups, materials, cp.camera(),
+                               "irbake bench/cycles/scenes.py (Cornell Box Data, Cornell University PCG)")
+    return path
+
+
 def build_sponza(shared, out):
     src, doc, binchunk, root = read_level(shared, "dabrovic_sponza", "sponza.glb")
     add_light(doc, root, {"type": "directional", "name": "sun", "intensity": SUN_IRRADIANCE, "color": [1.0, 1.0, 1.0]},
@@ -365,10 +396,14 @@ def build_sibenik(shared, out):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("which", choices=["mcguire", "sponza", "sibenik", "all"])
+    ap.add_argument("which", choices=["mcguire", "cornell_published", "sponza", "sibenik", "all"])
     ap.add_argument("outdir")
     ap.add_argument("--shared", help="shared scenes folder (default: ../shared/scenes from the repository root)")
     args = ap.parse_args()
+    if args.which in ("cornell_published", "all"):
+        build_cornell_published(args.outdir)
+        if args.which == "cornell_published":
+            return
     shared = shared_dir(args)
     if args.which in ("mcguire", "all"):
         build_mcguire(shared, args.outdir)
