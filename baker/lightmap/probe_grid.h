@@ -76,13 +76,10 @@ struct ProbeBlend {
   float weight = 0.0f;  // their summed trilinear weight (0: none; coefficients then 0)
 };
 
-// Trilinear over the 8 probes around p (clamped to the grid), each weighted by its validity and, when
-// `visible` is given, by whether p sees the probe's baked position (a wall between them: weight 0, so light
-// never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p.
-inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
-                                    const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
-  ProbeBlend out;
-  if (g.size() == 0 || !(g.spacing > 0.0f)) return out;
+// The trilinear blend's probes around p (the cell clamped to the grid): corner(index, weight) for each of
+// the 8 with a positive weight, a one-probe axis's single layer once. Returns the cell's base corner.
+template <class Corner>
+glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corner&& corner) {
   const glm::vec3 f = (p - g.origin) / g.spacing;
   glm::ivec3 base;
   glm::vec3 t;
@@ -92,19 +89,31 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
     base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.counts[a] - 2));
     t[a] = g.counts[a] > 1 ? c - static_cast<float>(base[a]) : 0.0f;
   }
-  auto use = [&](size_t idx) { return g.valid[idx] && (!visible || visible(p, g.position(idx))); };
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::ivec3 d(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+  for (int k = 0; k < 8; ++k) {
+    const glm::ivec3 d(k & 1, (k >> 1) & 1, (k >> 2) & 1);
     const glm::ivec3 q = glm::min(base + d, g.counts - 1);
-    if (glm::any(glm::notEqual(base + d, q))) continue;  // a one-probe axis: its single layer counted once
+    if (glm::any(glm::notEqual(base + d, q))) continue;
     float w = 1.0f;
     for (int a = 0; a < 3; ++a) w *= d[a] ? t[a] : 1.0f - t[a];
-    const size_t idx = g.index(q.x, q.y, q.z);
-    if (w <= 0.0f || !use(idx)) continue;
+    if (w > 0.0f) corner(g.index(q.x, q.y, q.z), w);
+  }
+  return base;
+}
+
+// Trilinear over the 8 probes around p (clamped to the grid), each weighted by its validity and, when
+// `visible` is given, by whether p sees the probe's baked position (a wall between them: weight 0, so light
+// never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p.
+inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
+                                    const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
+  ProbeBlend out;
+  if (g.size() == 0 || !(g.spacing > 0.0f)) return out;
+  auto use = [&](size_t idx) { return g.valid[idx] && (!visible || visible(p, g.position(idx))); };
+  const glm::ivec3 base = forEachBlendCorner(g, p, [&](size_t idx, float w) {
+    if (!use(idx)) return;
     for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += w * g.coefficients[idx][k];
     out.weight += w;
     ++out.probes;
-  }
+  });
   if (out.weight > 0.0f) {
     for (auto& c : out.coefficients) c /= out.weight;
     return out;

@@ -28,27 +28,12 @@ struct FitSample {
 
 // The blend's weights at p as interpolateProbes forms them (without visibility): 0 corners when no valid probe.
 int blendWeights(const LightProbeGrid& g, const glm::vec3& p, std::array<uint32_t, 8>& idx, std::array<float, 8>& w) {
-  const glm::vec3 f = (p - g.origin) / g.spacing;
-  glm::ivec3 base;
-  glm::vec3 t;
-  for (int a = 0; a < 3; ++a) {
-    const float hi = static_cast<float>(g.counts[a] - 1);
-    const float c = std::clamp(f[a], 0.0f, hi);
-    base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.counts[a] - 2));
-    t[a] = g.counts[a] > 1 ? c - static_cast<float>(base[a]) : 0.0f;
-  }
   int n = 0;
   float total = 0.0f;
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::ivec3 d(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-    const glm::ivec3 q = glm::min(base + d, g.counts - 1);
-    if (glm::any(glm::notEqual(base + d, q))) continue;
-    float wc = 1.0f;
-    for (int a = 0; a < 3; ++a) wc *= d[a] ? t[a] : 1.0f - t[a];
-    const size_t i = g.index(q.x, q.y, q.z);
-    if (wc <= 0.0f || !g.valid[i]) continue;
+  forEachBlendCorner(g, p, [&](size_t i, float wc) {
+    if (!g.valid[i]) return;
     idx[n] = static_cast<uint32_t>(i), w[n] = wc, total += wc, ++n;
-  }
+  });
   for (int k = 0; k < n; ++k) w[k] /= total;
   return n;
 }
