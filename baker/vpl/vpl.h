@@ -34,6 +34,9 @@ struct WalkOptions {
   int maxAutoSplit = 4;          // auto: at most this many children per path (more cost time for no less error)
   int minAutoSplit = 1;          // auto: at least this many (the bake plan raises it where the VPL sum is the map's
                                  // bounced light: the deep bounces' few carriers are the seed-to-seed noise there)
+  int walkFactor = 1;            // the walk traces this many times `paths`, then each bounce is resampled
+                                 // (vpl/resample.h) to keepShare × its VPL count / walkFactor
+  std::vector<double> keepShare{1.0};  // per bounce (the last entry for the deeper ones): the share kept
   uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };
@@ -50,6 +53,7 @@ struct VplSet {
   double rehitFraction = 1.0;               // auto split: V_2 M_1 / (V_1 M_2), the share of paths leaving
                                             // bounce 1 that hit the scene again
   int bounces = 0;                          // deepest bounce generated
+  size_t walked = 0;                        // VPLs the walk left before resampling (vpl/resample.h)
   glm::dvec3 tailFactor{1.0};               // bounces ⌈J/2⌉…J carry this × their own power: with it, the
                                             // light of bounces > J, P_J r/(1−r) per channel, r the ratio of
                                             // successive bounce powers pooled over those bounces
@@ -65,7 +69,8 @@ struct VplSet {
     }
     return {{"count", vpls.size()},          {"bounces", bounces},     {"meanReflectivity", meanReflectivity},
             {"emittedPower", rgb(emittedPower)}, {"totalPower", rgb(total)}, {"perBounce", perBounce},
-            {"split", split},                {"rehitFraction", rehitFraction}, {"lightReach", lightReach}};
+            {"split", split},                {"rehitFraction", rehitFraction}, {"lightReach", lightReach},
+            {"walked", walked}};
   }
 };
 

@@ -24,6 +24,7 @@
 #include "common/error.h"
 #include "common/maths.h"
 #include "vpl/light_sources.h"
+#include "vpl/resample.h"
 #include "sampling/sampling.h"
 #include "vpl/vpl.h"
 
@@ -370,7 +371,8 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   if (sources.all.empty() || channelMean(sources.totalPower) <= 0.0) return out;
 
   // Surviving path counts M_j (fractional absorption) and the deepest bounce.
-  const uint64_t N = static_cast<uint64_t>(options.paths);
+  const int walkFactor = std::max(1, options.walkFactor);
+  const uint64_t N = static_cast<uint64_t>(options.paths) * static_cast<uint64_t>(walkFactor);
   const bool autoDepth = !options.maxBounces.has_value();
   const int cap = autoDepth ? autoBounceDepth(N, rho, options) : *options.maxBounces;
   std::vector<uint64_t> survivors{N};
@@ -416,6 +418,15 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   out.split = split;
   orderByBounce(perPath, maxBounce, out);
   if (autoDepth && options.geometricTail && out.bounces >= 1) addGeometricTail(out);
+  out.walked = out.vpls.size();
+  if (walkFactor > 1) {
+    std::vector<size_t> keep(out.countPerBounce.size());
+    for (size_t j = 0; j < keep.size(); ++j) {
+      const double share = options.keepShare.empty() ? 1.0 : options.keepShare[std::min(j, options.keepShare.size() - 1)];
+      keep[j] = static_cast<size_t>(std::ceil(share * static_cast<double>(out.countPerBounce[j]) / walkFactor - 1e-9));
+    }
+    resampleVpls(out, keep, options.seed);
+  }
   if (options.progress) options.progress("walk", 1.0);
   return out;
 }
