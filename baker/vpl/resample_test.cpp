@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sampling/sampling.h"
+#include "raytrace/ray_tracer.h"
 #include "testing/scenes.h"
 #include "vpl/resample.h"
 
@@ -97,4 +98,31 @@ TEST(VplResample, KeptVplsAreSpreadOverSpace) {
   int empty = 0;
   for (int c : cells) empty += c == 0;
   EXPECT_LE(empty, 1);  // the Morton curve's quadrants are the cells; only rounding at the cell edges can move a pick
+}
+
+// A walk of 8× the paths split 4 ways, resampled to a plain walk's counts: in a closed grey room every bounce keeps
+// exactly its energy, Φ ρ^j, on M_j = ⌊N ρ^j⌋ VPLs (the rounding of the big walk's counts aside).
+TEST(VplResample, WalkFactorKeepsAPlainWalksCountsAndEveryBouncesEnergy) {
+  Scene s;
+  addBox(s, addMaterial(s, glm::vec3(0.6f), glm::vec3(1.0f)), glm::vec3(0), glm::vec3(1), true, 2);
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 500;
+  o.geometricTail = false;
+  o.split = 4;
+  o.walkFactor = 8;
+  const VplSet set = generateVpls(s, rt, o);
+  const double Phi = set.emittedPower.x;
+  ASSERT_GE(set.bounces, 5);
+  EXPECT_GT(set.walked, 8 * 4 * 500 * 0.36);  // the big walk's bounce 2 alone
+  for (int j = 0; j <= 5; ++j) {
+    const double m = std::floor(500 * std::pow(0.6, j) + 1e-9);
+    EXPECT_NEAR(double(set.countPerBounce[j]), m, 1.0) << "bounce " << j;
+    EXPECT_NEAR(set.powerPerBounce[j].x, Phi * std::pow(0.6, j), 1e-5 * Phi) << "bounce " << j;
+  }
+  // Two VPLs per surviving path past bounce 1.
+  o.evaluatedSplit = 2;
+  const VplSet two = generateVpls(s, rt, o);
+  EXPECT_NEAR(double(two.countPerBounce[2]), 2 * std::floor(500 * 0.36 + 1e-9), 2.0);
+  EXPECT_NEAR(two.powerPerBounce[2].x, Phi * 0.36, 1e-5 * Phi);
 }

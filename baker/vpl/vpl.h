@@ -34,9 +34,10 @@ struct WalkOptions {
   int maxAutoSplit = 4;          // auto: at most this many children per path (more cost time for no less error)
   int minAutoSplit = 1;          // auto: at least this many (the bake plan raises it where the VPL sum is the map's
                                  // bounced light: the deep bounces' few carriers are the seed-to-seed noise there)
-  int walkFactor = 1;            // the walk traces this many times `paths`, then each bounce is resampled
-                                 // (vpl/resample.h) to keepShare × its VPL count / walkFactor
-  std::vector<double> keepShare{1.0};  // per bounce (the last entry for the deeper ones): the share kept
+  int walkFactor = 1;            // the walk follows this many times `paths`, then each bounce is resampled
+                                 // (vpl/resample.h) to the count a walk of `paths` would leave there
+  int evaluatedSplit = 1;        // with walkFactor > 1: VPLs kept per surviving path at bounces ≥ 2 (1: a plain
+                                 // walk's M_j, however many ways the walk split)
   uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };

@@ -420,11 +420,12 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   if (autoDepth && options.geometricTail && out.bounces >= 1) addGeometricTail(out);
   out.walked = out.vpls.size();
   if (walkFactor > 1) {
+    // Bounce j keeps V_j / walkFactor VPLs (V_j: the walk's count there), past bounce 1 also divided by the
+    // split and times evaluatedSplit: the counts a walk of `paths` would leave, escapes included.
     std::vector<size_t> keep(out.countPerBounce.size());
-    for (size_t j = 0; j < keep.size(); ++j) {
-      const double share = options.keepShare.empty() ? 1.0 : options.keepShare[std::min(j, options.keepShare.size() - 1)];
-      keep[j] = static_cast<size_t>(std::ceil(share * static_cast<double>(out.countPerBounce[j]) / walkFactor - 1e-9));
-    }
+    const double deep = static_cast<double>(std::clamp(options.evaluatedSplit, 1, split)) / split;
+    for (size_t j = 0; j < keep.size(); ++j)
+      keep[j] = static_cast<size_t>(std::ceil((j >= 2 ? deep : 1.0) * static_cast<double>(out.countPerBounce[j]) / walkFactor - 1e-9));
     resampleVpls(out, keep, options.seed);
   }
   if (options.progress) options.progress("walk", 1.0);
