@@ -55,14 +55,15 @@ TEST(BakeOptions, HelpFitsAScreenAndHelpAllListsEveryOption) {
 // Each preset sets the walk's paths and the stages' rays; an option given on its own still wins.
 TEST(BakeOptions, QualityPresetsSetPathsAndRaysAndOwnOptionsWin) {
   const fs::path dir = scratch("quality");
-  // Emitters: no final gather, so the walk forks past bounce 1 from the preset's reduced paths (docs/units.md).
+  // Emitters: no final gather, so half the preset's paths are evaluated, resampled from a walk of 8x as many that
+  // forks past bounce 1 (docs/units.md).
   const std::string scene = (samples() / "cornell_box.gltf").string();
   struct Case {
     std::vector<std::string> extra;
     int paths, compRays;
   };
-  const std::vector<Case> cases = {{{"--quality", "preview"}, 384, 4},
-                                   {{}, 3072, 16},
+  const std::vector<Case> cases = {{{"--quality", "preview"}, 256, 4},
+                                   {{}, 2048, 16},
                                    {{"--quality", "high", "--paths", "300", "--comp-rays", "3"}, 300, 3}};
   for (size_t i = 0; i < cases.size(); ++i) {
     const fs::path out = dir / std::string("o").append(std::to_string(i));  // append: GCC 12 warns falsely on "o" + string

@@ -91,28 +91,40 @@ void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& op
 }
 
 // The auto walk split's least children per path where the final gather does not run (docs/units.md, "The
-// walk's random numbers and the split past bounce 1"); the paths are then the preset's reduced ones, as under
-// the gather, so the VPL count (and with it the clamp and the interleave) stays near the plain walk's.
+// walk's random numbers and the split past bounce 1").
 constexpr int kMinSplitWithoutGather = 4;
+// There the walk also follows kWalkFactor times the evaluated paths and resamples each bounce to the count
+// of a plain walk of those (docs/units.md, "Walking more paths than are evaluated"): the bounces' totals rest
+// on the big walk, the evaluation's cost on the kept VPLs. The evaluated paths are the preset's halved.
+constexpr int kWalkFactorWithoutGather = 8;
+constexpr int kEvaluatedPathsDivisor = 2;
 
 // The walk's paths: finalGatherPaths where the final gather runs (it reads their map averaged).
 void settleWalk(BakePlan& plan, const BakeOptions& options) {
   plan.walk = options.walk;
   // Without the final gather the VPL sum is the map's bounced light, and its seed-to-seed noise is the deep
-  // bounces' few carriers (M_j = N ρ̄^j paths): they fork past bounce 1 even in a closed scene.
+  // bounces' few carriers (M_j = N ρ̄^j paths): they fork past bounce 1 even in a closed scene, and the walk
+  // follows more paths than are evaluated.
   const bool splitDeep = !plan.finalGather && !options.walk.split;
-  if (splitDeep) plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
+  if (splitDeep) {
+    plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
+    plan.walk.walkFactor = std::max(plan.walk.walkFactor, kWalkFactorWithoutGather);
+  }
   // finalGatherPaths is set where the paths were left to the quality preset.
   const bool automatic = options.finalGatherPaths.has_value();
   const bool underGather = plan.finalGather && automatic;
-  if (automatic && (underGather || splitDeep)) plan.walk.paths = *options.finalGatherPaths;
+  if (underGather) plan.walk.paths = *options.finalGatherPaths;
+  else if (automatic && splitDeep) plan.walk.paths = std::max(1, options.walk.paths / kEvaluatedPathsDivisor);
   plan.settle("paths", plan.walk.paths,
               !automatic   ? "asked for"
               : underGather ? "the preset's paths under the final gather, which reads their map averaged"
-              : splitDeep   ? "the preset's reduced paths: past bounce 1 each forks into at least " +
-                                std::to_string(kMinSplitWithoutGather)
+              : splitDeep   ? "half the preset's paths evaluated: the walk follows " +
+                                std::to_string(kWalkFactorWithoutGather) + "x as many, forks past bounce 1, and is resampled"
                             : "the preset's paths",
               automatic);
+  if (splitDeep)
+    plan.settle("walk-factor", plan.walk.walkFactor,
+                "without the final gather the bounces' totals rest on a walk of this many times the paths, resampled", true);
 }
 
 // The clamp compensation and whether its rays run beside the GL evaluator. With the final gather its

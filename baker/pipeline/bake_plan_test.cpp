@@ -28,7 +28,8 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
   const RayTracer rtEmissive(emissive);
   const BakePlan withEmitter = planBake(emissive, rtEmissive, autoOptions(), softwareGl);
   EXPECT_FALSE(withEmitter.finalGather);
-  EXPECT_EQ(withEmitter.walk.paths, 3072);  // the preset's reduced paths: the deep bounces fork 4 ways instead
+  EXPECT_EQ(withEmitter.walk.paths, 2048);  // half the preset's paths evaluated: the walk follows 8x as many
+  EXPECT_EQ(withEmitter.walk.walkFactor, 8);
   EXPECT_EQ(withEmitter.compensation.refineRays, autoOptions().compensation.refineRays);
   EXPECT_EQ(withEmitter.backend, BackendKind::Gl);  // 32 triangles, no see-through material
   EXPECT_EQ(withEmitter.walk.minAutoSplit, 4);  // the VPL sum is the map's bounced light: deep bounces fork
@@ -39,6 +40,7 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
   EXPECT_TRUE(gathered.finalGather);
   EXPECT_EQ(gathered.walk.paths, 3072);         // the preset's paths under the gather
   EXPECT_EQ(gathered.walk.minAutoSplit, 1);     // the gather reads their map averaged: the walk's own split rule
+  EXPECT_EQ(gathered.walk.walkFactor, 1);       // and every VPL walked is evaluated
   EXPECT_EQ(gathered.compensation.refineRays, 0);  // the gather replaces the residual at the texel
   EXPECT_LE(gathered.compensation.minRays, 2);
   EXPECT_FALSE(gathered.compensation.filterEachSweep);
@@ -64,7 +66,10 @@ TEST(BakePlan, AskedForChoicesAreNotAutomatic) {
   EXPECT_EQ(plan.backend, BackendKind::Embree);
   EXPECT_FALSE(plan.finalGather);
   EXPECT_EQ(plan.walk.paths, 4096);
+  EXPECT_EQ(plan.walk.walkFactor, 8);  // no gather: the paths asked for are evaluated, 8x as many walked
   for (const char* key : {"backend", "final-gather", "paths"}) EXPECT_FALSE(plan.choices.at(key).automatic) << key;
+  o.walk.split = 1;  // --walk-split 1: Keller's walk, every VPL evaluated
+  EXPECT_EQ(planBake(lamp, rt, o, noGl).walk.walkFactor, 1);
 }
 
 TEST(BakePlan, CompensationOverlapsOnlyOnHardwareGl) {

@@ -39,6 +39,7 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
                       {"leakControl", f.options.texels.leakControl}};
   report["vpls"] = f.vpls.toJson();
   report["vpls"]["paths"] = f.plan.walk.paths;
+  report["vpls"]["walkFactor"] = f.plan.walk.walkFactor;  // paths × walkFactor walked, resampled to `count`
   report["vpls"]["seed"] = f.options.walk.seed;
   if (f.plan.importanceFactor > 1.0 || f.importance.evenness > 0.0) report["vplImportance"] = f.importance.toJson();
   report["eval"] = {{"clampBound", f.plan.eval.clampBound},
