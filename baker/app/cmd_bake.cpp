@@ -169,7 +169,8 @@ void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
       ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
   app->add_option("--paths,--vpls", a.paths,
                   "light paths of the quasi-random walk (default auto: by --quality;\n" + shown(q.pathsUnderGather) +
-                      " (the final gather reads their map averaged; without it they fork past bounce 1),\n" +
+                      " under the final gather, which reads their map averaged; without it\n" + shown(q.paths / 2) +
+                      " evaluated, from 8x as many walked, forked past bounce 1 and resampled;\n" +
                       "or " + shown(q.paths) + " with --walk-split N and no final gather)")
       ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
   app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
@@ -626,7 +627,8 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
     if (flag) value = "false";
     if (option->get_type_name().find("auto") != std::string::npos) value = "auto";
     if (name == "paths") value = "auto (" + std::to_string(preset.paths) + ", or " + std::to_string(preset.pathsUnderGather) +
-                                 " under the final gather)";
+                                 " under the final gather, or " + std::to_string(preset.paths / 2) +
+                                 " evaluated of 8x as many walked without it)";
     if (name == "clamp") value = "derived from the scene (0: no clamp)";
     for (const auto& [knob, v] : fromPreset)
       if (knob == name) value = v + " (--quality " + preset.name + ")";
