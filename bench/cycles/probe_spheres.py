@@ -3,7 +3,7 @@
 
 usage (from the repository root; Debian's /usr/bin/python3 with python3-numpy and python3-openimageio):
   /usr/bin/python3 bench/cycles/probe_spheres.py [--scenes cornell,sponza] [--seeds 0,1,2,3,4]
-      [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere camera|scene] [--bake-opts "--probes 1"]
+      [--places arcade,gallery] [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere camera|scene] [--bake-opts "--probes 1"]
       [--irbake build/baker/irbake --irview build/runtime/irview]
 
 For each scene (build/cycles-scenes from scenes.py: the McGuire Cornell box; Sponza with its sun and the sky
@@ -387,7 +387,7 @@ def probe_sun_share(gltf, tris, centre):
     origin, spacing, counts = np.array(ext["origin"]), float(ext["spacing"]), ext["counts"]
     offsets = read_accessor(doc, bufs, ext["offsets"]).astype(np.float64)
     valid = read_accessor(doc, bufs, ext["valid"]).ravel()
-    g = np.clip((np.array(centre) - origin) / spacing, 0, np.array(counts) - 1.000001)
+    g = np.clip((np.array(centre) - origin) / spacing, 0, np.maximum(np.array(counts) - 1.000001, 0))
     base, f = np.floor(g).astype(int), g - np.floor(g)
     to_sun = -np.array(SUN) / np.linalg.norm(SUN)
     pts, wts = [], []
@@ -469,6 +469,8 @@ def run_scene(args, name, rows):
     for seed in ([] if args.cycles_only else args.seed_list):
         our_bake(args, scene, opts, seed, os.path.join(work, "seed%d" % seed))
     for place, centre, radius, view, dist, fov in PLACES[name]:
+        if args.places and place not in args.places.split(","):
+            continue
         v = np.array(view) / np.linalg.norm(view)
         eye = tuple(np.array(centre) + dist * v)
         clearance, sunlit, seen = place_checks(tris, centre, radius, eye)
@@ -512,6 +514,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenes", default="cornell,sponza")
     ap.add_argument("--seeds", default="0", help="our bake's --seed values, e.g. 0,1,2,3,4")
+    ap.add_argument("--places", default="", help="only these places, e.g. arcade,gallery (default: every one)")
     ap.add_argument("--spp", type=int, default=1024, help="Cycles samples per pixel (two halves)")
     ap.add_argument("--size", type=int, default=96, help="image width and height (pixels)")
     ap.add_argument("--ours", choices=["irview", "probe"], default="irview")
