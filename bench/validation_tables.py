@@ -172,7 +172,8 @@ def t_cycles_sibenik():
 
 def t_cycles_ladder():
     out = []
-    for name in ["cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv", "cycles_sponza_sun_x4.csv"]:
+    for name in ["cycles_cornell_sample.csv", "cycles_cornell_published.csv", "cycles_mcguire_cornell.csv",
+                 "cycles_sponza_sun_x4.csv"]:
         rows = [r for r in read(name) if r["mode"] == "map-cycles"]
         for r in sorted(latest(rows, lambda r: r["cycles_spp"]), key=lambda r: int(r["cycles_spp"])):
             out.append([SCENES[name], f"`{r['commit']}`", r["cycles_spp"], num(r["cycles_s"], 1),
