@@ -125,4 +125,11 @@ TEST(VplResample, WalkFactorKeepsAPlainWalksCountsAndEveryBouncesEnergy) {
   const VplSet two = generateVpls(s, rt, o);
   EXPECT_NEAR(double(two.countPerBounce[2]), 2 * std::floor(500 * 0.36 + 1e-9), 2.0);
   EXPECT_NEAR(two.powerPerBounce[2].x, Phi * 0.36, 1e-5 * Phi);
+  // Half the emitter's VPLs, each twice as heavy: bounce 0 still carries Φ.
+  o.evaluatedSplit = 1;
+  o.evaluatedEmitterShare = 0.5;
+  const VplSet half = generateVpls(s, rt, o);
+  EXPECT_EQ(half.countPerBounce[0], 250u);
+  EXPECT_NEAR(half.powerPerBounce[0].x, Phi, 1e-5 * Phi);
+  EXPECT_NEAR(double(half.countPerBounce[1]), 300.0, 1.0);
 }

@@ -38,6 +38,8 @@ struct WalkOptions {
                                  // (vpl/resample.h) to the count a walk of `paths` would leave there
   int evaluatedSplit = 1;        // with walkFactor > 1: VPLs kept per surviving path at bounces ≥ 2 (1: a plain
                                  // walk's M_j, however many ways the walk split)
+  double evaluatedEmitterShare = 1.0;  // with walkFactor > 1: bounce 0 keeps this share of `paths` VPLs (on small
+                                       // emitters they lie close together, so fewer light the scene as well)
   uint32_t seed = 0;       // seeds the Halton digit permutations
   ProgressCallback progress;
 };

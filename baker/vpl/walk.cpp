@@ -421,11 +421,15 @@ VplSet generateVpls(const Scene& scene, const RayTracer& rt, const WalkOptions& 
   out.walked = out.vpls.size();
   if (walkFactor > 1) {
     // Bounce j keeps V_j / walkFactor VPLs (V_j: the walk's count there), past bounce 1 also divided by the
-    // split and times evaluatedSplit: the counts a walk of `paths` would leave, escapes included.
+    // split and times evaluatedSplit: the counts a walk of `paths` would leave, escapes included; bounce 0
+    // (the emitters') times evaluatedEmitterShare.
     std::vector<size_t> keep(out.countPerBounce.size());
     const double deep = static_cast<double>(std::clamp(options.evaluatedSplit, 1, split)) / split;
-    for (size_t j = 0; j < keep.size(); ++j)
-      keep[j] = static_cast<size_t>(std::ceil((j >= 2 ? deep : 1.0) * static_cast<double>(out.countPerBounce[j]) / walkFactor - 1e-9));
+    const double emitter = std::clamp(options.evaluatedEmitterShare, 1e-6, 1.0);
+    for (size_t j = 0; j < keep.size(); ++j) {
+      const double share = j >= 2 ? deep : j == 0 ? emitter : 1.0;
+      keep[j] = static_cast<size_t>(std::ceil(share * static_cast<double>(out.countPerBounce[j]) / walkFactor - 1e-9));
+    }
     resampleVpls(out, keep, options.seed);
   }
   if (options.progress) options.progress("walk", 1.0);
