@@ -95,9 +95,11 @@ void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& op
 constexpr int kMinSplitWithoutGather = 4;
 // There the walk also follows kWalkFactor times the evaluated paths and resamples each bounce to the count
 // of a plain walk of those (docs/units.md, "Walking more paths than are evaluated"): the bounces' totals rest
-// on the big walk, the evaluation's cost on the kept VPLs. The evaluated paths are the preset's halved.
+// on the big walk, the evaluation's cost on the kept VPLs. The evaluated paths are the preset's halved, and
+// the emitters' VPLs half of those: the final gather is off where emitters are small, so theirs lie close together.
 constexpr int kWalkFactorWithoutGather = 8;
 constexpr int kEvaluatedPathsDivisor = 2;
+constexpr double kEmitterShareWithoutGather = 0.5;
 
 // The walk's paths: finalGatherPaths where the final gather runs (it reads their map averaged).
 void settleWalk(BakePlan& plan, const BakeOptions& options) {
@@ -109,6 +111,7 @@ void settleWalk(BakePlan& plan, const BakeOptions& options) {
   if (splitDeep) {
     plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
     plan.walk.walkFactor = std::max(plan.walk.walkFactor, kWalkFactorWithoutGather);
+    plan.walk.evaluatedEmitterShare = std::min(plan.walk.evaluatedEmitterShare, kEmitterShareWithoutGather);
   }
   // finalGatherPaths is set where the paths were left to the quality preset.
   const bool automatic = options.finalGatherPaths.has_value();

@@ -30,6 +30,7 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
   EXPECT_FALSE(withEmitter.finalGather);
   EXPECT_EQ(withEmitter.walk.paths, 2048);  // half the preset's paths evaluated: the walk follows 8x as many
   EXPECT_EQ(withEmitter.walk.walkFactor, 8);
+  EXPECT_EQ(withEmitter.walk.evaluatedEmitterShare, 0.5);  // the emitter's VPLs: half of those paths
   EXPECT_EQ(withEmitter.compensation.refineRays, autoOptions().compensation.refineRays);
   EXPECT_EQ(withEmitter.backend, BackendKind::Gl);  // 32 triangles, no see-through material
   EXPECT_EQ(withEmitter.walk.minAutoSplit, 4);  // the VPL sum is the map's bounced light: deep bounces fork
@@ -41,6 +42,7 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
   EXPECT_EQ(gathered.walk.paths, 3072);         // the preset's paths under the gather
   EXPECT_EQ(gathered.walk.minAutoSplit, 1);     // the gather reads their map averaged: the walk's own split rule
   EXPECT_EQ(gathered.walk.walkFactor, 1);       // and every VPL walked is evaluated
+  EXPECT_EQ(gathered.walk.evaluatedEmitterShare, 1.0);
   EXPECT_EQ(gathered.compensation.refineRays, 0);  // the gather replaces the residual at the texel
   EXPECT_LE(gathered.compensation.minRays, 2);
   EXPECT_FALSE(gathered.compensation.filterEachSweep);
