@@ -77,6 +77,7 @@ SCENES = {
     "cycles_sponza_sun_x4.csv": "Sponza, sun",
     "cycles_sponza_sun_sky.csv": "Sponza, sun + sky",
     "cycles_sibenik_lamp.csv": "Sibenik, lamp",
+    "cycles_sponza_sun_sky_tpu6.csv": "Sponza, sun + sky",
 }
 
 
@@ -119,6 +120,48 @@ def t_seed_spread():
                   "seed noise 4×4, RMS", "worst seed", "median wall (s)", "1-min load (largest)"], out)
 
 
+# Scenes whose map is scored against Cycles on every seed: (CSV, options without --seed, what the options mean).
+EVERY_SEED = [
+    ("cycles_cornell_published.csv", "", "default"),
+    ("cycles_mcguire_cornell.csv", "", "default"),
+    ("cycles_sponza_sun_sky_tpu6.csv", "--sky 0.4,0.5,0.7 --texels-per-unit 6", "sun + sky, 6 texels per metre"),
+]
+
+
+def without_seed(options):
+    tokens = options.split()
+    if "--seed" in tokens:
+        i = tokens.index("--seed")
+        del tokens[i:i + 2]
+    return " ".join(tokens)
+
+
+def t_every_seed():
+    """The map against Cycles' bake in our atlas for every seed of one baker: the latest commit with most seeds."""
+    out = []
+    for name, options, label in EVERY_SEED:
+        if not os.path.isfile(os.path.join(RESULTS, name)):
+            continue
+        rows = [r for r in read(name) if r["mode"] == "map" and without_seed(r["our_options"]) == options]
+        by_commit = {}
+        for r in rows:
+            by_commit.setdefault(r["commit"], []).append(r)
+        if not by_commit:
+            continue
+        per_seed = {c: latest(rs, lambda r: seed_of(r["our_options"])) for c, rs in by_commit.items()}
+        commit = max(per_seed, key=lambda c: (len(per_seed[c]), max(r["date"] for r in per_seed[c])))
+        current = sorted(per_seed[commit], key=lambda r: int(seed_of(r["our_options"])))
+        errors = [float(r["rel_rmse_4_corrected"]) for r in current]
+        ratios = [float(r["mean_ratio"]) for r in current]
+        scene = SCENES.get(name, name)
+        out.append([scene, label, f"`{commit}`", ", ".join(seed_of(r["our_options"]) for r in current),
+                    " / ".join(pct(e) for e in errors), f"**{pct(max(errors))}**",
+                    f"{min(ratios):.4f} … {max(ratios):.4f}", f"**{pct(max(ratios) - min(ratios))}**",
+                    num(median(r["our_wall_s"] for r in current), 1), current[0]["ref_spp"]])
+    return table(["scene", "options", "baker", "seeds", "rel. RMSE 4×4, noise removed, per seed", "worst seed",
+                  "mean ours/Cycles", "spread of the mean", "median wall (s)", "Cycles spp"], out)
+
+
 def t_cycles_sponza():
     return cycles_rows(["cycles_sponza_sun_x4.csv", "cycles_sponza_sun_sky.csv"])
 
@@ -129,7 +172,8 @@ def t_cycles_sibenik():
 
 def t_cycles_ladder():
     out = []
-    for name in ["cycles_cornell_sample.csv", "cycles_mcguire_cornell.csv", "cycles_sponza_sun_x4.csv"]:
+    for name in ["cycles_cornell_sample.csv", "cycles_cornell_published.csv", "cycles_mcguire_cornell.csv",
+                 "cycles_sponza_sun_x4.csv"]:
         rows = [r for r in read(name) if r["mode"] == "map-cycles"]
         for r in sorted(latest(rows, lambda r: r["cycles_spp"]), key=lambda r: int(r["cycles_spp"])):
             out.append([SCENES[name], f"`{r['commit']}`", r["cycles_spp"], num(r["cycles_s"], 1),

@@ -61,6 +61,9 @@ TEST(ProbeGridView, ProbeObjectBlendsValidProbesOnly) {
   LightProbeGrid grid = twoProbes();
   const ProbeSphere s = probeObject(grid, glm::vec3(0.7f, 0.0f, 0.0f), 0.2f, "grid.gltf");
   for (int k = 0; k < kShCoefficients; ++k) EXPECT_EQ(s.coefficients[k], grid.coefficients[0][k]);
+  // Its ends at ± R blend probe 0 alone too, so the field over it is flat.
+  for (int a = 0; a < 3; ++a)
+    for (int k = 0; k < kShCoefficients; ++k) EXPECT_EQ(s.gradient[a][k], glm::vec3(0.0f)) << a << " " << k;
   EXPECT_FLOAT_EQ(s.radius, 0.2f);
   grid.valid = {0, 0};
   try {

@@ -16,15 +16,16 @@ namespace irbake::view {
 ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, float radius,
                         const std::filesystem::path& file) {
   // No visibility rays: irview does not link the ray tracer, so every probe is visible from the point.
-  const ProbeBlend blend = interpolateProbes(grid, centre, [](const glm::vec3&, const glm::vec3&) { return true; });
-  if (blend.probes == 0)
+  const ProbeField field = probeFieldOver(grid, centre, radius, [](const glm::vec3&, const glm::vec3&) { return true; });
+  if (field.probes == 0)
     throw Error(ErrorCode::InvalidData, file.string(),
                 "--probe-object at " + std::to_string(centre.x) + "," + std::to_string(centre.y) + "," +
                     std::to_string(centre.z) + ": no valid probe near it");
   ProbeSphere s;
   s.centre = centre;
   s.radius = radius;
-  s.coefficients = blend.coefficients;
+  s.coefficients = field.centre;
+  s.gradient = field.gradient;
   return s;
 }
 
@@ -71,7 +72,7 @@ class ProbeOverlay {
     glUniform3fv(p.uniform("uEye"), 1, &eye[0]);
     glUniform1f(p.uniform("uExposureScale"), std::exp2(settings.exposure));
     const GLint centre = p.uniform("uCentre"), radius = p.uniform("uRadius"), sh = p.uniform("uSh"),
-                valid = p.uniform("uValid");
+                gradient = p.uniform("uShGradient"), valid = p.uniform("uValid");
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDisable(GL_CULL_FACE);  // both sides of the box: the back faces still cover the sphere with the eye inside it
@@ -80,6 +81,7 @@ class ProbeOverlay {
       glUniform3fv(centre, 1, &s.centre[0]);
       glUniform1f(radius, s.radius);
       glUniform3fv(sh, kShCoefficients, &s.coefficients[0][0]);
+      glUniform3fv(gradient, 3 * kShCoefficients, &s.gradient[0][0][0]);
       glUniform1i(valid, s.valid ? 1 : 0);
       glDrawArrays(GL_TRIANGLES, 0, 36);
     }

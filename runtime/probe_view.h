@@ -1,8 +1,9 @@
 // The baked irradiance probes (IRBAKE_light_probes, docs/export.md) in irview: matte white spheres lit by the
-// probes (--probe-object X,Y,Z[,R]: the probes' SH interpolated once at the centre, as a dynamic object would be),
+// probes (--probe-object X,Y,Z[,R]: the probes' SH blended at the centre with its gradient over the sphere,
+// lightmap/probe_field.h, as a dynamic object would be),
 // and the grid itself (--view probes: a small sphere at each probe, lit by its own SH, invalid ones red).
-// A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(coefficients, n) at normal n, clamped at
-// 0 (L2 ringing); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
+// A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(c(p), n) at the point p with normal n,
+// c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
 #pragma once
 #include <filesystem>
 #include <memory>
@@ -10,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include "lightmap/probe_field.h"
 #include "lightmap/probe_grid.h"
 
 namespace irbake::view {
@@ -20,12 +22,13 @@ struct ViewerOptions;
 struct ProbeSphere {
   glm::vec3 centre{0.0f};
   float radius = 0.1f;
-  ShCoefficients coefficients{};  // E(n)/π = shIrradiance(coefficients, n)
+  ShCoefficients coefficients{};  // at the centre: E(n)/π = shIrradiance(coefficients, n)
+  std::array<ShCoefficients, 3> gradient{};  // ∂coefficients/∂x, y, z (zero for the grid's own probes)
   bool valid = true;              // false: drawn in flat red (a probe left out of interpolation)
 };
 
-// The probes at a dynamic object's centre: trilinear over the 8 around it, valid ones only, weights renormalised
-// (interpolateProbes). irview has no ray tracer, so every probe counts as visible from the point, unlike `irbake
+// The probes over a dynamic object: trilinear over the 8 around its centre, valid ones only, weights renormalised
+// (interpolateProbes), and their gradient over its radius (probeFieldOver). irview has no ray tracer, so every probe counts as visible from the point, unlike `irbake
 // probe`, which drops the probes a wall hides; the two agree wherever the point sees its 8 probes. Throws
 // Error(InvalidData, file) when no valid probe is near.
 ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, float radius,

@@ -1,6 +1,6 @@
 // irview's probe spheres on a real bake (the Cornell box sample, probes on, Embree, 512 paths): a matte white
-// sphere of albedo 1 lit by the probes shows E(n)/π = shIrradiance(c, n) at each pixel's normal n, c the probes
-// interpolated at its centre. The expected value is computed here from the exported glTF as `irbake probe`
+// sphere of albedo 1 lit by the probes shows E(n)/π = shIrradiance(c(p), n) at each pixel's point p and normal n,
+// c(p) the probes' field over the sphere (probeFieldOver: the blend at its centre and its gradient). The expected value is computed here from the exported glTF as `irbake probe`
 // computes it (readLightProbes, interpolateProbes with visibility rays) and the normal from the camera ray's own
 // intersection with the sphere (double precision), so the renderer's ray-cast, its SH and its interpolation
 // (without visibility rays) are all checked. The centre sees its 8 probes, so both interpolations agree.
@@ -55,13 +55,13 @@ const std::filesystem::path& bakedBox() {
 }
 
 // What `irbake probe FILE --at kCentre` blends: valid probes the point sees (visibility rays on the glTF).
-ProbeBlend referenceBlend(const std::filesystem::path& file) {
+ProbeField referenceField(const std::filesystem::path& file) {
   const LightProbeGrid grid = readLightProbes(file);
   LoadOptions load;
   load.decodeImages = false;
   const Scene scene = loadScene(file, load);
   const RayTracer rt(scene);
-  return interpolateProbes(grid, kCentre, [&](const glm::vec3& from, const glm::vec3& to) {
+  return probeFieldOver(grid, kCentre, kRadius, [&](const glm::vec3& from, const glm::vec3& to) {
     const glm::vec3 d = to - from;
     const float r = glm::length(d);
     return !(r > 0.0f) || !rt.occluded(from, d / r, 0.0f, r);
@@ -93,9 +93,10 @@ struct SphereCheck {
   double worst = 0.0;  // largest |pixel − expected| over channels, relative to the largest expected value
 };
 
-// Every sphere pixel against max(0, shIrradiance(c, n)).
+// Every sphere pixel against max(0, shIrradiance(c(p), n)), p = centre + r n.
 SphereCheck checkSphere(const std::vector<glm::vec4>& pixels, const ViewCamera& camera, int w, int h,
-                        const ShCoefficients& c) {
+                        const ProbeField& field) {
+  const ShCoefficients& c = field.centre;
   SphereCheck out;
   const glm::vec3 top = shIrradiance(c, glm::vec3(0, 1, 0));
   const double scale = std::max({top.x, top.y, top.z, 1e-6f});
@@ -103,7 +104,8 @@ SphereCheck checkSphere(const std::vector<glm::vec4>& pixels, const ViewCamera& 
     for (int x = 0; x < w; ++x) {
       glm::dvec3 n;
       if (!sphereNormalAt(camera, w, h, x, y, 0.02, n)) continue;
-      const glm::vec3 expected = glm::max(shIrradiance(c, glm::vec3(n)), glm::vec3(0.0f));
+      const glm::vec3 expected =
+          glm::max(shIrradiance(field.at(kRadius * glm::vec3(n)), glm::vec3(n)), glm::vec3(0.0f));
       const glm::vec4& px = pixels[static_cast<size_t>(y) * w + x];
       for (int k = 0; k < 3; ++k) out.worst = std::max(out.worst, std::abs(px[k] - expected[k]) / scale);
       ++out.pixels;
@@ -113,9 +115,9 @@ SphereCheck checkSphere(const std::vector<glm::vec4>& pixels, const ViewCamera& 
 
 TEST(ProbeView, SphereShowsTheProbesIrradianceAtEachPixelsNormal) {
   const std::filesystem::path file = bakedBox();
-  const ProbeBlend reference = referenceBlend(file);
+  const ProbeField reference = referenceField(file);
   ASSERT_EQ(reference.probes, 8) << "the centre should see its 8 probes";
-  const glm::vec3 mean = shAverage(reference.coefficients);
+  const glm::vec3 mean = shAverage(reference.centre);
   ASSERT_GT(mean.x, 0.01f) << "the probes at the centre are dark";
 
   ViewerScene v = loadViewerScene(file);
@@ -131,16 +133,16 @@ TEST(ProbeView, SphereShowsTheProbesIrradianceAtEachPixelsNormal) {
   for (const glm::vec3& eye : eyes) {
     const ViewCamera camera = lookAt(eye, kCentre, 40.0f, v.scene.bounds());
     const RgbaImage img = renderer.render(camera, w, h, {});
-    const SphereCheck check = checkSphere(img.pixels, camera, w, h, reference.coefficients);
+    const SphereCheck check = checkSphere(img.pixels, camera, w, h, reference);
     EXPECT_GT(check.pixels, 300) << "the sphere should fill much of the view";
     // Float shading of the same sum in GLSL and C++, the normal from a float ray: 1e-3 of the brightest value.
     EXPECT_LT(check.worst, 1e-3) << "eye " << eye.x << "," << eye.y << "," << eye.z;
     RecordProperty("worstRelativeError", std::to_string(check.worst));
   }
-  // From above, the middle pixel: what `irbake probe FILE --at centre --normal 0,1,0` prints.
+  // From above, the middle pixel: the field at the sphere's top point, normal +Y.
   const ViewCamera above = lookAt(eyes[1], kCentre, 40.0f, v.scene.bounds());
   const glm::vec4 middle = renderer.render(above, w, h, {}).at(w / 2, h / 2);
-  const glm::vec3 top = shIrradiance(reference.coefficients, glm::vec3(0, 1, 0));
+  const glm::vec3 top = shIrradiance(reference.at(glm::vec3(0.0f, kRadius, 0.0f)), glm::vec3(0, 1, 0));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(middle[k], top[k], 1e-3f * top[k]) << "channel " << k;
 }
 
@@ -155,7 +157,7 @@ std::string runIrview(const std::string& args, const std::filesystem::path& log)
 // The command line another tool drives (Cycles comparisons): the EXR is linear radiance of the albedo-1 sphere.
 TEST(ProbeView, IrviewProbeObjectScreenshotIsTheSpheresRadiance) {
   const std::filesystem::path file = bakedBox();
-  const ProbeBlend reference = referenceBlend(file);
+  const ProbeField reference = referenceField(file);
   ASSERT_EQ(reference.probes, 8);
   const std::filesystem::path exr = outDir() / "sphere.exr";
   std::filesystem::remove(exr);
@@ -178,7 +180,7 @@ TEST(ProbeView, IrviewProbeObjectScreenshotIsTheSpheresRadiance) {
   for (size_t i = 0; i < pixels.size(); ++i)
     for (int k = 0; k < 3; ++k) pixels[i][k] = px[i * spec.nchannels + k];
   const ViewCamera camera = lookAt(eye, kCentre, 40.0f, loadViewerScene(file).scene.bounds());
-  const SphereCheck check = checkSphere(pixels, camera, spec.width, spec.height, reference.coefficients);
+  const SphereCheck check = checkSphere(pixels, camera, spec.width, spec.height, reference);
   EXPECT_GT(check.pixels, 300);
   // The EXR's channels may be half floats (11-bit mantissa, 4.9e-4 relative): 1e-3 plus that.
   EXPECT_LT(check.worst, 1.5e-3);

@@ -1,23 +1,25 @@
 // irview's probe spheres: the ray from the eye through this fragment meets the sphere at p, normal
-// n = (p − centre)/r; a white Lambert surface there shows E(n)/π, the probes' SH convolved with the clamped
-// cosine as three.js's shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0.
+// n = (p − centre)/r; a white Lambert surface there shows E(n)/π, the probes' SH at p (the centre's plus
+// (p − centre)·gradient, lightmap/probe_field.h) convolved with the clamped cosine as three.js's
+// shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0.
 uniform mat4 uViewProjection;
 uniform vec3 uEye;
 uniform vec3 uCentre;
 uniform float uRadius;
 uniform vec3 uSh[9];
+uniform vec3 uShGradient[27];  // ∂uSh/∂x (0..8), ∂uSh/∂y (9..17), ∂uSh/∂z (18..26)
 uniform int uValid;
 uniform float uExposureScale;
 in vec3 vWorld;
 out vec4 fragColor;
 
-vec3 shIrradiance(vec3 n) {
+vec3 shIrradiance(vec3 sh[9], vec3 n) {
   float x = n.x, y = n.y, z = n.z;
-  vec3 r = uSh[0] * 0.886227;
-  r += uSh[1] * (2.0 * 0.511664 * y) + uSh[2] * (2.0 * 0.511664 * z) + uSh[3] * (2.0 * 0.511664 * x);
-  r += uSh[4] * (2.0 * 0.429043 * x * y) + uSh[5] * (2.0 * 0.429043 * y * z);
-  r += uSh[6] * (0.743125 * z * z - 0.247708) + uSh[7] * (2.0 * 0.429043 * x * z);
-  r += uSh[8] * (0.429043 * (x * x - y * y));
+  vec3 r = sh[0] * 0.886227;
+  r += sh[1] * (2.0 * 0.511664 * y) + sh[2] * (2.0 * 0.511664 * z) + sh[3] * (2.0 * 0.511664 * x);
+  r += sh[4] * (2.0 * 0.429043 * x * y) + sh[5] * (2.0 * 0.429043 * y * z);
+  r += sh[6] * (0.743125 * z * z - 0.247708) + sh[7] * (2.0 * 0.429043 * x * z);
+  r += sh[8] * (0.429043 * (x * x - y * y));
   return r;
 }
 
@@ -34,7 +36,9 @@ void main() {
   vec3 n = normalize(p - uCentre);
   vec4 clip = uViewProjection * vec4(p, 1.0);
   gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
-  vec3 radiance = uValid != 0 ? max(shIrradiance(n), vec3(0.0)) : vec3(1.0, 0.0, 0.0);
+  vec3 o = p - uCentre, sh[9];
+  for (int k = 0; k < 9; ++k) sh[k] = uSh[k] + o.x * uShGradient[k] + o.y * uShGradient[9 + k] + o.z * uShGradient[18 + k];
+  vec3 radiance = uValid != 0 ? max(shIrradiance(sh, n), vec3(0.0)) : vec3(1.0, 0.0, 0.0);
 #if OUTPUT == 1
   fragColor = vec4(encodeSrgb(radiance * uExposureScale), 1.0);
 #else

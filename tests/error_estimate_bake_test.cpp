@@ -79,10 +79,12 @@ TEST(ErrorEstimateBake, TargetErrorAddsRoundsUntilMet) {
     EXPECT_LE(e["rounds"].back()["estimatedError"].get<double>(), target);
     // The finished map's walk part (its normaliser has the compensation's light too: no larger).
     EXPECT_LE(e["breakdown"]["vpls"].get<double>(), target * 1.05);
-    for (size_t k = 1; k < e["rounds"].size(); ++k)  // falls about as 1/√rounds, give or take its own noise
+    for (size_t k = 1; k < e["rounds"].size(); ++k) {  // falls about as 1/√rounds, give or take its own noise
       EXPECT_LT(e["rounds"][k]["estimatedError"].get<double>(), 1.25 * e["rounds"][k - 1]["estimatedError"].get<double>());
-    if (e["rounds"].size() > 2)
+    }
+    if (e["rounds"].size() > 2) {
       EXPECT_LT(e["rounds"].back()["estimatedError"].get<double>(), 0.8 * e["rounds"][0]["estimatedError"].get<double>());
+    }
     EXPECT_GE(e["rounds"].size(), lastRounds);
     lastRounds = e["rounds"].size();
     measured.push_back(measuredError(r.maps, referenceMaps()));

@@ -3,7 +3,7 @@
 
 usage (from the repository root; Debian's /usr/bin/python3 with python3-numpy and python3-openimageio):
   /usr/bin/python3 bench/cycles/probe_spheres.py [--scenes cornell,sponza] [--seeds 0,1,2,3,4]
-      [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere camera|scene] [--bake-opts "--probes 1"]
+      [--places arcade,gallery] [--spp 1024] [--size 96] [--ours irview|probe] [--cycles-sphere camera|scene] [--bake-opts "--probes 1"]
       [--irbake build/baker/irbake --irview build/runtime/irview]
 
 For each scene (build/cycles-scenes from scenes.py: the McGuire Cornell box; Sponza with its sun and the sky
@@ -16,17 +16,18 @@ For each scene (build/cycles-scenes from scenes.py: the McGuire Cornell box; Spo
           --cycles-dir as given: pass the path the cached renders were made with to reuse them).
   ours    `irbake bake SCENE --seed K` without the sphere (default options: probes auto), then
           `irview OUT/scene.gltf --probe-object X,Y,Z,R` from the same camera at 4x the size, averaged 4x4
-          down (Cycles' pixels average their area). With --ours probe: the same sphere shaded from
+          down (Cycles' pixels average their area; irview shades each point with the probes' blend at the centre
+          and its gradient over the sphere, docs/export.md). With --ours probe: the same sphere shaded from
           `irbake probe OUT --at CENTRE --normal N` (a quadratic in N, E(N)/pi of an L2 probe, fitted to
-          18 normals), evaluated at 4x4 sub-pixel normals.
+          18 normals), evaluated at 4x4 sub-pixel normals: the centre's SH alone, without the gradient.
 Pixels compared: the sphere's image disc from the camera (vertical fov, pixel centres, the image's row 0 at the
 top), each pixel fully covered (8x8 sub-pixel rays) and so are its 8 neighbours (the silhouette's 1-pixel ring
 is left out). Figures: ratio ours/Cycles of the summed RGB over the kept pixels, and on each quarter of the
 disc (split at the projected centre, which is the image centre: the camera targets it); the reference's noise
 = half the difference of its two halves over their mean. Diagnosis: `ratio_exact_direct` and
-`worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone (the sun,
-times the sphere's sunlit share, and the emitters seen from the centre, as exact clamped cosines in place of
-their L2 parts): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
+`worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone at each
+surface point (the sun, times the sphere's sunlit share, and the emitters seen from the point, as exact clamped
+cosines in place of their L2 parts): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
 probes around the centre whose own point sees the sun (a sun shadow edge between probes shows as a share below
 `sunlit`; the bake fits each probe's sun over its cube, docs/units.md, so the blended sun may differ). Rows are appended to bench/results/probe_spheres.csv.
 Every process runs under `nice -n 15`; Cycles with --threads 2.
@@ -327,40 +328,12 @@ def ours_from_probe(args, gltf, eye, target, fov, size, centre, radius):
     return img.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
 
 
-def direct_light(tris, emission, centre, sunlit, has_sun):
-    """The direct light at the centre as deltas (unit directions, RGB weights: E(n) = sum w max(n.w_k, 0)) and
-    how many lead the list as suns: the sun (times the sphere's sunlit share), then the emitters seen from the
-    centre (front faces, 50k lattice rays)."""
-    dirs, weights = [], []
-    if has_sun and sunlit > 0:
-        dirs.append(-np.array(SUN)[None] / np.linalg.norm(SUN))
-        weights.append(np.full((1, 3), SUN_IRRADIANCE * sunlit))
-    if emission.max(initial=0.0) > 0:
-        n = 50000
-        d = fibonacci_dirs(n)
-        best, which = np.full(n, np.inf), np.full(n, -1)
-        o = np.array(centre, float)
-        for k in range(len(tris)):  # few triangles (the box): loop over them, rays vectorised
-            a, e1, e2 = tris[k, 0], tris[k, 1] - tris[k, 0], tris[k, 2] - tris[k, 0]
-            p = np.cross(d, e2)
-            det = p @ e1
-            inv = np.where(np.abs(det) > 1e-12, 1.0 / np.where(np.abs(det) > 1e-12, det, 1.0), 0.0)
-            u = (p @ (o - a)) * inv
-            q = np.cross(o - a, e1)
-            v = (d @ q) * inv
-            t = (q @ e2) * inv
-            hit = (inv != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < best)
-            best[hit], which[hit] = t[hit], k
-        front = which >= 0
-        front[front] &= emission[which[front]].max(axis=1) > 0
-        front[front] &= np.einsum("ij,ij->i", d[front], np.cross(tris[which[front], 1] - tris[which[front], 0],
-                                                                  tris[which[front], 2] - tris[which[front], 0])) < 0
-        dirs.append(d[front])
-        weights.append(emission[which[front]] * 4 * math.pi / n)
-    suns = 1 if has_sun and sunlit > 0 else 0
-    if not dirs:
-        return np.zeros((0, 3)), np.zeros((0, 3)), 0
-    return np.concatenate(dirs), np.concatenate(weights), suns
+def sun_light(centre, sunlit, has_sun):
+    """The sun as a delta (unit direction, RGB weight: E(n) = w max(n.l, 0)) times the sphere's sunlit share; none
+    without a sun."""
+    if not (has_sun and sunlit > 0):
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    return -np.array(SUN)[None] / np.linalg.norm(SUN), np.full((1, 3), SUN_IRRADIANCE * sunlit)
 
 
 def emitter_points(tris, emission, per_side=24):
@@ -381,28 +354,27 @@ def emitter_points(tris, emission, per_side=24):
     return np.concatenate(pts), np.concatenate(nrm), np.concatenate(wts)
 
 
-def direct_l2_residual(eye, target, fov, size, centre, radius, dirs, weights, suns, emitters):
-    """What an L2 probe at the centre misses of the sphere's direct light, per pixel (2x2 sub-pixel points):
-    the exact direct E(p, n)/pi at the surface point p (the sun's clamped cosine; the emitters' area integral at
-    p, unoccluded, so with their 1/r^2 across the sphere) minus the L2 part of the direct light at the centre
-    (a delta of weight w along l gives w (3/32 + c/2 + 15c^2/32), c = n.l: the clamped cosine's Legendre series
-    to l = 2)."""
+def direct_l2_residual(eye, target, fov, size, centre, radius, dirs, weights, emitters):
+    """What the L2 band limit takes from the sphere's direct light, per pixel (2x2 sub-pixel points): at each surface
+    point p with normal n, the exact E(p, n)/pi minus its L2 part, for the sun (the deltas dirs, weights) and the
+    emitters seen from p itself (their points' solid angles at p, unoccluded); a delta of weight w along l gives
+    w max(c, 0) exactly and w (3/32 + c/2 + 15c^2/32) in L2, c = n.l (the clamped cosine's Legendre series to
+    l = 2). The probes' field already follows the light's change across the sphere, so this is the band limit alone."""
     sub = 2
     hit, n = sphere_hits(eye, camera_rays(eye, target, fov, size, sub), centre, radius)
     n = n.reshape(-1, 3)
     p = np.array(centre, float) + radius * n
-    out = np.zeros((len(n), 3))
-    for k in range(0, len(dirs), 256):
-        c = n @ dirs[k:k + 256].T
-        out -= (3 / 32 + c / 2 + 15 * c * c / 32) @ weights[k:k + 256]
-    for k in range(suns):  # the sun: no 1/r^2, its clamped cosine at every point
-        out += np.maximum(n @ dirs[k], 0)[:, None] * weights[k][None]
+
+    def clamped_minus_l2(c):
+        return np.maximum(c, 0) - (3 / 32 + c / 2 + 15 * c * c / 32)
+    out = clamped_minus_l2(n @ dirs.T) @ weights if len(dirs) else np.zeros((len(n), 3))
     q, qn, qw = emitters
     for k in range(0, len(q), 64):
         d = q[None, k:k + 64] - p[:, None]
-        r2 = np.einsum("ijk,ijk->ij", d, d)
-        w = np.maximum(np.einsum("ijk,jk->ij", d, -qn[k:k + 64]), 0) * np.maximum(np.einsum("ijk,ik->ij", d, n), 0)
-        out += (w / (r2 * r2)) @ qw[k:k + 64]
+        r = np.sqrt(np.einsum("ijk,ijk->ij", d, d))
+        cos_q = np.maximum(np.einsum("ijk,jk->ij", d, -qn[k:k + 64]), 0) / r
+        c = np.einsum("ijk,ik->ij", d, n) / r
+        out += (clamped_minus_l2(c) * cos_q / (r * r)) @ qw[k:k + 64]
     out = np.where(hit.reshape(-1, 1), out / math.pi, 0.0)
     return out.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
 
@@ -415,7 +387,7 @@ def probe_sun_share(gltf, tris, centre):
     origin, spacing, counts = np.array(ext["origin"]), float(ext["spacing"]), ext["counts"]
     offsets = read_accessor(doc, bufs, ext["offsets"]).astype(np.float64)
     valid = read_accessor(doc, bufs, ext["valid"]).ravel()
-    g = np.clip((np.array(centre) - origin) / spacing, 0, np.array(counts) - 1.000001)
+    g = np.clip((np.array(centre) - origin) / spacing, 0, np.maximum(np.array(counts) - 1.000001, 0))
     base, f = np.floor(g).astype(int), g - np.floor(g)
     to_sun = -np.array(SUN) / np.linalg.norm(SUN)
     pts, wts = [], []
@@ -497,6 +469,8 @@ def run_scene(args, name, rows):
     for seed in ([] if args.cycles_only else args.seed_list):
         our_bake(args, scene, opts, seed, os.path.join(work, "seed%d" % seed))
     for place, centre, radius, view, dist, fov in PLACES[name]:
+        if args.places and place not in args.places.split(","):
+            continue
         v = np.array(view) / np.linalg.norm(view)
         eye = tuple(np.array(centre) + dist * v)
         clearance, sunlit, seen = place_checks(tris, centre, radius, eye)
@@ -510,8 +484,7 @@ def run_scene(args, name, rows):
         a, b = (compare.read_exr(r[0])[..., :3] for r in refs)
         keep = kept_mask(eye, centre, fov, args.size, centre, radius)
         residual = direct_l2_residual(eye, centre, fov, args.size, centre, radius,
-                                      *direct_light(tris, emission, centre, sunlit, name == "sponza"),
-                                      emitter_points(tris, emission))
+                                      *sun_light(centre, sunlit, name == "sponza"), emitter_points(tris, emission))
         for seed in ([] if args.cycles_only else args.seed_list):
             out = os.path.join(work, "seed%d" % seed)
             gltf = os.path.join(out, "scene.gltf")
@@ -541,6 +514,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenes", default="cornell,sponza")
     ap.add_argument("--seeds", default="0", help="our bake's --seed values, e.g. 0,1,2,3,4")
+    ap.add_argument("--places", default="", help="only these places, e.g. arcade,gallery (default: every one)")
     ap.add_argument("--spp", type=int, default=1024, help="Cycles samples per pixel (two halves)")
     ap.add_argument("--size", type=int, default=96, help="image width and height (pixels)")
     ap.add_argument("--ours", choices=["irview", "probe"], default="irview")

@@ -4,9 +4,11 @@
 // Probe (i, j, k), index i + nx (j + ny k), stands at origin + spacing (i, j, k); it holds 9 RGB coefficients of
 // three.js's SphericalHarmonics3 of the incident radiance / π (E(n)/π = shGetIrradianceAt(n)), validity 0 or 1.
 // lightObject(mesh) blends the 8 probes around the mesh's centre (trilinear, valid ones only, weights
-// renormalised: baker/lightmap/probe_grid.h, interpolateProbes, without its visibility rays as irview) into one
-// SH per mesh, and its Lambert material then adds radiance = albedo × max(0, shGetIrradianceAt(n)): the same
-// value as irview, since three.js shades irradiance × albedo/π and the material's probe term is π × E/π.
+// renormalised: baker/lightmap/probe_grid.h, interpolateProbes, without its visibility rays as irview) and their
+// gradient over its bounding radius (the secant of the blends at centre ± r: baker/lightmap/probe_field.h), so a
+// surface point p takes the SH c + (p − centre)·∇c; its Lambert material then adds radiance = albedo ×
+// max(0, shGetIrradianceAt(n)): the same value as irview, since three.js shades irradiance × albedo/π and the
+// material's probe term is π × E/π.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
 import { Box3, SphericalHarmonics3, Vector3 } from 'three';
@@ -77,39 +79,73 @@ export class IrbakeProbeGrid {
     return out;
   }
 
-  // Lights `mesh` (its material must be a MeshLambertMaterial, cloned here so meshes do not share probes) with
-  // the probes at `point` (default: the centre of its world bounding box). Returns the blend; throws when no
-  // valid probe is near.
-  lightObject(mesh, point = null) {
-    if (!point) {
-      mesh.updateWorldMatrix(true, false);
-      point = new Box3().setFromObject(mesh).getCenter(new Vector3()).toArray();
+  // The probes over an object of bounding radius r around `centre`: the blend there ({ coefficients, probes,
+  // weight }) and gradient (3 Float64Array(27): per metre along x, y, z), the secant of the blends at centre ± r;
+  // an axis whose blend at either end finds no probe keeps a zero gradient (probeFieldOver).
+  field(centre, radius) {
+    const blend = this.interpolate(centre);
+    const gradient = [0, 1, 2].map(() => new Float64Array(27));
+    if (blend.probes === 0 || !(radius > 0)) return { ...blend, gradient };
+    for (let a = 0; a < 3; ++a) {
+      const hi = this.interpolate(centre.map((v, i) => (i === a ? v + radius : v)));
+      const lo = this.interpolate(centre.map((v, i) => (i === a ? v - radius : v)));
+      if (hi.probes === 0 || lo.probes === 0) continue;
+      for (let k = 0; k < 27; ++k) gradient[a][k] = (hi.coefficients[k] - lo.coefficients[k]) / (2 * radius);
     }
-    const blend = this.interpolate(point);
-    if (blend.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
+    return { ...blend, gradient };
+  }
+
+  // Lights `mesh` (its material must be a MeshLambertMaterial, cloned here so meshes do not share probes) with
+  // the probes' field around `point` (default: the centre of its world bounding box) over `radius` (default: its
+  // geometry's bounding sphere in world units). Returns the field; throws when no valid probe is near.
+  lightObject(mesh, point = null, radius = null) {
+    mesh.updateWorldMatrix(true, false);
+    if (!point) point = new Box3().setFromObject(mesh).getCenter(new Vector3()).toArray();
+    if (radius === null) {
+      if (!mesh.geometry.boundingSphere) mesh.geometry.computeBoundingSphere();
+      radius = mesh.geometry.boundingSphere.radius * mesh.matrixWorld.getMaxScaleOnAxis();
+    }
+    const field = this.field(point, radius);
+    if (field.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
     mesh.material = mesh.material.clone();
-    applyProbeSh(mesh.material, blend.coefficients);
-    return blend;
+    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient });
+    return field;
   }
 }
 
-// Adds π × max(0, shGetIrradianceAt(n, sh)) to a Lambert (or any lit) material's indirect irradiance, n the world
-// normal: three.js's own light-probe term, per material instead of per scene, clamped at 0 as irview.
-export function applyProbeSh(material, coefficients) {
-  const sh = [];
-  for (let k = 0; k < 9; ++k) sh.push(new Vector3(coefficients[3 * k], coefficients[3 * k + 1], coefficients[3 * k + 2]));
-  material.userData.irbakeProbeSh = { value: sh };
+// Adds π × max(0, shGetIrradianceAt(n, sh(p))) to a Lambert (or any lit) material's indirect irradiance, n the
+// world normal, sh(p) = coefficients + (p − centre)·gradient at the fragment's world point p (without `field`:
+// the coefficients everywhere): three.js's own light-probe term, per material instead of per scene, clamped at 0
+// as irview.
+export function applyProbeSh(material, coefficients, field = null) {
+  const vec3s = (a, from) => [...Array(9)].map((_, k) => new Vector3(a[from + 3 * k], a[from + 3 * k + 1], a[from + 3 * k + 2]));
+  const gradient = [];
+  for (let a = 0; a < 3; ++a) gradient.push(...vec3s(field ? field.gradient[a] : new Float64Array(27), 0));
+  material.userData.irbakeProbeSh = { value: vec3s(coefficients, 0) };
+  material.userData.irbakeProbeGradient = { value: gradient };
+  material.userData.irbakeProbeCentre = { value: new Vector3(...(field ? field.centre : [0, 0, 0])) };
   material.onBeforeCompile = shader => {
     shader.uniforms.irbakeProbeSh = material.userData.irbakeProbeSh;
-    const anchor = '#include <lights_fragment_maps>';
+    shader.uniforms.irbakeProbeGradient = material.userData.irbakeProbeGradient;
+    shader.uniforms.irbakeProbeCentre = material.userData.irbakeProbeCentre;
+    const anchor = '#include <lights_fragment_maps>', vertexAnchor = '#include <project_vertex>';
     if (!shader.fragmentShader.includes(anchor)) throw new Error(`${LIGHT_PROBES}: this three.js has no ${anchor}`);
+    if (!shader.vertexShader.includes(vertexAnchor)) throw new Error(`${LIGHT_PROBES}: this three.js has no ${vertexAnchor}`);
+    shader.vertexShader = shader.vertexShader
+      .replace('void main() {', 'uniform vec3 irbakeProbeCentre;\nvarying vec3 irbakeProbeOffset;\nvoid main() {')
+      .replace(vertexAnchor, `${vertexAnchor}
+  irbakeProbeOffset = ( modelMatrix * vec4( transformed, 1.0 ) ).xyz - irbakeProbeCentre;`);
     shader.fragmentShader = shader.fragmentShader
-      .replace('void main() {', 'uniform vec3 irbakeProbeSh[ 9 ];\nvoid main() {')
+      .replace('void main() {', 'uniform vec3 irbakeProbeSh[ 9 ];\nuniform vec3 irbakeProbeGradient[ 27 ];\nvarying vec3 irbakeProbeOffset;\nvoid main() {')
       .replace(anchor, `${anchor}
+  vec3 irbakeSh[ 9 ];
+  for ( int k = 0; k < 9; ++ k )
+    irbakeSh[ k ] = irbakeProbeSh[ k ] + irbakeProbeOffset.x * irbakeProbeGradient[ k ]
+                  + irbakeProbeOffset.y * irbakeProbeGradient[ 9 + k ] + irbakeProbeOffset.z * irbakeProbeGradient[ 18 + k ];
   irradiance += PI * max( shGetIrradianceAt( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ),
-                                             irbakeProbeSh ), vec3( 0.0 ) );`);
+                                             irbakeSh ), vec3( 0.0 ) );`);
   };
-  material.customProgramCacheKey = () => 'irbake-light-probes';
+  material.customProgramCacheKey = () => 'irbake-light-probes-field';
   material.needsUpdate = true;
 }
 

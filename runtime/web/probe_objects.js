@@ -3,7 +3,7 @@
 // irview --eye/--target/--fov.
 import * as THREE from 'three';
 
-// Adds one sphere per [x, y, z, r] to gltf.scene, each lit by the probes at its centre. Returns what each blended
+// Adds one sphere per [x, y, z, r] to gltf.scene, each lit by the probes' field over it (blend and gradient). Returns what each blended
 // ({ probes, weight }). Throws naming the scene when it has no probes.
 export function addProbeObjects(gltf, objects, sceneName) {
   if (!objects.length) return [];
@@ -15,7 +15,7 @@ export function addProbeObjects(gltf, objects, sceneName) {
                                 new THREE.MeshLambertMaterial({ color: new THREE.Color(1, 1, 1) }));
     mesh.position.set(x, y, z);
     gltf.scene.add(mesh);
-    const { probes, weight } = grid.lightObject(mesh, [x, y, z]);
+    const { probes, weight } = grid.lightObject(mesh, [x, y, z], r);
     return { probes, weight };
   });
 }

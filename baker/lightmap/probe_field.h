@@ -1,0 +1,52 @@
+// A probe-lit object's light as a linear field over its extent: the probes blended at its centre c plus their
+// gradient, so that a surface point p takes c_k + (p − c)·∇c_k instead of the centre's SH alone. One blend for
+// the whole object misses how a near light changes across it: the Cornell box's ceiling light, 1.1 m from a
+// sphere of radius 0.1 m, meets the sphere's surface at other angles than its centre, and near the light's
+// terminator that is 17% of the direct light (docs/validation.md, "Probes against Cycles"). The gradient along each axis is the secant of the blends
+// at c ± r (r the object's bounding radius): exact for light that is linear across the object, and the grid's
+// own trilinear variation otherwise.
+#pragma once
+#include <array>
+#include <functional>
+
+#include "lightmap/probe_grid.h"
+
+namespace irbake {
+
+struct ProbeField {
+  ShCoefficients centre{};                   // the blend at the centre (interpolateProbes)
+  std::array<ShCoefficients, 3> gradient{};  // ∂c/∂x, ∂c/∂y, ∂c/∂z, per metre
+  int probes = 0;                            // the centre blend's probes and weight (0: no valid probe near)
+  float weight = 0.0f;
+
+  // The SH at centre + offset.
+  ShCoefficients at(const glm::vec3& offset) const {
+    ShCoefficients c = centre;
+    for (int k = 0; k < kShCoefficients; ++k)
+      c[k] += offset.x * gradient[0][k] + offset.y * gradient[1][k] + offset.z * gradient[2][k];
+    return c;
+  }
+};
+
+// The field of an object of bounding radius `radius` around `centre`; `visible` as interpolateProbes. An axis
+// whose blend at either end finds no probe keeps a zero gradient.
+inline ProbeField probeFieldOver(const LightProbeGrid& g, const glm::vec3& centre, float radius,
+                                 const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
+  ProbeField out;
+  const ProbeBlend c = interpolateProbes(g, centre, visible);
+  out.centre = c.coefficients;
+  out.probes = c.probes;
+  out.weight = c.weight;
+  if (c.probes == 0 || !(radius > 0.0f)) return out;
+  for (int a = 0; a < 3; ++a) {
+    glm::vec3 step(0.0f);
+    step[a] = radius;
+    const ProbeBlend hi = interpolateProbes(g, centre + step, visible), lo = interpolateProbes(g, centre - step, visible);
+    if (hi.probes == 0 || lo.probes == 0) continue;
+    for (int k = 0; k < kShCoefficients; ++k)
+      out.gradient[a][k] = (hi.coefficients[k] - lo.coefficients[k]) / (2.0f * radius);
+  }
+  return out;
+}
+
+}  // namespace irbake
