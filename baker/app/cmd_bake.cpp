@@ -221,7 +221,7 @@ void addStageOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
   app->add_option("--clamp-k", o.clampVplsPerMean,
                   "derived clamp: no VPL adds more than 1/K of the mean\n"
                   "(default with bias compensation: " + shown(kCompensatedClampVplsPerMean) + ", or " +
-                      shown(kCompensatedClampVplsPerMeanNoEmitters) + " in a scene\nwithout emissive surfaces; " +
+                      shown(kCompensatedClampVplsPerMeanNoEmitters) + " in a scene\nwithout small emissive surfaces (under half the surface); " +
                       shown(kClampVplsPerMean) + " without; 0 = automatic)")
       ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
   app->add_flag("--no-bias-compensation", a.noBiasCompensation,

@@ -70,11 +70,16 @@ double emissiveAreaShare(const Scene& scene) {
   return all > 0.0 ? emitting / all : 0.0;
 }
 
+// Emitters a gather's rays would find only by chance: emissive surfaces covering less than kGatheredEmitterShare.
+bool hasSmallEmitters(const Scene& scene) {
+  return scene.hasEmissiveSurface() && emissiveAreaShare(scene) < kGatheredEmitterShare;
+}
+
 void settleFinalGather(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
   const bool vplBackend = plan.backend != BackendKind::Reference && options.eval.includeVpls;
   const std::string seeThrough = seeThroughMaterials(scene);
   const double emitterShare = emissiveAreaShare(scene);
-  const bool smallEmitters = scene.hasEmissiveSurface() && emitterShare < kGatheredEmitterShare;
+  const bool smallEmitters = hasSmallEmitters(scene);
   plan.finalGather = vplBackend && (options.finalGather == FinalGatherMode::On ||
                                     (options.finalGather == FinalGatherMode::Auto && !smallEmitters &&
                                      seeThrough.empty()));
@@ -230,16 +235,19 @@ void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene,
     return;
   }
   const bool given = options.clampVplsPerMean > 0.0;
+  // The tighter clamp wherever no small emitter is near: none, or emitters the gathers' rays meet anyway.
+  const bool smallEmitters = hasSmallEmitters(scene);
   plan.clampK = given                           ? options.clampVplsPerMean
                 : !plan.eval.biasCompensation  ? kClampVplsPerMean
-                : scene.hasEmissiveSurface()   ? kCompensatedClampVplsPerMean
+                : smallEmitters                ? kCompensatedClampVplsPerMean
                                                : kCompensatedClampVplsPerMeanNoEmitters;
   plan.eval.clampBound = deriveClampBound(scene, vpls, plan.clampK);
   plan.clampDerived = true;
   plan.settle("clamp-k", plan.clampK,
               given                         ? "asked for"
               : !plan.eval.biasCompensation ? "no bias compensation: a loose clamp keeps the bias small"
-              : scene.hasEmissiveSurface()  ? "compensated, with emissive surfaces"
+              : smallEmitters               ? "compensated, with small emissive surfaces"
+              : scene.hasEmissiveSurface()  ? "compensated, emitters cover at least half the surface (the gathers meet them)"
                                             : "compensated, no emissive surfaces",
               !given);
   plan.settle("clamp", plan.eval.clampBound, "derived: no VPL adds more than 1/k of the mean (1/m²)");

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "samples/sample_scenes.h"
 
 namespace irbake {
@@ -55,6 +58,28 @@ TEST(BakePlan, FinalGatherAutoFollowsEmittersAndEveryChoiceHasAReason) {
     EXPECT_TRUE(j[key]["automatic"].get<bool>()) << key;
   }
   EXPECT_EQ(j["final-gather"]["value"], "on");
+}
+
+// The compensated clamp's k: 256 near small emitters (the gathers' rays would meet them by chance), 1024 where
+// there is none, or where emitters cover the surface (the final gather's rule), each with its reason.
+TEST(BakePlan, TheTightClampWhereNoSmallEmitterIsNear) {
+  struct Case {
+    const char* name;
+    Scene scene;
+    double k;
+  };
+  for (Case& c : std::vector<Case>{{"cornell", makeCornellBox(), 256.0},
+                                   {"furnace", samples::makeFurnace(0.9f, 0.1f), 1024.0},
+                                   {"corner", makeCorner(), 1024.0}}) {
+    const RayTracer rt(c.scene);
+    BakePlan plan = planBake(c.scene, rt, autoOptions(), softwareGl);
+    settleClamp(plan, autoOptions(), c.scene, VplSet{});
+    EXPECT_EQ(plan.clampK, c.k) << c.name;
+    const nlohmann::json j = plan.toJson();
+    ASSERT_TRUE(j.contains("clamp-k")) << c.name;
+    EXPECT_TRUE(j["clamp-k"]["automatic"].get<bool>()) << c.name;
+    EXPECT_FALSE(j["clamp-k"]["reason"].get<std::string>().empty()) << c.name;
+  }
 }
 
 TEST(BakePlan, AskedForChoicesAreNotAutomatic) {

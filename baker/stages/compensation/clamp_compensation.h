@@ -32,9 +32,11 @@ namespace irbake {
 // instead of 2.3) removes the VPL splotches and the gather gives the near-field back; a larger k lets the
 // gather's own noise (its rays finding a small bright emitter) dominate (docs/validation.md).
 constexpr double kCompensatedClampVplsPerMean = 256.0;
-// The same without emissive surfaces (punctual lights, sun, sky): the gather then reads only ρ·M (the
-// direct light in M exact), so a tighter clamp hands more of the transport to the gather instead of to the
-// few VPLs that reach a dim region; past this a sharp sunlit map makes the gather noisy in close-ups.
+// The same without small emitters (punctual lights, sun, sky, or emissive surfaces covering at least half the
+// surface, which the gather's rays meet anyway): the gather then meets no small bright emitter, so a tighter
+// clamp hands more of the transport to the gather instead of to the few VPLs that reach a dim region or, under
+// emitters everywhere, that lie near a corner (their count was the corner's noise); past this a sharp sunlit map
+// makes the gather noisy in close-ups.
 constexpr double kCompensatedClampVplsPerMeanNoEmitters = 1024.0;
 
 struct ClampCompensationOptions {
