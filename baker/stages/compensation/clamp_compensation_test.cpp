@@ -248,6 +248,18 @@ TEST(ClampCompensation, SweepsStopWhenAnotherBounceNoLongerChangesTheMap) {
   EXPECT_GT(std::abs(first / converged - 1.0), 2e-3);
 }
 
+// The clamped maps after the compensation's sweeps (tolerance < 0: all of them), with or without the tail.
+std::vector<Lightmap> sweptMaps(const BakeInputs& in, const std::vector<Lightmap>& clamped, int sweeps, double tolerance,
+                                bool tail, ClampCompensationStats* stats) {
+  std::vector<Lightmap> maps = clamped;
+  ClampCompensationOptions o;
+  o.sweeps = sweeps;
+  o.sweepTolerance = tolerance;
+  o.extrapolateTail = tail;
+  ClampGather(in, o).apply(maps, stats);
+  return maps;
+}
+
 // The geometric tail: in a furnace of albedo 0.9 every bounce inside the clamp radius returns 0.9 of the
 // one before, so the sweeps converge slowly. With the tail extrapolated the gather stops after a few sweeps
 // and lands as close to 40 sweeps as the tolerance; without it, at the same sweep count, it is short.
@@ -256,13 +268,7 @@ TEST(ClampCompensation, GeometricTailMatchesManySweepsAfterFewer) {
   const BakeInputs in = f.inputs();
   const auto clamped = bakeEmbree(in);
   auto run = [&](int sweeps, double tolerance, bool tail, ClampCompensationStats* stats) {
-    std::vector<Lightmap> maps = clamped;
-    ClampCompensationOptions o;
-    o.sweeps = sweeps;
-    o.sweepTolerance = tolerance;
-    o.extrapolateTail = tail;
-    ClampGather(in, o).apply(maps, stats);
-    return validMean(maps);
+    return validMean(sweptMaps(in, clamped, sweeps, tolerance, tail, stats));
   };
   ClampCompensationStats withTail, cut, full;
   const double tailed = run(40, 1e-4, true, &withTail);
@@ -286,13 +292,7 @@ TEST(ClampCompensation, GeometricTailConvergesEveryTexel) {
   const BakeInputs in = f.inputs();
   const auto clamped = bakeEmbree(in);
   auto run = [&](int sweeps, double tolerance, bool tail, ClampCompensationStats* stats) {
-    std::vector<Lightmap> maps = clamped;
-    ClampCompensationOptions o;
-    o.sweeps = sweeps;
-    o.sweepTolerance = tolerance;
-    o.extrapolateTail = tail;
-    ClampGather(in, o).apply(maps, stats);
-    return maps;
+    return sweptMaps(in, clamped, sweeps, tolerance, tail, stats);
   };
   ClampCompensationStats tailed, full;
   const std::vector<Lightmap> withTail = run(40, 5e-4, true, &tailed), converged = run(40, -1.0, false, &full);
