@@ -299,7 +299,7 @@ TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
   EXPECT_NE(seeThrough.report["backendChoice"]["reason"].get<std::string>().find("BLEND"), std::string::npos);
 }
 
-// Each clamp mode reaches the backends as one bound: derived = deriveClampBound at k = 256 (with bias
+// Each clamp mode reaches the backends as one bound: derived = deriveClampBound at the plan's k (with bias
 // compensation) on the bake's own VPLs, off = 0 (no clamp), fixed = the given bound; fixed and off leave k at 0.
 TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
   for (ClampMode mode : {ClampMode::Derived, ClampMode::Off, ClampMode::Fixed}) {
@@ -308,12 +308,13 @@ TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
     o.clampBound = 5.0f;  // read by Fixed only
     const BakeResult r = bake(loadSample("furnace"), o);
     const nlohmann::json& eval = r.report["eval"];
-    const float expected = mode == ClampMode::Derived ? deriveClampBound(r.scene, r.vpls, 256.0)
+    // k = 1024: the furnace's emitters cover its surface, so no small emitter is near (the tight clamp).
+    const float expected = mode == ClampMode::Derived ? deriveClampBound(r.scene, r.vpls, 1024.0)
                            : mode == ClampMode::Fixed ? 5.0f
                                                       : 0.0f;
     EXPECT_EQ(eval["clampBound"].get<float>(), expected) << static_cast<int>(mode);
     EXPECT_EQ(eval["clampDerived"].get<bool>(), mode == ClampMode::Derived);
-    EXPECT_EQ(eval["clampVplsPerMean"].get<double>(), mode == ClampMode::Derived ? 256.0 : 0.0);
+    EXPECT_EQ(eval["clampVplsPerMean"].get<double>(), mode == ClampMode::Derived ? 1024.0 : 0.0);
     if (mode == ClampMode::Derived) {
       EXPECT_GT(expected, 0.0f);
     }

@@ -107,30 +107,34 @@ constexpr int kEvaluatedPathsDivisor = 2;
 constexpr double kEmitterShareWithoutGather = 0.5;
 
 // The walk's paths: finalGatherPaths where the final gather runs (it reads their map averaged).
-void settleWalk(BakePlan& plan, const BakeOptions& options) {
+void settleWalk(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
   plan.walk = options.walk;
   // Without the final gather the VPL sum is the map's bounced light, and its seed-to-seed noise is the deep
   // bounces' few carriers (M_j = N ρ̄^j paths): they fork past bounce 1 even in a closed scene, and the walk
-  // follows more paths than are evaluated.
+  // follows more paths than are evaluated where emitters are its only sources. A punctual light or a sky
+  // leaves VPLs of other powers (a sun's on a closed room's roof), which resampling by power would favour.
   const bool splitDeep = !plan.finalGather && !options.walk.split;
-  if (splitDeep) {
-    plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
+  const bool resample = splitDeep && scene.lights.empty() && !scene.environment.present();
+  if (splitDeep) plan.walk.minAutoSplit = std::max(plan.walk.minAutoSplit, kMinSplitWithoutGather);
+  if (resample) {
     plan.walk.walkFactor = std::max(plan.walk.walkFactor, kWalkFactorWithoutGather);
     plan.walk.evaluatedEmitterShare = std::min(plan.walk.evaluatedEmitterShare, kEmitterShareWithoutGather);
   }
   // finalGatherPaths is set where the paths were left to the quality preset.
   const bool automatic = options.finalGatherPaths.has_value();
   const bool underGather = plan.finalGather && automatic;
-  if (underGather) plan.walk.paths = *options.finalGatherPaths;
-  else if (automatic && splitDeep) plan.walk.paths = std::max(1, options.walk.paths / kEvaluatedPathsDivisor);
+  if (underGather || (automatic && splitDeep && !resample)) plan.walk.paths = *options.finalGatherPaths;
+  else if (automatic && resample) plan.walk.paths = std::max(1, options.walk.paths / kEvaluatedPathsDivisor);
   plan.settle("paths", plan.walk.paths,
               !automatic   ? "asked for"
               : underGather ? "the preset's paths under the final gather, which reads their map averaged"
-              : splitDeep   ? "half the preset's paths evaluated: the walk follows " +
+              : resample    ? "half the preset's paths evaluated: the walk follows " +
                                 std::to_string(kWalkFactorWithoutGather) + "x as many, forks past bounce 1, and is resampled"
+              : splitDeep   ? "the preset's reduced paths: past bounce 1 each forks into at least " +
+                                std::to_string(kMinSplitWithoutGather)
                             : "the preset's paths",
               automatic);
-  if (splitDeep)
+  if (resample)
     plan.settle("walk-factor", plan.walk.walkFactor,
                 "without the final gather the bounces' totals rest on a walk of this many times the paths, resampled", true);
 }
@@ -214,7 +218,7 @@ BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOpti
   plan.directional = options.directional;
   settleBackend(plan, scene, options, probeGl);
   settleFinalGather(plan, scene, options);
-  settleWalk(plan, options);
+  settleWalk(plan, scene, options);
   settleCompensation(plan, options, probeGl);
   settleSky(plan, scene, rayTracer, options);
   plan.shadowEdges = options.shadowEdges;

@@ -93,10 +93,14 @@ TEST(BakePlan, AskedForChoicesAreNotAutomatic) {
   EXPECT_EQ(plan.backend, BackendKind::Embree);
   EXPECT_FALSE(plan.finalGather);
   EXPECT_EQ(plan.walk.paths, 4096);
-  EXPECT_EQ(plan.walk.walkFactor, 8);  // no gather: the paths asked for are evaluated, 8x as many walked
+  EXPECT_EQ(plan.walk.walkFactor, 1);  // a spot light's VPLs outweigh an emitter's: the walk is evaluated whole
   for (const char* key : {"backend", "final-gather", "paths"}) EXPECT_FALSE(plan.choices.at(key).automatic) << key;
+  const Scene box = makeCornellBox();  // emitters only, no gather: the paths asked for are evaluated, 8x as many walked
+  const RayTracer boxRt(box);
+  EXPECT_EQ(planBake(box, boxRt, o, noGl).walk.walkFactor, 8);
+  EXPECT_EQ(planBake(box, boxRt, o, noGl).walk.paths, 4096);
   o.walk.split = 1;  // --walk-split 1: Keller's walk, every VPL evaluated
-  EXPECT_EQ(planBake(lamp, rt, o, noGl).walk.walkFactor, 1);
+  EXPECT_EQ(planBake(box, boxRt, o, noGl).walk.walkFactor, 1);
 }
 
 TEST(BakePlan, CompensationOverlapsOnlyOnHardwareGl) {
