@@ -39,14 +39,13 @@ double weightOf(const Vpl& v) {
 }
 
 // How many times each VPL of [first, last) is picked when `keep` picks fall at (k + u) W / keep along the
-// Morton order (k = 0…keep−1).
-std::vector<uint32_t> systematicPicks(const std::vector<Vpl>& vpls, size_t first, size_t last, size_t keep, double u) {
+// Morton order (k = 0…keep−1); total = W, the VPLs' Σ weightOf.
+std::vector<uint32_t> systematicPicks(const std::vector<Vpl>& vpls, size_t first, size_t last, size_t keep, double u,
+                                      double total) {
   const std::vector<uint32_t> codes = mortonCodes(vpls, first, last);
   std::vector<size_t> order(last - first);
   std::iota(order.begin(), order.end(), size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return codes[a] < codes[b]; });
-  double total = 0.0;
-  for (size_t v = first; v < last; ++v) total += weightOf(vpls[v]);
   std::vector<uint32_t> picks(last - first, 0);
   if (!(total > 0.0)) return picks;
   const double step = total / static_cast<double>(keep);
@@ -82,7 +81,7 @@ void resampleVpls(VplSet& set, const std::vector<size_t>& keep, uint64_t seed) {
       double total = 0.0;
       for (size_t v = first; v < last; ++v) total += weightOf(set.vpls[v]);
       Rng rng(hashSeed(seed, 0x726573616d706c65ull, j));  // "resample"
-      const std::vector<uint32_t> picks = systematicPicks(set.vpls, first, last, k, rng.uniform());
+      const std::vector<uint32_t> picks = systematicPicks(set.vpls, first, last, k, rng.uniform(), total);
       for (size_t v = first; v < last; ++v) {
         if (picks[v - first] == 0) continue;
         Vpl vpl = set.vpls[v];
