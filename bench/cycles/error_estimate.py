@@ -8,7 +8,8 @@ usage (from the repository root, after compare.py --maps has cached Cycles' bake
 Each DIR is an `irbake bake ... --estimate-error` output (scene.gltf, lightmap_0.exr, report.json). The score is
 compare.py's MAP score on the same texels (covered, chart-border ring and hidden texels left out, 4x4 bins with
 at least half their texels kept): rel_rmse_4, the reference's own noise and rel_rmse_4_corrected; the row adds
-the estimate and the ratio estimate / rel_rmse_4_corrected. Cycles runs (cached) exactly as compare.py runs it.
+the estimate on the same kind of bins (the report's estimatedError.interior: the chart-border ring left out;
+estimated_all_bins is the headline figure over every valid texel) and the ratio estimate / rel_rmse_4_corrected. Cycles runs (cached) exactly as compare.py runs it.
 """
 import argparse
 import csv
@@ -23,7 +24,7 @@ import compare  # noqa: E402
 
 FIELDS = ["date", "commit", "scene", "seed", "our_options", "texels", "estimated", "est_vpls", "est_compensation_rays",
           "est_gather_rays", "rel_rmse_4", "ref_noise_4", "rel_rmse_4_corrected", "ratio", "mean_ratio", "ref_spp",
-          "our_bake_s", "load_1min"]
+          "our_bake_s", "load_1min", "estimate_bins", "estimated_all_bins"]
 
 
 def score_bake(args, out):
@@ -54,8 +55,9 @@ def score_bake(args, out):
     e = rep.get("estimatedError")
     if e is None:
         compare.fail("%s: no estimatedError in the report (bake with --estimate-error)" % out)
-    br = e.get("breakdown", {})
-    return rep, s, e, br, 2 * half
+    # The figure on the bins this score keeps (chart-border ring left out) where the report has it.
+    scored = e.get("interior", e)
+    return rep, s, e, scored, 2 * half
 
 
 def main():
@@ -79,20 +81,22 @@ def main():
         args.bake_script = os.path.join(compare.REPO, "bench", "cycles", "cycles_bake_lights.py")
     rows = []
     for out in args.bakes:
-        rep, s, e, br, spp = score_bake(args, out)
+        rep, s, e, scored, spp = score_bake(args, out)
+        br = scored.get("breakdown", {})
         corrected = s["rel_rmse_4_corrected"]
         opts = rep.get("options", {})
         row = {"date": datetime.datetime.utcnow().strftime("%Y-%m-%dT%H:%MZ"), "commit": compare.git_commit(args.irbake),
                "scene": args.name, "seed": opts.get("seed", "0"),
                "our_options": " ".join("--%s %s" % (k, v) for k, v in sorted(opts.items()) if k != "seed"),
-               "texels": rep["texels"]["valid"], "estimated": e["relative"], "est_vpls": br.get("vpls", ""),
+               "texels": rep["texels"]["valid"], "estimated": scored["relative"], "est_vpls": br.get("vpls", ""),
                "est_compensation_rays": br.get("compensationRays", ""), "est_gather_rays": br.get("finalGatherRays", br.get("compensationAndGatherRays", "")),
                "rel_rmse_4": s["rel_rmse_4"], "ref_noise_4": s["ref_noise_4"], "rel_rmse_4_corrected": corrected,
-               "ratio": e["relative"] / corrected if corrected > 0 else "", "mean_ratio": s["mean_ratio"], "ref_spp": spp,
-               "our_bake_s": rep["timings"]["seconds"]["bake"], "load_1min": open("/proc/loadavg").read().split()[0]}
+               "ratio": scored["relative"] / corrected if corrected > 0 else "", "mean_ratio": s["mean_ratio"], "ref_spp": spp,
+               "our_bake_s": rep["timings"]["seconds"]["bake"], "load_1min": open("/proc/loadavg").read().split()[0],
+               "estimate_bins": "interior" if "interior" in e else "valid", "estimated_all_bins": e["relative"]}
         rows.append(row)
         compare.log("%s seed %s: estimated %.2f%%, measured %.2f%% (corrected %.2f%%, ref noise %.2f%%), ratio %.2f" % (
-            args.name, row["seed"], 100 * e["relative"], 100 * s["rel_rmse_4"], 100 * corrected, 100 * s["ref_noise_4"],
+            args.name, row["seed"], 100 * scored["relative"], 100 * s["rel_rmse_4"], 100 * corrected, 100 * s["ref_noise_4"],
             row["ratio"] if row["ratio"] != "" else float("nan")))
     new = not os.path.isfile(args.csv)
     with open(args.csv, "a", newline="") as f:
