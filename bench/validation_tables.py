@@ -78,6 +78,7 @@ SCENES = {
     "cycles_sponza_sun_sky.csv": "Sponza, sun + sky",
     "cycles_sibenik_lamp.csv": "Sibenik, lamp",
     "cycles_sponza_sun_sky_tpu6.csv": "Sponza, sun + sky",
+    "cycles_sponza_sun_sky_default.csv": "Sponza, sun + sky",
 }
 
 
@@ -122,9 +123,11 @@ def t_seed_spread():
 
 # Scenes whose map is scored against Cycles on every seed: (CSV, options without --seed, what the options mean).
 EVERY_SEED = [
+    ("cycles_cornell_sample.csv", "", "default"),
     ("cycles_cornell_published.csv", "", "default"),
     ("cycles_mcguire_cornell.csv", "", "default"),
     ("cycles_sponza_sun_sky_tpu6.csv", "--sky 0.4,0.5,0.7 --texels-per-unit 6", "sun + sky, 6 texels per metre"),
+    ("cycles_sponza_sun_sky_default.csv", "--sky 0.4,0.5,0.7", "sun + sky, default density"),
 ]
 
 
