@@ -1,5 +1,7 @@
 #include "testing/scenes.h"
 
+#include <cmath>
+
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -128,25 +130,27 @@ AtlasedScene::AtlasedScene(Scene s, int pageSize) : scene(std::move(s)) {
 double exactLitShare(const Scene& s, const TexelSamples& ts, size_t t, const std::function<bool(glm::vec3)>& lit,
                      const std::function<bool(glm::vec3)>& visible) {
   const Primitive& prim = s.primitives[ts.primitive[t]];
-  const uint32_t tri = ts.triangle[t];
   const glm::vec2 size(ts.width, ts.height);
-  const glm::vec2 a = prim.uv1[prim.indices[3 * tri]] * size, b = prim.uv1[prim.indices[3 * tri + 1]] * size,
-                  c = prim.uv1[prim.indices[3 * tri + 2]] * size;
-  const glm::vec3 &pa = prim.positions[prim.indices[3 * tri]], &pb = prim.positions[prim.indices[3 * tri + 1]],
-                  &pc = prim.positions[prim.indices[3 * tri + 2]];
   auto cross2 = [](glm::vec2 u, glm::vec2 v) { return u.x * v.y - u.y * v.x; };
-  const float area = cross2(b - a, c - a);
   const int x = static_cast<int>(t % ts.width), y = static_cast<int>(t / ts.width), K = 64;
   int inside = 0, litCount = 0;
   for (int j = 0; j < K; ++j)
     for (int i = 0; i < K; ++i) {
       const glm::vec2 q(x + (i + 0.5f) / K, y + (j + 0.5f) / K);
-      const float u = cross2(q - a, c - a) / area, v = cross2(b - a, q - a) / area;
-      if (u < 0 || v < 0 || u + v > 1) continue;
-      const glm::vec3 p = (1 - u - v) * pa + u * pb + v * pc;
-      if (!visible(p)) continue;
-      ++inside;
-      litCount += lit(p) ? 1 : 0;
+      for (size_t tri = 0; tri < prim.triangleCount(); ++tri) {  // the first triangle that holds q
+        const uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
+        const glm::vec2 a = prim.uv1[i0] * size, b = prim.uv1[i1] * size, c = prim.uv1[i2] * size;
+        const float area = cross2(b - a, c - a);
+        if (!(std::abs(area) > 1e-12f)) continue;
+        const float u = cross2(q - a, c - a) / area, v = cross2(b - a, q - a) / area;
+        if (u < 0 || v < 0 || u + v > 1) continue;
+        const glm::vec3 p = (1 - u - v) * prim.positions[i0] + u * prim.positions[i1] + v * prim.positions[i2];
+        if (visible(p)) {
+          ++inside;
+          litCount += lit(p) ? 1 : 0;
+        }
+        break;
+      }
     }
   return inside ? double(litCount) / inside : -1.0;
 }

@@ -74,8 +74,8 @@ struct AtlasedScene {
   AtlasedScene(Scene s, int pageSize);
 };
 
-// Of the part of texel t's square on its own triangle where visible(p), the share where lit(p), from a 64×64 grid
-// of points (closed-form predicates, no rays); -1 where no point is in that part.
+// Of the part of texel t's square on its primitive's triangles where visible(p), the share where lit(p), from a
+// 64×64 grid of points (closed-form predicates, no rays); -1 where no point is in that part.
 double exactLitShare(const Scene& s, const TexelSamples& ts, size_t t, const std::function<bool(glm::vec3)>& lit,
                      const std::function<bool(glm::vec3)>& visible = [](glm::vec3) { return true; });
 

@@ -54,15 +54,16 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     if (ts.supersample != 1 || map.size() != ts.layerSize()) continue;
     const std::vector<uint8_t>& valid = map.valid.size() == map.size() ? map.valid : ts.valid;
     const std::vector<uint8_t> edge = edgeTexels(visibleShare(in, ts, map, valid), ts.width, ts.height, options.jump);
+    const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {
         if (!edge[t]) continue;
-        const glm::vec3 n(ts.normal[t]);
         SquareMean mean;
-        const bool sampled = averageOverTexelSquare(in, ts, t, S, [&](const glm::vec3& xs, const glm::vec3& origin, glm::vec3* values) {
+        const bool sampled = averageOverTexelSquare(in, ts, t, S, &squares, [&](const glm::vec3& xs, const glm::vec3& nx,
+                                                                                const glm::vec3& origin, glm::vec3* values) {
           bool anyLit = false;
           for (size_t i = 0; i < in.scene.lights.size(); ++i) {
-            const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, n);
+            const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
             if (c.mapValue == glm::vec3(0.0f)) continue;
             const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
             if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
@@ -76,7 +77,7 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
         }, mean);
         points += static_cast<size_t>(mean.points);
         dropped += static_cast<size_t>(mean.dropped);
-        if (!sampled || mean.kept == 0) continue;  // no sub-point of this triangle in the square: the centre's value stays
+        if (!sampled || mean.kept == 0) continue;  // no sub-point on the chart in the square: the centre's value stays
         map.texels[t] = glm::vec3(mean.sum[0] / double(mean.kept));
         if (part) (*part->pages)[p].texels[t] = glm::vec3(mean.sum[1] / double(mean.kept));
         ++edges;

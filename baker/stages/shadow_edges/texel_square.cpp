@@ -1,5 +1,6 @@
 #include "stages/shadow_edges/texel_square.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -9,6 +10,14 @@ namespace irbake {
 namespace {
 
 float cross2(const glm::vec2& a, const glm::vec2& b) { return a.x * b.y - a.y * b.x; }
+
+glm::vec3 triangleNormal(const Primitive& prim, uint32_t tri) {
+  const glm::vec3 &p0 = prim.positions[prim.indices[3 * tri]], &p1 = prim.positions[prim.indices[3 * tri + 1]],
+                  &p2 = prim.positions[prim.indices[3 * tri + 2]];
+  const glm::vec3 g = glm::cross(p1 - p0, p2 - p0);
+  const float gl = glm::length(g);
+  return gl > 0.0f ? g / gl : glm::vec3(0.0f, 0.0f, 1.0f);
+}
 
 }  // namespace
 
@@ -36,36 +45,100 @@ std::vector<uint8_t> edgeTexels(const std::vector<float>& share, int w, int h, f
   return edge;
 }
 
-bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S, const SubPointVisit& visit,
-                            SquareMean& out) {
+SquareTriangles squareTriangles(const Scene& scene, const TexelSamples& ts, const std::vector<uint8_t>& marked) {
+  SquareTriangles out;
+  const size_t layer = ts.layerSize();
+  out.first.assign(layer + 1, 0);
+  const glm::vec2 size(ts.width, ts.height);
+  // Two passes over the page's triangles: count per marked texel, then fill (scene order kept).
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<uint32_t> next;
+    if (pass == 1) {
+      for (size_t t = 0; t < layer; ++t) out.first[t + 1] += out.first[t];
+      out.tris.resize(out.first[layer]);
+      next.assign(out.first.begin(), out.first.end() - 1);
+    }
+    for (uint32_t pi = 0; pi < scene.primitives.size(); ++pi) {
+      const Primitive& prim = scene.primitives[pi];
+      if (prim.lightmap.page != ts.page || prim.uv1.size() != prim.positions.size()) continue;
+      for (uint32_t tri = 0; tri < prim.triangleCount(); ++tri) {
+        const glm::vec2 a = prim.uv1[prim.indices[3 * tri]] * size, b = prim.uv1[prim.indices[3 * tri + 1]] * size,
+                        c = prim.uv1[prim.indices[3 * tri + 2]] * size;
+        const glm::vec2 lo = glm::min(a, glm::min(b, c)), hi = glm::max(a, glm::max(b, c));
+        const int x0 = std::max(0, int(std::floor(lo.x))), x1 = std::min(ts.width - 1, int(std::floor(hi.x)));
+        const int y0 = std::max(0, int(std::floor(lo.y))), y1 = std::min(ts.height - 1, int(std::floor(hi.y)));
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) {
+            const size_t t = static_cast<size_t>(y) * ts.width + x;
+            if (!marked[t]) continue;
+            if (pass == 0) ++out.first[t + 1];
+            else out.tris[next[t]++] = glm::uvec2(pi, tri);
+          }
+      }
+    }
+  }
+  return out;
+}
+
+bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S, const SquareTriangles* squares,
+                            const SubPointVisit& visit, SquareMean& out) {
   if (ts.positionWeight[t].w <= 0.0f || ts.primitive[t] >= in.scene.primitives.size()) return false;
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   const glm::vec2 size(ts.width, ts.height);
-  const uint32_t pi = ts.primitive[t], tri = ts.triangle[t];
-  const Primitive& prim = in.scene.primitives[pi];
-  const uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
-  const glm::vec2 t0 = prim.uv1[i0] * size, t1 = prim.uv1[i1] * size, t2 = prim.uv1[i2] * size;
-  const float area2 = cross2(t1 - t0, t2 - t0);
-  if (!(std::abs(area2) > 1e-12f)) return false;
-  const glm::vec3 &p0 = prim.positions[i0], &p1 = prim.positions[i1], &p2 = prim.positions[i2];
+  const glm::uvec2 own(ts.primitive[t], ts.triangle[t]);
+  const glm::uvec2* tris = &own;
+  size_t count = 1;
+  if (squares && squares->first.size() > t + 1 && squares->first[t + 1] > squares->first[t]) {
+    tris = squares->tris.data() + squares->first[t];
+    count = squares->first[t + 1] - squares->first[t];
+  }
   const glm::vec3 n(ts.normal[t]);
-  const glm::vec3 centre = rt.insetPoint(pi, tri, glm::vec3(ts.positionWeight[t])) + n * eps;
+  // The centre's normal may face away from its triangle's winding (a surface seen from its back): the other
+  // triangles' normals turn the same way.
+  const float side = glm::dot(n, triangleNormal(in.scene.primitives[own.x], own.y)) < 0.0f ? -1.0f : 1.0f;
+  const glm::vec3 centre = rt.insetPoint(own.x, own.y, glm::vec3(ts.positionWeight[t])) + n * eps;
   const int x = static_cast<int>(t % ts.width), y = static_cast<int>(t / ts.width);
+  bool any = false;
   for (int sy = 0; sy < S; ++sy)
     for (int sx = 0; sx < S; ++sx) {
       const glm::vec2 q(x + (sx + 0.5f) / S, y + (sy + 0.5f) / S);
-      const float b1 = cross2(q - t0, t2 - t0) / area2, b2 = cross2(t1 - t0, q - t0) / area2;
-      const float tol = -1e-4f;
-      if (b1 < tol || b2 < tol || b1 + b2 > 1.0f - tol) continue;  // another triangle's part of the square
-      const glm::vec3 xs = rt.insetPoint(pi, tri, (1.0f - b1 - b2) * p0 + b1 * p1 + b2 * p2);
-      const glm::vec3 origin = xs + n * eps;
+      // The first triangle that holds q (none: the square's part off the chart, not sampled).
+      glm::vec3 xs, nx;
+      bool found = false;
+      for (size_t k = 0; k < count && !found; ++k) {
+        const Primitive& prim = in.scene.primitives[tris[k].x];
+        const uint32_t tri = tris[k].y;
+        const uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
+        const glm::vec2 t0 = prim.uv1[i0] * size, t1 = prim.uv1[i1] * size, t2 = prim.uv1[i2] * size;
+        const float area2 = cross2(t1 - t0, t2 - t0);
+        if (!(std::abs(area2) > 1e-12f)) continue;
+        any = true;
+        const float b1 = cross2(q - t0, t2 - t0) / area2, b2 = cross2(t1 - t0, q - t0) / area2;
+        const float tol = -1e-4f;
+        if (b1 < tol || b2 < tol || b1 + b2 > 1.0f - tol) continue;
+        found = true;
+        const float b0 = 1.0f - b1 - b2;
+        xs = rt.insetPoint(tris[k].x, tri, b0 * prim.positions[i0] + b1 * prim.positions[i1] + b2 * prim.positions[i2]);
+        if (tris[k] == own) {
+          nx = n;
+        } else {
+          nx = side * triangleNormal(prim, tri);
+          if (prim.normals.size() == prim.positions.size()) {
+            const glm::vec3 m = b0 * prim.normals[i0] + b1 * prim.normals[i1] + b2 * prim.normals[i2];
+            const float ml = glm::length(m);
+            if (ml > 1e-12f && std::isfinite(ml)) nx = side * m / ml;
+          }
+        }
+      }
+      if (!found) continue;
+      const glm::vec3 origin = xs + nx * eps;
       ++out.points;
       glm::vec3 values[SquareMean::kValues] = {glm::vec3(0.0f), glm::vec3(0.0f)};
-      // Dark: shadowed, or cut off from the centre by a surface standing on the triangle (the floor under a box
+      // Dark: shadowed, or cut off from the centre by a surface standing on the chart (the floor under a box
       // resting on it), which is covered, not shadowed, and no part of what a viewer sees. A lit sub-point
       // cannot be under a closed box, so only the dark ones need the ray along the surface.
-      if (!visit(xs, origin, values)) {
+      if (!visit(xs, nx, origin, values)) {
         const glm::vec3 step = origin - centre;
         const float reach = glm::length(step);
         if (reach > eps && rt.occluded(centre, step / reach, 0.0f, reach)) {
@@ -76,7 +149,7 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
       for (int k = 0; k < SquareMean::kValues; ++k) out.sum[k] += glm::dvec3(values[k]);
       ++out.kept;
     }
-  return true;
+  return any;
 }
 
 }  // namespace irbake

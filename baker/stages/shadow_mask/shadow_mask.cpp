@@ -75,14 +75,15 @@ void refineEdges(const BakeInputs& in, const TexelSamples& ts, const Light& ligh
                  std::vector<float>& vis, ShadowMaskStats& stats) {
   if (options.subSamples <= 1 || ts.supersample != 1) return;
   const std::vector<uint8_t> edge = edgeTexels(vis, ts.width, ts.height, options.jump);
+  const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
   std::atomic<size_t> edges{0}, points{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (!edge[t]) continue;
       SquareMean mean;
       const bool sampled = averageOverTexelSquare(
-          in, ts, t, options.subSamples,
-          [&](const glm::vec3& xs, const glm::vec3& origin, glm::vec3* values) {
+          in, ts, t, options.subSamples, &squares,
+          [&](const glm::vec3& xs, const glm::vec3&, const glm::vec3& origin, glm::vec3* values) {
             values[0] = glm::vec3(visibility(in.rayTracer, light, xs, origin));
             return values[0].x > 0.0f;
           },
