@@ -2,7 +2,7 @@
 // at the texel's centre: a texel a hard shadow edge crosses stores the centre's side of the edge, and the
 // bilinear read spreads that over the texel's whole square, so a region's mean is off by up to half a texel
 // of shadow along every edge (narrow sunlit strips show it most). Here the texels where the lights' visibility jumps between neighbours get the mean of that light over
-// their own square instead: S×S sub-points on the texel's triangle, one shadow ray each, so the map's mean
+// their own square instead: S×S sub-points on the chart's triangles that cover it, one shadow ray each, so the map's mean
 // over any region equals the irradiance's up to the bilinear blur. Both backends: the direct stage's pages
 // (punctual lights only) before the VPLs are added; the centre's value is replaced, not corrected, so GL's
 // shadow-map texels on an edge come out as the rays say. docs/units.md, "Shadow edges".
@@ -23,7 +23,7 @@ struct ShadowEdgeOptions {
 
 struct ShadowEdgeStats {
   size_t edgeTexels = 0;     // texels whose value was replaced
-  size_t subPoints = 0;      // sub-points traced (inside their triangle)
+  size_t subPoints = 0;      // sub-points traced (on a triangle of the chart)
   size_t droppedInside = 0;  // of those, cut off from the texel's centre by a surface (under a box on the floor)
   double seconds = 0.0;
 };
