@@ -59,8 +59,7 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
       for (size_t t = r.begin(); t != r.end(); ++t) {
         if (!edge[t]) continue;
         SquareMean mean;
-        const bool sampled = averageOverTexelSquare(in, ts, t, S, &squares, [&](const glm::vec3& xs, const glm::vec3& nx,
-                                                                                const glm::vec3& origin, glm::vec3* values) {
+        auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
           bool anyLit = false;
           for (size_t i = 0; i < in.scene.lights.size(); ++i) {
             const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
@@ -74,7 +73,8 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
             if (part && (*part->lights)[i]) values[1] += v;
           }
           return anyLit;
-        }, mean);
+        };
+        const bool sampled = averageOverTexelSquare(in, ts, t, S, &squares, visit, mean);
         points += static_cast<size_t>(mean.points);
         dropped += static_cast<size_t>(mean.dropped);
         if (!sampled || mean.kept == 0) continue;  // no sub-point on the chart in the square: the centre's value stays

@@ -80,8 +80,8 @@ SquareTriangles squareTriangles(const Scene& scene, const TexelSamples& ts, cons
   return out;
 }
 
-bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S, const SquareTriangles* squares,
-                            const SubPointVisit& visit, SquareMean& out) {
+bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S,
+                            const SquareTriangles* squares, const SubPointVisit& visit, SquareMean& out) {
   if (ts.positionWeight[t].w <= 0.0f || ts.primitive[t] >= in.scene.primitives.size()) return false;
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
@@ -96,8 +96,10 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
   const glm::vec3 n(ts.normal[t]);
   // The centre's normal may face away from its triangle's winding (a surface seen from its back): the other
   // triangles' normals turn the same way.
-  const float side = glm::dot(n, triangleNormal(in.scene.primitives[own.x], own.y)) < 0.0f ? -1.0f : 1.0f;
-  const glm::vec3 centre = rt.insetPoint(own.x, own.y, glm::vec3(ts.positionWeight[t])) + n * eps;
+  const glm::vec3 ownNormal = triangleNormal(in.scene.primitives[own.x], own.y);
+  const float side = glm::dot(n, ownNormal) < 0.0f ? -1.0f : 1.0f;
+  const glm::vec3 centreOnSurface = rt.insetPoint(own.x, own.y, glm::vec3(ts.positionWeight[t]));
+  const glm::vec3 centre = centreOnSurface + n * eps;
   const int x = static_cast<int>(t % ts.width), y = static_cast<int>(t / ts.width);
   bool any = false;
   for (int sy = 0; sy < S; ++sy)
@@ -105,7 +107,7 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
       const glm::vec2 q(x + (sx + 0.5f) / S, y + (sy + 0.5f) / S);
       // The first triangle that holds q (none: the square's part off the chart, not sampled).
       glm::vec3 xs, nx;
-      bool found = false;
+      bool found = false, ownPlane = true;
       for (size_t k = 0; k < count && !found; ++k) {
         const Primitive& prim = in.scene.primitives[tris[k].x];
         const uint32_t tri = tris[k].y;
@@ -123,7 +125,10 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
         if (tris[k] == own) {
           nx = n;
         } else {
-          nx = side * triangleNormal(prim, tri);
+          const glm::vec3 g = triangleNormal(prim, tri);
+          ownPlane = std::abs(glm::dot(g, ownNormal)) > 0.9999f &&
+                     std::abs(glm::dot(xs - centreOnSurface, ownNormal)) <= eps;
+          nx = side * g;
           if (prim.normals.size() == prim.positions.size()) {
             const glm::vec3 m = b0 * prim.normals[i0] + b1 * prim.normals[i1] + b2 * prim.normals[i2];
             const float ml = glm::length(m);
@@ -137,8 +142,9 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
       glm::vec3 values[SquareMean::kValues] = {glm::vec3(0.0f), glm::vec3(0.0f)};
       // Dark: shadowed, or cut off from the centre by a surface standing on the chart (the floor under a box
       // resting on it), which is covered, not shadowed, and no part of what a viewer sees. A lit sub-point
-      // cannot be under a closed box, so only the dark ones need the ray along the surface.
-      if (!visit(xs, nx, origin, values)) {
+      // cannot be under a closed box, so only the dark ones need the ray along the surface, and only in the
+      // centre's plane: across a convex crease or a curved chart that ray would pass under the surface itself.
+      if (!visit(xs, nx, origin, values) && ownPlane) {
         const glm::vec3 step = origin - centre;
         const float reach = glm::length(step);
         if (reach > eps && rt.occluded(centre, step / reach, 0.0f, reach)) {

@@ -37,7 +37,7 @@ SquareTriangles squareTriangles(const Scene& scene, const TexelSamples& ts, cons
 // when texel t has no triangle to sample (the centre's value stays).
 using SubPointVisit =
     std::function<bool(const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values)>;
-bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S, const SquareTriangles* squares,
-                            const SubPointVisit& visit, SquareMean& out);
+bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t t, int S,
+                            const SquareTriangles* squares, const SubPointVisit& visit, SquareMean& out);
 
 }  // namespace irbake
