@@ -48,6 +48,9 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
+  int volumeFitSamples = 2;           // S: the rest of the light fitted over S³ points per probe, each traced
+  int volumeFitRays = 128;            // with this many lattice rays (blend_fit.h); 0: each probe's own rays
+  double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
 };
 
 struct ProbeStats {
@@ -56,10 +59,13 @@ struct ProbeStats {
   size_t rays = 0;  // lattice and shadow rays, relocation tests and the visibility fit's included
   size_t lightFitSamples = 0;  // volume samples the punctual lights' visibility was fitted to
   int lightFitSweeps = 0;      // the fit's Gauss–Seidel sweeps
+  size_t volumeFitSamples = 0;  // volume samples the rest of the light was fitted to
+  int volumeFitSweeps = 0;
   double seconds = 0.0;
   nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
     return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays},
-            {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps}};
+            {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps},
+            {"volumeFitSamples", volumeFitSamples}, {"volumeFitSweeps", volumeFitSweeps}};
   }
 };
 
