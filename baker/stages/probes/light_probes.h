@@ -12,6 +12,9 @@
 // An emitter's Le is found by both: they are combined by the power heuristic (weights a²/(a² + b²), b²/(a² + b²)
 // for the densities a = N/(4π), b = K p(ω)), so a small light (few lattice rays find it) comes from the shadow
 // rays and a large emissive wall from the lattice, and nothing is counted twice.
+// The lattice's and emitters' light is then fitted over the volume the clients blend, as the punctual lights'
+// visibility is: S³ points in each probe's cube, each traced with fewer rays, kept where every probe of their
+// blend sees them, and least squares on the blend with each probe's own value as one more sample (blend_fit.h).
 // A probe whose rays meet back faces in more than maxBackFaceShare of the directions is inside geometry: moved
 // through the nearest back face (at most half a spacing), else left invalid. Walls between a point and a probe
 // are the reader's to test (interpolateProbes' visibility), so no light crosses them.
@@ -48,8 +51,10 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
-  int volumeFitSamples = 2;           // S: the rest of the light fitted over S³ points per probe, each traced
-  int volumeFitRays = 128;            // with this many lattice rays (blend_fit.h); 0: each probe's own rays
+  int volumeFitSamples = 3;           // S: the rest of the light fitted over S³ points per probe, each traced
+  int volumeFitRays = 128;            // with this many lattice rays (blend_fit.h); 0: each probe's own rays.
+                                      // Sponza's gallery read 0.936 of Cycles with none, 0.961 with 2³, 1.003
+                                      // with 3³ (docs/validation.md, "Probes against Cycles")
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
 };
 
