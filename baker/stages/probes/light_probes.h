@@ -12,8 +12,8 @@
 // An emitter's Le is found by both: they are combined by the power heuristic (weights a²/(a² + b²), b²/(a² + b²)
 // for the densities a = N/(4π), b = K p(ω)), so a small light (few lattice rays find it) comes from the shadow
 // rays and a large emissive wall from the lattice, and nothing is counted twice.
-// The lattice's and emitters' light is then fitted over the volume the clients blend, as the punctual lights'
-// visibility is: S³ points in each probe's cube, each traced with fewer rays, kept where every probe of their
+// With volumeFitSamples, the lattice's and emitters' light is then fitted over the volume the clients blend, as
+// the punctual lights' visibility is: S³ points in each probe's cube, each traced with fewer rays, kept where every probe of their
 // blend sees them, and least squares on the blend with each probe's own value as one more sample (blend_fit.h).
 // A probe whose rays meet back faces in more than maxBackFaceShare of the directions is inside geometry: moved
 // through the nearest back face (at most half a spacing), else left invalid. Walls between a point and a probe
@@ -51,10 +51,11 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
-  int volumeFitSamples = 3;           // S: the rest of the light fitted over S³ points per probe, each traced
+  int volumeFitSamples = 0;           // S: the rest of the light fitted over S³ points per probe, each traced
   int volumeFitRays = 128;            // with this many lattice rays (blend_fit.h); 0: each probe's own rays.
-                                      // Sponza's gallery read 0.936 of Cycles with none, 0.961 with 2³, 1.003
-                                      // with 3³ (docs/validation.md, "Probes against Cycles")
+                                      // Off by default: 3³ raised Sponza's gallery (three seeds' mean 0.952 to
+                                      // 0.976 of Cycles) but lowered the Cornell box's low sphere (1.007 to
+                                      // 0.962; docs/validation.md, "Probes against Cycles")
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
 };
 
