@@ -171,9 +171,10 @@ size_t addEmitters(const BakeInputs& in, const EmitterSampler& emitters, const g
   return traced;
 }
 
-// The lattice and emitters' light (everything but the punctual lights) fitted over each probe's cube
-// (probe_volume_fit in light_probes.h): S³ jittered points per valid probe that it sees and that are not inside
-// geometry, each traced with `volumeFitRays` lattice rays, and each probe's own SH as one more sample.
+// The lattice's and emitters' light (everything but the punctual lights) fitted over each probe's cube
+// (ProbeOptions::volumeFitSamples): S³ jittered points per valid probe, kept where every probe of their blend sees
+// them and they are not inside geometry, each traced with `volumeFitRays` lattice rays; each probe's own SH is
+// one more sample, weighted volumeFitAnchor.
 struct VolumeFitStats {
   size_t rays = 0, samples = 0;
   int sweeps = 0;
@@ -221,9 +222,9 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, Lig
     }
     traced += count;
   });
-  std::vector<float> anchors(n * m), x(n * m);
+  std::vector<float> anchors(n * m);
   for (size_t i = 0; i < n; ++i) std::memcpy(&anchors[i * m], grid.coefficients[i].data(), m * sizeof(float));
-  x = anchors;
+  std::vector<float> x = anchors;
   float scale = 0.0f;
   for (float v : anchors) scale = std::max(scale, std::abs(v));
   const BlendFitResult r = solveBlendFit(grid, samples, targets, anchors, m, options.volumeFitAnchor, std::nullopt,
