@@ -54,8 +54,8 @@ struct ProbeOptions {
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
   int volumeFitSamples = 0;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
                                       // 0: each probe's own rays. Off by default: 3³ raised Sponza's gallery
-                                      // (three seeds' mean 0.952 to 0.976 of Cycles) but lowered the Cornell
-                                      // box's low sphere (1.007 to 0.962; docs/validation.md, "Probes against
+                                      // (three seeds' mean 0.953 to 0.976 of Cycles) but lowered the Cornell
+                                      // box's low sphere (1.004 to 0.962; docs/validation.md, "Probes against
                                       // Cycles")
   int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
