@@ -78,6 +78,7 @@ SCENES = {
     "cycles_sponza_sun_sky.csv": "Sponza, sun + sky",
     "cycles_sibenik_lamp.csv": "Sibenik, lamp",
     "cycles_sponza_sun_sky_tpu6.csv": "Sponza, sun + sky",
+    "cycles_sponza_sun_sky_default.csv": "Sponza, sun + sky",
 }
 
 
@@ -122,9 +123,11 @@ def t_seed_spread():
 
 # Scenes whose map is scored against Cycles on every seed: (CSV, options without --seed, what the options mean).
 EVERY_SEED = [
+    ("cycles_cornell_sample.csv", "", "default"),
     ("cycles_cornell_published.csv", "", "default"),
     ("cycles_mcguire_cornell.csv", "", "default"),
     ("cycles_sponza_sun_sky_tpu6.csv", "--sky 0.4,0.5,0.7 --texels-per-unit 6", "sun + sky, 6 texels per metre"),
+    ("cycles_sponza_sun_sky_default.csv", "--sky 0.4,0.5,0.7", "sun + sky, default density"),
 ]
 
 
@@ -297,7 +300,7 @@ def t_slurm():
                   "bytes identical to one machine", "load average"], out)
 
 
-ESTIMATE_SCENES = {"cornell_sample": "Cornell sample", "mcguire_cornell": "McGuire Cornell", "corner": "corner (sample)",
+ESTIMATE_SCENES = {"cornell_sample": "Cornell sample", "cornell_published": "Cornell published", "mcguire_cornell": "McGuire Cornell", "corner": "corner (sample)",
                    "contacts": "contacts (sample)", "sponza_sun_sky": "Sponza, sun + sky", "sibenik_lamp": "Sibenik, lamp"}
 
 
@@ -310,15 +313,31 @@ def t_error_estimate():
             opts = " ".join(t for t in r["our_options"].replace("--estimate-error true", "").split())
             out.append([ESTIMATE_SCENES.get(scene, scene), f"`{opts}`" if opts else "default", r["seed"], f"`{r['commit']}`",
                         f"{int(r['texels']) / 1e3:.0f}k", pct(r["est_vpls"]), pct(r["est_compensation_rays"]),
-                        pct(r["est_gather_rays"]), f"**{pct(r['estimated'])}**", pct(r["rel_rmse_4"]),
-                        pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**", num(r["ratio"], 2), r["ref_spp"]])
+                        pct(r["est_gather_rays"]), f"**{pct(r['estimated'])}**", pct(r.get("estimated_all_bins") or r["estimated"]),
+                        pct(r["rel_rmse_4"]), pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**",
+                        num(r["ratio"], 2), r["ref_spp"]])
         rms = lambda k: math.sqrt(sum(float(r[k]) ** 2 for r in group) / len(group))
         out.append([ESTIMATE_SCENES.get(scene, scene), "RMS over seeds", len(group), "", "", "", "", "",
-                    f"**{pct(rms('estimated'))}**", "", "", f"**{pct(rms('rel_rmse_4_corrected'))}**",
+                    f"**{pct(rms('estimated'))}**", "", "", "", f"**{pct(rms('rel_rmse_4_corrected'))}**",
                     f"**{num(rms('estimated') / rms('rel_rmse_4_corrected'), 2)}**", ""])
     return table(["scene", "options", "seed", "baker", "texels", "estimate: walk", "compensation rays",
-                  "final-gather rays (and the compensation's under it)", "estimate", "measured", "Cycles' noise", "measured, noise removed",
+                  "final-gather rays (and the compensation's under it)", "estimate (interior bins)",
+                  "estimate (every valid bin)", "measured", "Cycles' noise", "measured, noise removed",
                   "estimate / measured", "Cycles spp"], out)
+
+
+def t_error_estimate_seeds():
+    """The seeds of each error_estimate scene together (bench/cycles/error_estimate.py --seeds-csv)."""
+    rows = latest(read("error_estimate_seeds.csv"), lambda r: r["scene"])
+    out = []
+    for r in rows:
+        est, spread, sys_, meas = (float(r[k]) for k in ("estimated_rms", "seed_noise", "systematic", "measured_rms"))
+        out.append([ESTIMATE_SCENES.get(r["scene"], r["scene"]), f"`{r['commit']}`", r["seeds"], r["bins"], pct(est),
+                    pct(spread), f"**{num(est / spread, 2)}**", pct(sys_), f"{r['worst_bins']}: {pct(r['worst_share'], 0)}",
+                    pct(r["systematic_without_worst"]), pct(meas), f"**{num(math.sqrt(est ** 2 + sys_ ** 2) / meas, 2)}**"])
+    return table(["scene", "baker", "seeds", "bins scored", "estimate, RMS over seeds", "one bake's spread over the seeds",
+                  "estimate / spread", "systematic against Cycles", "worst 1% of bins: share of its square",
+                  "systematic without them", "measured, noise removed, RMS", "√(estimate² + systematic²) / measured"], out)
 
 
 def t_vpl_blocks():

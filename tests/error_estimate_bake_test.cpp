@@ -32,8 +32,9 @@ BakeOptions cornellBake(int paths, uint32_t seed) {
 // rel_rmse_4 of bench/cycles/compare.py: RMS over 4×4 bins (at least half valid) and channels of the bin
 // means' difference, over the RMS of the reference's bin means. replicateError on {a, b} gives
 // s²/2 = (a − b)²/4 per bin, so twice its noise is the RMS difference.
-double measuredError(const std::vector<Lightmap>& maps, const std::vector<Lightmap>& reference) {
-  const BinnedError e = replicateError({maps, reference}, &reference);
+double measuredError(const std::vector<Lightmap>& maps, const std::vector<Lightmap>& reference,
+                     BinTexels texels = BinTexels::Valid) {
+  const BinnedError e = replicateError({maps, reference}, &reference, 4, 1.0, texels);
   return 2.0 * e.relative;
 }
 
@@ -45,9 +46,10 @@ const std::vector<Lightmap>& referenceMaps() {
 
 // The estimate against the error measured on the reference: their RMS over eight seeds within ±30% (the
 // reference shares the clamp's bias, so both are the walk's noise; measured 1.17 on 8 seeds, 1.09 on 12),
-// each seed within 0.4–2.5× (two halves of a few hundred VPLs: one bake's estimate is itself noisy).
+// each seed within 0.4–2.5× (two halves of a few hundred VPLs: one bake's estimate is itself noisy). The
+// interior figure (estimatedError.interior) likewise against the error measured on interior texels' bins.
 TEST(ErrorEstimateBake, EstimateMatchesTheMeasuredErrorWithin30Percent) {
-  double estimates2 = 0.0, measured2 = 0.0;
+  double estimates2 = 0.0, measured2 = 0.0, interiorEstimates2 = 0.0, interiorMeasured2 = 0.0;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
     BakeOptions o = cornellBake(256, seed);
     o.errorEstimate.enabled = true;
@@ -60,8 +62,15 @@ TEST(ErrorEstimateBake, EstimateMatchesTheMeasuredErrorWithin30Percent) {
     EXPECT_LT(estimate / measured, 2.5) << "seed " << seed << ": estimate " << estimate << ", measured " << measured;
     estimates2 += estimate * estimate;
     measured2 += measured * measured;
+    const nlohmann::json& interior = r.report["estimatedError"]["interior"];
+    EXPECT_LT(interior["bins"].get<size_t>(), r.report["estimatedError"]["bins"].get<size_t>());
+    const double interiorEstimate = interior["relative"].get<double>();
+    const double interiorMeasured = measuredError(r.maps, referenceMaps(), BinTexels::Interior);
+    interiorEstimates2 += interiorEstimate * interiorEstimate;
+    interiorMeasured2 += interiorMeasured * interiorMeasured;
   }
   EXPECT_NEAR(std::sqrt(estimates2 / measured2), 1.0, 0.3);
+  EXPECT_NEAR(std::sqrt(interiorEstimates2 / interiorMeasured2), 1.0, 0.3);
 }
 
 // Tighter targets: more rounds, a smaller measured error, the target met; the estimate falls round by

@@ -107,6 +107,7 @@ struct StagedBake::State {
   nlohmann::json rounds = nlohmann::json::array();  // the estimate after each round
   std::string stoppedBy;
   nlohmann::json stageNoise = nlohmann::json::object();  // a stage's own ray noise (RMS on bins, map units)
+  nlohmann::json stageNoiseInterior = nlohmann::json::object();  // the same on interior bins (BinTexels)
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
   std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
@@ -316,40 +317,43 @@ struct StagedBake::State {
 
   // A stage's own ray noise: the stage again with rays of another seed on the same input; one stage's
   // variance per bin is half the two results' squared difference (twice replicateError's s²/2 of the pair).
-  double rayNoise(const std::vector<Lightmap>& once, const std::vector<Lightmap>& twice) const {
-    return std::sqrt(2.0) * replicateError({once, twice}, nullptr, options.errorEstimate.bin).noiseRms;
+  // Recorded as `stage` on every valid texel's bins and on the interior ones.
+  void rayNoise(const std::string& stage, const std::vector<Lightmap>& once, const std::vector<Lightmap>& twice) {
+    const int bin = options.errorEstimate.bin;
+    stageNoise[stage] = std::sqrt(2.0) * replicateError({once, twice}, nullptr, bin).noiseRms;
+    stageNoiseInterior[stage] = std::sqrt(2.0) * replicateError({once, twice}, nullptr, bin, 1.0, BinTexels::Interior).noiseRms;
   }
   // before: the compensation's input, replaced by its second run's output.
   void compensationRayNoise(std::vector<Lightmap>& before, const std::vector<Lightmap>& after) {
     ClampCompensationOptions o = plan.compensation;
     o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x636f6d70ull));  // "comp"
     ClampGather(*wholeInputs, o).apply(before);
-    if (!plan.finalGather) stageNoise["compensationRays"] = rayNoise(after, before);
+    if (!plan.finalGather) rayNoise("compensationRays", after, before);
   }
   void gatherRayNoise(std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
     FinalGatherOptions o = plan.gather;
     o.seed = static_cast<uint32_t>(hashSeed(options.walk.seed, 0x676174686572ull));  // "gather"
     finalGather(*wholeInputs, directMaps, before, o);
-    stageNoise[plan.compensate ? "compensationAndGatherRays" : "finalGatherRays"] = rayNoise(after, before);
+    rayNoise(plan.compensate ? "compensationAndGatherRays" : "finalGatherRays", after, before);
   }
 
   // The finished bake's estimate (before post, on the map as the stages left it) into the report.
   std::vector<Lightmap> finalEstimate(const std::vector<Lightmap>& maps, nlohmann::json& report) const {
     std::vector<std::vector<Lightmap>> reps = plan.finalGather ? gatheredHalves()
                                                                : std::vector<std::vector<Lightmap>>{halves[0], halves[1]};
-    BinnedError e = replicateError(reps, &maps, options.errorEstimate.bin);
-    // The stages' own ray noise is independent of the walk's: the variances add.
-    nlohmann::json breakdown = {{"vpls", e.relative}};
-    double noise2 = e.noiseRms * e.noiseRms;
-    for (const auto& [stage, rms] : stageNoise.items()) {
-      noise2 += rms.get<double>() * rms.get<double>();
-      breakdown[stage] = e.signalRms > 0.0 ? rms.get<double>() / e.signalRms : 0.0;
-    }
-    e.noiseRms = std::sqrt(noise2);
-    e.relative = e.signalRms > 0.0 ? e.noiseRms / e.signalRms : 0.0;
+    const int bin = options.errorEstimate.bin;
+    nlohmann::json breakdown;
+    BinnedError e = withStages(replicateError(reps, &maps, bin), stageNoise, breakdown);
+    nlohmann::json interiorBreakdown;
+    const BinnedError interior =
+        withStages(replicateError(reps, &maps, bin, 1.0, BinTexels::Interior), stageNoiseInterior, interiorBreakdown);
     nlohmann::json& j = report["estimatedError"] = e.toJson();
     j["replicates"] = replicates.size();
     j["breakdown"] = breakdown;
+    j["interior"] = interior.toJson();
+    j["interior"]["breakdown"] = interiorBreakdown;
+    j["interior"]["texels"] = "valid texels whose four neighbours are valid: the chart-border ring left out, as "
+                              "bench/cycles/compare.py scores a map";
     j["binTexels"] = options.errorEstimate.bin;
     j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
                   "compensation's and final gather's own ray noise (each run again with another seed)";
@@ -364,6 +368,20 @@ struct StagedBake::State {
               "x" + std::to_string(options.errorEstimate.bin) + "-texel bins, " + std::to_string(replicates.size()) +
               " replicates)");
     return standardErrorPages(reps);
+  }
+
+  // The walk's figure with the stages' own ray noise added (independent of the walk's: the variances add),
+  // each part relative to the same signal in `breakdown`.
+  static BinnedError withStages(BinnedError e, const nlohmann::json& stages, nlohmann::json& breakdown) {
+    breakdown = {{"vpls", e.relative}};
+    double noise2 = e.noiseRms * e.noiseRms;
+    for (const auto& [stage, rms] : stages.items()) {
+      noise2 += rms.get<double>() * rms.get<double>();
+      breakdown[stage] = e.signalRms > 0.0 ? rms.get<double>() / e.signalRms : 0.0;
+    }
+    e.noiseRms = std::sqrt(noise2);
+    e.relative = e.signalRms > 0.0 ? e.noiseRms / e.signalRms : 0.0;
+    return e;
   }
 
   static std::string percent(double x) {

@@ -438,7 +438,7 @@ def main():
     old = list(csv.DictReader(open(args.csv))) if os.path.isfile(args.csv) else []
     tmp = args.csv + ".tmp"
     with open(tmp, "w", newline="") as f:  # rewritten whole: an older file may lack newer columns
-        wr = csv.DictWriter(f, fieldnames=CSV_FIELDS, extrasaction="ignore")
+        wr = csv.DictWriter(f, fieldnames=CSV_FIELDS, extrasaction="ignore", lineterminator="\n")
         wr.writeheader()
         for r in old:
             wr.writerow(r)

@@ -23,6 +23,13 @@ void checkReplicates(const std::vector<std::vector<Lightmap>>& replicates) {
 
 bool validAt(const Lightmap& m, size_t t) { return m.valid.size() != m.size() || m.valid[t]; }
 
+// Valid with its four in-page neighbours valid (compare.py's erode_cover: the page's edge does not erode).
+bool interiorAt(const Lightmap& m, int x, int y) {
+  const auto at = [&](int u, int v) { return validAt(m, static_cast<size_t>(v) * m.width + u); };
+  return at(x, y) && (x == 0 || at(x - 1, y)) && (x + 1 == m.width || at(x + 1, y)) && (y == 0 || at(x, y - 1)) &&
+         (y + 1 == m.height || at(x, y + 1));
+}
+
 // Per bin: the valid texels' mean of each replicate and of the value map, accumulated into sums of squares.
 struct BinSums {
   double noise2 = 0.0, signal2 = 0.0;
@@ -30,7 +37,7 @@ struct BinSums {
 };
 
 void scorePage(const std::vector<std::vector<Lightmap>>& replicates, size_t p, const Lightmap* value, int bin,
-               double scale, BinSums& sums) {
+               double scale, BinTexels which, BinSums& sums) {
   const Lightmap& first = replicates[0][p];
   const size_t R = replicates.size();
   std::vector<glm::dvec3> means(R);
@@ -42,7 +49,7 @@ void scorePage(const std::vector<std::vector<Lightmap>>& replicates, size_t p, c
       for (int y = by; y < by + bin; ++y)
         for (int x = bx; x < bx + bin; ++x) {
           const size_t t = static_cast<size_t>(y) * first.width + x;
-          if (!validAt(first, t)) continue;
+          if (which == BinTexels::Interior ? !interiorAt(first, x, y) : !validAt(first, t)) continue;
           ++n;
           for (size_t r = 0; r < R; ++r) means[r] += glm::dvec3(replicates[r][p].texels[t]);
           if (value) v += glm::dvec3(value->texels[t]);
@@ -69,7 +76,7 @@ nlohmann::json BinnedError::toJson() const {
 }
 
 BinnedError replicateError(const std::vector<std::vector<Lightmap>>& replicates, const std::vector<Lightmap>* value,
-                           int bin, double scale) {
+                           int bin, double scale, BinTexels texels) {
   checkReplicates(replicates);
   if (value && value->size() != replicates[0].size())
     throw Error(ErrorCode::InvalidData, "", "error estimate: the value map has a different page count");
@@ -78,7 +85,7 @@ BinnedError replicateError(const std::vector<std::vector<Lightmap>>& replicates,
     const Lightmap* v = value ? &(*value)[p] : nullptr;
     if (v && v->texels.size() != replicates[0][p].size())
       throw Error(ErrorCode::InvalidData, "", "error estimate: the value page has a different size");
-    scorePage(replicates, p, v, std::max(1, bin), scale, sums);
+    scorePage(replicates, p, v, std::max(1, bin), scale, texels, sums);
   }
   BinnedError e;
   e.bins = sums.bins;

@@ -32,12 +32,16 @@ struct BinnedError {
   nlohmann::json toJson() const;
 };
 
+// Which texels a bin averages: every valid texel, or only the interior ones (valid, and so are the four
+// neighbours inside the page): the texels bench/cycles/compare.py scores, its chart-border ring left out.
+enum class BinTexels { Valid, Interior };
+
 // Error of the mean of R ≥ 2 independent, identically distributed replicates (replicates[r][page]), scaled
 // by `scale` (an extra factor on every replicate's deviation: 1 for the plain mean), normalised by `value`'s
 // bins (the map the bake writes, or the replicates' mean when null). Unbiased for the mean's squared error on
 // each bin: s²/R with s² the replicates' sample variance of the bin mean. Pages must match in size.
 BinnedError replicateError(const std::vector<std::vector<Lightmap>>& replicates, const std::vector<Lightmap>* value,
-                           int bin = 4, double scale = 1.0);
+                           int bin = 4, double scale = 1.0, BinTexels texels = BinTexels::Valid);
 
 // Per texel: the standard error of the replicates' mean, sqrt(s²/R) per channel (0 on invalid texels).
 std::vector<Lightmap> standardErrorPages(const std::vector<std::vector<Lightmap>>& replicates);
