@@ -136,7 +136,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit"}},
+    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -321,6 +321,11 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
   app->add_option("--probe-light-fit", o.probes.lightFitSamples,
                   "the punctual lights' visibility at the probes fitted over S×S×S points per probe\n"
                   "(default " + std::to_string(ProbeOptions{}.lightFitSamples) + "; 0: each probe's own shadow ray)")
+      ->transform(cli::integerIn(0, 8))->type_name("S");
+  app->add_option("--probe-volume-fit", o.probes.volumeFitSamples,
+                  "the rest of the probes' light fitted over S×S×S points per probe, " +
+                      std::to_string(ProbeOptions{}.volumeFitRays) + " rays each\n(default " +
+                      std::to_string(ProbeOptions{}.volumeFitSamples) + "; 0: each probe's own rays)")
       ->transform(cli::integerIn(0, 8))->type_name("S");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");

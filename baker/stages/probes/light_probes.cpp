@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 
 #include <tbb/parallel_for.h>
 
@@ -11,6 +12,7 @@
 #include "common/progress.h"
 #include "sampling/sampling.h"
 #include "transport/geometry_term.h"
+#include "stages/probes/blend_fit.h"
 #include "stages/probes/light_visibility_fit.h"
 #include "vpl/light_sources.h"
 
@@ -18,6 +20,7 @@ namespace irbake {
 namespace {
 
 constexpr uint64_t kProbeStream = 0x9b;  // the probes' lattice rotations and emitter-sample offsets
+constexpr uint64_t kVolumeStream = 0x9d;  // the volume fit's sample points and their lattices
 constexpr double kGoldenRatio = 1.6180339887498949;
 
 // What one probe's lattice rays found.
@@ -168,6 +171,72 @@ size_t addEmitters(const BakeInputs& in, const EmitterSampler& emitters, const g
   return traced;
 }
 
+// The lattice's and emitters' light (everything but the punctual lights) fitted over each probe's cube
+// (ProbeOptions::volumeFitSamples): S³ jittered points per valid probe, kept where every probe of their blend sees
+// them and they are not inside geometry, each traced with `volumeFitRays` lattice rays; each probe's own SH is
+// one more sample, weighted volumeFitAnchor.
+struct VolumeFitStats {
+  size_t rays = 0, samples = 0;
+  int sweeps = 0;
+};
+
+VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, LightProbeGrid& grid,
+                              const ProbeOptions& options) {
+  VolumeFitStats out;
+  const int S = std::max(0, options.volumeFitSamples);
+  if (S == 0) return out;
+  const int rays = std::max(16, options.volumeFitRays);
+  const int emitterSamples = options.emitterSamples > 0
+                                 ? std::max(1, static_cast<int>(std::lround(double(options.emitterSamples) * rays / std::max(16, options.rays))))
+                                 : 0;
+  const EmitterSampler emitters(in.scene, emitterSamples, rays);
+  const int tooManyBack = static_cast<int>(std::floor(options.maxBackFaceShare * rays));
+  const size_t n = grid.size(), perProbe = static_cast<size_t>(S) * S * S, m = 3 * kShCoefficients;
+  std::vector<BlendSample> samples(n * perProbe);
+  std::vector<float> targets(n * perProbe * m, 0.0f);
+  std::atomic<size_t> traced{0};
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    if (!grid.valid[i]) return;
+    Rng rng(hashSeed(options.seed, kVolumeStream, i));
+    const glm::vec3 at = grid.position(i), corner = at - grid.offsets[i] - 0.5f * grid.spacing;
+    size_t count = 0;
+    for (size_t s = 0; s < perProbe; ++s) {
+      const glm::vec3 cell(static_cast<float>(s % S), static_cast<float>(s / S % S), static_cast<float>(s / (S * S)));
+      const glm::vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
+      const double r1 = rng.uniform(), r2 = rng.uniform(), r3 = rng.uniform(), r4 = rng.uniform();
+      const glm::vec3 x = corner + grid.spacing * (cell + jitter) / static_cast<float>(S);
+      ++count;
+      if (!probeSees(in, at, x)) continue;
+      // Kept only where every probe of its blend sees it: a cell across a floor or a wall would otherwise fit
+      // the probes on one side to the light on the other (the clients blend without visibility).
+      const BlendSample blend = blendSampleAt(grid, x);
+      bool seen = blend.corners > 0;
+      for (int c = 0; c < blend.corners && seen; ++c, ++count) seen = probeSees(in, grid.position(blend.probe[c]), x);
+      if (!seen) continue;
+      ProbeTrace t = traceProbe(reader, emitters, x, rays, r1, r2);
+      count += static_cast<size_t>(rays);
+      if (t.backFaces > tooManyBack) continue;  // inside geometry: no light a client would read there
+      count += addEmitters(in, emitters, x, r3, r4, t.sh);
+      std::memcpy(&targets[(i * perProbe + s) * m], t.sh.data(), m * sizeof(float));
+      samples[i * perProbe + s] = blend;
+    }
+    traced += count;
+  });
+  std::vector<float> anchors(n * m);
+  for (size_t i = 0; i < n; ++i) std::memcpy(&anchors[i * m], grid.coefficients[i].data(), m * sizeof(float));
+  std::vector<float> x = anchors;
+  float scale = 0.0f;
+  for (float v : anchors) scale = std::max(scale, std::abs(v));
+  const BlendFitResult r = solveBlendFit(grid, samples, targets, anchors, m, options.volumeFitAnchor, std::nullopt,
+                                         1e-5 * std::max(scale, 1e-6f), 400, x);
+  for (size_t i = 0; i < n; ++i)
+    if (grid.valid[i]) std::memcpy(grid.coefficients[i].data(), &x[i * m], m * sizeof(float));
+  out.rays = traced;
+  out.samples = r.samples;
+  out.sweeps = r.sweeps;
+  return out;
+}
+
 }  // namespace
 
 float chooseProbeSpacing(const Bounds3& volume, double probes) {
@@ -235,7 +304,10 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     }
     traced += count;
   });
-  // The punctual lights once every probe's validity is known: their visibility is fitted over the blend.
+  // The rest of the light fitted over the blend, then the punctual lights, once every probe's validity is known:
+  // their visibility is fitted over the blend as well.
+  const VolumeFitStats volume = fitProbeVolume(in, reader, grid, options);
+  traced += volume.rays;
   const LightVisibilityFit fit = fitLightVisibility(in, grid, options.lightFitSamples, options.seed);
   if (fit.lights > 0)
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
@@ -250,6 +322,8 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     stats->rays = traced;
     stats->lightFitSamples = fit.samples;
     stats->lightFitSweeps = fit.sweeps;
+    stats->volumeFitSamples = volume.samples;
+    stats->volumeFitSweeps = volume.sweeps;
     stats->seconds = watch.seconds();
   }
 }

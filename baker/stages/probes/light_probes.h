@@ -12,6 +12,10 @@
 // An emitter's Le is found by both: they are combined by the power heuristic (weights a²/(a² + b²), b²/(a² + b²)
 // for the densities a = N/(4π), b = K p(ω)), so a small light (few lattice rays find it) comes from the shadow
 // rays and a large emissive wall from the lattice, and nothing is counted twice.
+// With volumeFitSamples, the lattice's and emitters' light is then fitted over the volume the clients blend, as
+// the punctual lights' visibility is: S³ points in each probe's cube, each traced with fewer rays, kept where
+// every probe of their blend sees them; least squares on the blend, each probe's own value one more sample
+// (blend_fit.h).
 // A probe whose rays meet back faces in more than maxBackFaceShare of the directions is inside geometry: moved
 // through the nearest back face (at most half a spacing), else left invalid. Walls between a point and a probe
 // are the reader's to test (interpolateProbes' visibility), so no light crosses them.
@@ -48,6 +52,13 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
+  int volumeFitSamples = 0;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
+                                      // 0: each probe's own rays. Off by default: 3³ raised Sponza's gallery
+                                      // (three seeds' mean 0.953 to 0.976 of Cycles) but lowered the Cornell
+                                      // box's low sphere (1.004 to 0.962; docs/validation.md, "Probes against
+                                      // Cycles")
+  int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
+  double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
 };
 
 struct ProbeStats {
@@ -56,10 +67,13 @@ struct ProbeStats {
   size_t rays = 0;  // lattice and shadow rays, relocation tests and the visibility fit's included
   size_t lightFitSamples = 0;  // volume samples the punctual lights' visibility was fitted to
   int lightFitSweeps = 0;      // the fit's Gauss–Seidel sweeps
+  size_t volumeFitSamples = 0;  // volume samples the rest of the light was fitted to
+  int volumeFitSweeps = 0;
   double seconds = 0.0;
   nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
     return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays},
-            {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps}};
+            {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps},
+            {"volumeFitSamples", volumeFitSamples}, {"volumeFitSweeps", volumeFitSweeps}};
   }
 };
 

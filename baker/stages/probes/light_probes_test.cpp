@@ -52,6 +52,7 @@ LightProbeGrid bakeOne(AtlasedScene& s, const std::vector<Lightmap>& maps, glm::
   options.rays = rays;
   options.emitterSamples = emitterSamples;
   options.seed = seed;
+  options.volumeFitSamples = 0;  // the probe's own value: one probe's volume fit is its cube's mean light
   bakeLightProbes(in, maps, grid, options);
   return grid;
 }

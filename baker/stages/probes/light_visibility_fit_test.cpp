@@ -122,8 +122,11 @@ TEST(LightVisibilityFit, NoFitKeepsEachProbesOwnShadowRay) {
     o.lightFitSamples = samples;
     bakeLightProbes(in, maps, g, o);
     const LightVisibilityFit expect = fitLightVisibility(in, g, samples, o.seed);
-    for (size_t i = 0; i < g.size(); ++i)
-      if (g.valid[i]) EXPECT_NEAR(g.coefficients[i][0].x, 0.282095 * expect.visibility[i] * 2.0 / 3.14159265, 1e-5) << i;
+    for (size_t i = 0; i < g.size(); ++i) {
+      if (g.valid[i]) {
+        EXPECT_NEAR(g.coefficients[i][0].x, 0.282095 * expect.visibility[i] * 2.0 / 3.14159265, 1e-5) << i;
+      }
+    }
   }
 }
 
