@@ -6,7 +6,7 @@
 # (cycles_bake.py BAKE_TIME_S, Blender start and import excluded) and the ratio; appends to
 # bench/results/equal_error_time.csv.
 # A scene whose light is the file's own lights plus a sky (Sponza): SKY=R,G,B BAKE_OPTS="--sky R,G,B" bakes it
-# with Cycles' --bake-lights script, which keeps direct light in the map as ours does; LABEL names the row.
+# with Cycles' --bake-lights script, which keeps direct light in the map as ours does; LABEL names the row (commas become semicolons).
 set -euo pipefail
 SCENE=$1; SPP=$2; RUNS=${3:-3}
 IRBAKE=${IRBAKE:-build/baker/irbake}
@@ -29,7 +29,7 @@ cyc=$(blender -b --factory-startup "${CYCLES_SCRIPT[@]}" --scene "$OUT/ours/scen
       awk '/^BAKE_TIME_S/ {print $2}')
 load=$(cut -d' ' -f1 /proc/loadavg)
 ratio=$(python3 -c "import sys; print(round(float(sys.argv[2])/float(sys.argv[1]),2))" "$ours" "$cyc")
-LABEL=${LABEL:-$(basename "$SCENE")}
+LABEL=${LABEL:-$(basename "$SCENE")}; LABEL=${LABEL//,/;}  # a CSV field
 echo "$LABEL: ours ${ours} s (median of $RUNS), Cycles ${SPP} spp ${cyc} s, Cycles/ours ${ratio}x, load ${load}"
 CSV=bench/results/equal_error_time.csv
 [[ -f $CSV ]] || echo "date,commit,scene,our_wall_s_median,runs,cycles_spp,cycles_bake_s,ratio,load_avg" > $CSV
