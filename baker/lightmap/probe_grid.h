@@ -61,11 +61,14 @@ struct LightProbeGrid {
   size_t index(int i, int j, int k) const {
     return static_cast<size_t>(i) + static_cast<size_t>(counts.x) * (static_cast<size_t>(j) + static_cast<size_t>(counts.y) * k);
   }
+  glm::ivec3 cell(size_t index) const {  // (i, j, k) of a probe index
+    return glm::ivec3(static_cast<int>(index % counts.x), static_cast<int>(index / counts.x % counts.y),
+                      static_cast<int>(index / (static_cast<size_t>(counts.x) * counts.y)));
+  }
   glm::vec3 gridPoint(int i, int j, int k) const { return origin + spacing * glm::vec3(i, j, k); }
   glm::vec3 position(size_t index) const {
-    const int i = static_cast<int>(index % counts.x), j = static_cast<int>(index / counts.x % counts.y),
-              k = static_cast<int>(index / (static_cast<size_t>(counts.x) * counts.y));
-    return gridPoint(i, j, k) + (index < offsets.size() ? offsets[index] : glm::vec3(0.0f));
+    const glm::ivec3 c = cell(index);
+    return gridPoint(c.x, c.y, c.z) + (index < offsets.size() ? offsets[index] : glm::vec3(0.0f));
   }
 };
 

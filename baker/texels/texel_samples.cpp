@@ -72,28 +72,6 @@ bool overlapsTexel(const RasterTriangle& t, int x, int y) {
   return true;
 }
 
-struct SurfacePoint {
-  glm::vec3 position, shadingNormal, geometricNormal;
-};
-
-SurfacePoint surfacePoint(const Primitive& prim, uint32_t tri, glm::vec2 b) {
-  uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
-  float w0 = 1.0f - b.x - b.y;
-  SurfacePoint s;
-  const glm::vec3 &p0 = prim.positions[i0], &p1 = prim.positions[i1], &p2 = prim.positions[i2];
-  s.position = w0 * p0 + b.x * p1 + b.y * p2;
-  glm::vec3 g = glm::cross(p1 - p0, p2 - p0);
-  float gl = glm::length(g);
-  s.geometricNormal = gl > 0.0f ? g / gl : glm::vec3(0.0f, 0.0f, 1.0f);
-  s.shadingNormal = s.geometricNormal;
-  if (prim.normals.size() == prim.positions.size()) {
-    glm::vec3 n = w0 * prim.normals[i0] + b.x * prim.normals[i1] + b.y * prim.normals[i2];
-    float nl = glm::length(n);
-    if (nl > 1e-12f && std::isfinite(nl)) s.shadingNormal = n / nl;
-  }
-  return s;
-}
-
 // World-space edge of one texel on this triangle: sqrt(3D area / texel-space area).
 float texelFootprint(const Primitive& prim, uint32_t tri, const glm::ivec2& pageSize) {
   uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
@@ -254,6 +232,24 @@ TexelSamples rasterisePage(const Scene& scene, int page, int width, int height, 
 }
 
 }  // namespace
+
+SurfacePoint surfacePoint(const Primitive& prim, uint32_t tri, glm::vec2 b) {
+  uint32_t i0 = prim.indices[3 * tri], i1 = prim.indices[3 * tri + 1], i2 = prim.indices[3 * tri + 2];
+  float w0 = 1.0f - b.x - b.y;
+  SurfacePoint s;
+  const glm::vec3 &p0 = prim.positions[i0], &p1 = prim.positions[i1], &p2 = prim.positions[i2];
+  s.position = w0 * p0 + b.x * p1 + b.y * p2;
+  glm::vec3 g = glm::cross(p1 - p0, p2 - p0);
+  float gl = glm::length(g);
+  s.geometricNormal = gl > 0.0f ? g / gl : glm::vec3(0.0f, 0.0f, 1.0f);
+  s.shadingNormal = s.geometricNormal;
+  if (prim.normals.size() == prim.positions.size()) {
+    glm::vec3 n = w0 * prim.normals[i0] + b.x * prim.normals[i1] + b.y * prim.normals[i2];
+    float nl = glm::length(n);
+    if (nl > 1e-12f && std::isfinite(nl)) s.shadingNormal = n / nl;
+  }
+  return s;
+}
 
 std::vector<TexelSamples> buildTexelSamples(const Scene& scene, const RayTracer& rt, const TexelSampleOptions& options) {
   const int S = std::max(1, options.supersample);

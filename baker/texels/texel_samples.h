@@ -54,6 +54,13 @@ bool texelMean(const TexelSamples& ts, size_t t, ValueOfSlot&& value, T& mean) {
   return true;
 }
 
+// A point of triangle tri at barycentrics b (weights of vertices 1 and 2): geometric normal as wound (+z when
+// degenerate), shading normal interpolated from the vertex normals where the primitive has them.
+struct SurfacePoint {
+  glm::vec3 position, shadingNormal, geometricNormal;
+};
+SurfacePoint surfacePoint(const Primitive& prim, uint32_t tri, glm::vec2 b);
+
 // Builds samples for every page referenced by the scene's primitives (pages sized as in LightmapRef).
 std::vector<TexelSamples> buildTexelSamples(const Scene& scene, const RayTracer& rt, const TexelSampleOptions& options);
 

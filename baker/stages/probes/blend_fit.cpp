@@ -8,14 +8,9 @@ namespace {
 
 constexpr int kStencil = 27;  // a probe and its 26 neighbours
 
-glm::ivec3 gridCell(const LightProbeGrid& g, size_t v) {
-  return glm::ivec3(static_cast<int>(v % g.counts.x), static_cast<int>(v / g.counts.x % g.counts.y),
-                    static_cast<int>(v / (static_cast<size_t>(g.counts.x) * g.counts.y)));
-}
-
 // The stencil slot of neighbour j of probe i (both within one step on every axis).
 int stencilSlot(const LightProbeGrid& g, size_t i, size_t j) {
-  const glm::ivec3 d = gridCell(g, j) - gridCell(g, i) + 1;
+  const glm::ivec3 d = g.cell(j) - g.cell(i) + 1;
   return d.x + 3 * (d.y + 3 * d.z);
 }
 
@@ -67,7 +62,7 @@ BlendFitResult solveBlendFit(const LightProbeGrid& g, const std::vector<BlendSam
     for (size_t i = 0; i < n; ++i) {
       const double diag = N[i * kStencil + 13];
       if (!g.valid[i] || !(diag > 0.0)) continue;
-      const glm::ivec3 c = gridCell(g, i);
+      const glm::ivec3 c = g.cell(i);
       for (size_t l = 0; l < m; ++l) r[l] = b[i * m + l];
       for (int s = 0; s < kStencil; ++s) {
         const double a = N[i * kStencil + s];

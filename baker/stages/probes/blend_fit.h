@@ -1,6 +1,7 @@
 // Least squares on the clients' trilinear blend, shared by the punctual lights' visibility fit
-// (light_visibility_fit.h) and the probes' volume fit (probe_volume_fit.h): per-probe values x_i (m per probe)
-// whose blend best matches targets f_s at sample points s, each probe's own value y_i kept as one more sample:
+// (light_visibility_fit.h) and the probes' volume fit (ProbeOptions::volumeFitSamples): per-probe values x_i
+// (m per probe) whose blend best matches targets f_s at sample points s, each probe's own value y_i kept as one
+// more sample:
 //   minimise Σ_s |Σ_i a_si x_i − f_s|² + λ Σ_i |x_i − y_i|²
 // a_si the blend's weights at s (valid probes, renormalised: interpolateProbes without visibility), solved by
 // (projected) Gauss–Seidel on the normal equations, a 27-point stencil (a sample's probes are one cell's corners).

@@ -5,19 +5,13 @@
 
 #include <tbb/parallel_for.h>
 
+#include "texels/texel_samples.h"
+
 namespace irbake {
 
 namespace {
 
 float cross2(const glm::vec2& a, const glm::vec2& b) { return a.x * b.y - a.y * b.x; }
-
-glm::vec3 triangleNormal(const Primitive& prim, uint32_t tri) {
-  const glm::vec3 &p0 = prim.positions[prim.indices[3 * tri]], &p1 = prim.positions[prim.indices[3 * tri + 1]],
-                  &p2 = prim.positions[prim.indices[3 * tri + 2]];
-  const glm::vec3 g = glm::cross(p1 - p0, p2 - p0);
-  const float gl = glm::length(g);
-  return gl > 0.0f ? g / gl : glm::vec3(0.0f, 0.0f, 1.0f);
-}
 
 }  // namespace
 
@@ -96,7 +90,7 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
   const glm::vec3 n(ts.normal[t]);
   // The centre's normal may face away from its triangle's winding (a surface seen from its back): the other
   // triangles' normals turn the same way.
-  const glm::vec3 ownNormal = triangleNormal(in.scene.primitives[own.x], own.y);
+  const glm::vec3 ownNormal = surfacePoint(in.scene.primitives[own.x], own.y, glm::vec2(0.0f)).geometricNormal;
   const float side = glm::dot(n, ownNormal) < 0.0f ? -1.0f : 1.0f;
   const glm::vec3 centreOnSurface = rt.insetPoint(own.x, own.y, glm::vec3(ts.positionWeight[t]));
   const glm::vec3 centre = centreOnSurface + n * eps;
@@ -120,20 +114,14 @@ bool averageOverTexelSquare(const BakeInputs& in, const TexelSamples& ts, size_t
         const float tol = -1e-4f;
         if (b1 < tol || b2 < tol || b1 + b2 > 1.0f - tol) continue;
         found = true;
-        const float b0 = 1.0f - b1 - b2;
-        xs = rt.insetPoint(tris[k].x, tri, b0 * prim.positions[i0] + b1 * prim.positions[i1] + b2 * prim.positions[i2]);
+        const SurfacePoint sp = surfacePoint(prim, tri, glm::vec2(b1, b2));
+        xs = rt.insetPoint(tris[k].x, tri, sp.position);
         if (tris[k] == own) {
           nx = n;
         } else {
-          const glm::vec3 g = triangleNormal(prim, tri);
-          ownPlane = std::abs(glm::dot(g, ownNormal)) > 0.9999f &&
+          ownPlane = std::abs(glm::dot(sp.geometricNormal, ownNormal)) > 0.9999f &&
                      std::abs(glm::dot(xs - centreOnSurface, ownNormal)) <= eps;
-          nx = side * g;
-          if (prim.normals.size() == prim.positions.size()) {
-            const glm::vec3 m = b0 * prim.normals[i0] + b1 * prim.normals[i1] + b2 * prim.normals[i2];
-            const float ml = glm::length(m);
-            if (ml > 1e-12f && std::isfinite(ml)) nx = side * m / ml;
-          }
+          nx = side * sp.shadingNormal;
         }
       }
       if (!found) continue;
