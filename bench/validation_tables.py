@@ -301,7 +301,9 @@ def t_slurm():
 
 
 ESTIMATE_SCENES = {"cornell_sample": "Cornell sample", "cornell_published": "Cornell published", "mcguire_cornell": "McGuire Cornell", "corner": "corner (sample)",
-                   "contacts": "contacts (sample)", "sponza_sun_sky": "Sponza, sun + sky", "sibenik_lamp": "Sibenik, lamp"}
+                   "contacts": "contacts (sample)", "sponza_sun_sky": "Sponza, sun + sky",
+                   "sponza_sun_sky_grid4": "Sponza, sun + sky; Cycles 4×4 points per texel", "sibenik_lamp": "Sibenik, lamp",
+                   "sibenik_lamp_grid4": "Sibenik, lamp; Cycles 4×4 points per texel"}
 
 
 def t_error_estimate():

@@ -14,7 +14,9 @@ With two or more bakes (seeds of one atlas), a row in --seeds-csv: one bake's sp
 scored bins (what the estimate should match, without Cycles), the seeds' mean's systematic difference from
 Cycles (both noises removed) and the share of its square in the worst 1% of bins (logged with their texels).
 --score-only prints the score of any bakes of the atlas (no estimate needed), against Cycles or, with --halves
-A B, against two of our own bakes (two seeds of `--backend reference`: our bias without Cycles' scene). Cycles runs (cached) exactly as compare.py runs it.
+A B, against two of our own bakes (two seeds of `--backend reference`: our bias without Cycles' scene). Cycles runs (cached) exactly as compare.py runs it;
+--map-grid 4 bakes it at 4x the atlas' size and averages back, so that its texel is the mean over the whole square as ours
+(see grid_mean; name such rows NAME_grid4).
 """
 import argparse
 import csv
@@ -38,6 +40,23 @@ SEED_FIELDS = ["date", "commit", "scene", "seeds", "bins", "estimated_rms", "see
                "worst_share", "systematic_without_worst", "measured_rms"]
 
 
+def grid_mean(img, g):
+    """A map baked at g x the atlas' size, back to the atlas: each texel the mean of its covered sub-texels (A = the
+    covered share). Cycles' bake averages a texel over the middle half of its side only (Blender's texel
+    differentials are half a texel) and on the triangle under its centre; at g = 4 and one sample per sub-texel
+    (Cycles' first sample is the centre) a texel is a 4 x 4 grid of points over its whole square, as ours."""
+    if g == 1:
+        return img
+    h, w = img.shape[0] // g, img.shape[1] // g
+    blk = img[:h * g, :w * g].reshape(h, g, w, g, 4)
+    cov = (blk[..., 3] > 0.5).astype(np.float64)
+    n = cov.sum(axis=(1, 3))
+    out = np.zeros((h, w, 4))
+    out[..., :3] = (blk[..., :3] * cov[..., None]).sum(axis=(1, 3)) / np.maximum(n, 1)[..., None]
+    out[..., 3] = (n >= g * g / 2).astype(np.float64)
+    return out
+
+
 def cycles_halves(args, out):
     """Cycles' two cached half bakes of out's atlas and the texels the map score keeps."""
     rep = json.load(open(os.path.join(out, "report.json")))
@@ -46,23 +65,25 @@ def cycles_halves(args, out):
         compare.fail("%s: %d pages (the map comparison needs one)" % (out, len(pages)))
     w, h = pages[0]["width"], pages[0]["height"]
     scene = os.path.join(out, "scene.gltf")
-    base = ["--uv", "UVMap.001", "--width", str(w), "--height", str(h), "--max-bounces", str(args.max_bounces)]
+    g = args.map_grid
+    base = ["--uv", "UVMap.001", "--width", str(g * w), "--height", str(g * h), "--max-bounces", str(args.max_bounces)]
     if args.bake_lights:
         base += ["--cycles-dir", args.cycles_dir]
         if args.sky:
             base += ["--sky", args.sky]
     half = max(1, args.map_spp // 2)
+    sub = max(1, half // (g * g))  # samples per sub-texel: the same samples per texel
     kf = [compare.export_key_file(scene, out)]
-    refs = [compare.cycles_cached(args, args.bake_script, scene, base + ["--spp", str(half), "--seed", str(s)], "map.exr", kf)
+    refs = [compare.cycles_cached(args, args.bake_script, scene, base + ["--spp", str(sub), "--seed", str(s)], "map.exr", kf)
             for s in (1, 2)]
-    a, b = compare.read_exr(refs[0][0]), compare.read_exr(refs[1][0])
+    a, b = (grid_mean(compare.read_exr(r[0]), g) for r in refs)
     cov = (a[..., 3] > 0.5) & (b[..., 3] > 0.5)
     lum = (a[..., :3] + b[..., :3]).mean(axis=2)
     hidden = cov & (lum < args.hidden_cut * lum[cov].mean())
     for _ in range(2):
         hidden = ~compare.erode_cover(~hidden)
     mask = compare.erode_cover(cov) & ~hidden
-    return rep, a, b, mask, 2 * half
+    return rep, a, b, mask, 2 * sub * g * g
 
 
 def score_only(args):
@@ -138,6 +159,8 @@ def main():
     ap.add_argument("--sky", default="")
     ap.add_argument("--max-bounces", type=int, default=64)
     ap.add_argument("--hidden-cut", type=float, default=0.02)
+    ap.add_argument("--map-grid", type=int, default=1, help="Cycles bakes the atlas at N x its size, 1 sample per "
+                    "sub-texel when --map-spp allows, averaged back: a texel over its whole square (see grid_mean)")
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--cycles-dir", default=os.path.join(compare.REPO, "..", "shared", "tools", "cycles"))
     ap.add_argument("--cache", default=os.path.join(compare.REPO, "build", "cycles-cache"))
