@@ -37,6 +37,37 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
   return share;
 }
 
+// Texels whose centre agrees with its neighbours although a shadow or a lit strip narrower than a texel crosses
+// its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
+// centre's triangle, against the centre's; a texel where they differ by more than `jump` is marked too.
+void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share, float jump,
+                       std::vector<uint8_t>& edge) {
+  const RayTracer& rt = in.rayTracer;
+  const float eps = rt.epsilon();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t != r.end(); ++t) {
+      if (edge[t] || share[t] < 0.0f) continue;
+      SquareMean mean;
+      auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
+        for (const Light& l : in.scene.lights) {
+          const PunctualContribution c = punctualDirect(l, xs, nx);
+          if (c.mapValue == glm::vec3(0.0f)) continue;
+          values[1] += c.mapValue;
+          const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+          if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
+          values[0] += c.mapValue;
+        }
+        return true;  // no covered test here: the full refinement drops what a surface cuts off
+      };
+      if (!averageOverTexelSquare(in, ts, t, 2, nullptr, visit, mean) || mean.kept == 0) continue;
+      const double unshadowed = std::max(mean.sum[1].x, std::max(mean.sum[1].y, mean.sum[1].z));
+      if (!(unshadowed > 0.0)) continue;
+      const double probe = std::max(mean.sum[0].x, std::max(mean.sum[0].y, mean.sum[0].z)) / unshadowed;
+      if (std::abs(probe - share[t]) > jump) edge[t] = 1;
+    }
+  });
+}
+
 }  // namespace
 
 ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& directPages,
@@ -53,7 +84,9 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     Lightmap& map = directPages[p];
     if (ts.supersample != 1 || map.size() != ts.layerSize()) continue;
     const std::vector<uint8_t>& valid = map.valid.size() == map.size() ? map.valid : ts.valid;
-    const std::vector<uint8_t> edge = edgeTexels(visibleShare(in, ts, map, valid), ts.width, ts.height, options.jump);
+    const std::vector<float> share = visibleShare(in, ts, map, valid);
+    std::vector<uint8_t> edge = edgeTexels(share, ts.width, ts.height, options.jump);
+    markSubTexelEdges(in, ts, share, options.jump, edge);
     const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {

@@ -139,6 +139,66 @@ TEST(ShadowEdges, UnderABoxRestingOnTheFloorIsCoveredNotShadowed) {
               checked, errRefined / checked, errAsShadow / checked);
 }
 
+// A roof with a slit a quarter of a texel wide, the sun tilted so that its lit strip on the floor falls between
+// two rows of texel centres (0.1 to 0.35 of a texel past one): every centre is dark, no neighbour sees a jump,
+// and only the 2×2 probe of each square finds the strip. Each texel it crosses gets its lit share, 1/4.
+TEST(ShadowEdges, AStripNarrowerThanATexelBetweenCentresIsFound) {
+  constexpr double kTexelsPerUnit = 16.0, h = 1.0 / kTexelsPerUnit, slitLo = 0.0, slitHi = 0.25 * h;
+  Scene s;
+  const int white = addMaterial(s, glm::vec3(0.5f));
+  addQuad(s, white, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0});  // the floor, facing +z
+  addQuad(s, white, {-2, -2, 0.5f}, {2 + float(slitLo), 0, 0}, {0, 4, 0});
+  addQuad(s, white, {float(slitHi), -2, 0.5f}, {2 - float(slitHi), 0, 0}, {0, 4, 0});
+  AtlasOptions atlas;
+  atlas.texelsPerUnit = kTexelsPerUnit;
+  buildAtlas(s, atlas);
+  RayTracer rt(s);
+  std::vector<TexelSamples> texels = buildTexelSamples(s, rt, {});
+  // The floor's texel centres in x sit on a grid of pitch h: the centre nearest x = 0 (away from the floor's
+  // border, where samples are pulled inside their triangle).
+  double c = 1e9;
+  for (const TexelSamples& ts : texels)
+    for (size_t t = 0; t < ts.layerSize(); ++t)
+      if (ts.valid[t] && ts.primitive[t] == 0 && std::abs(ts.positionWeight[t].y) < 0.5f &&
+          std::abs(ts.positionWeight[t].x) < std::abs(c))
+        c = ts.positionWeight[t].x;
+  ASSERT_LT(std::abs(c), 0.51 * h);
+  // Light leaving the slit along (dx, 0, -1) lands at x + 0.5 dx: the strip [c + 0.1h, c + 0.35h].
+  const double dx = 2.0 * (c + 0.1 * h - slitLo);
+  const glm::vec3 dir = glm::normalize(glm::vec3(float(dx), 0.0f, -1.0f));
+  s.lights.push_back(directionalLight(dir, kPiF));
+  const float cosine = -dir.z;
+  VplSet none;
+  VplEvalOptions e;
+  e.includeVpls = false;
+  const BakeInputs in{s, rt, texels, none, e, {}};
+  const std::vector<Lightmap> centre = bakeEmbree(in);
+  std::vector<Lightmap> refined = centre;
+  ShadowEdgeOptions o;
+  o.subSamples = 8;
+  refineShadowEdges(in, refined, o);
+  auto lit = [&](glm::vec3 p) { return p.x >= c + 0.1 * h && p.x <= c + 0.35 * h; };
+  size_t crossed = 0;
+  for (size_t p = 0; p < texels.size(); ++p)
+    for (size_t t = 0; t < texels[p].layerSize(); ++t) {
+      const TexelSamples& ts = texels[p];
+      if (!ts.valid[t] || ts.primitive[t] != 0 || std::abs(ts.positionWeight[t].y) > 0.9f) continue;
+      const double exact = exactLitShare(s, ts, t, lit);
+      if (exact < 0) continue;
+      ASSERT_EQ(centre[p].texels[t].x, 0.0f) << "a centre in the strip";
+      if (exact > 0.0) {
+        ++crossed;
+        // 8×8 sub-points: two of their columns fall in the strip, exactly its quarter of the square.
+        ASSERT_NEAR(refined[p].texels[t].x / cosine, exact, 0.07) << "texel " << t % ts.width << "," << t / ts.width;
+      } else {
+        ASSERT_EQ(refined[p].texels[t].x, 0.0f) << "texel " << t % ts.width << "," << t / ts.width;
+      }
+    }
+  EXPECT_GE(crossed, 20u);
+  std::printf("[ figure ] strip a quarter of a texel wide between centres: %zu texels crossed, each at its share\n",
+              crossed);
+}
+
 TEST(ShadowEdges, OffWithOneSubSampleOrSupersampledTexels) {
   SunOverFloor f(false);
   const BakeInputs in = f.inputs();
