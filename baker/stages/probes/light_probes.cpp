@@ -14,6 +14,7 @@
 #include "transport/geometry_term.h"
 #include "stages/probes/blend_fit.h"
 #include "stages/probes/light_visibility_fit.h"
+#include "stages/probes/sun_level.h"
 #include "vpl/light_sources.h"
 
 namespace irbake {
@@ -314,6 +315,20 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
       if (grid.valid[i]) addPunctualLights(in, grid.position(i), &fit.visibility[i * fit.lights], grid.coefficients[i]);
     });
   traced += fit.rays;
+  // The strongest directional light's visibility refined where its shadow crosses a cell (sun_level.h).
+  SunLevelStats sunStats;
+  grid.sun = ProbeSunLevel{};
+  const int sun = strongestDirectionalLight(in.scene.lights);
+  if (sun >= 0 && fit.lights > 0) {
+    std::vector<float> carried(n, 0.0f);
+    for (size_t i = 0; i < n; ++i)
+      if (grid.valid[i]) carried[i] = fit.visibility[i * fit.lights + static_cast<size_t>(sun)];
+    SunLevelOptions sunOptions;
+    sunOptions.subdivisions = options.sunSubdivisions;
+    sunOptions.tolerance = options.sunTolerance;
+    grid.sun = bakeSunLevel(in, grid, static_cast<size_t>(sun), carried, sunOptions, &sunStats);
+  }
+  traced += sunStats.rays;
   if (stats) {
     stats->count = n;
     stats->valid = static_cast<size_t>(std::count(grid.valid.begin(), grid.valid.end(), uint8_t(1)));
@@ -324,6 +339,8 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     stats->lightFitSweeps = fit.sweeps;
     stats->volumeFitSamples = volume.samples;
     stats->volumeFitSweeps = volume.sweeps;
+    stats->sunCells = sunStats.cells;
+    stats->sunRays = sunStats.rays;
     stats->seconds = watch.seconds();
   }
 }
