@@ -4,7 +4,9 @@
 # (irbake_light_probes.js, ?probeObject=) and require the sphere's pixels to agree: mean absolute difference
 # ≤ 1 (8-bit; what is left is the three.js sphere's tessellated normals and the two sRGB encoders' rounding).
 # Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
-# the problem.
+# the problem. The same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
+# straight down, the sphere across the square's shadow edge in a refined cell; and refusals of a sun visibility
+# outside [0, 1] and unsorted cells.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
@@ -26,3 +28,20 @@ node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_zero
   --expect-error "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_nan.gltf" \
   --expect-error "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
+
+# The sun level: probes every 0.5 m, x = ..., 0.25, 0.75, ...; the shadow edge x = 0.5 crosses that cell.
+"$irbake" bake "$work/samples/quad_over_plane.gltf" -o "$work/sun" --vpls 256 --texels-per-unit 20 --sun 0,-1,0,3 \
+  --probes 0.5 --probe-box=-2,0.05,-2,2,0.95,2 --quiet > "$work/sun.log" 2>&1
+node -e "const e = JSON.parse(require('fs').readFileSync('$work/sun/scene.gltf')).extensions.IRBAKE_light_probes;
+         if (!e.sun) { console.error('no sun level in the bake'); process.exit(1); }"
+sphere=0.55,0.5,0,0.08 eye=0.85,0.6,-0.3 target=0.55,0.5,0
+"$irview" "$work/sun/scene.gltf" --probe-object $sphere --eye $eye --target $target --fov $fov --width $w --height $h \
+  --screenshot "$work/irview_sun.png" > "$work/irview_sun.log" 2>&1
+view=(--modules "$modules" --probe-object $sphere --eye $eye --target $target --fov $fov --width $w --height $h)
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene.gltf" --reference "$work/irview_sun.png" \
+  --out "$work/web_sun.png" --max-mean-abs 1
+node "$here/corrupt_probes.mjs" "$work/sun/scene.gltf"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_visibility.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.visibility: probe 0 holds 2 (0 to 1)"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_cells.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
