@@ -122,12 +122,12 @@ TEST(ProbeSunLevel, HoldsTheRoofsShadowEdgeWithinOneLatticeStep) {
     return doc["bufferViews"][a["bufferView"].get<int>()].value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0));
   };
   std::string b = bin;
-  const float nan = std::numeric_limits<float>::quiet_NaN(), over = 1.5f;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(b.data() + at("sh"), &nan, 4);
   refused("sun_nan", doc, b, "IRBAKE_light_probes.sun.sh: a non-finite coefficient");
-  b = bin;
-  std::memcpy(b.data() + at("visibility"), &over, 4);
-  refused("sun_over", doc, b, "IRBAKE_light_probes.sun.visibility: probe 0 holds 1.5");
+  json shortVisibility = doc;  // 20 probes, 4 a word
+  shortVisibility["accessors"][ext["sun"]["visibility"].get<int>()]["count"] = 4;
+  refused("sun_visibility", shortVisibility, bin, "IRBAKE_light_probes.sun.visibility: 4 elements, the grid needs 5");
   b = bin;
   const uint32_t outside = 4;  // probe (4, 0, 0): the last along x, no cell's base
   std::memcpy(b.data() + at("cells"), &outside, 4);

@@ -48,22 +48,25 @@ glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file, cons
   return r;
 }
 
-// The sun level (ProbeSunLevel) as the extension's optional `sun` object: its SH and the probes' visibilities
-// as floats, the refined cells and the lattice's bits as 32-bit unsigned integers (bits packed: a byte per
-// point would be 8× the size, and 1-byte accessors came back scrambled through meshopt).
+// The sun level (ProbeSunLevel) as the extension's optional `sun` object: its SH as floats; the probes'
+// visibilities as bytes (k/255), the refined cells and the lattice's bits in 32-bit unsigned integers (packed: 1-byte
+// accessors came back scrambled through meshopt, and floats would be 4× the size).
 json sunLevelJson(GltfDocument& doc, const ProbeSunLevel& sun) {
   const glm::vec3 d = sun.direction;
+  std::vector<uint32_t> visibility((sun.visibility.size() + 3) / 4, 0u);
+  for (size_t i = 0; i < sun.visibility.size(); ++i)
+    visibility[i / 4] |= static_cast<uint32_t>(std::lround(std::clamp(sun.visibility[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
   return {{"direction", {d.x, d.y, d.z}},
           {"sh", addAccessor(doc, sun.sh.data(), sizeof(ShCoefficients), kFloat, kShCoefficients, "VEC3")},
-          {"visibility", addAccessor(doc, sun.visibility.data(), sun.visibility.size() * sizeof(float), kFloat,
-                                     sun.visibility.size(), "SCALAR")},
+          {"visibility", addAccessor(doc, visibility.data(), visibility.size() * sizeof(uint32_t), kUnsignedInt,
+                                     visibility.size(), "SCALAR")},
           {"cells", addAccessor(doc, sun.cells.data(), sun.cells.size() * sizeof(uint32_t), kUnsignedInt, sun.cells.size(), "SCALAR")},
           {"subdivisions", sun.subdivisions},
           {"fine", addAccessor(doc, sun.fine.data(), sun.fine.size() * sizeof(uint32_t), kUnsignedInt, sun.fine.size(), "SCALAR")}};
 }
 
 // The extension's `sun` object, checked against the grid: every field present and of its type, the SH finite,
-// the visibilities in [0, 1], the cells ascending and each the base probe of a cell, the bits as many as the cells
+// the cells ascending and each the base probe of a cell, the bits as many as the cells
 // need. Throws Error(InvalidData, file) naming the field.
 ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const LightProbeGrid& g, const std::string& file) {
   const json& sun = ext["sun"];
@@ -82,13 +85,11 @@ ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const Light
     if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
       throw Error(ErrorCode::InvalidData, file, what + ".sh: a non-finite coefficient");
   const size_t n = g.size();
-  const AccessorBytes v = probeAccessor(doc, sun, "visibility", kFloat, "SCALAR", n, file, what);
+  const AccessorBytes v = probeAccessor(doc, sun, "visibility", kUnsignedInt, "SCALAR", (n + 3) / 4, file, what);
+  std::vector<uint32_t> packed((n + 3) / 4);
+  std::memcpy(packed.data(), v.bytes.data(), packed.size() * sizeof(uint32_t));
   out.visibility.resize(n);
-  std::memcpy(out.visibility.data(), v.bytes.data(), n * sizeof(float));
-  for (size_t i = 0; i < n; ++i)
-    if (!(out.visibility[i] >= 0.0f && out.visibility[i] <= 1.0f))
-      throw Error(ErrorCode::InvalidData, file, what + ".visibility: probe " + std::to_string(i) + " holds " +
-                                                    std::to_string(out.visibility[i]) + " (0 to 1)");
+  for (size_t i = 0; i < n; ++i) out.visibility[i] = static_cast<float>((packed[i / 4] >> (8 * (i % 4))) & 255u) / 255.0f;
   if (!sun.contains("cells") || !sun["cells"].is_number_integer())
     throw Error(ErrorCode::InvalidData, file, what + ".cells: no accessor index");
   const AccessorBytes cells = readAccessor(doc, sun["cells"].get<int>(), file);

@@ -3,7 +3,7 @@
 //   NAME_probe_zero.gltf:   counts[1] = 0
 //   NAME_probe_nan.gltf:    the first coefficient NaN (in a copy of the buffer, NAME_probe_nan.bin)
 // and, when the grid has a sun level (`sun`):
-//   NAME_sun_visibility.gltf: probe 0's sun visibility 2 (in NAME_sun_visibility.bin)
+//   NAME_sun_nan.gltf:        the sun's first SH coefficient NaN (in NAME_sun_nan.bin)
 //   NAME_sun_cells.gltf:      the refined cells' first two swapped (or the only one past the grid)
 // Usage: node corrupt_probes.mjs SCENE.gltf
 import fs from 'node:fs';
@@ -38,13 +38,13 @@ if (sun) {
     const a = doc.accessors[index], v = doc.bufferViews[a.bufferView];
     return [(v.byteOffset ?? 0) + (a.byteOffset ?? 0), a.count, v.buffer];
   };
-  const [vis, , visBuffer] = at(sun.visibility);
-  const visBytes = fs.readFileSync(path.join(dir, doc.buffers[visBuffer].uri));
-  visBytes.writeFloatLE(2, vis);
-  const badVis = structuredClone(doc);
-  badVis.buffers[visBuffer].uri = `${stem}_sun_visibility.bin`;
-  fs.writeFileSync(path.join(dir, `${stem}_sun_visibility.bin`), visBytes);
-  fs.writeFileSync(path.join(dir, `${stem}_sun_visibility.gltf`), JSON.stringify(badVis));
+  const [sh, , shBuffer] = at(sun.sh);
+  const shBytes = fs.readFileSync(path.join(dir, doc.buffers[shBuffer].uri));
+  shBytes.writeFloatLE(NaN, sh);
+  const badSh = structuredClone(doc);
+  badSh.buffers[shBuffer].uri = `${stem}_sun_nan.bin`;
+  fs.writeFileSync(path.join(dir, `${stem}_sun_nan.bin`), shBytes);
+  fs.writeFileSync(path.join(dir, `${stem}_sun_nan.gltf`), JSON.stringify(badSh));
   const [cells, count, cellBuffer] = at(sun.cells);
   const cellBytes = fs.readFileSync(path.join(dir, doc.buffers[cellBuffer].uri));
   if (count > 1) {

@@ -23,7 +23,7 @@ export const PROBE_ACCESSORS = { coefficients: [5126, 'VEC3', 9], offsets: [5126
 // The optional sun level's accessors (`sun.<key>`): component type, type, and the element count for a grid of
 // `probes` probes whose level has `cells` refined cells of S subdivisions (null: any).
 export const SUN_ACCESSORS = {
-  sh: [5126, 'VEC3', () => 9], visibility: [5126, 'SCALAR', probes => probes], cells: [5125, 'SCALAR', () => null],
+  sh: [5126, 'VEC3', () => 9], visibility: [5125, 'SCALAR', probes => Math.ceil(probes / 4)], cells: [5125, 'SCALAR', () => null],
   fine: [5125, 'SCALAR', (probes, cells, S) => cells * Math.ceil((S + 1) ** 3 / 32)],
 };
 // An IRBAKE_light_probes definition without its accessor indices (those of `sun` included): what read → write keeps.

@@ -54,9 +54,9 @@ export async function readSunLevel(ext, counts, read) {
   const n = counts[0] * counts[1] * counts[2];
   const sh = await read('sh', FLOAT, 'VEC3', 9);
   if (!sh.every(Number.isFinite)) fail('sh', 'a non-finite coefficient');
-  const visibility = await read('visibility', FLOAT, 'SCALAR', n);
-  for (let i = 0; i < n; ++i)
-    if (!(visibility[i] >= 0 && visibility[i] <= 1)) fail('visibility', `probe ${i} holds ${visibility[i]} (0 to 1)`);
+  const packed = await read('visibility', UNSIGNED_INT, 'SCALAR', Math.ceil(n / 4));  // a byte each, k/255
+  const visibility = new Float32Array(n);
+  for (let i = 0; i < n; ++i) visibility[i] = ((packed[i >> 2] >>> (8 * (i & 3))) & 255) / 255;
   const cells = await read('cells', UNSIGNED_INT, 'SCALAR', null);
   const [nx, ny] = counts;
   for (let c = 0; c < cells.length; ++c) {

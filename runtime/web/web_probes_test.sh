@@ -6,7 +6,7 @@
 # Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
 # the problem. The same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
 # straight down, the sphere across the square's shadow edge in a refined cell; and refusals of a sun visibility
-# outside [0, 1] and unsorted cells.
+# SH that is not finite and unsorted cells.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
@@ -41,7 +41,7 @@ view=(--modules "$modules" --probe-object $sphere --eye $eye --target $target --
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene.gltf" --reference "$work/irview_sun.png" \
   --out "$work/web_sun.png" --max-mean-abs 1
 node "$here/corrupt_probes.mjs" "$work/sun/scene.gltf"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_visibility.gltf" \
-  --expect-error "IRBAKE_light_probes.sun.visibility: probe 0 holds 2 (0 to 1)"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_nan.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.sh: a non-finite coefficient"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_cells.gltf" \
   --expect-error "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
