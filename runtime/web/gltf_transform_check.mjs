@@ -3,10 +3,10 @@
 //     every material of the bake that has MOZ_lightmap (and IRBAKE_lightmap_directional) has it in the output
 //     with the same numbers and texCoord 1 on an existing texture; every light-mapped primitive has TEXCOORD_1
 //     with POSITION's vertex count; the light-mapped triangles are as many as in the bake; with --probes,
-//     IRBAKE_light_probes keeps its fields and every accessor value.
+//     IRBAKE_light_probes keeps its fields and every accessor value (its sun level's included).
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
-//     non-numeric intensity, incomplete directional extension, a probe grid that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
+//     non-numeric intensity, incomplete directional extension, a probe grid or sun level that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
 //     throw an Error naming the material or mesh.
 //   shadowmask --modules DIR --input BAKE.gltf   (a bake with --light-mode ...=shadowmask)
 //     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
