@@ -186,8 +186,8 @@ TEST(ProbeView, IrviewProbeObjectScreenshotIsTheSpheresRadiance) {
   EXPECT_LT(check.worst, 1.5e-3);
 }
 
-// A corrupted probe extension is refused naming the file and the problem, exit non-zero, no screenshot; so is
-// a scene without probes.
+// A corrupted probe extension (its sun level included) is refused naming the file and the problem, exit non-zero,
+// no screenshot; so is a scene without probes.
 TEST(ProbeView, IrviewRefusesABadProbeGrid) {
   const std::filesystem::path file = bakedBox();
   nlohmann::json doc;
@@ -202,10 +202,13 @@ TEST(ProbeView, IrviewRefusesABadProbeGrid) {
   longer["extensions"]["IRBAKE_light_probes"]["counts"][0] = longer["extensions"]["IRBAKE_light_probes"]["counts"][0].get<int>() + 1;
   nlohmann::json none = doc;
   none["extensions"].erase("IRBAKE_light_probes");
+  nlohmann::json badSun = doc;  // a sun level of no subdivisions (its other fields absent)
+  badSun["extensions"]["IRBAKE_light_probes"]["sun"] = {{"subdivisions", 0}};
   const struct {
     std::filesystem::path file;
     std::string problem;
-  } cases[] = {{write(longer, "bad_counts.gltf"), "the grid needs"}, {write(none, "no_probes.gltf"), "no IRBAKE_light_probes"}};
+  } cases[] = {{write(longer, "bad_counts.gltf"), "the grid needs"}, {write(none, "no_probes.gltf"), "no IRBAKE_light_probes"},
+               {write(badSun, "bad_sun.gltf"), "IRBAKE_light_probes.sun.subdivisions: needs a whole number from 1 to 16"}};
   for (const auto& c : cases) {
     const std::filesystem::path png = outDir() / "refused.png";
     std::filesystem::remove(png);

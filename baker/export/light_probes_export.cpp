@@ -14,6 +14,8 @@ namespace {
 
 using json = nlohmann::json;
 constexpr int kFloat = 5126;
+constexpr int kUnsignedInt = 5125;
+constexpr int kMaxSunSubdivisions = 16;
 
 int addAccessor(GltfDocument& doc, const void* data, size_t bytes, int componentType, size_t count, const char* type) {
   const int view = doc.addBufferView(data, bytes);
@@ -22,8 +24,9 @@ int addAccessor(GltfDocument& doc, const void* data, size_t bytes, int component
 
 // Accessor `key` of the extension as tightly packed bytes, checked against the type and count the grid needs.
 AccessorBytes probeAccessor(const GltfDocument& doc, const json& ext, const char* key, int componentType,
-                            const char* type, size_t count, const std::string& file) {
-  const std::string what = std::string(kLightProbesExtension) + "." + key;
+                            const char* type, size_t count, const std::string& file,
+                            const std::string& prefix = kLightProbesExtension) {
+  const std::string what = prefix + "." + key;
   if (!ext.contains(key) || !ext[key].is_number_integer()) throw Error(ErrorCode::InvalidData, file, what + ": no accessor index");
   AccessorBytes a = readAccessor(doc, ext[key].get<int>(), file);
   if (a.componentType != componentType || a.type != type)
@@ -35,14 +38,82 @@ AccessorBytes probeAccessor(const GltfDocument& doc, const json& ext, const char
   return a;
 }
 
-glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file) {
+glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file, const std::string& prefix = kLightProbesExtension) {
   const json* v = ext.contains(key) ? &ext[key] : nullptr;
   if (!v || !v->is_array() || v->size() != 3 || !(*v)[0].is_number() || !(*v)[1].is_number() || !(*v)[2].is_number())
-    throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + "." + key + ": needs 3 numbers");
+    throw Error(ErrorCode::InvalidData, file, prefix + "." + key + ": needs 3 numbers");
   const glm::vec3 r((*v)[0].get<float>(), (*v)[1].get<float>(), (*v)[2].get<float>());
   if (!std::isfinite(r.x) || !std::isfinite(r.y) || !std::isfinite(r.z))
-    throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + "." + key + ": not finite");
+    throw Error(ErrorCode::InvalidData, file, prefix + "." + key + ": not finite");
   return r;
+}
+
+// The sun level (ProbeSunLevel) as the extension's optional `sun` object: its SH as floats; the probes'
+// visibilities as bytes (k/255), the refined cells and the lattice's bits in 32-bit unsigned integers (packed: 1-byte
+// accessors came back scrambled through meshopt, and floats would be 4× the size).
+json sunLevelJson(GltfDocument& doc, const ProbeSunLevel& sun) {
+  const glm::vec3 d = sun.direction;
+  std::vector<uint32_t> visibility((sun.visibility.size() + 3) / 4, 0u);
+  for (size_t i = 0; i < sun.visibility.size(); ++i)
+    visibility[i / 4] |= static_cast<uint32_t>(std::lround(std::clamp(sun.visibility[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
+  return {{"direction", {d.x, d.y, d.z}},
+          {"sh", addAccessor(doc, sun.sh.data(), sizeof(ShCoefficients), kFloat, kShCoefficients, "VEC3")},
+          {"visibility", addAccessor(doc, visibility.data(), visibility.size() * sizeof(uint32_t), kUnsignedInt,
+                                     visibility.size(), "SCALAR")},
+          {"cells", addAccessor(doc, sun.cells.data(), sun.cells.size() * sizeof(uint32_t), kUnsignedInt, sun.cells.size(), "SCALAR")},
+          {"subdivisions", sun.subdivisions},
+          {"fine", addAccessor(doc, sun.fine.data(), sun.fine.size() * sizeof(uint32_t), kUnsignedInt, sun.fine.size(), "SCALAR")}};
+}
+
+// The extension's `sun` object, checked against the grid: every field present and of its type, the SH finite,
+// the cells ascending and each the base probe of a cell, the bits as many as the cells
+// need. Throws Error(InvalidData, file) naming the field.
+ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const LightProbeGrid& g, const std::string& file) {
+  const json& sun = ext["sun"];
+  const std::string what = std::string(kLightProbesExtension) + ".sun";
+  if (!sun.is_object()) throw Error(ErrorCode::InvalidData, file, what + ": not an object");
+  ProbeSunLevel out;
+  if (!sun.contains("subdivisions") || !sun["subdivisions"].is_number_integer() || sun["subdivisions"].get<int>() < 1 ||
+      sun["subdivisions"].get<int>() > kMaxSunSubdivisions)
+    throw Error(ErrorCode::InvalidData, file, what + ".subdivisions: needs a whole number from 1 to " + std::to_string(kMaxSunSubdivisions));
+  out.subdivisions = sun["subdivisions"].get<int>();
+  out.direction = vec3Of(sun, "direction", file, what);
+  if (std::abs(glm::length(out.direction) - 1.0f) > 1e-3f) throw Error(ErrorCode::InvalidData, file, what + ".direction: not a unit vector");
+  const AccessorBytes sh = probeAccessor(doc, sun, "sh", kFloat, "VEC3", kShCoefficients, file, what);
+  std::memcpy(out.sh.data(), sh.bytes.data(), sizeof(ShCoefficients));
+  for (const glm::vec3& c : out.sh)
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
+      throw Error(ErrorCode::InvalidData, file, what + ".sh: a non-finite coefficient");
+  const size_t n = g.size();
+  const AccessorBytes v = probeAccessor(doc, sun, "visibility", kUnsignedInt, "SCALAR", (n + 3) / 4, file, what);
+  std::vector<uint32_t> packed((n + 3) / 4);
+  std::memcpy(packed.data(), v.bytes.data(), packed.size() * sizeof(uint32_t));
+  out.visibility.resize(n);
+  for (size_t i = 0; i < n; ++i) out.visibility[i] = static_cast<float>((packed[i / 4] >> (8 * (i % 4))) & 255u) / 255.0f;
+  if (!sun.contains("cells") || !sun["cells"].is_number_integer())
+    throw Error(ErrorCode::InvalidData, file, what + ".cells: no accessor index");
+  const AccessorBytes cells = readAccessor(doc, sun["cells"].get<int>(), file);
+  if (cells.componentType != kUnsignedInt || cells.type != "SCALAR")
+    throw Error(ErrorCode::InvalidData, file, what + ".cells: accessor of componentType " + std::to_string(cells.componentType) +
+                                                  " " + cells.type + ", expected 5125 SCALAR");
+  out.cells.resize(cells.count);
+  std::memcpy(out.cells.data(), cells.bytes.data(), cells.count * sizeof(uint32_t));
+  for (size_t c = 0; c < out.cells.size(); ++c) {
+    const uint32_t i = out.cells[c];
+    bool base = i < n;
+    if (base) {
+      const glm::ivec3 q = g.cell(i);
+      for (int a = 0; a < 3; ++a) base = base && q[a] < std::max(1, g.counts[a] - 1);
+    }
+    if (!base) throw Error(ErrorCode::InvalidData, file, what + ".cells: " + std::to_string(i) + " is not a cell of the grid");
+    if (c > 0 && i <= out.cells[c - 1])
+      throw Error(ErrorCode::InvalidData, file, what + ".cells: not in ascending order at element " + std::to_string(c));
+  }
+  const AccessorBytes fine = probeAccessor(doc, sun, "fine", kUnsignedInt, "SCALAR",
+                                           out.cells.size() * static_cast<size_t>(out.wordsPerCell()), file, what);
+  out.fine.resize(fine.count);
+  std::memcpy(out.fine.data(), fine.bytes.data(), fine.count * sizeof(uint32_t));
+  return out;
 }
 
 }  // namespace
@@ -64,6 +135,7 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
               {"valid", addAccessor(doc, valid.data(), n * sizeof(float), kFloat, n, "SCALAR")},
               {"units", "irradiance/pi"},
               {"convention", "three.js SphericalHarmonics3"}};
+  if (grid.sun.present() && !grid.sun.cells.empty() && grid.sun.visibility.size() == n) ext["sun"] = sunLevelJson(doc, grid.sun);
   doc.root["extensions"][kLightProbesExtension] = std::move(ext);
   doc.useExtension(kLightProbesExtension);
 }
@@ -130,6 +202,7 @@ LightProbeGrid readLightProbes(const std::filesystem::path& path) {
                                                     " holds " + std::to_string(valid[i]) + " (0 or 1)");
     g.valid[i] = valid[i] == 1.0f;
   }
+  if (ext->contains("sun")) g.sun = readSunLevel(doc, *ext, g, file);
   return g;
 }
 

@@ -49,6 +49,53 @@ inline void shAddDirectional(ShCoefficients& c, const glm::vec3& d, const glm::v
   for (int k = 0; k < kShCoefficients; ++k) c[k] += value * y[k];
 }
 
+// The strongest directional light's visibility on a finer lattice in the cells its shadow crosses (docs/export.md,
+// "IRBAKE_light_probes", `sun`). A blend of probes a spacing apart smears a sun's shadow edge over the cell; a
+// point p of a refined cell instead takes its probes' blend plus (v_fine(p) − Σ w_i v_i) · sh: v_fine the
+// trilinear interpolation of the cell's (S+1)³ lattice of binary visibilities, v_i the visibility probe i's
+// coefficients carry, w_i the blend's own weights.
+struct ProbeSunLevel {
+  glm::vec3 direction{0.0f};      // the light's travel direction (world, unit)
+  ShCoefficients sh{};            // its SH at visibility 1, map units (what a probe that fully sees it got)
+  std::vector<float> visibility;  // per probe: the visibility its coefficients carry, in [0, 1]
+  std::vector<uint32_t> cells;    // refined cells, ascending: the linear index i + nx (j + ny k) of the base probe
+  int subdivisions = 0;           // S per axis (0: no sun level)
+  std::vector<uint32_t> fine;     // bits: cell c's point (a, b, d), 0..S each, is bit a + (S+1)(b + (S+1) d) of
+                                  // the words [c W, (c + 1) W), W = wordsPerCell(), bit n of a word = 1 << n
+
+  bool present() const { return subdivisions > 0; }
+  int pointsPerCell() const { return (subdivisions + 1) * (subdivisions + 1) * (subdivisions + 1); }
+  int wordsPerCell() const { return (pointsPerCell() + 31) / 32; }
+  bool bit(size_t cell, int a, int b, int d) const {
+    const int s1 = subdivisions + 1, n = a + s1 * (b + s1 * d);
+    return (fine[cell * wordsPerCell() + n / 32] >> (n % 32)) & 1u;
+  }
+  // v_fine at the cell-local fraction t ∈ [0, 1]³ of the cell whose base probe is `base`; -1 when that cell
+  // is not refined.
+  float fineVisibility(size_t base, const glm::vec3& t) const {
+    if (!present()) return -1.0f;
+    const auto it = std::lower_bound(cells.begin(), cells.end(), static_cast<uint32_t>(base));
+    if (it == cells.end() || *it != base) return -1.0f;
+    const size_t cell = static_cast<size_t>(it - cells.begin());
+    const float S = static_cast<float>(subdivisions);
+    glm::ivec3 lo;
+    glm::vec3 f;
+    for (int a = 0; a < 3; ++a) {
+      const float x = std::clamp(t[a], 0.0f, 1.0f) * S;
+      lo[a] = std::min(static_cast<int>(std::floor(x)), subdivisions - 1);
+      f[a] = x - static_cast<float>(lo[a]);
+    }
+    float v = 0.0f;
+    for (int k = 0; k < 8; ++k) {
+      const glm::ivec3 d(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      float w = 1.0f;
+      for (int a = 0; a < 3; ++a) w *= d[a] ? f[a] : 1.0f - f[a];
+      if (w > 0.0f && bit(cell, lo.x + d.x, lo.y + d.y, lo.z + d.z)) v += w;
+    }
+    return v;
+  }
+};
+
 struct LightProbeGrid {
   glm::vec3 origin{0.0f};        // position of probe (0, 0, 0), metres, world space
   float spacing = 0.0f;          // between neighbours along each axis
@@ -56,6 +103,7 @@ struct LightProbeGrid {
   std::vector<ShCoefficients> coefficients;  // one per probe (map units: see above)
   std::vector<glm::vec3> offsets;            // where each probe was baked, relative to its grid point
   std::vector<uint8_t> valid;                // 0: inside geometry or behind a wall, left out of interpolation
+  ProbeSunLevel sun;                         // optional: the sun's visibility refined where its shadow crosses
 
   size_t size() const { return static_cast<size_t>(counts.x) * counts.y * counts.z; }
   size_t index(int i, int j, int k) const {
@@ -80,9 +128,10 @@ struct ProbeBlend {
 };
 
 // The trilinear blend's probes around p (the cell clamped to the grid): corner(index, weight) for each of
-// the 8 with a positive weight, a one-probe axis's single layer once. Returns the cell's base corner.
+// the 8 with a positive weight, a one-probe axis's single layer once. Returns the cell's base corner; `fraction`,
+// when given, receives p's position in the cell (0..1 per axis, 0 along a one-probe axis).
 template <class Corner>
-glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corner&& corner) {
+glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corner&& corner, glm::vec3* fraction = nullptr) {
   const glm::vec3 f = (p - g.origin) / g.spacing;
   glm::ivec3 base;
   glm::vec3 t;
@@ -92,6 +141,7 @@ glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corne
     base[a] = std::min(static_cast<int>(std::floor(c)), std::max(0, g.counts[a] - 2));
     t[a] = g.counts[a] > 1 ? c - static_cast<float>(base[a]) : 0.0f;
   }
+  if (fraction) *fraction = t;
   for (int k = 0; k < 8; ++k) {
     const glm::ivec3 d(k & 1, (k >> 1) & 1, (k >> 2) & 1);
     const glm::ivec3 q = glm::min(base + d, g.counts - 1);
@@ -105,20 +155,28 @@ glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corne
 
 // Trilinear over the 8 probes around p (clamped to the grid), each weighted by its validity and, when
 // `visible` is given, by whether p sees the probe's baked position (a wall between them: weight 0, so light
-// never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p.
+// never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p. In a
+// cell of the sun level, the blend's sun is replaced by the fine lattice's (ProbeSunLevel).
 inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
                                     const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
   ProbeBlend out;
   if (g.size() == 0 || !(g.spacing > 0.0f)) return out;
   auto use = [&](size_t idx) { return g.valid[idx] && (!visible || visible(p, g.position(idx))); };
+  const bool sun = g.sun.present() && g.sun.visibility.size() == g.size();
+  float sunBlend = 0.0f;
+  glm::vec3 t(0.0f);
   const glm::ivec3 base = forEachBlendCorner(g, p, [&](size_t idx, float w) {
     if (!use(idx)) return;
     for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += w * g.coefficients[idx][k];
+    if (sun) sunBlend += w * g.sun.visibility[idx];
     out.weight += w;
     ++out.probes;
-  });
+  }, &t);
   if (out.weight > 0.0f) {
     for (auto& c : out.coefficients) c /= out.weight;
+    const float fine = sun ? g.sun.fineVisibility(g.index(base.x, base.y, base.z), t) : -1.0f;
+    if (fine >= 0.0f)
+      for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * g.sun.sh[k];
     return out;
   }
   float best = 1e30f;

@@ -9,6 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "texels/contact_cuts.h"
+
 namespace irbake {
 
 SurfaceFilter::SurfaceFilter(const TexelSamples& ts) : width_(ts.width), height_(ts.height) {
@@ -37,9 +39,36 @@ SurfaceFilter::SurfaceFilter(const TexelSamples& ts) : width_(ts.width), height_
         d.push_back(glm::length(position_[i] - position_[j]));
       }
     }
-  if (d.empty()) return;
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  spacing_ = d[d.size() / 2];
+  if (!d.empty()) {
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    spacing_ = d[d.size() / 2];
+  }
+  if (ts.cut.size() != layer) return;
+  rowCuts_.assign(layer, 0);
+  colCuts_.assign(layer, 0);
+  tbb::parallel_for(0, H, [&](int y) {  // each row's counts
+    for (int x = 1; x < W; ++x) {
+      const size_t i = static_cast<size_t>(y) * W + x;
+      rowCuts_[i] = rowCuts_[i - 1] + ((ts.cut[i - 1] & kCutRight) ? 1u : 0u);
+    }
+  });
+  tbb::parallel_for(0, W, [&](int x) {  // each column's counts
+    for (int y = 1; y < H; ++y) {
+      const size_t i = static_cast<size_t>(y) * W + x;
+      colCuts_[i] = colCuts_[i - W] + ((ts.cut[i - W] & kCutDown) ? 1u : 0u);
+    }
+  });
+}
+
+bool SurfaceFilter::uncut(int x, int y, int dx, int dy) const {
+  const size_t W = static_cast<size_t>(width_);
+  auto rowClear = [&](int row, int x0, int x1) {
+    return rowCuts_[row * W + std::max(x0, x1)] == rowCuts_[row * W + std::min(x0, x1)];
+  };
+  auto colClear = [&](int col, int y0, int y1) {
+    return colCuts_[std::max(y0, y1) * W + col] == colCuts_[std::min(y0, y1) * W + col];
+  };
+  return (rowClear(y, x, x + dx) && colClear(x + dx, y, y + dy)) || (colClear(x, y, y + dy) && rowClear(y + dy, x, x + dx));
 }
 
 std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values, const std::vector<uint8_t>& valid,
@@ -56,7 +85,8 @@ std::vector<glm::vec3> SurfaceFilter::apply(const std::vector<glm::vec3>& values
   if (glm::dot(normal_[i], normal_[j]) < options.minNormalCos) return false;
   const float unit = options.maxSpacings * spacing_;  // reach = unit × |(dx, dy)|, compared squared
   const glm::vec3 d = position_[j] - position_[i];
-  return glm::dot(d, d) <= unit * unit * static_cast<float>(dx * dx + dy * dy);
+  if (glm::dot(d, d) > unit * unit * static_cast<float>(dx * dx + dy * dy)) return false;
+  return rowCuts_.empty() || uncut(static_cast<int>(i % width_), static_cast<int>(i / width_), dx, dy);
 }
 
 template <class Visit>

@@ -1,7 +1,8 @@
 // A geometry-aware box filter over a page's texels: smooths a per-texel estimate that is noisy but
 // spatially smooth on each surface (the clamp residual, interleaved VPL subsets) without mixing light
-// across surfaces: a neighbour counts only if it is valid, on a surface facing the same way and close
-// in world space (not just in the atlas, where unrelated charts can touch).
+// across surfaces: a neighbour counts only if it is valid, on a surface facing the same way, close
+// in world space (not just in the atlas, where unrelated charts can touch) and not behind a contact line
+// (an occluder standing on the surface between them: texels/contact_cuts.h).
 #pragma once
 #include <array>
 #include <cstddef>
@@ -67,8 +68,15 @@ class SurfaceFilter {
                        Visit&& visit) const;
 
   int width_ = 0, height_ = 0;
+  // Whether texel (x, y) reaches (x + dx, y + dy) along one of the two L-shaped texel paths (row first or
+  // column first) without crossing a contact cut (TexelSamples::cut): symmetric, as accepts() must be.
+  bool uncut(int x, int y, int dx, int dy) const;
+
   std::vector<glm::vec3> position_, normal_;  // per texel
   std::vector<uint8_t> hasSample_;            // per texel: some sample has weight
+  // Contact cuts as prefix counts (empty without cuts): rowCuts_[y·W + x] counts the cut steps (x′, y) → (x′ + 1, y)
+  // with x′ < x; colCuts_[y·W + x] the cut steps (x, y′) → (x, y′ + 1) with y′ < y.
+  std::vector<uint32_t> rowCuts_, colCuts_;
   float spacing_ = 0.0f;
 };
 

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/maths.h"
+#include "texels/contact_cuts.h"
 
 namespace irbake {
 namespace {
@@ -305,6 +306,7 @@ std::vector<TexelSamples> buildTexelSamples(const Scene& scene, const RayTracer&
         if (ts.primitive[slot] != kNone) ts.positionWeight[slot].w = 1.0f / kept;
       }
     }
+    markContactCuts(ts, rt);
     pages.push_back(std::move(ts));
   }
   if (options.progress) options.progress("texels", 1.0);

@@ -30,6 +30,8 @@ struct TexelSamples {
   std::vector<uint32_t> triangle;         // per slot: triangle index within that primitive
   std::vector<uint8_t> covered;           // per texel: some triangle touches it (before leak control)
   std::vector<uint8_t> valid;             // per texel: at least one valid sample after leak control
+  std::vector<uint8_t> cut;               // per texel: an occluder between it and its right / lower neighbour
+                                          // (texels/contact_cuts.h bits); empty where no pair is cut
   size_t layerSize() const { return static_cast<size_t>(width) * height; }
   size_t slotCount() const { return layerSize() * supersample * supersample; }
 };

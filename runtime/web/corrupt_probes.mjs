@@ -1,7 +1,10 @@
-// Writes two broken copies of a baked glTF's IRBAKE_light_probes beside it, for the refusal tests:
+// Writes broken copies of a baked glTF's IRBAKE_light_probes beside it, for the refusal tests:
 //   NAME_probe_counts.gltf: counts[0] one larger (the accessors are then too short for the grid)
 //   NAME_probe_zero.gltf:   counts[1] = 0
 //   NAME_probe_nan.gltf:    the first coefficient NaN (in a copy of the buffer, NAME_probe_nan.bin)
+// and, when the grid has a sun level (`sun`):
+//   NAME_sun_nan.gltf:        the sun's first SH coefficient NaN (in NAME_sun_nan.bin)
+//   NAME_sun_cells.gltf:      the refined cells' first two swapped (or the only one past the grid)
 // Usage: node corrupt_probes.mjs SCENE.gltf
 import fs from 'node:fs';
 import path from 'node:path';
@@ -28,3 +31,31 @@ const nan = structuredClone(doc);
 nan.buffers[view.buffer].uri = `${stem}_probe_nan.bin`;
 fs.writeFileSync(path.join(dir, `${stem}_probe_nan.bin`), bytes);
 fs.writeFileSync(path.join(dir, `${stem}_probe_nan.gltf`), JSON.stringify(nan));
+
+const sun = ext.sun;
+if (sun) {
+  const at = index => {
+    const a = doc.accessors[index], v = doc.bufferViews[a.bufferView];
+    return [(v.byteOffset ?? 0) + (a.byteOffset ?? 0), a.count, v.buffer];
+  };
+  const [sh, , shBuffer] = at(sun.sh);
+  const shBytes = fs.readFileSync(path.join(dir, doc.buffers[shBuffer].uri));
+  shBytes.writeFloatLE(NaN, sh);
+  const badSh = structuredClone(doc);
+  badSh.buffers[shBuffer].uri = `${stem}_sun_nan.bin`;
+  fs.writeFileSync(path.join(dir, `${stem}_sun_nan.bin`), shBytes);
+  fs.writeFileSync(path.join(dir, `${stem}_sun_nan.gltf`), JSON.stringify(badSh));
+  const [cells, count, cellBuffer] = at(sun.cells);
+  const cellBytes = fs.readFileSync(path.join(dir, doc.buffers[cellBuffer].uri));
+  if (count > 1) {
+    const first = cellBytes.readUInt32LE(cells);
+    cellBytes.writeUInt32LE(cellBytes.readUInt32LE(cells + 4), cells);
+    cellBytes.writeUInt32LE(first, cells + 4);
+  } else {
+    cellBytes.writeUInt32LE(ext.counts[0] * ext.counts[1] * ext.counts[2], cells);
+  }
+  const badCells = structuredClone(doc);
+  badCells.buffers[cellBuffer].uri = `${stem}_sun_cells.bin`;
+  fs.writeFileSync(path.join(dir, `${stem}_sun_cells.bin`), cellBytes);
+  fs.writeFileSync(path.join(dir, `${stem}_sun_cells.gltf`), JSON.stringify(badCells));
+}

@@ -3,10 +3,10 @@
 //     every material of the bake that has MOZ_lightmap (and IRBAKE_lightmap_directional) has it in the output
 //     with the same numbers and texCoord 1 on an existing texture; every light-mapped primitive has TEXCOORD_1
 //     with POSITION's vertex count; the light-mapped triangles are as many as in the bake; with --probes,
-//     IRBAKE_light_probes keeps its fields and every accessor value.
+//     IRBAKE_light_probes keeps its fields and every accessor value (its sun level's included).
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
-//     non-numeric intensity, incomplete directional extension, a probe grid that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
+//     non-numeric intensity, incomplete directional extension, a probe grid or sun level that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
 //     throw an Error naming the material or mesh.
 //   shadowmask --modules DIR --input BAKE.gltf   (a bake with --light-mode ...=shadowmask)
 //     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
@@ -16,7 +16,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHT_PROBES, IRBAKE_LIGHTMAP_DIRECTIONAL,
-  IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS } from './gltf_transform_irbake.mjs';
+  IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS, probeFields, SUN_ACCESSORS } from './gltf_transform_irbake.mjs';
 
 const [mode, ...rest] = process.argv.slice(2);
 // --name value, or --name alone (a flag: true).
@@ -113,10 +113,10 @@ function probesSurvive(inDoc, outDoc, inJson, outJson) {
   check((outJson.extensionsUsed ?? []).includes(IRBAKE_LIGHT_PROBES), `${args.output}: ${IRBAKE_LIGHT_PROBES} not in extensionsUsed`);
   check(!(outJson.extensionsRequired ?? []).includes(IRBAKE_LIGHT_PROBES), `${args.output}: ${IRBAKE_LIGHT_PROBES} required`);
   if (!inDef || !outDef) return 0;
-  const fields = d => Object.fromEntries(Object.entries(d).filter(([k]) => !(k in PROBE_ACCESSORS)));
-  check(same(fields(inDef), fields(outDef)), `${IRBAKE_LIGHT_PROBES}: fields ${JSON.stringify(fields(outDef))}`);
+  check(same(probeFields(inDef), probeFields(outDef)), `${IRBAKE_LIGHT_PROBES}: fields ${JSON.stringify(probeFields(outDef))}`);
   const gridA = inDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES), gridB = outDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
-  for (const key of Object.keys(PROBE_ACCESSORS)) {
+  const keys = [...Object.keys(PROBE_ACCESSORS), ...(inDef.sun ? Object.keys(SUN_ACCESSORS).map(k => `sun_${k}`) : [])];
+  for (const key of keys) {
     const a = gridA?.getAccessor(key)?.getArray(), b = gridB?.getAccessor(key)?.getArray();
     check(a && b && a.length === b.length && a.every((v, i) => Object.is(v, b[i])),
           `${IRBAKE_LIGHT_PROBES}.${key}: ${a?.length} values in, ${b?.length} out${a && b && a.length === b.length ? ', some differ' : ''}`);
@@ -170,7 +170,7 @@ async function refusals() {
 
   // IRBAKE_light_probes: read → write keeps its fields; a grid that does not fit its accessors is refused.
   if (original.json.extensions?.[IRBAKE_LIGHT_PROBES]) {
-    const fields = d => Object.fromEntries(Object.entries(d).filter(([k]) => !(k in PROBE_ACCESSORS)));
+    const fields = probeFields;
     check(same(fields(written.json.extensions[IRBAKE_LIGHT_PROBES]), fields(original.json.extensions[IRBAKE_LIGHT_PROBES])),
           `read → write changed ${IRBAKE_LIGHT_PROBES}`);
     const badGrid = mutate => () => { const doc = clone(); mutate(doc.json.extensions[IRBAKE_LIGHT_PROBES]); return io.readJSON(doc); };
@@ -178,6 +178,10 @@ async function refusals() {
     await throws('probe spacing', badGrid(e => { e.spacing = -1; }), `${IRBAKE_LIGHT_PROBES}.spacing -1`);
     await throws('probe accessor', badGrid(e => { e.valid = 9999; }), `${IRBAKE_LIGHT_PROBES}.valid`, 'does not exist');
     await throws('probe counts type', badGrid(e => { e.counts = [2, 2]; }), `${IRBAKE_LIGHT_PROBES}.counts`);
+    if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun) {
+      await throws('sun fine', badGrid(e => { e.sun.fine = e.sun.cells; }), `${IRBAKE_LIGHT_PROBES}.sun.fine`, 'the grid needs');
+      await throws('sun subdivisions', badGrid(e => { e.sun.subdivisions = 0; }), `${IRBAKE_LIGHT_PROBES}.sun.subdivisions`);
+    }
   } else {
     failures.push(`${args.input}: no ${IRBAKE_LIGHT_PROBES} (baked with --probes off?)`);
   }

@@ -20,6 +20,18 @@ export const IRBAKE_LIGHTMAP_DIRECTIONAL = 'IRBAKE_lightmap_directional';
 export const IRBAKE_LIGHT_PROBES = 'IRBAKE_light_probes';
 // The probe grid's accessors (docs/export.md, "IRBAKE_light_probes"): component type, type and elements per probe.
 export const PROBE_ACCESSORS = { coefficients: [5126, 'VEC3', 9], offsets: [5126, 'VEC3', 1], valid: [5126, 'SCALAR', 1] };
+// The optional sun level's accessors (`sun.<key>`): component type, type, and the element count for a grid of
+// `probes` probes whose level has `cells` refined cells of S subdivisions (null: any).
+export const SUN_ACCESSORS = {
+  sh: [5126, 'VEC3', () => 9], visibility: [5125, 'SCALAR', probes => Math.ceil(probes / 4)], cells: [5125, 'SCALAR', () => null],
+  fine: [5125, 'SCALAR', (probes, cells, S) => cells * Math.ceil((S + 1) ** 3 / 32)],
+};
+// An IRBAKE_light_probes definition without its accessor indices (those of `sun` included): what read → write keeps.
+export function probeFields(def) {
+  const fields = Object.fromEntries(Object.entries(def).filter(([k]) => !(k in PROBE_ACCESSORS)));
+  if (isObject(def.sun)) fields.sun = Object.fromEntries(Object.entries(def.sun).filter(([k]) => !(k in SUN_ACCESSORS)));
+  return fields;
+}
 export const IRBAKE_SHADOWMASK = 'IRBAKE_shadowmask';
 // The UV set of every light map (docs/export.md): TEXCOORD_1.
 export const LIGHTMAP_TEXCOORD = 1;
@@ -353,11 +365,12 @@ export function defineIrbakeExtensions(core) {
       this.parentTypes = [PropertyType.ROOT];
     }
     getDefaults() {
-      return Object.assign(super.getDefaults(), { coefficients: null, offsets: null, valid: null, fields: {} });
+      return Object.assign(super.getDefaults(), { coefficients: null, offsets: null, valid: null, sun_sh: null,
+                                                  sun_visibility: null, sun_cells: null, sun_fine: null, fields: {} });
     }
     getAccessor(key) { return this.getRef(key); }
     setAccessor(key, accessor) { return this.setRef(key, accessor, { usage: 'OTHER' }); }  // no vertex data: a view of its own
-    getFields() { return this.get('fields'); }  // origin, spacing, counts, units, convention, anything else
+    getFields() { return this.get('fields'); }  // origin, spacing, counts, units, convention, sun's, anything else
     setFields(fields) { return this.set('fields', fields); }
   }
 
@@ -371,15 +384,29 @@ export function defineIrbakeExtensions(core) {
       const json = context.jsonDoc.json, def = json.extensions?.[IRBAKE_LIGHT_PROBES];
       if (def === undefined) return this;
       const probes = checkProbeGrid(def);
-      const grid = this.createLightProbeGrid().setFields(without(def, Object.keys(PROBE_ACCESSORS)));
-      for (const [key, [componentType, type, per]] of Object.entries(PROBE_ACCESSORS)) {
-        const index = def[key], accessorDef = json.accessors?.[index];
-        const what = `${IRBAKE_LIGHT_PROBES}.${key}`;
+      const grid = this.createLightProbeGrid().setFields(probeFields(def));
+      const accessor = (holder, key, ref, componentType, type, count) => {
+        const index = holder[key], accessorDef = json.accessors?.[index];
+        const what = `${IRBAKE_LIGHT_PROBES}.${ref.replace('_', '.')}`;
         if (!Number.isInteger(index) || accessorDef === undefined) throw new Error(`${what}: accessor ${JSON.stringify(index)} does not exist`);
-        if (accessorDef.componentType !== componentType || accessorDef.type !== type || accessorDef.count !== probes * per)
+        if (count === null) count = accessorDef.count;
+        if (accessorDef.componentType !== componentType || accessorDef.type !== type || accessorDef.count !== count)
           throw new Error(`${what}: accessor ${index} is ${accessorDef.count} × ${accessorDef.type} of componentType ` +
-                          `${accessorDef.componentType}, the grid needs ${probes * per} × ${type} of ${componentType}`);
-        grid.setAccessor(key, context.accessors[index]);
+                          `${accessorDef.componentType}, the grid needs ${count} × ${type} of ${componentType}`);
+        grid.setAccessor(ref, context.accessors[index]);
+        return accessorDef.count;
+      };
+      for (const [key, [componentType, type, per]] of Object.entries(PROBE_ACCESSORS))
+        accessor(def, key, key, componentType, type, probes * per);
+      if (def.sun !== undefined) {
+        const S = def.sun?.subdivisions;
+        if (!isObject(def.sun) || !(Number.isInteger(S) && S >= 1 && S <= 16))
+          throw new Error(`${IRBAKE_LIGHT_PROBES}.sun.subdivisions ${JSON.stringify(S)} needs a whole number from 1 to 16`);
+        let cells = 0;
+        for (const [key, [componentType, type, count]] of Object.entries(SUN_ACCESSORS)) {
+          const n = accessor(def.sun, key, `sun_${key}`, componentType, type, count(probes, cells, S));
+          if (key === 'cells') cells = n;
+        }
       }
       this.document.getRoot().setExtension(IRBAKE_LIGHT_PROBES, grid);
       return this;
@@ -389,11 +416,16 @@ export function defineIrbakeExtensions(core) {
       const grid = this.document.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
       if (!grid) return this;
       const def = { ...grid.getFields() };
-      for (const key of Object.keys(PROBE_ACCESSORS)) {
-        const accessor = grid.getAccessor(key);
+      const indexOf = ref => {
+        const accessor = grid.getAccessor(ref);
         const index = accessor ? context.accessorIndexMap.get(accessor) : undefined;
-        if (index === undefined) throw new Error(`${IRBAKE_LIGHT_PROBES}: the ${key} accessor was lost`);
-        def[key] = index;
+        if (index === undefined) throw new Error(`${IRBAKE_LIGHT_PROBES}: the ${ref.replace('_', '.')} accessor was lost`);
+        return index;
+      };
+      for (const key of Object.keys(PROBE_ACCESSORS)) def[key] = indexOf(key);
+      if (def.sun !== undefined) {
+        def.sun = { ...def.sun };
+        for (const key of Object.keys(SUN_ACCESSORS)) def.sun[key] = indexOf(`sun_${key}`);
       }
       const json = context.jsonDoc.json;
       json.extensions = json.extensions ?? {};

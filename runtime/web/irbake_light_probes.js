@@ -9,9 +9,12 @@
 // surface point p takes the SH c + (p − centre)·∇c; its Lambert material then adds radiance = albedo ×
 // max(0, shGetIrradianceAt(n)): the same value as irview, since three.js shades irradiance × albedo/π and the
 // material's probe term is π × E/π.
+// With the optional `sun` level (irbake_probe_sun.js), a point in one of its cells takes the blend with its sun
+// replaced by the finer lattice's, so the field over an object needs no other change.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
 import { Box3, SphericalHarmonics3, Vector3 } from 'three';
+import { readSunLevel } from './irbake_probe_sun.js';
 
 export const LIGHT_PROBES = 'IRBAKE_light_probes';
 const FLOAT = 5126;
@@ -20,8 +23,8 @@ const COMPONENTS = { SCALAR: 1, VEC3: 3 };
 // The probe grid: coefficients (Float32Array, 27 per probe: SphericalHarmonics3.fromArray's layout), offsets
 // (3 per probe), valid (Uint8Array).
 export class IrbakeProbeGrid {
-  constructor({ origin, spacing, counts, coefficients, offsets, valid }) {
-    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid });
+  constructor({ origin, spacing, counts, coefficients, offsets, valid, sun = null }) {
+    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid, sun });
   }
 
   get size() { return this.counts[0] * this.counts[1] * this.counts[2]; }
@@ -35,10 +38,11 @@ export class IrbakeProbeGrid {
 
   // The SH at point p ([x, y, z]): { coefficients: Float64Array(27), probes, weight }. Trilinear over the 8 probes
   // around p (clamped to the grid), valid ones only; where none is valid, the nearest valid probe of the 4×4×4
-  // around p; probes 0 when there is none.
+  // around p; probes 0 when there is none. In a cell of the sun level, the blend's sun is the lattice's.
   interpolate(p) {
     const out = { coefficients: new Float64Array(27), probes: 0, weight: 0 };
     const base = [0, 0, 0], t = [0, 0, 0];
+    let sunBlend = 0;
     for (let a = 0; a < 3; ++a) {
       const n = this.counts[a];
       const f = Math.fround((Math.fround(p[a]) - this.origin[a]) / this.spacing);
@@ -55,11 +59,15 @@ export class IrbakeProbeGrid {
       const idx = this.index(q[0], q[1], q[2]);
       if (w <= 0 || !this.valid[idx]) continue;
       for (let k = 0; k < 27; ++k) out.coefficients[k] += w * this.coefficients[27 * idx + k];
+      if (this.sun) sunBlend += w * this.sun.visibility[idx];
       out.weight += w;
       ++out.probes;
     }
     if (out.weight > 0) {
       for (let k = 0; k < 27; ++k) out.coefficients[k] /= out.weight;
+      const fine = this.sun ? this.sun.fineVisibility(this.index(base[0], base[1], base[2]), t) : -1;
+      if (fine >= 0)
+        for (let k = 0; k < 27; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * this.sun.sh[k];
       return out;
     }
     let best = Infinity, nearest = -1;
@@ -176,13 +184,17 @@ export async function readProbeGrid(json, accessor) {
   if (n > 1e8) fail('counts', 'more than 10^8 probes');
   const spacing = ext.spacing;
   if (typeof spacing !== 'number' || !(spacing > 0) || !Number.isFinite(spacing)) fail('spacing', 'needs a positive finite number');
-  const read = async (key, type, count) => {
-    const index = ext[key];
+  // Accessor ext[key] (field `prefix + key` in messages) of componentType `component` and `type`, `count`
+  // elements (null: any), as a typed array.
+  const readFrom = (holder, prefix) => async (key, component, type, count) => {
+    const index = holder[key];
+    key = prefix + key;
     if (!Number.isInteger(index)) fail(key, 'no accessor index');
     const def = json.accessors?.[index];
     if (!def) fail(key, `accessor ${index} does not exist`);
-    if (def.componentType !== FLOAT || def.type !== type)
-      fail(key, `accessor of componentType ${def.componentType} ${def.type}, expected ${FLOAT} ${type}`);
+    if (def.componentType !== component || def.type !== type)
+      fail(key, `accessor of componentType ${def.componentType} ${def.type}, expected ${component} ${type}`);
+    if (count === null) count = def.count;
     if (def.count !== count) fail(key, `${def.count} elements, the grid needs ${count}`);
     // An accessor without a buffer view is zeros (glTF 2.0, 3.6.2.1), as optimisers write an all-zero one.
     if (def.bufferView !== undefined) {
@@ -197,14 +209,15 @@ export async function readProbeGrid(json, accessor) {
     } catch (e) {
       fail(key, `accessor ${index} cannot be read: ${e.message}`);
     }
-    const values = new Float32Array(count * COMPONENTS[type]);
+    const values = new (component === FLOAT ? Float32Array : Uint32Array)(count * COMPONENTS[type]);
     for (let i = 0; i < count; ++i)
       for (let c = 0; c < COMPONENTS[type]; ++c) values[i * COMPONENTS[type] + c] = attribute.getComponent(i, c);
     return values;
   };
-  const coefficients = await read('coefficients', 'VEC3', 9 * n);
-  const offsets = await read('offsets', 'VEC3', n);
-  const validity = await read('valid', 'SCALAR', n);
+  const read = readFrom(ext, '');
+  const coefficients = await read('coefficients', FLOAT, 'VEC3', 9 * n);
+  const offsets = await read('offsets', FLOAT, 'VEC3', n);
+  const validity = await read('valid', FLOAT, 'SCALAR', n);
   const valid = new Uint8Array(n);
   for (let i = 0; i < n; ++i) {
     let finite = Number.isFinite(offsets[3 * i]) && Number.isFinite(offsets[3 * i + 1]) && Number.isFinite(offsets[3 * i + 2]);
@@ -213,7 +226,8 @@ export async function readProbeGrid(json, accessor) {
     if (validity[i] !== 0 && validity[i] !== 1) fail('valid', `probe ${i} holds ${validity[i]} (0 or 1)`);
     valid[i] = validity[i];
   }
-  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid });
+  const sun = ext.sun === undefined ? null : await readSunLevel(ext, counts, readFrom(ext.sun ?? {}, 'sun.'));
+  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun });
 }
 
 // The loader plugin: after the document loads, gltf.userData.irbakeLightProbes is the grid (null without the

@@ -4,7 +4,11 @@
 # (irbake_light_probes.js, ?probeObject=) and require the sphere's pixels to agree: mean absolute difference
 # ≤ 1 (8-bit; what is left is the three.js sphere's tessellated normals and the two sRGB encoders' rounding).
 # Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
-# the problem.
+# the problem. The same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
+# straight down, the sphere across the square's shadow edge in a refined cell; and refusals of a sun visibility
+# SH that is not finite and unsorted cells. glTF-Transform optimize (meshopt) with runtime/web's config must keep
+# the sun level's accessors bit for bit (gltf_transform_check.mjs survives) and its refusals of bad sun data,
+# and the Khronos validator finds no error in the bake (validate.mjs); skipped when the CLI is not installed.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
@@ -26,3 +30,33 @@ node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_zero
   --expect-error "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_nan.gltf" \
   --expect-error "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
+
+# The sun level (with --directional, which gltf_transform_check.mjs refusals needs): probes every 0.5 m,
+# x = ..., 0.25, 0.75, ...; the shadow edge x = 0.5 crosses that cell.
+"$irbake" bake "$work/samples/quad_over_plane.gltf" -o "$work/sun" --vpls 256 --texels-per-unit 20 --sun 0,-1,0,3 --directional \
+  --probes 0.5 --probe-box=-2,0.05,-2,2,0.95,2 --quiet > "$work/sun.log" 2>&1
+node -e "const e = JSON.parse(require('fs').readFileSync('$work/sun/scene.gltf')).extensions.IRBAKE_light_probes;
+         if (!e.sun) { console.error('no sun level in the bake'); process.exit(1); }"
+sphere=0.55,0.5,0,0.08 eye=0.85,0.6,-0.3 target=0.55,0.5,0
+"$irview" "$work/sun/scene.gltf" --probe-object $sphere --eye $eye --target $target --fov $fov --width $w --height $h \
+  --screenshot "$work/irview_sun.png" > "$work/irview_sun.log" 2>&1
+view=(--modules "$modules" --probe-object $sphere --eye $eye --target $target --fov $fov --width $w --height $h)
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene.gltf" --reference "$work/irview_sun.png" \
+  --out "$work/web_sun.png" --max-mean-abs 1
+node "$here/corrupt_probes.mjs" "$work/sun/scene.gltf"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_nan.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.sh: a non-finite coefficient"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_cells.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
+
+gltf_transform="$modules/node_modules/.bin/gltf-transform"
+if [[ -x "$gltf_transform" && -d "$modules/node_modules/gltf-validator" ]]; then
+  "$gltf_transform" optimize "$work/sun/scene.gltf" "$work/sun_opt.glb" --config "$here/gltf-transform.config.mjs" \
+    > "$work/gltf-transform.log" 2>&1
+  node "$here/gltf_transform_check.mjs" survives --modules "$modules" --input "$work/sun/scene.gltf" \
+    --output "$work/sun_opt.glb" --probes
+  node "$here/gltf_transform_check.mjs" refusals --modules "$modules" --input "$work/sun/scene.gltf"
+  node "$here/validate.mjs" --modules "$modules" --output "$work/sun/scene.gltf"
+else
+  echo "glTF-Transform or gltf-validator not installed: the sun level's optimiser and validator checks skipped"
+fi

@@ -202,12 +202,53 @@ std::vector<std::vector<uint16_t>> ClampGather::Impl::traceFirstRound() {
   return firstHits;
 }
 
-// Round 2: more rays where many first rays found clamped transport, within the same budget again.
+// Which samples round 2 refines: those with a sample of their own texel or of the 8 around it (any of its
+// S×S layers) whose first rays found clamped transport, the sample itself left out. A sample's own first rays
+// must not choose it: every hit is divided by its slot's ray count, so refining only the samples whose own
+// rays hit would average those hits with more rays where they happened to land and leave the rest at 0,
+// short of the residual by (1 − P(hit)) · extra / (base + extra) where first rays find it by chance
+// (ClampCompensation.RefinementKeepsTheResidualUnbiased). The neighbours' rays are independent of the
+// sample's: any of its estimates, refined or not, stays unbiased.
+namespace {
+std::vector<std::vector<uint8_t>> refinedSlots(const std::vector<TexelSamples>& texels,
+                                               const std::vector<std::vector<uint16_t>>& firstHits, int refineHits) {
+  std::vector<std::vector<uint8_t>> refine(texels.size());
+  for (size_t p = 0; p < texels.size(); ++p) {
+    const TexelSamples& ts = texels[p];
+    const int W = ts.width, H = ts.height, layers = ts.supersample * ts.supersample;
+    const size_t layer = ts.layerSize();
+    auto found = [&](size_t s) { return firstHits[p][s] > 0 && firstHits[p][s] >= refineHits; };
+    refine[p].assign(ts.slotCount(), 0);
+    tbb::parallel_for(0, H, [&](int y) {
+      for (int x = 0; x < W; ++x)
+        for (int l = 0; l < layers; ++l) {
+          const size_t s = static_cast<size_t>(l) * layer + static_cast<size_t>(y) * W + x;
+          if (!(ts.positionWeight[s].w > 0.0f)) continue;
+          bool any = false;
+          for (int dy = -1; dy <= 1 && !any; ++dy)
+            for (int dx = -1; dx <= 1 && !any; ++dx) {
+              const int xx = x + dx, yy = y + dy;
+              if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+              for (int m = 0; m < layers && !any; ++m) {
+                const size_t o = static_cast<size_t>(m) * layer + static_cast<size_t>(yy) * W + xx;
+                any = o != s && found(o);
+              }
+            }
+          refine[p][s] = any ? 1 : 0;
+        }
+    });
+  }
+  return refine;
+}
+}  // namespace
+
+// Round 2: more rays where the first rays of the samples around found clamped transport, within the same
+// budget again.
 void ClampGather::Impl::traceRefinement(const std::vector<std::vector<uint16_t>>& firstHits, const RayPlan& plan) {
+  const std::vector<std::vector<uint8_t>> refine = refinedSlots(in.texels, firstHits, plan.refineHits);
   size_t candidates = 0;
-  for (size_t p = 0; p < in.texels.size(); ++p)
-    for (size_t s = 0; s < firstHits[p].size(); ++s)
-      candidates += firstHits[p][s] > 0 && firstHits[p][s] >= plan.refineHits;
+  for (const std::vector<uint8_t>& page : refine)
+    for (uint8_t r : page) candidates += r;
   int extra = std::min(plan.extraRays, 65535 - baseRays);
   if (options.rayBudget > 0 && candidates > 0)
     extra = static_cast<int>(std::min<size_t>(static_cast<size_t>(std::max(extra, 0)), options.rayBudget / candidates));
@@ -217,8 +258,7 @@ void ClampGather::Impl::traceRefinement(const std::vector<std::vector<uint16_t>>
     Tile& tile = tiles[ti];
     size_t tracedHere = 0, refinedHere = 0;
     for (size_t s = tile.begin; s < tile.end; ++s) {
-      const uint16_t h = firstHits[tile.page][s];
-      if (h == 0 || h < plan.refineHits) continue;
+      if (!refine[tile.page][s]) continue;
       traceSlot(tile.page, s, extra, 1, tile);
       tracedHere += extra;
       raysOf[tile.page][s] = static_cast<uint16_t>(raysOf[tile.page][s] + extra);

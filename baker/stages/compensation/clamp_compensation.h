@@ -44,8 +44,9 @@ struct ClampCompensationOptions {
   int minRays = 4;             // never fewer than this per sample
   size_t rayBudget = 1 << 21;  // first-round rays over all samples (0: no cap); large pages get fewer rays
                                // per sample and a wider filter instead
-  int refineRays = 112;        // extra rays (scaled like rays, within the budget again) at samples where at
-  float refineFraction = 0.0f; // least this fraction of the first rays hit clamped transport (0: any hit)
+  int refineRays = 112;        // extra rays (scaled like rays, within the budget again) at samples next to one
+  float refineFraction = 0.0f; // (own texel or the 8 around, itself left out) where at least this fraction of
+                               // the first rays hit clamped transport (0: any hit)
   std::optional<int> filterRadius;  // residual smoothed over (2r+1)² texels on the same surface (0: none); unset:
                                     // auto (below 32 rays: r ≤ 4 with r texels ≤ r_c / 20, r_c = 1/√B)
   int sweeps = 8;              // at most this many Jacobi sweeps; each reads the map with the previous sweep's

@@ -14,6 +14,7 @@
 #include "transport/geometry_term.h"
 #include "stages/probes/blend_fit.h"
 #include "stages/probes/light_visibility_fit.h"
+#include "stages/probes/sun_level.h"
 #include "vpl/light_sources.h"
 
 namespace irbake {
@@ -308,12 +309,33 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
   // their visibility is fitted over the blend as well.
   const VolumeFitStats volume = fitProbeVolume(in, reader, grid, options);
   traced += volume.rays;
-  const LightVisibilityFit fit = fitLightVisibility(in, grid, options.lightFitSamples, options.seed);
+  LightVisibilityFit fit = fitLightVisibility(in, grid, options.lightFitSamples, options.seed);
+  // The sun level's light: its visibilities in steps of 1/255, as the export stores them (a byte each), so that
+  // what the clients subtract is what the coefficients carry.
+  const int sun = options.sunSubdivisions > 0 ? strongestDirectionalLight(in.scene.lights) : -1;
+  if (sun >= 0 && fit.lights > 0)
+    for (size_t i = 0; i < n; ++i) {
+      float& v = fit.visibility[i * fit.lights + static_cast<size_t>(sun)];
+      v = std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+    }
   if (fit.lights > 0)
     tbb::parallel_for(size_t(0), n, [&](size_t i) {
       if (grid.valid[i]) addPunctualLights(in, grid.position(i), &fit.visibility[i * fit.lights], grid.coefficients[i]);
     });
   traced += fit.rays;
+  // The strongest directional light's visibility refined where its shadow crosses a cell (sun_level.h).
+  SunLevelStats sunStats;
+  grid.sun = ProbeSunLevel{};
+  if (sun >= 0 && fit.lights > 0) {
+    std::vector<float> carried(n, 0.0f);
+    for (size_t i = 0; i < n; ++i)
+      if (grid.valid[i]) carried[i] = fit.visibility[i * fit.lights + static_cast<size_t>(sun)];
+    SunLevelOptions sunOptions;
+    sunOptions.subdivisions = options.sunSubdivisions;
+    sunOptions.tolerance = options.sunTolerance;
+    grid.sun = bakeSunLevel(in, grid, static_cast<size_t>(sun), carried, sunOptions, &sunStats);
+  }
+  traced += sunStats.rays;
   if (stats) {
     stats->count = n;
     stats->valid = static_cast<size_t>(std::count(grid.valid.begin(), grid.valid.end(), uint8_t(1)));
@@ -324,6 +346,8 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     stats->lightFitSweeps = fit.sweeps;
     stats->volumeFitSamples = volume.samples;
     stats->volumeFitSweeps = volume.sweeps;
+    stats->sunCells = sunStats.cells;
+    stats->sunRays = sunStats.rays;
     stats->seconds = watch.seconds();
   }
 }

@@ -59,6 +59,9 @@ struct ProbeOptions {
                                       // Cycles")
   int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
+  int sunSubdivisions = 4;            // the strongest directional light's visibility on a lattice this many
+                                      // times finer in the cells its shadow crosses (sun_level.h); 0: none
+  float sunTolerance = 0.1f;          // refine a cell where that lattice and the probes' blend differ by more
 };
 
 struct ProbeStats {
@@ -69,11 +72,14 @@ struct ProbeStats {
   int lightFitSweeps = 0;      // the fit's Gauss–Seidel sweeps
   size_t volumeFitSamples = 0;  // volume samples the rest of the light was fitted to
   int volumeFitSweeps = 0;
+  size_t sunCells = 0;  // cells of the sun level
+  size_t sunRays = 0;   // its shadow rays (in `rays` too)
   double seconds = 0.0;
   nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
     return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays},
             {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps},
-            {"volumeFitSamples", volumeFitSamples}, {"volumeFitSweeps", volumeFitSweeps}};
+            {"volumeFitSamples", volumeFitSamples}, {"volumeFitSweeps", volumeFitSweeps},
+            {"sunCells", sunCells}, {"sunRays", sunRays}};
   }
 };
 
