@@ -49,6 +49,11 @@ inline IrbakeRun runIrbakeLogged(const std::vector<std::string>& args, const std
   const int code = waitForIrbake(startIrbake(args, log));
   return {code, fileText(log)};
 }
+// Runs irbake with its output in a numbered log of dir (a test's scratch folder).
+inline IrbakeRun runIrbakeIn(const std::filesystem::path& dir, const std::vector<std::string>& args) {
+  static int n = 0;
+  return runIrbakeLogged(args, dir / ("log_" + std::to_string(n++) + ".txt"));
+}
 
 // An empty folder test_scratch/<group>/<name> in the working directory (the build folder).
 inline std::filesystem::path scratchFolder(const std::string& group, const std::string& name) {

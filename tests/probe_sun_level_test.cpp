@@ -24,11 +24,6 @@ using json = nlohmann::json;
 
 namespace {
 
-IrbakeRun runIrbake(const fs::path& dir, const std::vector<std::string>& args) {
-  static int n = 0;
-  return runIrbakeLogged(args, dir / ("log_" + std::to_string(n++) + ".txt"));
-}
-
 // The floor and the roof as a glTF of two quads (positions, normals, indices), both black.
 void writeRoofScene(const fs::path& gltf) {
   const std::vector<float> p = {-4, 0, -4, 4, 0, -4, 4, 0, 4, -4, 0, 4,     // floor, facing +Y
@@ -66,7 +61,7 @@ void writeRoofScene(const fs::path& gltf) {
 
 // `irbake probe` facing up at `at`: the red channel (the scene is grey).
 double upAt(const fs::path& dir, const fs::path& gltf, const std::string& at) {
-  const IrbakeRun r = runIrbake(dir, {"probe", gltf.string(), "--at", at, "--normal", "0,1,0"});
+  const IrbakeRun r = runIrbakeIn(dir, {"probe", gltf.string(), "--at", at, "--normal", "0,1,0"});
   EXPECT_EQ(r.code, 0) << r.output;
   return r.code == 0 ? json::parse(r.output)["value"][0].get<double>() : -1.0;
 }
@@ -76,7 +71,7 @@ double upAt(const fs::path& dir, const fs::path& gltf, const std::string& at) {
 TEST(ProbeSunLevel, HoldsTheRoofsShadowEdgeWithinOneLatticeStep) {
   const fs::path dir = scratchFolder("probe_sun_level", "roof");
   writeRoofScene(dir / "roof.gltf");
-  const IrbakeRun bake = runIrbake(dir, {"bake", (dir / "roof.gltf").string(), "-o", (dir / "out").string(), "--sun",
+  const IrbakeRun bake = runIrbakeIn(dir, {"bake", (dir / "roof.gltf").string(), "-o", (dir / "out").string(), "--sun",
                                          "0,-1,0,3.14159265", "--probes", "1", "--probe-box=-2.8,0,-1,2.2,2,1", "--quiet"});
   ASSERT_EQ(bake.code, 0) << bake.output;
   const fs::path gltf = dir / "out" / "scene.gltf";
@@ -113,7 +108,7 @@ TEST(ProbeSunLevel, HoldsTheRoofsShadowEdgeWithinOneLatticeStep) {
     d["buffers"][0]["uri"] = name + ".bin";
     std::ofstream(f) << d.dump();
     std::ofstream(dir / "out" / (name + ".bin"), std::ios::binary) << bytes;
-    const IrbakeRun r = runIrbake(dir, {"probe", f.string(), "--at", "0.3,1,0"});
+    const IrbakeRun r = runIrbakeIn(dir, {"probe", f.string(), "--at", "0.3,1,0"});
     EXPECT_EQ(r.code, 5) << name << ": " << r.output;
     EXPECT_NE(r.output.find(message), std::string::npos) << name << ": " << r.output;
   };

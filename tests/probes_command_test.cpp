@@ -20,17 +20,11 @@ using json = nlohmann::json;
 
 namespace {
 
-// Runs irbake (stdout and stderr into a log of the test's scratch folder).
-IrbakeRun runIrbake(const fs::path& dir, const std::vector<std::string>& args) {
-  static int n = 0;
-  return runIrbakeLogged(args, dir / ("log_" + std::to_string(n++) + ".txt"));
-}
-
 // `irbake probe` → its JSON value (asserting exit 0).
 std::vector<double> probeValue(const fs::path& dir, const fs::path& gltf, const std::string& at, const std::string& normal = "") {
   std::vector<std::string> args = {"probe", gltf.string(), "--at", at};
   if (!normal.empty()) args.insert(args.end(), {"--normal", normal});
-  const IrbakeRun r = runIrbake(dir, args);
+  const IrbakeRun r = runIrbakeIn(dir, args);
   EXPECT_EQ(r.code, 0) << r.output;
   if (r.code != 0) return {0, 0, 0};
   return json::parse(r.output)["value"].get<std::vector<double>>();
@@ -45,7 +39,7 @@ TEST(ProbesCommand, FurnaceProbesReadLeOverOneMinusRho) {
   // test), and 3σ of 16384 independent rays is 3 · 1.28 · 2 / 128 = 0.06 (constant radiance: no L2 truncation).
   const fs::path dir = scratchFolder("probes_command", "furnace");
   const fs::path samples = sampleScenes("probes_command");
-  const IrbakeRun bake = runIrbake(dir, {"bake", (samples / "furnace.gltf").string(), "-o", (dir / "out").string(),
+  const IrbakeRun bake = runIrbakeIn(dir, {"bake", (samples / "furnace.gltf").string(), "-o", (dir / "out").string(),
                                       "--probes", "0.5", "--probe-rays", "16384", "--quiet"});
   ASSERT_EQ(bake.code, 0) << bake.output;
   const json report = readJson(dir / "out" / "report.json");
@@ -71,7 +65,7 @@ TEST(ProbesCommand, NoLightOnTheDarkSideOfTheThinWall) {
   // side, in cells whose corners straddle the wall too, read the dark room's probes only.
   const fs::path dir = scratchFolder("probes_command", "thin_wall");
   const fs::path samples = sampleScenes("probes_command");
-  const IrbakeRun bake = runIrbake(dir, {"bake", (samples / "thin_wall.gltf").string(), "-o", (dir / "out").string(),
+  const IrbakeRun bake = runIrbakeIn(dir, {"bake", (samples / "thin_wall.gltf").string(), "-o", (dir / "out").string(),
                                       "--probes", "0.3", "--quiet"});
   ASSERT_EQ(bake.code, 0) << bake.output;
   const fs::path gltf = dir / "out" / "scene.gltf";
@@ -89,15 +83,15 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
   const fs::path dir = scratchFolder("probes_command", "refusals");
   const fs::path samples = sampleScenes("probes_command");
   const std::string scene = (samples / "point_over_plane.gltf").string();
-  ASSERT_EQ(runIrbake(dir, {"bake", scene, "-o", (dir / "off").string(), "--probes", "off", "--quiet"}).code, 0);
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", scene, "-o", (dir / "off").string(), "--probes", "off", "--quiet"}).code, 0);
   const json offDoc = readJson(dir / "off" / "scene.gltf");
   EXPECT_FALSE(offDoc.contains("extensions") && offDoc["extensions"].contains("IRBAKE_light_probes"));
   EXPECT_FALSE(readJson(dir / "off" / "report.json").contains("probes"));
-  IrbakeRun r = runIrbake(dir, {"probe", (dir / "off" / "scene.gltf").string(), "--at", "0,1,0"});
+  IrbakeRun r = runIrbakeIn(dir, {"probe", (dir / "off" / "scene.gltf").string(), "--at", "0,1,0"});
   EXPECT_EQ(r.code, 5);
   EXPECT_NE(r.output.find("scene.gltf: no IRBAKE_light_probes extension"), std::string::npos) << r.output;
 
-  ASSERT_EQ(runIrbake(dir, {"bake", scene, "-o", (dir / "on").string(), "--probes", "2", "--probe-box",
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", scene, "-o", (dir / "on").string(), "--probes", "2", "--probe-box",
                          "-5,0.25,-5,5,0.75,5", "--quiet"}).code, 0);
   const fs::path gltf = dir / "on" / "scene.gltf";
   // The probe at (0, 0.5, 0), 0.5 m under the light (I = 10 W/sr): facing up the light's peak I/(π h²) times the
@@ -105,10 +99,10 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
   const std::vector<double> up = probeValue(dir, gltf, "0,0.5,0", "0,1,0");
   EXPECT_NEAR(up[0], 10.0 / (M_PI * 0.25) * 17.0 / 16.0, 0.3);
   // A bake of that export replaces its probes; with --probes off it drops them (no stale accessor indices).
-  ASSERT_EQ(runIrbake(dir, {"bake", gltf.string(), "-o", (dir / "again").string(), "--probes", "3", "--quiet"}).code, 0);
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", gltf.string(), "-o", (dir / "again").string(), "--probes", "3", "--quiet"}).code, 0);
   EXPECT_EQ(readJson(dir / "again" / "scene.gltf")["extensions"]["IRBAKE_light_probes"]["spacing"], 3.0);
-  EXPECT_EQ(runIrbake(dir, {"probe", (dir / "again" / "scene.gltf").string(), "--at", "0,0.5,0"}).code, 0);
-  ASSERT_EQ(runIrbake(dir, {"bake", gltf.string(), "-o", (dir / "again_off").string(), "--probes", "off", "--quiet"}).code, 0);
+  EXPECT_EQ(runIrbakeIn(dir, {"probe", (dir / "again" / "scene.gltf").string(), "--at", "0,0.5,0"}).code, 0);
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", gltf.string(), "-o", (dir / "again_off").string(), "--probes", "off", "--quiet"}).code, 0);
   const json againOff = readJson(dir / "again_off" / "scene.gltf");
   EXPECT_FALSE(againOff.contains("extensions") && againOff["extensions"].contains("IRBAKE_light_probes"));
   EXPECT_EQ(std::count(againOff["extensionsUsed"].begin(), againOff["extensionsUsed"].end(), "IRBAKE_light_probes"), 0);
@@ -122,7 +116,7 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
       if (e.path().extension() == ".png") fs::copy_file(e.path(), d / e.path().filename(), fs::copy_options::overwrite_existing);
     std::ofstream(d / "scene.gltf") << doc.dump();
     std::ofstream(d / "scene.bin", std::ios::binary) << bytes;
-    return runIrbake(d, {"probe", (d / "scene.gltf").string(), "--at", "0,0.5,0"});
+    return runIrbakeIn(d, {"probe", (d / "scene.gltf").string(), "--at", "0,0.5,0"});
   };
   json wrongCounts = good;
   wrongCounts["extensions"]["IRBAKE_light_probes"]["counts"][0] = good["extensions"]["IRBAKE_light_probes"]["counts"][0].get<int>() + 1;
@@ -154,10 +148,10 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
         {"bake", scene, "-o", (dir / "bad2").string(), "--probes", "often"},
         {"bake", scene, "-o", (dir / "bad3").string(), "--probes", "0.1", "--probe-box", "0,0,0,20,20,20"},  // 8M probes
         {"bake", scene, "-o", (dir / "bad4").string(), "--probe-box", "1,1,1,0,0,0"}}) {
-    r = runIrbake(dir, args);
+    r = runIrbakeIn(dir, args);
     EXPECT_EQ(r.code, 2) << args.back() << ": " << r.output;
     EXPECT_FALSE(fs::exists(fs::path(args[3]) / "scene.gltf"));
   }
-  r = runIrbake(dir, {"probe", gltf.string(), "--at", "0,1,0", "--normal", "0,0,0"});
+  r = runIrbakeIn(dir, {"probe", gltf.string(), "--at", "0,1,0", "--normal", "0,0,0"});
   EXPECT_EQ(r.code, 2) << r.output;
 }

@@ -24,6 +24,18 @@ using namespace testing;
 constexpr float kEdgeX = 0.1234f;  // the occluder covers x < kEdgeX over the floor
 constexpr float kBoxY[] = {-0.77f, -0.43f, -0.08f, 0.27f, 0.61f};  // box centres (y) on the floor
 
+// Evaluation options for the lights' direct term alone (no VPLs), and the edge stage with S×S sub-points.
+VplEvalOptions directOnly() {
+  VplEvalOptions e;
+  e.includeVpls = false;
+  return e;
+}
+ShadowEdgeOptions subPoints(int n) {
+  ShadowEdgeOptions o;
+  o.subSamples = n;
+  return o;
+}
+
 struct SunOverFloor {
   Scene s;
   std::unique_ptr<RayTracer> rt;
@@ -45,11 +57,7 @@ struct SunOverFloor {
     rt = std::make_unique<RayTracer>(s);
     texels = buildTexelSamples(s, *rt, {});
   }
-  BakeInputs inputs() {
-    VplEvalOptions e;
-    e.includeVpls = false;
-    return BakeInputs{s, *rt, texels, none, e, {}};
-  }
+  BakeInputs inputs() { return BakeInputs{s, *rt, texels, none, directOnly(), {}}; }
 };
 
 TEST(ShadowEdges, EdgeTexelsGetTheLitShareOfTheirSquare) {
@@ -169,14 +177,10 @@ TEST(ShadowEdges, AStripNarrowerThanATexelBetweenCentresIsFound) {
   s.lights.push_back(directionalLight(dir, kPiF));
   const float cosine = -dir.z;
   VplSet none;
-  VplEvalOptions e;
-  e.includeVpls = false;
-  const BakeInputs in{s, rt, texels, none, e, {}};
+  const BakeInputs in{s, rt, texels, none, directOnly(), {}};
   const std::vector<Lightmap> centre = bakeEmbree(in);
   std::vector<Lightmap> refined = centre;
-  ShadowEdgeOptions o;
-  o.subSamples = 8;
-  refineShadowEdges(in, refined, o);
+  refineShadowEdges(in, refined, subPoints(8));
   auto lit = [&](glm::vec3 p) { return p.x >= c + 0.1 * h && p.x <= c + 0.35 * h; };
   size_t crossed = 0;
   for (size_t p = 0; p < texels.size(); ++p)
