@@ -23,22 +23,23 @@ struct FineLattice {
   }
 };
 
-// The blend of the probes' visibilities at the lattice point `t` (cell fraction) of the cell at `base`: valid
-// probes only, weights renormalised, as the clients blend; -1 when no corner is valid.
-float blendVisibility(const LightProbeGrid& g, const std::vector<float>& v, const glm::ivec3& base, const glm::vec3& t) {
+// The blend of the probes' visibilities at p exactly as the clients blend (valid probes only, weights
+// renormalised); -1 when no corner is valid.
+float blendVisibility(const LightProbeGrid& g, const std::vector<float>& v, const glm::vec3& p) {
   float sum = 0.0f, weight = 0.0f;
-  for (int k = 0; k < 8; ++k) {
-    const glm::ivec3 d(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-    const glm::ivec3 q = base + d;
-    if (q.x >= g.counts.x || q.y >= g.counts.y || q.z >= g.counts.z) continue;
-    float w = 1.0f;
-    for (int a = 0; a < 3; ++a) w *= d[a] ? t[a] : 1.0f - t[a];
-    const size_t idx = g.index(q.x, q.y, q.z);
-    if (!(w > 0.0f) || !g.valid[idx]) continue;
+  forEachBlendCorner(g, p, [&](size_t idx, float w) {
+    if (!g.valid[idx]) return;
     sum += w * v[idx];
     weight += w;
-  }
+  });
   return weight > 0.0f ? sum / weight : -1.0f;
+}
+
+// Whether probe `base` is a cell's base corner: not the last along an axis of more than one probe.
+bool isCellBase(const LightProbeGrid& g, const glm::ivec3& base) {
+  for (int a = 0; a < 3; ++a)
+    if (g.counts[a] > 1 && base[a] >= g.counts[a] - 1) return false;
+  return true;
 }
 
 }  // namespace
@@ -78,44 +79,40 @@ ProbeSunLevel bakeSunLevel(const BakeInputs& in, const LightProbeGrid& g, size_t
     lit[i] = punctualVisibility(in, sun, g.origin + g.spacing * q / static_cast<float>(S)) >= 0.5f;
   });
 
-  const glm::ivec3 cellCounts = glm::max(g.counts - 1, glm::ivec3(1));
-  const size_t cellTotal = static_cast<size_t>(cellCounts.x) * cellCounts.y * cellCounts.z;
-  std::vector<uint8_t> refine(cellTotal, 0);
-  tbb::parallel_for(size_t(0), cellTotal, [&](size_t c) {
-    const glm::ivec3 base(static_cast<int>(c % cellCounts.x), static_cast<int>(c / cellCounts.x % cellCounts.y),
-                          static_cast<int>(c / (static_cast<size_t>(cellCounts.x) * cellCounts.y)));
+  // Lattice point o (0..S per axis) of the cell whose base probe is `base`, in the whole grid's lattice.
+  auto latticeIndex = [&](const glm::ivec3& base, const glm::ivec3& o) {
+    glm::ivec3 q;
+    for (int k = 0; k < 3; ++k) q[k] = g.counts[k] > 1 ? base[k] * S + o[k] : 0;
+    return lattice.index(q.x, q.y, q.z);
+  };
+  // Refined cells, marked at their base probe (so ascending order is the probes' order).
+  std::vector<uint8_t> refine(g.size(), 0);
+  tbb::parallel_for(size_t(0), g.size(), [&](size_t c) {
+    const glm::ivec3 base = g.cell(c);
+    if (!isCellBase(g, base)) return;
     for (int d = 0; d <= S; ++d)
       for (int b = 0; b <= S; ++b)
         for (int a = 0; a <= S; ++a) {
           const glm::ivec3 o(a, b, d);
-          glm::vec3 t;
-          glm::ivec3 q;
-          for (int k = 0; k < 3; ++k) {
-            t[k] = g.counts[k] > 1 ? static_cast<float>(o[k]) / S : 0.0f;
-            q[k] = g.counts[k] > 1 ? base[k] * S + o[k] : 0;
-          }
-          const float blend = blendVisibility(g, visibility, base, t);
+          const glm::vec3 p = g.gridPoint(base.x, base.y, base.z) + g.spacing * glm::vec3(o) / static_cast<float>(S);
+          const float blend = blendVisibility(g, visibility, p);
           if (blend < 0.0f) return;  // no valid probe: nothing a client would correct
-          if (std::abs(static_cast<float>(lit[lattice.index(q.x, q.y, q.z)]) - blend) > options.tolerance) refine[c] = 1;
+          if (std::abs(static_cast<float>(lit[latticeIndex(base, o)]) - blend) > options.tolerance) refine[c] = 1;
         }
   });
 
   const int W = out.wordsPerCell(), s1 = S + 1;
-  for (size_t c = 0; c < cellTotal; ++c) {
+  for (size_t c = 0; c < g.size(); ++c) {
     if (!refine[c]) continue;
-    const glm::ivec3 base(static_cast<int>(c % cellCounts.x), static_cast<int>(c / cellCounts.x % cellCounts.y),
-                          static_cast<int>(c / (static_cast<size_t>(cellCounts.x) * cellCounts.y)));
-    out.cells.push_back(static_cast<uint32_t>(g.index(base.x, base.y, base.z)));
+    const glm::ivec3 base = g.cell(c);
+    out.cells.push_back(static_cast<uint32_t>(c));
     out.fine.resize(out.fine.size() + W, 0u);
     uint32_t* words = &out.fine[out.fine.size() - W];
     for (int d = 0; d <= S; ++d)
       for (int b = 0; b <= S; ++b)
         for (int a = 0; a <= S; ++a) {
-          const glm::ivec3 o(a, b, d);
-          glm::ivec3 q;
-          for (int k = 0; k < 3; ++k) q[k] = g.counts[k] > 1 ? base[k] * S + o[k] : 0;
           const int n = a + s1 * (b + s1 * d);
-          if (lit[lattice.index(q.x, q.y, q.z)]) words[n / 32] |= 1u << (n % 32);
+          if (lit[latticeIndex(base, glm::ivec3(a, b, d))]) words[n / 32] |= 1u << (n % 32);
         }
   }
   if (stats) {
