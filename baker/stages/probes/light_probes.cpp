@@ -119,6 +119,35 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
   return out;
 }
 
+// The distance from p to the nearest surface K lattice rays meet (1e30 when none), and whether p is inside
+// geometry (back faces of single-sided surfaces in more than `tooManyBack` of them): where an object's centre
+// can be, for the volume fit's samples.
+struct Clearance {
+  float nearest = 1e30f;
+  bool inside = false;
+};
+Clearance clearanceAt(const Scene& scene, const RayTracer& rt, const glm::vec3& p, int rays, double r1, double r2,
+                      float maxBackFaceShare) {
+  constexpr int kRays = 32;
+  glm::vec3 dirs[kRays];
+  RayHit hits[kRays];
+  const int count = std::min(kRays, rays);
+  for (int k = 0; k < count; ++k) {
+    const double u = (k + 0.5) / count + r1, v = k / kGoldenRatio + r2;
+    dirs[k] = uniformSphere(u - std::floor(u), v - std::floor(v));
+  }
+  rt.intersectPackets(p, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Surface);
+  Clearance out;
+  int back = 0;
+  for (int k = 0; k < count; ++k)
+    if (hits[k].hit) {
+      out.nearest = std::min(out.nearest, hits[k].t);
+      if (hits[k].backFace && !doubleSided(scene, hits[k].primitive)) ++back;
+    }
+  out.inside = back > static_cast<int>(std::floor(maxBackFaceShare * count));
+  return out;
+}
+
 // Every punctual light as a delta from its direction, times its visibility at the probe (`visibility`, one per
 // light: the fitted value, light_visibility_fit.h) and the colour of the see-through surfaces on the way.
 void addPunctualLights(const BakeInputs& in, const glm::vec3& p, const float* visibility, ShCoefficients& sh) {
@@ -187,6 +216,7 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, Lig
   const int S = std::max(0, options.volumeFitSamples);
   if (S == 0) return out;
   const int rays = std::max(16, options.volumeFitRays);
+  const float clearance = std::max(0.0f, options.volumeFitClearance) * grid.spacing;
   const int emitterSamples = options.emitterSamples > 0
                                  ? std::max(1, static_cast<int>(std::lround(double(options.emitterSamples) * rays / std::max(16, options.rays))))
                                  : 0;
@@ -214,6 +244,11 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, Lig
       bool seen = blend.corners > 0;
       for (int c = 0; c < blend.corners && seen; ++c, ++count) seen = probeSees(in, grid.position(blend.probe[c]), x);
       if (!seen) continue;
+      // Kept only where an object's centre can be: not inside geometry, and at least `clearance` from every
+      // surface (the light right beside a wall, which no object's centre reaches, would bend the blend).
+      const Clearance c = clearanceAt(in.scene, in.rayTracer, x, rays, r1, r2, options.maxBackFaceShare);
+      count += static_cast<size_t>(std::min(32, rays));
+      if (c.inside || c.nearest < clearance) continue;
       ProbeTrace t = traceProbe(reader, emitters, x, rays, r1, r2);
       count += static_cast<size_t>(rays);
       if (t.backFaces > tooManyBack) continue;  // inside geometry: no light a client would read there

@@ -52,13 +52,14 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
-  int volumeFitSamples = 0;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
-                                      // 0: each probe's own rays. Off by default: 3³ raised Sponza's gallery
-                                      // (three seeds' mean 0.953 to 0.976 of Cycles) but lowered the Cornell
-                                      // box's low sphere (1.004 to 0.962; docs/validation.md, "Probes against
-                                      // Cycles")
-  int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
+  int volumeFitSamples = 3;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
+                                      // 0: each probe's own rays. A blend of point probes 1.64 m apart misses
+                                      // the light between Sponza's gallery piers (docs/validation.md, "Probes
+                                      // against Cycles")
+  int volumeFitRays = 512;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
+  float volumeFitClearance = 0.5f;    // a point is fitted only where an object's centre can be: at least this
+                                      // many spacings from every surface
   int sunSubdivisions = 4;            // the strongest directional light's visibility on a lattice this many
                                       // times finer in the cells its shadow crosses (sun_level.h); 0: none
   float sunTolerance = 0.1f;          // refine a cell where that lattice and the probes' blend differ by more
