@@ -136,7 +136,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit"}},
+    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays", "probe-volume-clearance"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -327,6 +327,13 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
                       std::to_string(ProbeOptions{}.volumeFitRays) + " rays each\n(default " +
                       std::to_string(ProbeOptions{}.volumeFitSamples) + "; 0: each probe's own rays)")
       ->transform(cli::integerIn(0, 8))->type_name("S");
+  app->add_option("--probe-volume-rays", o.probes.volumeFitRays,
+                  "lattice rays per point of the volume fit (default " + std::to_string(ProbeOptions{}.volumeFitRays) + ")")
+      ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
+  app->add_option("--probe-volume-clearance", o.probes.volumeFitClearance,
+                  "the volume fit's points at least this many spacings from every surface (default " +
+                      shown(ProbeOptions{}.volumeFitClearance) + ";\n0: every point the probes see)")
+      ->transform(cli::numberIn(0.0, 8.0))->type_name("C");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");

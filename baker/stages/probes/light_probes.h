@@ -56,7 +56,7 @@ struct ProbeOptions {
                                       // 0: each probe's own rays. A blend of point probes 1.64 m apart misses
                                       // the light between Sponza's gallery piers (docs/validation.md, "Probes
                                       // against Cycles")
-  int volumeFitRays = 512;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
+  int volumeFitRays = 256;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
   float volumeFitClearance = 0.5f;    // a point is fitted only where an object's centre can be: at least this
                                       // many spacings from every surface
