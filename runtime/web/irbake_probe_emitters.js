@@ -29,7 +29,7 @@ export async function readEmitters(ext, n, readFrom) {
     if (!positions.every(Number.isFinite)) fail(`${at}.positions`, 'a non-finite position');
     const radiance = e.radiance;
     if (!Array.isArray(radiance) || radiance.length !== 3 || !radiance.every(x => typeof x === 'number')) fail(`${at}.radiance`, 'needs 3 numbers');
-    if (!radiance.every(Number.isFinite)) fail(`${at}.radiance`, 'not finite');
+    if (!radiance.map(Math.fround).every(Number.isFinite)) fail(`${at}.radiance`, 'not finite');  // as 32-bit floats
     if (radiance.some(x => x < 0)) fail(`${at}.radiance`, 'negative');
     const packed = await read('visibility', UNSIGNED_INT, 'SCALAR', Math.ceil(n / 4));  // a byte each, k/255
     const visibility = new Float32Array(n);
