@@ -3,7 +3,8 @@
 // lightmap/probe_field.h, as a dynamic object would be),
 // and the grid itself (--view probes: a small sphere at each probe, lit by its own SH, invalid ones red).
 // A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(c(p), n) at the point p with normal n,
-// c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
+// c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing), plus the exact emitters' E/π
+// (lightmap/probe_emitter_field.h, shaders/probe_emitters.glsl); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
 #pragma once
 #include <filesystem>
 #include <memory>
@@ -11,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "lightmap/probe_emitter_field.h"
 #include "lightmap/probe_field.h"
 #include "lightmap/probe_grid.h"
 
@@ -25,6 +27,10 @@ struct ProbeSphere {
   ShCoefficients coefficients{};  // at the centre: E(n)/π = shIrradiance(coefficients, n)
   std::array<ShCoefficients, 3> gradient{};  // ∂coefficients/∂x, y, z (zero for the grid's own probes)
   bool valid = true;              // false: drawn in flat red (a probe left out of interpolation)
+  // The exact emitters (lightmap/probe_emitters.h; shared by every sphere of a grid) and their visibility at the
+  // centre with its gradient: their light E/π is added at each point, unclamped L2 term clamped first.
+  std::shared_ptr<const std::vector<ProbeEmitter>> emitters;
+  EmitterVisibilityField emitterVisibility;
 };
 
 // The probes over a dynamic object: trilinear over the 8 around its centre, valid ones only, weights renormalised

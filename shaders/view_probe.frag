@@ -1,7 +1,8 @@
 // irview's probe spheres: the ray from the eye through this fragment meets the sphere at p, normal
 // n = (p − centre)/r; a white Lambert surface there shows E(n)/π, the probes' SH at p (the centre's plus
 // (p − centre)·gradient, lightmap/probe_field.h) convolved with the clamped cosine as three.js's
-// shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0.
+// shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0, plus the exact emitters' E/π
+// (probe_emitters.glsl).
 uniform mat4 uViewProjection;
 uniform vec3 uEye;
 uniform vec3 uCentre;
@@ -39,6 +40,9 @@ void main() {
   vec3 o = p - uCentre, sh[9];
   for (int k = 0; k < 9; ++k) sh[k] = uSh[k] + o.x * uShGradient[k] + o.y * uShGradient[9 + k] + o.z * uShGradient[18 + k];
   vec3 radiance = uValid != 0 ? max(shIrradiance(sh, n), vec3(0.0)) : vec3(1.0, 0.0, 0.0);
+#if EMITTER_TRIANGLES > 0
+  if (uValid != 0) radiance += exactEmitterLight(p, n, o);
+#endif
 #if OUTPUT == 1
   fragColor = vec4(encodeSrgb(radiance * uExposureScale), 1.0);
 #else

@@ -24,6 +24,7 @@
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "export/gltf_export.h"
+#include "export/light_probes_export.h"
 #include "pipeline/backend_choice.h"
 #include "pipeline/bake.h"
 #include "pipeline/vpl_sum_file.h"
@@ -136,7 +137,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays", "probe-volume-clearance"}},
+    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays",
+                           "probe-volume-clearance", "probe-exact-emitters"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -334,6 +336,11 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
                   "the volume fit's points at least this many spacings from every surface (default " +
                       shown(ProbeOptions{}.volumeFitClearance) + ";\n0: every point the probes see)")
       ->transform(cli::numberIn(0.0, 8.0))->type_name("C");
+  app->add_option("--probe-exact-emitters", o.probes.exactEmitterTriangles,
+                  "uniform planar or small emitters of at most N triangles in all (brightest first) left out of the\n"
+                  "probes' SH for the clients' exact shading (default " + std::to_string(ProbeOptions{}.exactEmitterTriangles) +
+                      "; 0: every emitter in the SH)")
+      ->transform(cli::integerIn(0, kMaxExactEmitterTriangles))->type_name("N");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");

@@ -1,5 +1,6 @@
 // irbake probe OUT.gltf --at X,Y,Z [--normal NX,NY,NZ]: the baked irradiance probes (IRBAKE_light_probes) read
-// at a point as JSON: E(n)/π per channel with --normal, else the mean over every normal (the L0 term). Trilinear
+// at a point as JSON: E(n)/π per channel with --normal, else the mean over every normal (the L0 term), the exact
+// emitters (`emitters`) added at their blended visibility. Trilinear
 // over the 8 probes around the point, valid ones only, and only those the point sees (the glTF's geometry is
 // loaded for the visibility rays), so light never comes through a wall.
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "common/command_line.h"
 #include "common/error.h"
 #include "export/light_probes_export.h"
+#include "lightmap/probe_emitter_field.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"
 
@@ -51,12 +53,17 @@ int runProbe(const Args& args) {
   });
   if (blend.probes == 0)
     throw Error(ErrorCode::InvalidData, file, "no valid probe around " + at + " is visible from it");
-  const glm::vec3 value = normal.empty() ? shAverage(blend.coefficients) : shIrradiance(blend.coefficients, n);
+  glm::vec3 value = normal.empty() ? shAverage(blend.coefficients) : shIrradiance(blend.coefficients, n);
+  // Plus the exact emitters (docs/export.md, `emitters`) at their blended visibility.
+  const std::vector<float> v = blendEmitterVisibility(grid, blend);
+  if (!normal.empty()) value += exactEmitterLight(grid.emitters, v, point, n);
+  else value += exactEmitterMean(grid.emitters, v, point);
   nlohmann::json out = {{"file", file},
                         {"at", {point.x, point.y, point.z}},
                         {"value", {value.x, value.y, value.z}},
                         {"probes", blend.probes},
-                        {"weight", blend.weight}};
+                        {"weight", blend.weight},
+                        {"emitters", grid.emitters.size()}};
   if (!normal.empty()) out["normal"] = {n.x, n.y, n.z};
   else out["normal"] = nullptr;
   std::printf("%s\n", out.dump().c_str());

@@ -12,9 +12,12 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "lightmap/probe_emitters.h"
 
 namespace irbake {
 
@@ -104,6 +107,7 @@ struct LightProbeGrid {
   std::vector<glm::vec3> offsets;            // where each probe was baked, relative to its grid point
   std::vector<uint8_t> valid;                // 0: inside geometry or behind a wall, left out of interpolation
   ProbeSunLevel sun;                         // optional: the sun's visibility refined where its shadow crosses
+  std::vector<ProbeEmitter> emitters;        // optional: emitters shaded exactly, not in the coefficients
 
   size_t size() const { return static_cast<size_t>(counts.x) * counts.y * counts.z; }
   size_t index(int i, int j, int k) const {
@@ -125,6 +129,7 @@ struct ProbeBlend {
   ShCoefficients coefficients{};
   int probes = 0;       // valid, visible probes blended
   float weight = 0.0f;  // their summed trilinear weight (0: none; coefficients then 0)
+  std::array<std::pair<size_t, float>, 8> corners{};  // the blended probes and their weights (renormalised)
 };
 
 // The trilinear blend's probes around p (the cell clamped to the grid): corner(index, weight) for each of
@@ -170,10 +175,11 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
     for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += w * g.coefficients[idx][k];
     if (sun) sunBlend += w * g.sun.visibility[idx];
     out.weight += w;
-    ++out.probes;
+    out.corners[out.probes++] = {idx, w};
   }, &t);
   if (out.weight > 0.0f) {
     for (auto& c : out.coefficients) c /= out.weight;
+    for (int c = 0; c < out.probes; ++c) out.corners[c].second /= out.weight;
     const float fine = sun ? g.sun.fineVisibility(g.index(base.x, base.y, base.z), t) : -1.0f;
     if (fine >= 0.0f)
       for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * g.sun.sh[k];
@@ -191,6 +197,7 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
       }
   if (nearest == g.size()) return out;
   out.coefficients = g.coefficients[nearest];
+  out.corners[0] = {nearest, 1.0f};
   out.probes = 1;
   out.weight = 1.0f;
   return out;

@@ -10,11 +10,13 @@
 // max(0, shGetIrradianceAt(n)): the same value as irview, since three.js shades irradiance × albedo/π and the
 // material's probe term is π × E/π.
 // With the optional `sun` level (irbake_probe_sun.js), a point in one of its cells takes the blend with its sun
-// replaced by the finer lattice's, so the field over an object needs no other change.
+// replaced by the finer lattice's, so the field over an object needs no other change. With the optional `emitters`
+// (irbake_probe_emitters.js), their exact light is added at each point, their visibility blended as the SH.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
-import { Box3, SphericalHarmonics3, Vector3 } from 'three';
+import { Box3, SphericalHarmonics3, Vector3, Vector4 } from 'three';
 import { readSunLevel } from './irbake_probe_sun.js';
+import { emitterGlsl, emitterUniforms, readEmitters, visibilityField } from './irbake_probe_emitters.js';
 
 export const LIGHT_PROBES = 'IRBAKE_light_probes';
 const FLOAT = 5126;
@@ -23,8 +25,8 @@ const COMPONENTS = { SCALAR: 1, VEC3: 3 };
 // The probe grid: coefficients (Float32Array, 27 per probe: SphericalHarmonics3.fromArray's layout), offsets
 // (3 per probe), valid (Uint8Array).
 export class IrbakeProbeGrid {
-  constructor({ origin, spacing, counts, coefficients, offsets, valid, sun = null }) {
-    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid, sun });
+  constructor({ origin, spacing, counts, coefficients, offsets, valid, sun = null, emitters = [] }) {
+    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid, sun, emitters });
   }
 
   get size() { return this.counts[0] * this.counts[1] * this.counts[2]; }
@@ -40,7 +42,7 @@ export class IrbakeProbeGrid {
   // around p (clamped to the grid), valid ones only; where none is valid, the nearest valid probe of the 4×4×4
   // around p; probes 0 when there is none. In a cell of the sun level, the blend's sun is the lattice's.
   interpolate(p) {
-    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0 };
+    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0, corners: [] };
     const base = [0, 0, 0], t = [0, 0, 0];
     let sunBlend = 0;
     for (let a = 0; a < 3; ++a) {
@@ -62,9 +64,11 @@ export class IrbakeProbeGrid {
       if (this.sun) sunBlend += w * this.sun.visibility[idx];
       out.weight += w;
       ++out.probes;
+      out.corners.push([idx, w]);
     }
     if (out.weight > 0) {
       for (let k = 0; k < 27; ++k) out.coefficients[k] /= out.weight;
+      for (const c of out.corners) c[1] /= out.weight;
       const fine = this.sun ? this.sun.fineVisibility(this.index(base[0], base[1], base[2]), t) : -1;
       if (fine >= 0)
         for (let k = 0; k < 27; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * this.sun.sh[k];
@@ -84,6 +88,7 @@ export class IrbakeProbeGrid {
     out.coefficients.set(this.coefficients.subarray(27 * nearest, 27 * nearest + 27));
     out.probes = 1;
     out.weight = 1;
+    out.corners = [[nearest, 1]];
     return out;
   }
 
@@ -116,7 +121,8 @@ export class IrbakeProbeGrid {
     const field = this.field(point, radius);
     if (field.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
     mesh.material = mesh.material.clone();
-    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient });
+    const emitters = this.emitters.length ? emitterUniforms(this.emitters, visibilityField(this, point, radius)) : null;
+    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient, emitters });
     return field;
   }
 }
@@ -124,7 +130,7 @@ export class IrbakeProbeGrid {
 // Adds π × max(0, shGetIrradianceAt(n, sh(p))) to a Lambert (or any lit) material's indirect irradiance, n the
 // world normal, sh(p) = coefficients + (p − centre)·gradient at the fragment's world point p (without `field`:
 // the coefficients everywhere): three.js's own light-probe term, per material instead of per scene, clamped at 0
-// as irview.
+// as irview; plus, with field.emitters (irbake_probe_emitters.js, emitterUniforms), the exact emitters' π × E/π.
 export function applyProbeSh(material, coefficients, field = null) {
   const vec3s = (a, from) => [...Array(9)].map((_, k) => new Vector3(a[from + 3 * k], a[from + 3 * k + 1], a[from + 3 * k + 2]));
   const gradient = [];
@@ -132,8 +138,18 @@ export function applyProbeSh(material, coefficients, field = null) {
   material.userData.irbakeProbeSh = { value: vec3s(coefficients, 0) };
   material.userData.irbakeProbeGradient = { value: gradient };
   material.userData.irbakeProbeCentre = { value: new Vector3(...(field ? field.centre : [0, 0, 0])) };
+  const emitters = field?.emitters?.triangles > 0 ? field.emitters : null;
+  if (emitters) {
+    const vectors = (a, size, Type) => [...Array(a.length / size)].map((_, i) => new Type(...a.slice(size * i, size * i + size)));
+    material.userData.irbakeEmitterPositions = { value: vectors(emitters.positions, 3, Vector3) };
+    material.userData.irbakeEmitterRadiance = { value: vectors(emitters.radiance, 3, Vector3) };
+    material.userData.irbakeEmitterVisibility = { value: vectors(emitters.visibility, 4, Vector4) };
+  }
   material.onBeforeCompile = shader => {
     shader.uniforms.irbakeProbeSh = material.userData.irbakeProbeSh;
+    if (emitters)
+      for (const name of ['irbakeEmitterPositions', 'irbakeEmitterRadiance', 'irbakeEmitterVisibility'])
+        shader.uniforms[name] = material.userData[name];
     shader.uniforms.irbakeProbeGradient = material.userData.irbakeProbeGradient;
     shader.uniforms.irbakeProbeCentre = material.userData.irbakeProbeCentre;
     const anchor = '#include <lights_fragment_maps>', vertexAnchor = '#include <project_vertex>';
@@ -152,8 +168,14 @@ export function applyProbeSh(material, coefficients, field = null) {
                   + irbakeProbeOffset.y * irbakeProbeGradient[ 9 + k ] + irbakeProbeOffset.z * irbakeProbeGradient[ 18 + k ];
   irradiance += PI * max( shGetIrradianceAt( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ),
                                              irbakeSh ), vec3( 0.0 ) );`);
+    if (emitters)
+      shader.fragmentShader = shader.fragmentShader
+        .replace('void main() {', `uniform vec3 irbakeProbeCentre;\n${emitterGlsl(emitters.triangles)}\nvoid main() {`)
+        .replace(anchor, `${anchor}
+  irradiance += PI * irbakeExactEmitterLight( irbakeProbeCentre + irbakeProbeOffset,
+    normalize( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ) ), irbakeProbeOffset );`);
   };
-  material.customProgramCacheKey = () => 'irbake-light-probes-field';
+  material.customProgramCacheKey = () => `irbake-light-probes-field-${emitters ? emitters.triangles : 0}`;
   material.needsUpdate = true;
 }
 
@@ -227,7 +249,8 @@ export async function readProbeGrid(json, accessor) {
     valid[i] = validity[i];
   }
   const sun = ext.sun === undefined ? null : await readSunLevel(ext, counts, readFrom(ext.sun ?? {}, 'sun.'));
-  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun });
+  const emitters = ext.emitters === undefined ? [] : await readEmitters(ext, n, readFrom);
+  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun, emitters });
 }
 
 // The loader plugin: after the document loads, gltf.userData.irbakeLightProbes is the grid (null without the
