@@ -1,5 +1,7 @@
 // irbake probe OUT.gltf --at X,Y,Z [--normal NX,NY,NZ]: the baked irradiance probes (IRBAKE_light_probes) read
-// at a point as JSON: E(n)/π per channel with --normal, else the mean over every normal (the L0 term). Trilinear
+// at a point as JSON: E(n)/π per channel with --normal (the sun level's sun as an exact clamped cosine, the rest
+// through L2: shadeProbeLambert), else the mean over every normal (the L0 term, which the exact sun leaves as it
+// is: the clamped cosine's mean, 1/4, is its L0 part). Trilinear
 // over the 8 probes around the point, valid ones only, and only those the point sees (the glTF's geometry is
 // loaded for the visibility rays), so light never comes through a wall.
 #include <cmath>
@@ -51,12 +53,14 @@ int runProbe(const Args& args) {
   });
   if (blend.probes == 0)
     throw Error(ErrorCode::InvalidData, file, "no valid probe around " + at + " is visible from it");
-  const glm::vec3 value = normal.empty() ? shAverage(blend.coefficients) : shIrradiance(blend.coefficients, n);
+  const glm::vec3 value =
+      normal.empty() ? shAverage(blend.coefficients) : shadeProbeLambert(blend.coefficients, blend.sunVisibility, grid.sun, n);
   nlohmann::json out = {{"file", file},
                         {"at", {point.x, point.y, point.z}},
                         {"value", {value.x, value.y, value.z}},
                         {"probes", blend.probes},
                         {"weight", blend.weight}};
+  if (grid.sun.present()) out["sunVisibility"] = blend.sunVisibility;
   if (!normal.empty()) out["normal"] = {n.x, n.y, n.z};
   else out["normal"] = nullptr;
   std::printf("%s\n", out.dump().c_str());

@@ -27,7 +27,9 @@ disc (split at the projected centre, which is the image centre: the camera targe
 = half the difference of its two halves over their mean. Diagnosis: `ratio_exact_direct` and
 `worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone at each
 surface point (the sun, times the sphere's sunlit share, and the emitters seen from the point, as exact clamped
-cosines in place of their L2 parts): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
+cosines in place of their L2 parts): what is left is not the SH band limit. A bake whose probes have a sun level
+(IRBAKE_light_probes.sun) already has its sun exact in irview's image (docs/units.md, "The sun shaded exactly"),
+so there only the emitters' part is undone (Sponza has none: the columns equal the plain ratio). `probe_sun_share`: the blend weight of the 8
 probes around the centre whose own point sees the sun (a sun shadow edge between probes shows as a share below
 `sunlit`; the bake fits each probe's sun over its cube, docs/units.md, so the blended sun may differ). Rows are appended to bench/results/probe_spheres.csv.
 Every process runs under `nice -n 15`; Cycles with --threads 2.
@@ -379,6 +381,12 @@ def direct_l2_residual(eye, target, fov, size, centre, radius, dirs, weights, em
     return out.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
 
 
+def has_sun_level(gltf):
+    """Whether the bake's probes carry a sun level, whose sun the clients shade as an exact clamped cosine."""
+    with open(gltf) as f:
+        return "sun" in json.load(f).get("extensions", {}).get("IRBAKE_light_probes", {})
+
+
 def probe_sun_share(gltf, tris, centre):
     """The trilinear weight (valid probes, renormalised, as irview blends them) of the 8 probes around the centre
     whose baked position (grid point + offset) sees the sun: the sun's share the blended probe carries."""
@@ -483,8 +491,11 @@ def run_scene(args, name, rows):
         refs = cycles_pair(args, sphere_scene, sky, eye, centre, fov, args.cycles_sphere == "camera")
         a, b = (compare.read_exr(r[0])[..., :3] for r in refs)
         keep = kept_mask(eye, centre, fov, args.size, centre, radius)
+        emitters = emitter_points(tris, emission)
         residual = direct_l2_residual(eye, centre, fov, args.size, centre, radius,
-                                      *sun_light(centre, sunlit, name == "sponza"), emitter_points(tris, emission))
+                                      *sun_light(centre, sunlit, name == "sponza"), emitters)
+        residual_without_sun = direct_l2_residual(eye, centre, fov, args.size, centre, radius,
+                                                  *sun_light(centre, 0.0, False), emitters)
         for seed in ([] if args.cycles_only else args.seed_list):
             out = os.path.join(work, "seed%d" % seed)
             gltf = os.path.join(out, "scene.gltf")
@@ -496,7 +507,8 @@ def run_scene(args, name, rows):
             f = figures(ours, a, b, keep, args.size)
             if name == "sponza":
                 f["probe_sun_share"] = probe_sun_share(gltf, tris, centre)
-            fs = figures(ours + residual, a, b, keep, args.size)
+            sun_exact = args.ours == "irview" and has_sun_level(gltf)  # our image has the sun exact already
+            fs = figures(ours + (residual_without_sun if sun_exact else residual), a, b, keep, args.size)
             f["ratio_exact_direct"], f["worst_quarter_exact_direct"] = fs["ratio"], fs["worst_quarter"]
             row = {"date": datetime.date.today().isoformat(), "commit": commit, "scene": name, "place": place,
                    "centre": " ".join("%g" % x for x in centre), "radius": radius, "sunlit": round(sunlit, 3),
