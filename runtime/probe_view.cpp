@@ -1,5 +1,6 @@
 #include "probe_view.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -28,12 +29,22 @@ ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, flo
   s.gradient = field.gradient;
   s.sunVisibility = field.sunVisibility;
   s.sunGradient = field.sunGradient;
+  if (!grid.emitters.empty()) {
+    s.emitters = std::make_shared<const std::vector<ProbeEmitter>>(grid.emitters);
+    s.emitterVisibility = emitterVisibilityOver(grid, centre, radius, [](const glm::vec3&, const glm::vec3&) { return true; });
+  }
   return s;
 }
 
 std::vector<ProbeSphere> probeGridSpheres(const LightProbeGrid& grid) {
   std::vector<ProbeSphere> spheres(grid.size());
+  const auto emitters = grid.emitters.empty() ? nullptr : std::make_shared<const std::vector<ProbeEmitter>>(grid.emitters);
   for (size_t i = 0; i < grid.size(); ++i) {
+    if (emitters) {  // each probe's own visibility, no gradient
+      spheres[i].emitters = emitters;
+      for (auto& g : spheres[i].emitterVisibility.gradient) g.assign(emitters->size(), 0.0f);
+      for (const ProbeEmitter& e : *emitters) spheres[i].emitterVisibility.centre.push_back(e.visibility[i]);
+    }
     spheres[i].centre = grid.position(i);
     spheres[i].radius = 0.12f * grid.spacing;
     spheres[i].coefficients = grid.coefficients[i];
@@ -64,10 +75,44 @@ std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& o, ProbeSphereSun*
 
 namespace {
 
+// The exact emitters' triangles (every sphere's are the same grid's), at most kMaxExactEmitterTriangles.
+int emitterTriangles(const std::vector<ProbeSphere>& spheres) {
+  size_t n = 0;
+  for (const ProbeSphere& s : spheres)
+    if (s.emitters) {
+      for (const ProbeEmitter& e : *s.emitters) n += e.positions.size() / 3;
+      break;
+    }
+  return static_cast<int>(std::min<size_t>(n, kMaxExactEmitterTriangles));
+}
+
+// Sphere `s`'s exact emitters as the shader's per-triangle uniforms (shaders/probe_emitters.glsl).
+void setEmitterUniforms(const GlProgram& p, const ProbeSphere& s, int triangles) {
+  if (triangles == 0 || !s.emitters) return;
+  std::vector<glm::vec3> positions, radiance;
+  std::vector<glm::vec4> visibility;
+  for (size_t e = 0; e < s.emitters->size(); ++e) {
+    const ProbeEmitter& em = (*s.emitters)[e];
+    const auto& v = s.emitterVisibility;
+    const glm::vec4 vis(e < v.centre.size() ? v.centre[e] : 0.0f, e < v.gradient[0].size() ? v.gradient[0][e] : 0.0f,
+                        e < v.gradient[1].size() ? v.gradient[1][e] : 0.0f, e < v.gradient[2].size() ? v.gradient[2][e] : 0.0f);
+    for (size_t t = 0; t + 2 < em.positions.size() && static_cast<int>(radiance.size()) < triangles; t += 3) {
+      positions.insert(positions.end(), em.positions.begin() + t, em.positions.begin() + t + 3);
+      radiance.push_back(em.radiance);
+      visibility.push_back(vis);
+    }
+  }
+  const GLsizei n = static_cast<GLsizei>(radiance.size());
+  glUniform3fv(p.uniform("uEmitterPositions"), 3 * n, &positions[0][0]);
+  glUniform3fv(p.uniform("uEmitterRadiance"), n, &radiance[0][0]);
+  glUniform4fv(p.uniform("uEmitterVisibility"), n, &visibility[0][0]);
+}
+
 // The spheres' GL side: one program per output encoding, an empty vertex array, one draw per sphere.
 class ProbeOverlay {
  public:
-  ProbeOverlay(std::vector<ProbeSphere> spheres, const ProbeSphereSun& sun) : spheres_(std::move(spheres)), sun_(sun) {
+  ProbeOverlay(std::vector<ProbeSphere> spheres, const ProbeSphereSun& sun)
+      : spheres_(std::move(spheres)), sun_(sun), emitterTriangles_(emitterTriangles(spheres_)) {
     glGenVertexArrays(1, &vao_);
     program(0);  // compile now: shader errors surface before the first frame
   }
@@ -102,6 +147,7 @@ class ProbeOverlay {
       glUniform1i(valid, s.valid ? 1 : 0);
       glUniform1f(sunVisibility, s.sunVisibility);
       glUniform3fv(sunGradient, 1, &s.sunGradient[0]);
+      setEmitterUniforms(p, s, emitterTriangles_);
       glDrawArrays(GL_TRIANGLES, 0, 36);
     }
     glBindVertexArray(0);
@@ -114,13 +160,16 @@ class ProbeOverlay {
     if (!p)
       p = std::make_unique<GlProgram>(
           std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_probe.vert"}},
-                                   {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_probe.frag"}}},
-          std::vector<std::string>{"#define OUTPUT " + std::to_string(output)}, "330 core");
+                                   {GL_FRAGMENT_SHADER, {"view_encode.glsl", "probe_emitters.glsl", "view_probe.frag"}}},
+          std::vector<std::string>{"#define OUTPUT " + std::to_string(output),
+                                   "#define EMITTER_TRIANGLES " + std::to_string(emitterTriangles_)},
+          "330 core");
     return *p;
   }
 
   std::vector<ProbeSphere> spheres_;
   ProbeSphereSun sun_;
+  int emitterTriangles_ = 0;  // the shader's EMITTER_TRIANGLES (0: no exact emitters)
   std::unique_ptr<GlProgram> programs_[2];
   GLuint vao_ = 0;
 };

@@ -3,9 +3,10 @@
 // lightmap/probe_field.h, as a dynamic object would be),
 // and the grid itself (--view probes: a small sphere at each probe, lit by its own SH, invalid ones red).
 // A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(c(p), n) at the point p with normal n,
-// c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing); with a sun level, its sun is taken out
-// of c(p) and shaded as an exact clamped cosine at the visibility v(p) (shadeProbeLambert); each pixel's normal is
-// exact: the sphere is ray-cast in the fragment shader, not tessellated.
+// c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing), plus the exact emitters' E/π
+// (lightmap/probe_emitter_field.h, shaders/probe_emitters.glsl); with a sun level, its sun is taken out of c(p) and
+// shaded as an exact clamped cosine at the visibility v(p) (shadeProbeLambert); each pixel's normal is exact: the
+// sphere is ray-cast in the fragment shader, not tessellated.
 #pragma once
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include <glm/glm.hpp>
 
+#include "lightmap/probe_emitter_field.h"
 #include "lightmap/probe_field.h"
 #include "lightmap/probe_grid.h"
 
@@ -29,6 +31,10 @@ struct ProbeSphere {
   bool valid = true;              // false: drawn in flat red (a probe left out of interpolation)
   float sunVisibility = 0.0f;     // the sun level's visibility at the centre and its gradient (probe_field.h)
   glm::vec3 sunGradient{0.0f};
+  // The exact emitters (lightmap/probe_emitters.h; shared by every sphere of a grid) and their visibility at the
+  // centre with its gradient: their light E/π is added at each point, unclamped L2 term clamped first.
+  std::shared_ptr<const std::vector<ProbeEmitter>> emitters;
+  EmitterVisibilityField emitterVisibility;
 };
 
 // The sun level's light as the spheres' shader takes it (zero irradiance and SH: no sun level).

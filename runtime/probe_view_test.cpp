@@ -1,6 +1,7 @@
 // irview's probe spheres on a real bake (the Cornell box sample, probes on, Embree, 512 paths): a matte white
 // sphere of albedo 1 lit by the probes shows E(n)/π = shIrradiance(c(p), n) at each pixel's point p and normal n,
-// c(p) the probes' field over the sphere (probeFieldOver: the blend at its centre and its gradient). The expected value is computed here from the exported glTF as `irbake probe`
+// c(p) the probes' field over the sphere (probeFieldOver: the blend at its centre and its gradient), plus the box's
+// ceiling light, an exact emitter (lightmap/probe_emitter_field.h). The expected value is computed here from the exported glTF as `irbake probe`
 // computes it (readLightProbes, interpolateProbes with visibility rays) and the normal from the camera ray's own
 // intersection with the sphere (double precision), so the renderer's ray-cast, its SH and its interpolation
 // (without visibility rays) are all checked. The centre sees its 8 probes, so both interpolations agree.
@@ -54,18 +55,34 @@ const std::filesystem::path& bakedBox() {
   return file;
 }
 
-// What `irbake probe FILE --at kCentre` blends: valid probes the point sees (visibility rays on the glTF).
-ProbeField referenceField(const std::filesystem::path& file) {
+// What `irbake probe FILE --at kCentre` blends: valid probes the point sees (visibility rays on the glTF); with
+// the exact emitters' visibility blended the same way.
+struct Reference : ProbeField {
+  std::vector<ProbeEmitter> emitters;
+  EmitterVisibilityField visibility;
+  // What a white Lambert point at centre + offset with normal n shows: max(0, SH) + the exact emitters.
+  glm::vec3 radiance(const glm::vec3& offset, const glm::vec3& n) const {
+    return glm::max(shIrradiance(at(offset), n), glm::vec3(0.0f)) +
+           exactEmitterLight(emitters, visibility.at(offset), kCentre + offset, n);
+  }
+};
+
+Reference referenceField(const std::filesystem::path& file) {
   const LightProbeGrid grid = readLightProbes(file);
   LoadOptions load;
   load.decodeImages = false;
   const Scene scene = loadScene(file, load);
   const RayTracer rt(scene);
-  return probeFieldOver(grid, kCentre, kRadius, [&](const glm::vec3& from, const glm::vec3& to) {
+  const auto visible = [&](const glm::vec3& from, const glm::vec3& to) {
     const glm::vec3 d = to - from;
     const float r = glm::length(d);
     return !(r > 0.0f) || !rt.occluded(from, d / r, 0.0f, r);
-  });
+  };
+  Reference out;
+  static_cast<ProbeField&>(out) = probeFieldOver(grid, kCentre, kRadius, visible);
+  out.emitters = grid.emitters;
+  out.visibility = emitterVisibilityOver(grid, kCentre, kRadius, visible);
+  return out;
 }
 
 // The sphere's normal seen through pixel (x, y) (row 0 at the top), from the camera's own matrices in double;
@@ -93,19 +110,17 @@ struct SphereCheck {
   double worst = 0.0;  // largest |pixel − expected| over channels, relative to the largest expected value
 };
 
-// Every sphere pixel against max(0, shIrradiance(c(p), n)), p = centre + r n.
+// Every sphere pixel against max(0, shIrradiance(c(p), n)) plus the exact emitters, p = centre + r n.
 SphereCheck checkSphere(const std::vector<glm::vec4>& pixels, const ViewCamera& camera, int w, int h,
-                        const ProbeField& field) {
-  const ShCoefficients& c = field.centre;
+                        const Reference& field) {
   SphereCheck out;
-  const glm::vec3 top = shIrradiance(c, glm::vec3(0, 1, 0));
+  const glm::vec3 top = field.radiance(glm::vec3(0.0f), glm::vec3(0, 1, 0));
   const double scale = std::max({top.x, top.y, top.z, 1e-6f});
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       glm::dvec3 n;
       if (!sphereNormalAt(camera, w, h, x, y, 0.02, n)) continue;
-      const glm::vec3 expected =
-          glm::max(shIrradiance(field.at(kRadius * glm::vec3(n)), glm::vec3(n)), glm::vec3(0.0f));
+      const glm::vec3 expected = field.radiance(kRadius * glm::vec3(n), glm::vec3(n));
       const glm::vec4& px = pixels[static_cast<size_t>(y) * w + x];
       for (int k = 0; k < 3; ++k) out.worst = std::max(out.worst, std::abs(px[k] - expected[k]) / scale);
       ++out.pixels;
@@ -115,8 +130,9 @@ SphereCheck checkSphere(const std::vector<glm::vec4>& pixels, const ViewCamera& 
 
 TEST(ProbeView, SphereShowsTheProbesIrradianceAtEachPixelsNormal) {
   const std::filesystem::path file = bakedBox();
-  const ProbeField reference = referenceField(file);
+  const Reference reference = referenceField(file);
   ASSERT_EQ(reference.probes, 8) << "the centre should see its 8 probes";
+  ASSERT_EQ(reference.emitters.size(), 1u) << "the box's ceiling light should be an exact emitter";
   const glm::vec3 mean = shAverage(reference.centre);
   ASSERT_GT(mean.x, 0.01f) << "the probes at the centre are dark";
 
@@ -142,7 +158,7 @@ TEST(ProbeView, SphereShowsTheProbesIrradianceAtEachPixelsNormal) {
   // From above, the middle pixel: the field at the sphere's top point, normal +Y.
   const ViewCamera above = lookAt(eyes[1], kCentre, 40.0f, v.scene.bounds());
   const glm::vec4 middle = renderer.render(above, w, h, {}).at(w / 2, h / 2);
-  const glm::vec3 top = shIrradiance(reference.at(glm::vec3(0.0f, kRadius, 0.0f)), glm::vec3(0, 1, 0));
+  const glm::vec3 top = reference.radiance(glm::vec3(0.0f, kRadius, 0.0f), glm::vec3(0, 1, 0));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(middle[k], top[k], 1e-3f * top[k]) << "channel " << k;
 }
 
@@ -157,7 +173,7 @@ std::string runIrview(const std::string& args, const std::filesystem::path& log)
 // The command line another tool drives (Cycles comparisons): the EXR is linear radiance of the albedo-1 sphere.
 TEST(ProbeView, IrviewProbeObjectScreenshotIsTheSpheresRadiance) {
   const std::filesystem::path file = bakedBox();
-  const ProbeField reference = referenceField(file);
+  const Reference reference = referenceField(file);
   ASSERT_EQ(reference.probes, 8);
   const std::filesystem::path exr = outDir() / "sphere.exr";
   std::filesystem::remove(exr);
@@ -186,7 +202,7 @@ TEST(ProbeView, IrviewProbeObjectScreenshotIsTheSpheresRadiance) {
   EXPECT_LT(check.worst, 1.5e-3);
 }
 
-// A corrupted probe extension (its sun level included) is refused naming the file and the problem, exit non-zero,
+// A corrupted probe extension (its sun level and exact emitters included) is refused naming the file and the problem, exit non-zero,
 // no screenshot; so is a scene without probes.
 TEST(ProbeView, IrviewRefusesABadProbeGrid) {
   const std::filesystem::path file = bakedBox();
@@ -206,12 +222,16 @@ TEST(ProbeView, IrviewRefusesABadProbeGrid) {
   badSun["extensions"]["IRBAKE_light_probes"]["sun"] = {{"subdivisions", 0}};
   nlohmann::json darkSun = doc;  // a negative irradiance (checked before the accessors)
   darkSun["extensions"]["IRBAKE_light_probes"]["sun"] = {{"subdivisions", 4}, {"direction", {0, -1, 0}}, {"irradiance", {1, -1, 1}}};
+  nlohmann::json badEmitter = doc;  // the ceiling light's triangle list pointing at the probes' validity (SCALAR)
+  auto& emitter = badEmitter["extensions"]["IRBAKE_light_probes"]["emitters"][0];
+  emitter["positions"] = badEmitter["extensions"]["IRBAKE_light_probes"]["valid"];
   const struct {
     std::filesystem::path file;
     std::string problem;
   } cases[] = {{write(longer, "bad_counts.gltf"), "the grid needs"}, {write(none, "no_probes.gltf"), "no IRBAKE_light_probes"},
                {write(badSun, "bad_sun.gltf"), "IRBAKE_light_probes.sun.subdivisions: needs a whole number from 1 to 16"},
-               {write(darkSun, "dark_sun.gltf"), "IRBAKE_light_probes.sun.irradiance: negative"}};
+               {write(darkSun, "dark_sun.gltf"), "IRBAKE_light_probes.sun.irradiance: negative"},
+               {write(badEmitter, "bad_emitter.gltf"), "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR"}};
   for (const auto& c : cases) {
     const std::filesystem::path png = outDir() / "refused.png";
     std::filesystem::remove(png);

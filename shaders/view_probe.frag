@@ -1,8 +1,9 @@
 // irview's probe spheres: the ray from the eye through this fragment meets the sphere at p, normal
 // n = (p − centre)/r; a white Lambert surface there shows E(n)/π, the probes' SH at p (the centre's plus
 // (p − centre)·gradient, lightmap/probe_field.h) convolved with the clamped cosine as three.js's
-// shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0. With a sun level its sun is
-// taken out of the SH at the visibility v(p) and added as an exact clamped cosine (shadeProbeLambert).
+// shGetIrradianceAt writes it (lightmap/probe_grid.h, shIrradiance), clamped at 0, plus the exact emitters' E/π
+// (probe_emitters.glsl). With a sun level its sun is taken out of the SH at the visibility v(p) and added as an
+// exact clamped cosine (shadeProbeLambert).
 uniform mat4 uViewProjection;
 uniform vec3 uEye;
 uniform vec3 uCentre;
@@ -47,6 +48,9 @@ void main() {
   for (int k = 0; k < 9; ++k)
     sh[k] = uSh[k] + o.x * uShGradient[k] + o.y * uShGradient[9 + k] + o.z * uShGradient[18 + k] - v * uSunSh[k];
   vec3 radiance = max(shIrradiance(sh, n), vec3(0.0)) + v * uSunIrradiance * max(0.0, -dot(n, uSunDirection));
+#if EMITTER_TRIANGLES > 0
+  radiance += exactEmitterLight(p, n, o);
+#endif
   if (uValid == 0) radiance = vec3(1.0, 0.0, 0.0);
 #if OUTPUT == 1
   fragColor = vec4(encodeSrgb(radiance * uExposureScale), 1.0);

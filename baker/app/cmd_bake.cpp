@@ -24,6 +24,7 @@
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "export/gltf_export.h"
+#include "export/light_probes_export.h"
 #include "pipeline/backend_choice.h"
 #include "pipeline/bake.h"
 #include "pipeline/vpl_sum_file.h"
@@ -136,7 +137,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit"}},
+    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-exact-emitters"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
     {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
@@ -327,6 +328,11 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
                       std::to_string(ProbeOptions{}.volumeFitRays) + " rays each\n(default " +
                       std::to_string(ProbeOptions{}.volumeFitSamples) + "; 0: each probe's own rays)")
       ->transform(cli::integerIn(0, 8))->type_name("S");
+  app->add_option("--probe-exact-emitters", o.probes.exactEmitterTriangles,
+                  "uniform planar or small emitters of at most N triangles in all (brightest first) left out of the\n"
+                  "probes' SH for the clients' exact shading (default " + std::to_string(ProbeOptions{}.exactEmitterTriangles) +
+                      "; 0: every emitter in the SH)")
+      ->transform(cli::integerIn(0, kMaxExactEmitterTriangles))->type_name("N");
   app->add_flag("--directional", o.directional,
                 "also bake directional (L1) maps (docs/export.md)");
   app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");

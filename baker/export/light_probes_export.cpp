@@ -125,6 +125,66 @@ ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const Light
   return out;
 }
 
+// The exact emitters (ProbeEmitter) as the extension's optional `emitters` array: each a world-space triangle list
+// (FLOAT VEC3), its radiance over π, and the probes' visibilities as bytes packed 4 to a 32-bit word (as `sun`'s).
+json emittersJson(GltfDocument& doc, const std::vector<ProbeEmitter>& emitters) {
+  json out = json::array();
+  for (const ProbeEmitter& e : emitters) {
+    std::vector<uint32_t> visibility((e.visibility.size() + 3) / 4, 0u);
+    for (size_t i = 0; i < e.visibility.size(); ++i)
+      visibility[i / 4] |= static_cast<uint32_t>(std::lround(std::clamp(e.visibility[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
+    out.push_back({{"positions", addAccessor(doc, e.positions.data(), e.positions.size() * sizeof(glm::vec3), kFloat,
+                                             e.positions.size(), "VEC3")},
+                   {"radiance", {e.radiance.x, e.radiance.y, e.radiance.z}},
+                   {"visibility", addAccessor(doc, visibility.data(), visibility.size() * sizeof(uint32_t), kUnsignedInt,
+                                              visibility.size(), "SCALAR")}});
+  }
+  return out;
+}
+
+// The extension's `emitters` array, checked: each an object with a FLOAT VEC3 triangle list of finite positions
+// (a whole number of triangles, at most kMaxExactEmitterTriangles in all), a finite non-negative radiance, and a
+// visibility word per 4 probes. Throws Error(InvalidData, file) naming the field.
+std::vector<ProbeEmitter> readEmitters(const GltfDocument& doc, const json& ext, const LightProbeGrid& g, const std::string& file) {
+  const json& list = ext["emitters"];
+  const std::string what = std::string(kLightProbesExtension) + ".emitters";
+  if (!list.is_array()) throw Error(ErrorCode::InvalidData, file, what + ": not an array");
+  std::vector<ProbeEmitter> out;
+  size_t triangles = 0;
+  const size_t n = g.size();
+  for (size_t k = 0; k < list.size(); ++k) {
+    const std::string at = what + "[" + std::to_string(k) + "]";
+    if (!list[k].is_object()) throw Error(ErrorCode::InvalidData, file, at + ": not an object");
+    ProbeEmitter e;
+    if (!list[k].contains("positions") || !list[k]["positions"].is_number_integer())
+      throw Error(ErrorCode::InvalidData, file, at + ".positions: no accessor index");
+    const AccessorBytes pos = readAccessor(doc, list[k]["positions"].get<int>(), file);
+    if (pos.componentType != kFloat || pos.type != "VEC3")
+      throw Error(ErrorCode::InvalidData, file, at + ".positions: accessor of componentType " + std::to_string(pos.componentType) +
+                                                    " " + pos.type + ", expected 5126 VEC3");
+    if (pos.count == 0 || pos.count % 3 != 0)
+      throw Error(ErrorCode::InvalidData, file, at + ".positions: " + std::to_string(pos.count) + " elements, not a whole number of triangles");
+    triangles += pos.count / 3;
+    if (triangles > static_cast<size_t>(kMaxExactEmitterTriangles))
+      throw Error(ErrorCode::InvalidData, file, what + ": more than " + std::to_string(kMaxExactEmitterTriangles) + " triangles");
+    e.positions.resize(pos.count);
+    std::memcpy(e.positions.data(), pos.bytes.data(), pos.count * sizeof(glm::vec3));
+    for (const glm::vec3& x : e.positions)
+      if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z))
+        throw Error(ErrorCode::InvalidData, file, at + ".positions: a non-finite position");
+    e.radiance = vec3Of(list[k], "radiance", file, at);
+    if (e.radiance.x < 0.0f || e.radiance.y < 0.0f || e.radiance.z < 0.0f)
+      throw Error(ErrorCode::InvalidData, file, at + ".radiance: negative");
+    const AccessorBytes v = probeAccessor(doc, list[k], "visibility", kUnsignedInt, "SCALAR", (n + 3) / 4, file, at);
+    std::vector<uint32_t> packed((n + 3) / 4);
+    std::memcpy(packed.data(), v.bytes.data(), packed.size() * sizeof(uint32_t));
+    e.visibility.resize(n);
+    for (size_t i = 0; i < n; ++i) e.visibility[i] = static_cast<float>((packed[i / 4] >> (8 * (i % 4))) & 255u) / 255.0f;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
 }  // namespace
 
 void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
@@ -145,6 +205,7 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
               {"units", "irradiance/pi"},
               {"convention", "three.js SphericalHarmonics3"}};
   if (grid.sun.present() && grid.sun.visibility.size() == n) ext["sun"] = sunLevelJson(doc, grid.sun);
+  if (!grid.emitters.empty()) ext["emitters"] = emittersJson(doc, grid.emitters);
   doc.root["extensions"][kLightProbesExtension] = std::move(ext);
   doc.useExtension(kLightProbesExtension);
 }
@@ -212,6 +273,7 @@ LightProbeGrid readLightProbes(const std::filesystem::path& path) {
     g.valid[i] = valid[i] == 1.0f;
   }
   if (ext->contains("sun")) g.sun = readSunLevel(doc, *ext, g, file);
+  if (ext->contains("emitters")) g.emitters = readEmitters(doc, *ext, g, file);
   return g;
 }
 

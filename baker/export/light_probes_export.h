@@ -12,6 +12,8 @@
 namespace irbake {
 
 constexpr const char* kLightProbesExtension = "IRBAKE_light_probes";
+// The most triangles the `emitters` may hold in all (the clients shade each at every pixel of a probe-lit object).
+constexpr int kMaxExactEmitterTriangles = 256;
 
 // Adds the grid's accessors (appended to buffer 0, no buffer-view target) and the extension.
 void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid);

@@ -12,9 +12,12 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "lightmap/probe_emitters.h"
 
 namespace irbake {
 
@@ -105,6 +108,7 @@ struct LightProbeGrid {
   std::vector<glm::vec3> offsets;            // where each probe was baked, relative to its grid point
   std::vector<uint8_t> valid;                // 0: inside geometry or behind a wall, left out of interpolation
   ProbeSunLevel sun;                         // optional: the sun's visibility refined where its shadow crosses
+  std::vector<ProbeEmitter> emitters;        // optional: emitters shaded exactly, not in the coefficients
 
   size_t size() const { return static_cast<size_t>(counts.x) * counts.y * counts.z; }
   size_t index(int i, int j, int k) const {
@@ -127,6 +131,7 @@ struct ProbeBlend {
   int probes = 0;       // valid, visible probes blended
   float weight = 0.0f;  // their summed trilinear weight (0: none; coefficients then 0)
   float sunVisibility = 0.0f;  // the sun level's visibility v(p) the coefficients carry (0 without a sun level)
+  std::array<std::pair<size_t, float>, 8> corners{};  // the blended probes and their weights (renormalised)
 };
 
 // The trilinear blend's probes around p (the cell clamped to the grid): corner(index, weight) for each of
@@ -173,10 +178,11 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
     for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += w * g.coefficients[idx][k];
     if (sun) sunBlend += w * g.sun.visibility[idx];
     out.weight += w;
-    ++out.probes;
+    out.corners[out.probes++] = {idx, w};
   }, &t);
   if (out.weight > 0.0f) {
     for (auto& c : out.coefficients) c /= out.weight;
+    for (int c = 0; c < out.probes; ++c) out.corners[c].second /= out.weight;
     const float fine = sun ? g.sun.fineVisibility(g.index(base.x, base.y, base.z), t) : -1.0f;
     if (fine >= 0.0f)
       for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * g.sun.sh[k];
@@ -195,6 +201,7 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
       }
   if (nearest == g.size()) return out;
   out.coefficients = g.coefficients[nearest];
+  out.corners[0] = {nearest, 1.0f};
   out.probes = 1;
   out.weight = 1.0f;
   if (sun) out.sunVisibility = g.sun.visibility[nearest];
@@ -204,12 +211,15 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
 // What a white Lambert surface with unit normal n shows (E(n)/π) under coefficients c that carry the sun level's
 // light at visibility v: the rest of the light through L2, clamped at 0 against its ringing, plus the sun as an
 // exact clamped cosine, v · irradiance · max(0, n·(−direction)). L2 alone rings on a delta: facing the sun it
-// reads 17/16 of it, at 90° from it 3/32 of it. Without a sun level: max(0, shIrradiance(c, n)).
-inline glm::vec3 shadeProbeLambert(const ShCoefficients& c, float v, const ProbeSunLevel& sun, const glm::vec3& n) {
-  if (!sun.present()) return glm::max(shIrradiance(c, n), glm::vec3(0.0f));
+// reads 17/16 of it, at 90° from it 3/32 of it. Without a sun level: max(0, shIrradiance(c, n)). `clampSh` false
+// leaves the L2 term unclamped (`irbake probe`, whose values the bench fits).
+inline glm::vec3 shadeProbeLambert(const ShCoefficients& c, float v, const ProbeSunLevel& sun, const glm::vec3& n,
+                                   bool clampSh = true) {
+  auto clamped = [&](const glm::vec3& e) { return clampSh ? glm::max(e, glm::vec3(0.0f)) : e; };
+  if (!sun.present()) return clamped(shIrradiance(c, n));
   ShCoefficients rest = c;
   for (int k = 0; k < kShCoefficients; ++k) rest[k] -= v * sun.sh[k];
-  return glm::max(shIrradiance(rest, n), glm::vec3(0.0f)) + v * sun.irradiance * std::max(0.0f, -glm::dot(n, sun.direction));
+  return clamped(shIrradiance(rest, n)) + v * sun.irradiance * std::max(0.0f, -glm::dot(n, sun.direction));
 }
 
 }  // namespace irbake

@@ -6,6 +6,10 @@
 //   NAME_sun_nan.gltf:        the sun's first SH coefficient NaN (in NAME_sun_nan.bin)
 //   NAME_sun_cells.gltf:      the refined cells' first two swapped (or the only one past the grid)
 //   NAME_sun_irradiance.gltf: the sun's irradiance negative
+// and, when it has exact emitters (`emitters`):
+//   NAME_emitter_positions.gltf:  the first emitter's positions pointing at the validity (FLOAT SCALAR)
+//   NAME_emitter_radiance.gltf:   its radiance [1, 1e39, 1] (not a finite float: JSON has no NaN)
+//   NAME_emitter_visibility.gltf: its visibility pointing at a copy of its accessor one element short
 // Usage: node corrupt_probes.mjs SCENE.gltf
 import fs from 'node:fs';
 import path from 'node:path';
@@ -64,4 +68,19 @@ if (sun?.cells !== undefined) {
   badCells.buffers[cellBuffer].uri = `${stem}_sun_cells.bin`;
   fs.writeFileSync(path.join(dir, `${stem}_sun_cells.bin`), cellBytes);
   fs.writeFileSync(path.join(dir, `${stem}_sun_cells.gltf`), JSON.stringify(badCells));
+}
+
+if (ext.emitters?.length) {
+  const write = (name, mutate) => {
+    const d = structuredClone(doc);
+    mutate(d, d.extensions.IRBAKE_light_probes.emitters[0]);
+    fs.writeFileSync(path.join(dir, `${stem}_${name}.gltf`), JSON.stringify(d));
+  };
+  write('emitter_positions', (d, e) => { e.positions = ext.valid; });
+  write('emitter_radiance', (d, e) => { e.radiance = [1, 1e39, 1]; });
+  // An UNSIGNED_INT SCALAR accessor of the wrong count: a copy of the visibility's with one element fewer.
+  write('emitter_visibility', (d, e) => {
+    d.accessors.push({ ...d.accessors[e.visibility], count: d.accessors[e.visibility].count - 1 });
+    e.visibility = d.accessors.length - 1;
+  });
 }

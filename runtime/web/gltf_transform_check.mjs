@@ -3,7 +3,7 @@
 //     every material of the bake that has MOZ_lightmap (and IRBAKE_lightmap_directional) has it in the output
 //     with the same numbers and texCoord 1 on an existing texture; every light-mapped primitive has TEXCOORD_1
 //     with POSITION's vertex count; the light-mapped triangles are as many as in the bake; with --probes,
-//     IRBAKE_light_probes keeps its fields and every accessor value (its sun level's included).
+//     IRBAKE_light_probes keeps its fields and every accessor value (its sun level's and exact emitters' included).
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
 //     non-numeric intensity, incomplete directional extension, a probe grid or sun level that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
@@ -16,7 +16,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHT_PROBES, IRBAKE_LIGHTMAP_DIRECTIONAL,
-  IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS, probeFields, SUN_ACCESSORS } from './gltf_transform_irbake.mjs';
+  EMITTER_ACCESSORS, IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS, probeFields, SUN_ACCESSORS } from './gltf_transform_irbake.mjs';
 
 const [mode, ...rest] = process.argv.slice(2);
 // --name value, or --name alone (a flag: true).
@@ -116,7 +116,8 @@ function probesSurvive(inDoc, outDoc, inJson, outJson) {
   check(same(probeFields(inDef), probeFields(outDef)), `${IRBAKE_LIGHT_PROBES}: fields ${JSON.stringify(probeFields(outDef))}`);
   const gridA = inDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES), gridB = outDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
   const keys = [...Object.keys(PROBE_ACCESSORS),
-                ...(inDef.sun ? Object.keys(SUN_ACCESSORS).filter(k => k in inDef.sun).map(k => `sun_${k}`) : [])];
+                ...(inDef.sun ? Object.keys(SUN_ACCESSORS).filter(k => k in inDef.sun).map(k => `sun_${k}`) : []),
+                ...(inDef.emitters ?? []).flatMap((_, i) => Object.keys(EMITTER_ACCESSORS).map(k => `emitters_${i}_${k}`))];
   for (const key of keys) {
     const a = gridA?.getAccessor(key)?.getArray(), b = gridB?.getAccessor(key)?.getArray();
     check(a && b && a.length === b.length && a.every((v, i) => Object.is(v, b[i])),
@@ -182,6 +183,11 @@ async function refusals() {
     if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun?.cells !== undefined) {
       await throws('sun fine', badGrid(e => { e.sun.fine = e.sun.cells; }), `${IRBAKE_LIGHT_PROBES}.sun.fine`, 'the grid needs');
       await throws('sun subdivisions', badGrid(e => { e.sun.subdivisions = 0; }), `${IRBAKE_LIGHT_PROBES}.sun.subdivisions`);
+    }
+    if (original.json.extensions[IRBAKE_LIGHT_PROBES].emitters) {
+      await throws('emitter visibility', badGrid(e => { e.emitters[0].visibility = e.valid; }),
+                   `${IRBAKE_LIGHT_PROBES}.emitters[0].visibility`, 'the grid needs');
+      await throws('emitter radiance', badGrid(e => { e.emitters[0].radiance = [1, null, 1]; }), `${IRBAKE_LIGHT_PROBES}.emitters[0].radiance`);
     }
   } else {
     failures.push(`${args.input}: no ${IRBAKE_LIGHT_PROBES} (baked with --probes off?)`);

@@ -27,10 +27,16 @@ export const SUN_ACCESSORS = {
   sh: [5126, 'VEC3', () => 9], visibility: [5125, 'SCALAR', probes => Math.ceil(probes / 4)], cells: [5125, 'SCALAR', () => null],
   fine: [5125, 'SCALAR', (probes, cells, S) => cells * Math.ceil((S + 1) ** 3 / 32)],
 };
-// An IRBAKE_light_probes definition without its accessor indices (those of `sun` included): what read → write keeps.
+// The optional exact emitters' accessors (`emitters[k].<key>`): component type, type, and the element count for a
+// grid of `probes` probes (null: any whole number of triangles).
+export const EMITTER_ACCESSORS = { positions: [5126, 'VEC3', () => null], visibility: [5125, 'SCALAR', probes => Math.ceil(probes / 4)] };
+// An IRBAKE_light_probes definition without its accessor indices (those of `sun` and `emitters` included): what
+// read → write keeps.
 export function probeFields(def) {
   const fields = Object.fromEntries(Object.entries(def).filter(([k]) => !(k in PROBE_ACCESSORS)));
   if (isObject(def.sun)) fields.sun = Object.fromEntries(Object.entries(def.sun).filter(([k]) => !(k in SUN_ACCESSORS)));
+  if (Array.isArray(def.emitters))
+    fields.emitters = def.emitters.map(e => Object.fromEntries(Object.entries(e ?? {}).filter(([k]) => !(k in EMITTER_ACCESSORS))));
   return fields;
 }
 export const IRBAKE_SHADOWMASK = 'IRBAKE_shadowmask';
@@ -388,7 +394,7 @@ export function defineIrbakeExtensions(core) {
       const grid = this.createLightProbeGrid().setFields(probeFields(def));
       const accessor = (holder, key, ref, componentType, type, count) => {
         const index = holder[key], accessorDef = json.accessors?.[index];
-        const what = `${IRBAKE_LIGHT_PROBES}.${ref.replace('_', '.')}`;
+        const what = `${IRBAKE_LIGHT_PROBES}.${refName(ref)}`;
         if (!Number.isInteger(index) || accessorDef === undefined) throw new Error(`${what}: accessor ${JSON.stringify(index)} does not exist`);
         if (count === null) count = accessorDef.count;
         if (accessorDef.componentType !== componentType || accessorDef.type !== type || accessorDef.count !== count)
@@ -411,6 +417,19 @@ export function defineIrbakeExtensions(core) {
           if (key === 'cells') cells = n;
         }
       }
+      if (def.emitters !== undefined) {
+        if (!Array.isArray(def.emitters)) throw new Error(`${IRBAKE_LIGHT_PROBES}.emitters is not an array`);
+        def.emitters.forEach((e, k) => {
+          if (!isObject(e)) throw new Error(`${IRBAKE_LIGHT_PROBES}.emitters[${k}] is not an object`);
+          if (!(Array.isArray(e.radiance) && e.radiance.length === 3 && e.radiance.every(x => typeof x === 'number' && Number.isFinite(x) && x >= 0)))
+            throw new Error(`${IRBAKE_LIGHT_PROBES}.emitters[${k}].radiance ${JSON.stringify(e.radiance)} needs 3 finite numbers ≥ 0`);
+          for (const [key, [componentType, type, count]] of Object.entries(EMITTER_ACCESSORS)) {
+            const n = accessor(e, key, `emitters_${k}_${key}`, componentType, type, count(probes));
+            if (key === 'positions' && (n === 0 || n % 3 !== 0))
+              throw new Error(`${IRBAKE_LIGHT_PROBES}.emitters[${k}].positions: ${n} elements, not a whole number of triangles`);
+          }
+        });
+      }
       this.document.getRoot().setExtension(IRBAKE_LIGHT_PROBES, grid);
       return this;
     }
@@ -422,7 +441,7 @@ export function defineIrbakeExtensions(core) {
       const indexOf = ref => {
         const accessor = grid.getAccessor(ref);
         const index = accessor ? context.accessorIndexMap.get(accessor) : undefined;
-        if (index === undefined) throw new Error(`${IRBAKE_LIGHT_PROBES}: the ${ref.replace('_', '.')} accessor was lost`);
+        if (index === undefined) throw new Error(`${IRBAKE_LIGHT_PROBES}: the ${refName(ref)} accessor was lost`);
         return index;
       };
       for (const key of Object.keys(PROBE_ACCESSORS)) def[key] = indexOf(key);
@@ -431,6 +450,12 @@ export function defineIrbakeExtensions(core) {
         for (const key of Object.keys(SUN_ACCESSORS))
           if (grid.getAccessor(`sun_${key}`) || (key !== 'cells' && key !== 'fine')) def.sun[key] = indexOf(`sun_${key}`);
       }
+      if (def.emitters !== undefined)
+        def.emitters = def.emitters.map((e, k) => {
+          const out = { ...e };
+          for (const key of Object.keys(EMITTER_ACCESSORS)) out[key] = indexOf(`emitters_${k}_${key}`);
+          return out;
+        });
       const json = context.jsonDoc.json;
       json.extensions = json.extensions ?? {};
       json.extensions[IRBAKE_LIGHT_PROBES] = def;
@@ -538,6 +563,11 @@ export function defineIrbakeExtensions(core) {
 }
 
 // The probe count of an IRBAKE_light_probes definition, or an Error naming the field that is wrong.
+// A reference's field name in messages: sun_sh → sun.sh, emitters_0_positions → emitters[0].positions.
+function refName(ref) {
+  return ref.replace(/^emitters_(\d+)_/, 'emitters[$1].').replace('_', '.');
+}
+
 export function checkProbeGrid(def) {
   const what = IRBAKE_LIGHT_PROBES;
   if (!isObject(def)) throw new Error(`${what} is not an object`);

@@ -13,10 +13,13 @@
 // replaced by the finer lattice's, and the sun is shaded as an exact clamped cosine at its visibility v(p) (blended
 // and given a gradient as the coefficients), taken out of the L2 term: max(0, shGetIrradianceAt(n, c − v·sh)) +
 // v·irradiance·max(0, n·(−direction)), as irview and `irbake probe --normal` (probe_grid.h, shadeProbeLambert).
+// With the optional `emitters` (irbake_probe_emitters.js), their exact light is added at each point, their
+// visibility blended as the SH.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
-import { Box3, SphericalHarmonics3, Vector3 } from 'three';
+import { Box3, SphericalHarmonics3, Vector3, Vector4 } from 'three';
 import { readSunLevel, SUN_SHADER, sunUniforms } from './irbake_probe_sun.js';
+import { emitterGlsl, emitterUniforms, readEmitters, visibilityField } from './irbake_probe_emitters.js';
 
 export const LIGHT_PROBES = 'IRBAKE_light_probes';
 const FLOAT = 5126;
@@ -25,8 +28,8 @@ const COMPONENTS = { SCALAR: 1, VEC3: 3 };
 // The probe grid: coefficients (Float32Array, 27 per probe: SphericalHarmonics3.fromArray's layout), offsets
 // (3 per probe), valid (Uint8Array).
 export class IrbakeProbeGrid {
-  constructor({ origin, spacing, counts, coefficients, offsets, valid, sun = null }) {
-    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid, sun });
+  constructor({ origin, spacing, counts, coefficients, offsets, valid, sun = null, emitters = [] }) {
+    Object.assign(this, { origin, spacing, counts, coefficients, offsets, valid, sun, emitters });
   }
 
   get size() { return this.counts[0] * this.counts[1] * this.counts[2]; }
@@ -43,7 +46,7 @@ export class IrbakeProbeGrid {
   // of the 4×4×4 around p; probes 0 when there is none. In a cell of the sun level, the blend's sun is the
   // lattice's; sunVisibility is the visibility the coefficients carry (0 without a sun level).
   interpolate(p) {
-    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0, sunVisibility: 0 };
+    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0, corners: [], sunVisibility: 0 };
     const base = [0, 0, 0], t = [0, 0, 0];
     let sunBlend = 0;
     for (let a = 0; a < 3; ++a) {
@@ -65,9 +68,11 @@ export class IrbakeProbeGrid {
       if (this.sun) sunBlend += w * this.sun.visibility[idx];
       out.weight += w;
       ++out.probes;
+      out.corners.push([idx, w]);
     }
     if (out.weight > 0) {
       for (let k = 0; k < 27; ++k) out.coefficients[k] /= out.weight;
+      for (const c of out.corners) c[1] /= out.weight;
       const fine = this.sun ? this.sun.fineVisibility(this.index(base[0], base[1], base[2]), t) : -1;
       if (fine >= 0)
         for (let k = 0; k < 27; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * this.sun.sh[k];
@@ -89,6 +94,7 @@ export class IrbakeProbeGrid {
     out.probes = 1;
     out.weight = 1;
     if (this.sun) out.sunVisibility = this.sun.visibility[nearest];
+    out.corners = [[nearest, 1]];
     return out;
   }
 
@@ -123,7 +129,8 @@ export class IrbakeProbeGrid {
     const field = this.field(point, radius);
     if (field.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
     mesh.material = mesh.material.clone();
-    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient, sun: this.sun,
+    const emitters = this.emitters.length ? emitterUniforms(this.emitters, visibilityField(this, point, radius)) : null;
+    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient, emitters, sun: this.sun,
                                                       sunVisibility: field.sunVisibility, sunGradient: field.sunGradient });
     return field;
   }
@@ -132,7 +139,8 @@ export class IrbakeProbeGrid {
 // Adds π × max(0, shGetIrradianceAt(n, sh(p))) to a Lambert (or any lit) material's indirect irradiance, n the
 // world normal, sh(p) = coefficients + (p − centre)·gradient at the fragment's world point p (without `field`:
 // the coefficients everywhere): three.js's own light-probe term, per material instead of per scene, clamped at 0
-// as irview. With `field.sun` (a sun level) its sun is taken out of sh(p) at the visibility
+// as irview; plus, with field.emitters (irbake_probe_emitters.js, emitterUniforms), the exact emitters' π × E/π.
+// With `field.sun` (a sun level) its sun is taken out of sh(p) at the visibility
 // v(p) = clamp(sunVisibility + (p − centre)·sunGradient, 0, 1) and added exactly (irbake_probe_sun.js, SUN_SHADER).
 export function applyProbeSh(material, coefficients, field = null) {
   const vec3s = (a, from) => [...Array(9)].map((_, k) => new Vector3(a[from + 3 * k], a[from + 3 * k + 1], a[from + 3 * k + 2]));
@@ -142,8 +150,18 @@ export function applyProbeSh(material, coefficients, field = null) {
   material.userData.irbakeProbeGradient = { value: gradient };
   material.userData.irbakeProbeCentre = { value: new Vector3(...(field ? field.centre : [0, 0, 0])) };
   material.userData.irbakeSun = sunUniforms(field?.sun ?? null, field?.sunVisibility ?? 0, field?.sunGradient ?? [0, 0, 0]);
+  const emitters = field?.emitters?.triangles > 0 ? field.emitters : null;
+  if (emitters) {
+    const vectors = (a, size, Type) => [...Array(a.length / size)].map((_, i) => new Type(...a.slice(size * i, size * i + size)));
+    material.userData.irbakeEmitterPositions = { value: vectors(emitters.positions, 3, Vector3) };
+    material.userData.irbakeEmitterRadiance = { value: vectors(emitters.radiance, 3, Vector3) };
+    material.userData.irbakeEmitterVisibility = { value: vectors(emitters.visibility, 4, Vector4) };
+  }
   material.onBeforeCompile = shader => {
     shader.uniforms.irbakeProbeSh = material.userData.irbakeProbeSh;
+    if (emitters)
+      for (const name of ['irbakeEmitterPositions', 'irbakeEmitterRadiance', 'irbakeEmitterVisibility'])
+        shader.uniforms[name] = material.userData[name];
     shader.uniforms.irbakeProbeGradient = material.userData.irbakeProbeGradient;
     shader.uniforms.irbakeProbeCentre = material.userData.irbakeProbeCentre;
     Object.assign(shader.uniforms, material.userData.irbakeSun);
@@ -166,8 +184,14 @@ varying vec3 irbakeProbeOffset;\nvoid main() {`)
                   + irbakeProbeOffset.y * irbakeProbeGradient[ 9 + k ] + irbakeProbeOffset.z * irbakeProbeGradient[ 18 + k ]
                   - irbakeSunV * irbakeSunSh[ k ];
   irradiance += PI * ( max( shGetIrradianceAt( irbakeN, irbakeSh ), vec3( 0.0 ) ) + ${SUN_SHADER.direct} );`);
+    if (emitters)
+      shader.fragmentShader = shader.fragmentShader
+        .replace('void main() {', `uniform vec3 irbakeProbeCentre;\n${emitterGlsl(emitters.triangles)}\nvoid main() {`)
+        .replace(anchor, `${anchor}
+  irradiance += PI * irbakeExactEmitterLight( irbakeProbeCentre + irbakeProbeOffset,
+    normalize( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ) ), irbakeProbeOffset );`);
   };
-  material.customProgramCacheKey = () => 'irbake-light-probes-field';
+  material.customProgramCacheKey = () => `irbake-light-probes-field-${emitters ? emitters.triangles : 0}`;
   material.needsUpdate = true;
 }
 
@@ -241,7 +265,8 @@ export async function readProbeGrid(json, accessor) {
     valid[i] = validity[i];
   }
   const sun = ext.sun === undefined ? null : await readSunLevel(ext, counts, readFrom(ext.sun ?? {}, 'sun.'));
-  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun });
+  const emitters = ext.emitters === undefined ? [] : await readEmitters(ext, n, readFrom);
+  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun, emitters });
 }
 
 // The loader plugin: after the document loads, gltf.userData.irbakeLightProbes is the grid (null without the

@@ -1,7 +1,7 @@
 // Runs the Khronos glTF-Validator (npm gltf-validator, validateBytes) on an export and, when given,
 // on its input. Passes (exit 0) when the export has 0 errors, no warning the input did not already
 // have (compared by code and count), and no UNUSED_OBJECT for a mesh or an accessor (but the accessors
-// IRBAKE_light_probes and its `sun` name: the validator does not know the extension). Prints the counts.
+// IRBAKE_light_probes and its `sun` and `emitters` name: the validator does not know the extension). Prints the counts.
 // Usage: node validate.mjs --modules DIR --output OUT.gltf|.glb [--input IN.gltf|.glb]
 import fs from 'node:fs';
 import path from 'node:path';
@@ -49,11 +49,13 @@ for (const [code, n] of Object.entries(out.warningCodes)) {
   if (n > before) problems.push(`warning ${code}: ${n} (input: ${before})`);
 }
 // IRBAKE_light_probes names its accessors from the root's extensions, which the validator does not read.
-// Its optional `sun` object names four more.
+// Its optional `sun` object names four more, and each of its optional `emitters` two.
 const probeExt = jsonOf(args.output).extensions?.IRBAKE_light_probes ?? {};
 const probeAccessors = new Set([
   ...Object.entries(probeExt).filter(([k]) => ['coefficients', 'offsets', 'valid'].includes(k)),
   ...Object.entries(probeExt.sun ?? {}).filter(([k]) => ['sh', 'visibility', 'cells', 'fine'].includes(k)),
+  ...(Array.isArray(probeExt.emitters) ? probeExt.emitters : []).flatMap(e => Object.entries(e ?? {}))
+    .filter(([k]) => ['positions', 'visibility'].includes(k)),
 ].map(([, v]) => `/accessors/${v}`));
 for (const m of out.report.issues.messages)
   if (m.code === 'UNUSED_OBJECT' && /^\/(meshes|accessors)\/\d+$/.test(m.pointer ?? '') && !probeAccessors.has(m.pointer))

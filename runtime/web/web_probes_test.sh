@@ -4,7 +4,8 @@
 # (irbake_light_probes.js, ?probeObject=) and require the sphere's pixels to agree: mean absolute difference
 # ≤ 1 (8-bit; what is left is the three.js sphere's tessellated normals and the two sRGB encoders' rounding).
 # Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
-# the problem. The same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
+# the problem, and three bad exact emitters (the box's ceiling light is one: IRBAKE_light_probes.emitters). The
+# same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
 # straight down, the sphere across the square's shadow edge in a refined cell, its sun shaded as an exact clamped
 # cosine by both (L2 would put 3/32 of the sun on its equator); and refusals of a sun visibility SH that is not
 # finite, unsorted cells and a negative sun irradiance. glTF-Transform optimize (meshopt) with runtime/web's config must keep
@@ -37,6 +38,16 @@ node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_zero
   --expect-error "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_nan.gltf" \
   --expect-error "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
+# The box's ceiling light is an exact emitter (IRBAKE_light_probes.emitters): the sphere above is lit by it so in
+# both clients; each refuses a bad entry naming the field.
+node -e "const e = JSON.parse(require('fs').readFileSync('$work/bake/scene.gltf')).extensions.IRBAKE_light_probes;
+         if (!(e.emitters?.length === 1)) { console.error('the ceiling light is not an exact emitter'); process.exit(1); }"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_positions.gltf" \
+  --expect-error "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR, expected 5126 VEC3"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_radiance.gltf" \
+  --expect-error "IRBAKE_light_probes.emitters[0].radiance: not finite"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_visibility.gltf" \
+  --expect-error "IRBAKE_light_probes.emitters[0].visibility: "
 
 # The sun level (with --directional, which gltf_transform_check.mjs refusals needs): probes every 0.5 m,
 # x = ..., 0.25, 0.75, ...; the shadow edge x = 0.5 crosses that cell.

@@ -13,6 +13,7 @@
 #include "sampling/sampling.h"
 #include "transport/geometry_term.h"
 #include "stages/probes/blend_fit.h"
+#include "stages/probes/exact_emitters.h"
 #include "stages/probes/light_visibility_fit.h"
 #include "stages/probes/sun_level.h"
 #include "vpl/light_sources.h"
@@ -37,16 +38,26 @@ struct ProbeTrace {
 // a = N/(4π), the emitter samples with b = K p(ω), p(ω) = p_A r²/cosθ_y; weighted a²/(a² + b²) and b²/(a² + b²),
 // an emitter's direction ω counts Le a/(a² + b²) per lattice ray and Le b/(a² + b²) per shadow ray: a small
 // emitter is nearly all shadow rays, a wall nearly all lattice, and no direction is counted twice.
+// The exact emitters' emission counts in neither (weight 0, never sampled): the clients shade it.
 struct EmitterSampler {
   LightSources sources;
+  const ExactEmitters& exact;
   int samples = 0;              // K
   double latticeDensity = 0.0;  // N/(4π)
-  EmitterSampler(const Scene& scene, int k, int rays) : sources(collectLightSources(scene)), latticeDensity(rays / (4.0 * kPi)) {
+  EmitterSampler(const Scene& scene, const ExactEmitters& kept, int k, int rays)
+      : sources(collectLightSources(scene)), exact(kept), latticeDensity(rays / (4.0 * kPi)) {
+    if (!exact.primitives.empty() && !sources.triangles.empty()) {
+      std::vector<double> weights(sources.triangles.size());
+      for (size_t t = 0; t < weights.size(); ++t)
+        weights[t] = exact.contains(sources.triangles[t].primitive) ? 0.0 : channelMean(sources.triangles[t].power);
+      sources.areaOnly = AliasTable(weights);
+    }
     const bool any = !sources.triangles.empty() && sources.areaOnly.total() > 0.0;
     samples = any ? std::max(0, k) : 0;
   }
   // The weight of a lattice ray's front-face hit on an emitter (1 where no shadow ray could find it).
   double latticeWeight(const RayHit& hit, const glm::vec3& dir) const {
+    if (exact.contains(hit.primitive)) return 0.0;
     if (samples == 0) return 1.0;
     const double pA = sources.areaPdf(hit.primitive, hit.triangle), cosY = -glm::dot(hit.geometricNormal, dir);
     if (!(pA > 0.0) || !(cosY > 0.0)) return 1.0;
@@ -181,8 +192,8 @@ struct VolumeFitStats {
   int sweeps = 0;
 };
 
-VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, LightProbeGrid& grid,
-                              const ProbeOptions& options) {
+VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, const ExactEmitters& exact,
+                              LightProbeGrid& grid, const ProbeOptions& options) {
   VolumeFitStats out;
   const int S = std::max(0, options.volumeFitSamples);
   if (S == 0) return out;
@@ -190,7 +201,7 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, Lig
   const int emitterSamples = options.emitterSamples > 0
                                  ? std::max(1, static_cast<int>(std::lround(double(options.emitterSamples) * rays / std::max(16, options.rays))))
                                  : 0;
-  const EmitterSampler emitters(in.scene, emitterSamples, rays);
+  const EmitterSampler emitters(in.scene, exact, emitterSamples, rays);
   const int tooManyBack = static_cast<int>(std::floor(options.maxBackFaceShare * rays));
   const size_t n = grid.size(), perProbe = static_cast<size_t>(S) * S * S, m = 3 * kShCoefficients;
   std::vector<BlendSample> samples(n * perProbe);
@@ -277,7 +288,8 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
   grid.valid.assign(n, 0);
   const MapReader reader(in, maps);
   const int rays = std::max(16, options.rays);
-  const EmitterSampler emitters(in.scene, options.emitterSamples, rays);
+  const ExactEmitters exact = chooseExactEmitters(in.scene, grid.spacing, std::max(0, options.exactEmitterTriangles));
+  const EmitterSampler emitters(in.scene, exact, options.emitterSamples, rays);
   const int tooManyBack = static_cast<int>(std::floor(options.maxBackFaceShare * rays));
   std::atomic<size_t> traced{0}, moved{0};
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
@@ -307,8 +319,10 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
   });
   // The rest of the light fitted over the blend, then the punctual lights, once every probe's validity is known:
   // their visibility is fitted over the blend as well.
-  const VolumeFitStats volume = fitProbeVolume(in, reader, grid, options);
+  const VolumeFitStats volume = fitProbeVolume(in, reader, exact, grid, options);
   traced += volume.rays;
+  const size_t emitterRays = bakeEmitterVisibility(in, exact, options.emitterVisibilitySamples, options.seed, grid);
+  traced += emitterRays;
   LightVisibilityFit fit = fitLightVisibility(in, grid, options.lightFitSamples, options.seed);
   // The sun level's light: its visibilities in steps of 1/255, as the export stores them (a byte each), so that
   // what the clients subtract is what the coefficients carry.
@@ -348,6 +362,9 @@ void bakeLightProbes(const BakeInputs& in, const std::vector<Lightmap>& maps, Li
     stats->volumeFitSweeps = volume.sweeps;
     stats->sunCells = sunStats.cells;
     stats->sunRays = sunStats.rays;
+    stats->exactEmitters = exact.emitters.size();
+    for (const ProbeEmitter& e : exact.emitters) stats->exactEmitterTriangles += e.positions.size() / 3;
+    stats->emitterVisibilityRays = emitterRays;
     stats->seconds = watch.seconds();
   }
 }

@@ -2,7 +2,8 @@
 // there from every direction as L2 spherical harmonics (lightmap/probe_grid.h), from the same light as the maps:
 //   punctual lights exact (their map value at normal incidence projected as a delta), times their visibility
 //   fitted over the volume the probe blends (light_visibility_fit.h);
-//   emissive triangles by next-event estimation: K shadow rays to points picked by power, on a rotated 2D
+//   emitters kept for the clients' exact shading (exact_emitters.h) left out, their visibility stored instead;
+//   the other emissive triangles by next-event estimation: K shadow rays to points picked by power, on a rotated 2D
 //   Fibonacci lattice, each direction's Le projected with its solid-angle density p(ω) = p_A r²/cosθ_y (front
 //   faces only);
 //   every other direction by N rays on a rotated spherical Fibonacci lattice, c_k = (4π/N)(1/π) Σ L_i Y_k(ω_i):
@@ -62,6 +63,9 @@ struct ProbeOptions {
   int sunSubdivisions = 4;            // the strongest directional light's visibility on a lattice this many
                                       // times finer in the cells its shadow crosses (sun_level.h); 0: none
   float sunTolerance = 0.1f;          // refine a cell where that lattice and the probes' blend differ by more
+  int exactEmitterTriangles = 64;     // emitters left out of the SH for the clients' exact shading, at most this
+                                      // many triangles in all (exact_emitters.h); 0: every emitter in the SH
+  int emitterVisibilitySamples = 64;  // shadow rays per probe to each exact emitter for its visibility
 };
 
 struct ProbeStats {
@@ -74,12 +78,15 @@ struct ProbeStats {
   int volumeFitSweeps = 0;
   size_t sunCells = 0;  // cells of the sun level
   size_t sunRays = 0;   // its shadow rays (in `rays` too)
+  size_t exactEmitters = 0, exactEmitterTriangles = 0;  // emitters shaded exactly by the clients
+  size_t emitterVisibilityRays = 0;                     // their visibility's shadow rays (in `rays` too)
   double seconds = 0.0;
   nlohmann::json toJson() const {  // report "probes" (seconds: under "timings", as every stage's wall time)
     return {{"count", count}, {"valid", valid}, {"moved", moved}, {"spacing", spacing}, {"rays", rays},
             {"lightFitSamples", lightFitSamples}, {"lightFitSweeps", lightFitSweeps},
             {"volumeFitSamples", volumeFitSamples}, {"volumeFitSweeps", volumeFitSweeps},
-            {"sunCells", sunCells}, {"sunRays", sunRays}};
+            {"sunCells", sunCells}, {"sunRays", sunRays}, {"exactEmitters", exactEmitters},
+            {"exactEmitterTriangles", exactEmitterTriangles}, {"emitterVisibilityRays", emitterVisibilityRays}};
   }
 };
 

@@ -12,6 +12,7 @@
 
 #include "common/error.h"
 
+#include "lightmap/probe_emitter_field.h"
 #include "lightmap/probe_grid.h"
 #include "testing/scenes.h"
 #include "samples/sample_scenes.h"
@@ -41,8 +42,9 @@ std::vector<Lightmap> filledMaps(const std::vector<TexelSamples>& pages, glm::ve
 }
 
 // One probe at p (a zero-extent box).
+// exactEmitterTriangles 0: every emitter in the SH (the tests of the SH's own emitter sampling).
 LightProbeGrid bakeOne(AtlasedScene& s, const std::vector<Lightmap>& maps, glm::vec3 p, int rays, int emitterSamples = 128,
-                       uint32_t seed = 0) {
+                       uint32_t seed = 0, int exactEmitterTriangles = ProbeOptions{}.exactEmitterTriangles) {
   const VplSet none;
   const BakeInputs in{s.scene, *s.rayTracer, s.pages, none, VplEvalOptions{}, {}};
   Bounds3 box;
@@ -52,6 +54,7 @@ LightProbeGrid bakeOne(AtlasedScene& s, const std::vector<Lightmap>& maps, glm::
   options.rays = rays;
   options.emitterSamples = emitterSamples;
   options.seed = seed;
+  options.exactEmitterTriangles = exactEmitterTriangles;
   options.volumeFitSamples = 0;  // the probe's own value: one probe's volume fit is its cube's mean light
   bakeLightProbes(in, maps, grid, options);
   return grid;
@@ -107,7 +110,7 @@ double squareCos2(double a, double h) {
 }
 
 TEST(LightProbes, SmallEmitterMatchesItsSolidAngleAndFormFactor) {
-  // A 0.4 × 0.4 m emitter 1 m above the probe: Ω = 0.154 sr, about 12 of the 1024 lattice rays. The mean over
+  // In the SH (no exact emitters: exact_emitters_test.cpp has those). A 0.4 × 0.4 m emitter 1 m above the probe: Ω = 0.154 sr, about 12 of the 1024 lattice rays. The mean over
   // normals (L0) is Le Ω/(4π) exactly; facing it, the L2 irradiance is (Le/π) ∫ K(cosθ) dω with the L2 kernel
   // K(c) = 1/4 + c/2 + (5/32)(3c² − 1): (Le/π)[(3/32) Ω + (π/2) F + (15/32) ∫cos²θ dω], F the form factor (the
   // true E/π = Le F differs by the L2 truncation, ≤ 3/32 of the peak). Above the emitter (its back) nothing.
@@ -117,14 +120,14 @@ TEST(LightProbes, SmallEmitterMatchesItsSolidAngleAndFormFactor) {
   const double omega = squareSolidAngle(a, h), F = squareViewFactor(a, h);
   const double mean = Le * omega / (4.0 * kPi);
   const double up = Le / kPi * (3.0 / 32.0 * omega + 0.5 * kPi * F + 15.0 / 32.0 * squareCos2(a, h));
-  const LightProbeGrid g = bakeOne(s, maps, glm::vec3(0.0f), 1024);
+  const LightProbeGrid g = bakeOne(s, maps, glm::vec3(0.0f), 1024, 128, 0, 0);
   ASSERT_EQ(g.valid[0], 1);
   const double gotMean = shAverage(g.coefficients[0]).x, gotUp = shIrradiance(g.coefficients[0], glm::vec3(0, 1, 0)).x;
   std::printf("mean %.6f (exact %.6f), up %.6f (L2 exact %.6f, true Le F %.6f)\n", gotMean, mean, gotUp, up, Le * F);
   EXPECT_NEAR(gotMean, mean, 0.005 * mean);
   EXPECT_NEAR(gotUp, up, 0.005 * up);
   EXPECT_NEAR(gotUp, Le * F, kTruncation * Le * F);
-  const LightProbeGrid above = bakeOne(s, maps, glm::vec3(0.0f, 2.0f * h, 0.0f), 1024);
+  const LightProbeGrid above = bakeOne(s, maps, glm::vec3(0.0f, 2.0f * h, 0.0f), 1024, 128, 0, 0);
   ASSERT_EQ(above.valid[0], 1);
   EXPECT_EQ(shAverage(above.coefficients[0]).x, 0.0f);
 }
@@ -141,7 +144,7 @@ TEST(LightProbes, EmitterSamplesCutTheSeedToSeedSpread) {
     double sum = 0.0, sum2 = 0.0;
     const int seeds = 16;
     for (int seed = 0; seed < seeds; ++seed) {
-      const double v = shAverage(bakeOne(s, maps, glm::vec3(0.0f), 1024, emitterSamples, seed).coefficients[0]).x / mean;
+      const double v = shAverage(bakeOne(s, maps, glm::vec3(0.0f), 1024, emitterSamples, seed, 0).coefficients[0]).x / mean;
       sum += v, sum2 += v * v;
     }
     const double m = sum / seeds;
@@ -154,6 +157,52 @@ TEST(LightProbes, EmitterSamplesCutTheSeedToSeedSpread) {
   EXPECT_NEAR(withSamples, 1.0, 0.005);
   EXPECT_LT(spreadWith, 0.002);
   EXPECT_GT(spreadLattice, 10.0 * spreadWith);
+}
+
+TEST(LightProbes, ExactEmitterLeavesTheShWithItsEnergyAndVisibility) {
+  // The lone square (32 triangles, uniform, planar) is an exact emitter: its light is in neither the lattice nor
+  // the shadow rays (every coefficient 0), the probe sees all of it (v = 1), and the clients' exact term's mean
+  // over normals, Le Ω/(4π), is what the SH's L0 held before (within its 0.5%).
+  const float a = 0.2f, h = 1.0f, Le = 5.0f;
+  AtlasedScene s = squareEmitter(a, h, Le);
+  const std::vector<Lightmap> black = filledMaps(s.pages, glm::vec3(0.0f));
+  const LightProbeGrid g = bakeOne(s, black, glm::vec3(0.0f), 1024);
+  ASSERT_EQ(g.emitters.size(), 1u);
+  ASSERT_EQ(g.emitters[0].positions.size(), 96u);
+  EXPECT_EQ(g.emitters[0].visibility[0], 1.0f);
+  for (const glm::vec3& c : g.coefficients[0]) EXPECT_EQ(c, glm::vec3(0.0f));
+  const double exact = exactEmitterMean(g.emitters, {1.0f}, glm::vec3(0.0f)).x, closed = Le * squareSolidAngle(a, h) / (4.0 * kPi);
+  EXPECT_NEAR(exact, closed, 1e-5 * closed);
+  const double old = shAverage(bakeOne(s, black, glm::vec3(0.0f), 1024, 128, 0, 0).coefficients[0]).x;
+  EXPECT_NEAR(exact, old, 0.005 * old);
+  // Over a grey floor (ρ 0.5, map 0.3): the floor's light stays in the SH, and SH + exact term = the old L0 (its
+  // emitter part by 8192 shadow rays: off the square's axis 128 left it 0.9–1.2% from the exact value).
+  Scene floorScene;
+  addQuad(floorScene, addMaterial(floorScene, glm::vec3(0.0f), glm::vec3(Le)), glm::vec3(-a, h, -a), glm::vec3(2 * a, 0, 0),
+          glm::vec3(0, 0, 2 * a), 4);
+  addQuad(floorScene, addMaterial(floorScene, glm::vec3(0.5f)), glm::vec3(-2, 0, -2), glm::vec3(0, 0, 4), glm::vec3(4, 0, 0), 4);
+  AtlasedScene f(std::move(floorScene), 32);
+  const std::vector<Lightmap> lit = filledMaps(f.pages, glm::vec3(0.3f));
+  for (const glm::vec3 p : {glm::vec3(0.1f, 0.4f, 0.2f), glm::vec3(-0.5f, 0.8f, 0.3f)}) {
+    const LightProbeGrid now = bakeOne(f, lit, p, 1024), before = bakeOne(f, lit, p, 1024, 8192, 0, 0);
+    ASSERT_EQ(now.emitters.size(), 1u);
+    const double sum = shAverage(now.coefficients[0]).x + exactEmitterMean(now.emitters, {now.emitters[0].visibility[0]}, p).x;
+    const double floorOnly = shAverage(now.coefficients[0]).x, was = shAverage(before.coefficients[0]).x;
+    std::printf("at %.1f,%.1f,%.1f: SH %.5f + exact = %.5f, before %.5f\n", p.x, p.y, p.z, floorOnly, sum, was);
+    EXPECT_GT(floorOnly, 0.0);
+    EXPECT_NEAR(sum, was, 0.001 * was);
+  }
+  // A black plate halfway up over the x < 0 half of the square's footprint hides exactly that half from the
+  // origin (by symmetry half the solid-angle-weighted samples): v = 1/2.
+  Scene shaded;
+  addQuad(shaded, addMaterial(shaded, glm::vec3(0.0f), glm::vec3(Le)), glm::vec3(-a, h, -a), glm::vec3(2 * a, 0, 0),
+          glm::vec3(0, 0, 2 * a), 4);
+  addQuad(shaded, addMaterial(shaded, glm::vec3(0.0f)), glm::vec3(-a / 2 - 0.01f, h / 2, -a / 2 - 0.01f),
+          glm::vec3(a / 2 + 0.01f, 0, 0), glm::vec3(0, 0, a + 0.02f));
+  AtlasedScene sh(std::move(shaded), 16);
+  const LightProbeGrid half = bakeOne(sh, filledMaps(sh.pages, glm::vec3(0.0f)), glm::vec3(0.0f), 1024);
+  ASSERT_EQ(half.emitters.size(), 1u);
+  EXPECT_NEAR(half.emitters[0].visibility[0], 0.5, 0.03);
 }
 
 TEST(LightProbes, ClosedFurnaceGivesLeOverOneMinusRhoEverywhere) {
