@@ -12,10 +12,11 @@ namespace irbake::view {
 std::vector<std::filesystem::path> runHeadless(const ViewerScene& v, const ViewerOptions& o) {
   // Check the output name before any GL work, so a typo fails fast.
   imageFormatFor(o.screenshot);
-  std::vector<ProbeSphere> probes = probeSpheresFor(o);
+  ProbeSphereSun probeSun;
+  std::vector<ProbeSphere> probes = probeSpheresFor(o, &probeSun);
   GlContext gl;
   ViewRenderer renderer(v);
-  addProbeOverlay(renderer, std::move(probes));
+  addProbeOverlay(renderer, std::move(probes), probeSun);
   DrawSettings settings;
   settings.mode = o.mode;
   settings.lightmapMode = o.lightmapMode;

@@ -27,6 +27,8 @@ ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, flo
   s.radius = radius;
   s.coefficients = field.centre;
   s.gradient = field.gradient;
+  s.sunVisibility = field.sunVisibility;
+  s.sunGradient = field.sunGradient;
   if (!grid.emitters.empty()) {
     s.emitters = std::make_shared<const std::vector<ProbeEmitter>>(grid.emitters);
     s.emitterVisibility = emitterVisibilityOver(grid, centre, radius, [](const glm::vec3&, const glm::vec3&) { return true; });
@@ -47,13 +49,24 @@ std::vector<ProbeSphere> probeGridSpheres(const LightProbeGrid& grid) {
     spheres[i].radius = 0.12f * grid.spacing;
     spheres[i].coefficients = grid.coefficients[i];
     spheres[i].valid = grid.valid[i] != 0;
+    if (grid.sun.present() && grid.sun.visibility.size() == grid.size()) spheres[i].sunVisibility = grid.sun.visibility[i];
   }
   return spheres;
 }
 
-std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& o) {
+ProbeSphereSun probeSphereSun(const LightProbeGrid& grid) {
+  ProbeSphereSun s;
+  if (!grid.sun.present()) return s;
+  s.direction = grid.sun.direction;
+  s.irradiance = grid.sun.irradiance;
+  s.sh = grid.sun.sh;
+  return s;
+}
+
+std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& o, ProbeSphereSun* sun) {
   if (o.probeObjects.empty() && !o.showProbes) return {};
   const LightProbeGrid grid = readLightProbes(o.scene);
+  if (sun) *sun = probeSphereSun(grid);
   std::vector<ProbeSphere> spheres = o.showProbes ? probeGridSpheres(grid) : std::vector<ProbeSphere>{};
   for (const glm::vec4& object : o.probeObjects)
     spheres.push_back(probeObject(grid, glm::vec3(object), object.w, o.scene));
@@ -98,8 +111,8 @@ void setEmitterUniforms(const GlProgram& p, const ProbeSphere& s, int triangles)
 // The spheres' GL side: one program per output encoding, an empty vertex array, one draw per sphere.
 class ProbeOverlay {
  public:
-  explicit ProbeOverlay(std::vector<ProbeSphere> spheres)
-      : spheres_(std::move(spheres)), emitterTriangles_(emitterTriangles(spheres_)) {
+  ProbeOverlay(std::vector<ProbeSphere> spheres, const ProbeSphereSun& sun)
+      : spheres_(std::move(spheres)), sun_(sun), emitterTriangles_(emitterTriangles(spheres_)) {
     glGenVertexArrays(1, &vao_);
     program(0);  // compile now: shader errors surface before the first frame
   }
@@ -117,7 +130,11 @@ class ProbeOverlay {
     glUniform3fv(p.uniform("uEye"), 1, &eye[0]);
     glUniform1f(p.uniform("uExposureScale"), std::exp2(settings.exposure));
     const GLint centre = p.uniform("uCentre"), radius = p.uniform("uRadius"), sh = p.uniform("uSh"),
-                gradient = p.uniform("uShGradient"), valid = p.uniform("uValid");
+                gradient = p.uniform("uShGradient"), valid = p.uniform("uValid"),
+                sunVisibility = p.uniform("uSunVisibility"), sunGradient = p.uniform("uSunGradient");
+    glUniform3fv(p.uniform("uSunDirection"), 1, &sun_.direction[0]);
+    glUniform3fv(p.uniform("uSunIrradiance"), 1, &sun_.irradiance[0]);
+    glUniform3fv(p.uniform("uSunSh"), kShCoefficients, &sun_.sh[0][0]);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDisable(GL_CULL_FACE);  // both sides of the box: the back faces still cover the sphere with the eye inside it
@@ -128,6 +145,8 @@ class ProbeOverlay {
       glUniform3fv(sh, kShCoefficients, &s.coefficients[0][0]);
       glUniform3fv(gradient, 3 * kShCoefficients, &s.gradient[0][0][0]);
       glUniform1i(valid, s.valid ? 1 : 0);
+      glUniform1f(sunVisibility, s.sunVisibility);
+      glUniform3fv(sunGradient, 1, &s.sunGradient[0]);
       setEmitterUniforms(p, s, emitterTriangles_);
       glDrawArrays(GL_TRIANGLES, 0, 36);
     }
@@ -149,6 +168,7 @@ class ProbeOverlay {
   }
 
   std::vector<ProbeSphere> spheres_;
+  ProbeSphereSun sun_;
   int emitterTriangles_ = 0;  // the shader's EMITTER_TRIANGLES (0: no exact emitters)
   std::unique_ptr<GlProgram> programs_[2];
   GLuint vao_ = 0;
@@ -156,9 +176,9 @@ class ProbeOverlay {
 
 }  // namespace
 
-void addProbeOverlay(ViewRenderer& renderer, std::vector<ProbeSphere> spheres) {
+void addProbeOverlay(ViewRenderer& renderer, std::vector<ProbeSphere> spheres, const ProbeSphereSun& sun) {
   if (spheres.empty()) return;
-  auto overlay = std::make_shared<ProbeOverlay>(std::move(spheres));
+  auto overlay = std::make_shared<ProbeOverlay>(std::move(spheres), sun);
   renderer.addOverlay([overlay](const ViewCamera& camera, const glm::mat4& viewProjection, const DrawSettings& settings) {
     overlay->draw(camera, viewProjection, settings);
   });

@@ -4,7 +4,9 @@
 // and the grid itself (--view probes: a small sphere at each probe, lit by its own SH, invalid ones red).
 // A sphere of albedo 1 (Lambert) shows radiance = E(n)/π = shIrradiance(c(p), n) at the point p with normal n,
 // c(p) = coefficients + (p − centre)·gradient, clamped at 0 (L2 ringing), plus the exact emitters' E/π
-// (lightmap/probe_emitter_field.h, shaders/probe_emitters.glsl); each pixel's normal is exact: the sphere is ray-cast in the fragment shader, not tessellated.
+// (lightmap/probe_emitter_field.h, shaders/probe_emitters.glsl); with a sun level, its sun is taken out of c(p) and
+// shaded as an exact clamped cosine at the visibility v(p) (shadeProbeLambert); each pixel's normal is exact: the
+// sphere is ray-cast in the fragment shader, not tessellated.
 #pragma once
 #include <filesystem>
 #include <memory>
@@ -27,10 +29,19 @@ struct ProbeSphere {
   ShCoefficients coefficients{};  // at the centre: E(n)/π = shIrradiance(coefficients, n)
   std::array<ShCoefficients, 3> gradient{};  // ∂coefficients/∂x, y, z (zero for the grid's own probes)
   bool valid = true;              // false: drawn in flat red (a probe left out of interpolation)
+  float sunVisibility = 0.0f;     // the sun level's visibility at the centre and its gradient (probe_field.h)
+  glm::vec3 sunGradient{0.0f};
   // The exact emitters (lightmap/probe_emitters.h; shared by every sphere of a grid) and their visibility at the
   // centre with its gradient: their light E/π is added at each point, unclamped L2 term clamped first.
   std::shared_ptr<const std::vector<ProbeEmitter>> emitters;
   EmitterVisibilityField emitterVisibility;
+};
+
+// The sun level's light as the spheres' shader takes it (zero irradiance and SH: no sun level).
+struct ProbeSphereSun {
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // travel
+  glm::vec3 irradiance{0.0f};              // E/π facing it at visibility 1
+  ShCoefficients sh{};                     // its SH at visibility 1
 };
 
 // The probes over a dynamic object: trilinear over the 8 around its centre, valid ones only, weights renormalised
@@ -46,9 +57,14 @@ std::vector<ProbeSphere> probeGridSpheres(const LightProbeGrid& grid);
 // The spheres the options ask for (--probe-object, --view probes), with the grid read from the scene file
 // (readLightProbes: throws Error naming the file and the problem for a missing or malformed extension). Empty
 // when neither is asked for; the file is then not read for probes.
-std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& options);
+// `sun`, when given, receives the grid's sun level.
+std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& options, ProbeSphereSun* sun = nullptr);
 
-// Draws `spheres` after the scene in every frame of `renderer` (ViewRenderer::addOverlay); GL context current.
-void addProbeOverlay(ViewRenderer& renderer, std::vector<ProbeSphere> spheres);
+// The shader's sun of a grid's sun level.
+ProbeSphereSun probeSphereSun(const LightProbeGrid& grid);
+
+// Draws `spheres` after the scene in every frame of `renderer` (ViewRenderer::addOverlay), their sun level `sun`;
+// GL context current.
+void addProbeOverlay(ViewRenderer& renderer, std::vector<ProbeSphere> spheres, const ProbeSphereSun& sun = {});
 
 }  // namespace irbake::view

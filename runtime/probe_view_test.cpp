@@ -220,6 +220,8 @@ TEST(ProbeView, IrviewRefusesABadProbeGrid) {
   none["extensions"].erase("IRBAKE_light_probes");
   nlohmann::json badSun = doc;  // a sun level of no subdivisions (its other fields absent)
   badSun["extensions"]["IRBAKE_light_probes"]["sun"] = {{"subdivisions", 0}};
+  nlohmann::json darkSun = doc;  // a negative irradiance (checked before the accessors)
+  darkSun["extensions"]["IRBAKE_light_probes"]["sun"] = {{"subdivisions", 4}, {"direction", {0, -1, 0}}, {"irradiance", {1, -1, 1}}};
   nlohmann::json badEmitter = doc;  // the ceiling light's triangle list pointing at the probes' validity (SCALAR)
   auto& emitter = badEmitter["extensions"]["IRBAKE_light_probes"]["emitters"][0];
   emitter["positions"] = badEmitter["extensions"]["IRBAKE_light_probes"]["valid"];
@@ -228,6 +230,7 @@ TEST(ProbeView, IrviewRefusesABadProbeGrid) {
     std::string problem;
   } cases[] = {{write(longer, "bad_counts.gltf"), "the grid needs"}, {write(none, "no_probes.gltf"), "no IRBAKE_light_probes"},
                {write(badSun, "bad_sun.gltf"), "IRBAKE_light_probes.sun.subdivisions: needs a whole number from 1 to 16"},
+               {write(darkSun, "dark_sun.gltf"), "IRBAKE_light_probes.sun.irradiance: negative"},
                {write(badEmitter, "bad_emitter.gltf"), "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR"}};
   for (const auto& c : cases) {
     const std::filesystem::path png = outDir() / "refused.png";

@@ -96,7 +96,8 @@ struct GlfwSession {
 }  // namespace
 
 int runWindow(const ViewerScene& v, const ViewerOptions& o) {
-  std::vector<ProbeSphere> probes = probeSpheresFor(o);  // a bad probe grid fails before the window opens
+  ProbeSphereSun probeSun;
+  std::vector<ProbeSphere> probes = probeSpheresFor(o, &probeSun);  // a bad probe grid fails before the window opens
   GlfwSession glfw;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -130,7 +131,7 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   {
     // The renderer's GL objects must go before the context does.
     ViewRenderer renderer(v);
-    addProbeOverlay(renderer, std::move(probes));
+    addProbeOverlay(renderer, std::move(probes), probeSun);
     s.renderer = &renderer;
     double last = glfwGetTime(), titleTime = last, frameSum = 0.0;
     int frame = 0, titleFrames = 0;

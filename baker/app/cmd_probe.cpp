@@ -1,6 +1,8 @@
 // irbake probe OUT.gltf --at X,Y,Z [--normal NX,NY,NZ]: the baked irradiance probes (IRBAKE_light_probes) read
-// at a point as JSON: E(n)/π per channel with --normal, else the mean over every normal (the L0 term), the exact
-// emitters (`emitters`) added at their blended visibility. Trilinear
+// at a point as JSON: E(n)/π per channel with --normal (the sun level's sun as an exact clamped cosine, the rest
+// through L2: shadeProbeLambert), else the mean over every normal (the L0 term, which the exact sun leaves as it
+// is: the clamped cosine's mean, 1/4, is its L0 part), the exact emitters (`emitters`) added at their blended
+// visibility. Trilinear
 // over the 8 probes around the point, valid ones only, and only those the point sees (the glTF's geometry is
 // loaded for the visibility rays), so light never comes through a wall.
 #include <cmath>
@@ -53,7 +55,8 @@ int runProbe(const Args& args) {
   });
   if (blend.probes == 0)
     throw Error(ErrorCode::InvalidData, file, "no valid probe around " + at + " is visible from it");
-  glm::vec3 value = normal.empty() ? shAverage(blend.coefficients) : shIrradiance(blend.coefficients, n);
+  glm::vec3 value =
+      normal.empty() ? shAverage(blend.coefficients) : shadeProbeLambert(blend.coefficients, blend.sunVisibility, grid.sun, n, false);
   // Plus the exact emitters (docs/export.md, `emitters`) at their blended visibility.
   const std::vector<float> v = blendEmitterVisibility(grid, blend);
   if (!normal.empty()) value += exactEmitterLight(grid.emitters, v, point, n);
@@ -64,6 +67,7 @@ int runProbe(const Args& args) {
                         {"probes", blend.probes},
                         {"weight", blend.weight},
                         {"emitters", grid.emitters.size()}};
+  if (grid.sun.present()) out["sunVisibility"] = blend.sunVisibility;
   if (!normal.empty()) out["normal"] = {n.x, n.y, n.z};
   else out["normal"] = nullptr;
   std::printf("%s\n", out.dump().c_str());

@@ -50,24 +50,29 @@ glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file, cons
 
 // The sun level (ProbeSunLevel) as the extension's optional `sun` object: its SH as floats; the probes'
 // visibilities as bytes (k/255), the refined cells and the lattice's bits in 32-bit unsigned integers (packed: 1-byte
-// accessors came back scrambled through meshopt, and floats would be 4× the size).
+// accessors came back scrambled through meshopt, and floats would be 4× the size); `cells` and `fine` omitted when
+// no cell is refined (glTF has no empty accessor).
 json sunLevelJson(GltfDocument& doc, const ProbeSunLevel& sun) {
-  const glm::vec3 d = sun.direction;
+  const glm::vec3 d = sun.direction, e = sun.irradiance;
   std::vector<uint32_t> visibility((sun.visibility.size() + 3) / 4, 0u);
   for (size_t i = 0; i < sun.visibility.size(); ++i)
     visibility[i / 4] |= static_cast<uint32_t>(std::lround(std::clamp(sun.visibility[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
-  return {{"direction", {d.x, d.y, d.z}},
-          {"sh", addAccessor(doc, sun.sh.data(), sizeof(ShCoefficients), kFloat, kShCoefficients, "VEC3")},
-          {"visibility", addAccessor(doc, visibility.data(), visibility.size() * sizeof(uint32_t), kUnsignedInt,
-                                     visibility.size(), "SCALAR")},
-          {"cells", addAccessor(doc, sun.cells.data(), sun.cells.size() * sizeof(uint32_t), kUnsignedInt, sun.cells.size(), "SCALAR")},
-          {"subdivisions", sun.subdivisions},
-          {"fine", addAccessor(doc, sun.fine.data(), sun.fine.size() * sizeof(uint32_t), kUnsignedInt, sun.fine.size(), "SCALAR")}};
+  json out = {{"direction", {d.x, d.y, d.z}},
+              {"irradiance", {e.x, e.y, e.z}},
+              {"sh", addAccessor(doc, sun.sh.data(), sizeof(ShCoefficients), kFloat, kShCoefficients, "VEC3")},
+              {"visibility", addAccessor(doc, visibility.data(), visibility.size() * sizeof(uint32_t), kUnsignedInt,
+                                         visibility.size(), "SCALAR")},
+              {"subdivisions", sun.subdivisions}};
+  if (!sun.cells.empty()) {
+    out["cells"] = addAccessor(doc, sun.cells.data(), sun.cells.size() * sizeof(uint32_t), kUnsignedInt, sun.cells.size(), "SCALAR");
+    out["fine"] = addAccessor(doc, sun.fine.data(), sun.fine.size() * sizeof(uint32_t), kUnsignedInt, sun.fine.size(), "SCALAR");
+  }
+  return out;
 }
 
-// The extension's `sun` object, checked against the grid: every field present and of its type, the SH finite,
-// the cells ascending and each the base probe of a cell, the bits as many as the cells
-// need. Throws Error(InvalidData, file) naming the field.
+// The extension's `sun` object, checked against the grid: every field present and of its type (`cells` and
+// `fine` together or neither), the SH finite, the irradiance finite and not negative, the cells ascending and each
+// the base probe of a cell, the bits as many as the cells need. Throws Error(InvalidData, file) naming the field.
 ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const LightProbeGrid& g, const std::string& file) {
   const json& sun = ext["sun"];
   const std::string what = std::string(kLightProbesExtension) + ".sun";
@@ -79,6 +84,9 @@ ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const Light
   out.subdivisions = sun["subdivisions"].get<int>();
   out.direction = vec3Of(sun, "direction", file, what);
   if (std::abs(glm::length(out.direction) - 1.0f) > 1e-3f) throw Error(ErrorCode::InvalidData, file, what + ".direction: not a unit vector");
+  out.irradiance = vec3Of(sun, "irradiance", file, what);
+  if (out.irradiance.x < 0.0f || out.irradiance.y < 0.0f || out.irradiance.z < 0.0f)
+    throw Error(ErrorCode::InvalidData, file, what + ".irradiance: negative");
   const AccessorBytes sh = probeAccessor(doc, sun, "sh", kFloat, "VEC3", kShCoefficients, file, what);
   std::memcpy(out.sh.data(), sh.bytes.data(), sizeof(ShCoefficients));
   for (const glm::vec3& c : out.sh)
@@ -90,6 +98,7 @@ ProbeSunLevel readSunLevel(const GltfDocument& doc, const json& ext, const Light
   std::memcpy(packed.data(), v.bytes.data(), packed.size() * sizeof(uint32_t));
   out.visibility.resize(n);
   for (size_t i = 0; i < n; ++i) out.visibility[i] = static_cast<float>((packed[i / 4] >> (8 * (i % 4))) & 255u) / 255.0f;
+  if (!sun.contains("cells") && !sun.contains("fine")) return out;  // no refined cell
   if (!sun.contains("cells") || !sun["cells"].is_number_integer())
     throw Error(ErrorCode::InvalidData, file, what + ".cells: no accessor index");
   const AccessorBytes cells = readAccessor(doc, sun["cells"].get<int>(), file);
@@ -195,7 +204,7 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
               {"valid", addAccessor(doc, valid.data(), n * sizeof(float), kFloat, n, "SCALAR")},
               {"units", "irradiance/pi"},
               {"convention", "three.js SphericalHarmonics3"}};
-  if (grid.sun.present() && !grid.sun.cells.empty() && grid.sun.visibility.size() == n) ext["sun"] = sunLevelJson(doc, grid.sun);
+  if (grid.sun.present() && grid.sun.visibility.size() == n) ext["sun"] = sunLevelJson(doc, grid.sun);
   if (!grid.emitters.empty()) ext["emitters"] = emittersJson(doc, grid.emitters);
   doc.root["extensions"][kLightProbesExtension] = std::move(ext);
   doc.useExtension(kLightProbesExtension);

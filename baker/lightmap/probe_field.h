@@ -6,6 +6,7 @@
 // at c ± r (r the object's bounding radius): exact for light that is linear across the object, and the grid's
 // own trilinear variation otherwise.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <functional>
 
@@ -18,6 +19,8 @@ struct ProbeField {
   std::array<ShCoefficients, 3> gradient{};  // ∂c/∂x, ∂c/∂y, ∂c/∂z, per metre
   int probes = 0;                            // the centre blend's probes and weight (0: no valid probe near)
   float weight = 0.0f;
+  float sunVisibility = 0.0f;                // the sun level's visibility at the centre (ProbeBlend) and its
+  glm::vec3 sunGradient{0.0f};               // gradient, the same secants: c carries v·sh of the sun
 
   // The SH at centre + offset.
   ShCoefficients at(const glm::vec3& offset) const {
@@ -26,6 +29,8 @@ struct ProbeField {
       c[k] += offset.x * gradient[0][k] + offset.y * gradient[1][k] + offset.z * gradient[2][k];
     return c;
   }
+  // The sun's visibility at centre + offset, clamped to [0, 1].
+  float sunAt(const glm::vec3& offset) const { return std::clamp(sunVisibility + glm::dot(offset, sunGradient), 0.0f, 1.0f); }
 };
 
 // The field of an object of bounding radius `radius` around `centre`; `visible` as interpolateProbes. An axis
@@ -37,6 +42,7 @@ inline ProbeField probeFieldOver(const LightProbeGrid& g, const glm::vec3& centr
   out.centre = c.coefficients;
   out.probes = c.probes;
   out.weight = c.weight;
+  out.sunVisibility = c.sunVisibility;
   if (c.probes == 0 || !(radius > 0.0f)) return out;
   for (int a = 0; a < 3; ++a) {
     glm::vec3 step(0.0f);
@@ -45,6 +51,7 @@ inline ProbeField probeFieldOver(const LightProbeGrid& g, const glm::vec3& centr
     if (hi.probes == 0 || lo.probes == 0) continue;
     for (int k = 0; k < kShCoefficients; ++k)
       out.gradient[a][k] = (hi.coefficients[k] - lo.coefficients[k]) / (2.0f * radius);
+    out.sunGradient[a] = (hi.sunVisibility - lo.sunVisibility) / (2.0f * radius);
   }
   return out;
 }

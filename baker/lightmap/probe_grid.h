@@ -59,6 +59,7 @@ inline void shAddDirectional(ShCoefficients& c, const glm::vec3& d, const glm::v
 // coefficients carry, w_i the blend's own weights.
 struct ProbeSunLevel {
   glm::vec3 direction{0.0f};      // the light's travel direction (world, unit)
+  glm::vec3 irradiance{0.0f};     // its map value (E/π facing it) at visibility 1: the clients shade it exactly
   ShCoefficients sh{};            // its SH at visibility 1, map units (what a probe that fully sees it got)
   std::vector<float> visibility;  // per probe: the visibility its coefficients carry, in [0, 1]
   std::vector<uint32_t> cells;    // refined cells, ascending: the linear index i + nx (j + ny k) of the base probe
@@ -129,6 +130,7 @@ struct ProbeBlend {
   ShCoefficients coefficients{};
   int probes = 0;       // valid, visible probes blended
   float weight = 0.0f;  // their summed trilinear weight (0: none; coefficients then 0)
+  float sunVisibility = 0.0f;  // the sun level's visibility v(p) the coefficients carry (0 without a sun level)
   std::array<std::pair<size_t, float>, 8> corners{};  // the blended probes and their weights (renormalised)
 };
 
@@ -161,7 +163,8 @@ glm::ivec3 forEachBlendCorner(const LightProbeGrid& g, const glm::vec3& p, Corne
 // Trilinear over the 8 probes around p (clamped to the grid), each weighted by its validity and, when
 // `visible` is given, by whether p sees the probe's baked position (a wall between them: weight 0, so light
 // never crosses it). Where none of the 8 counts, the nearest valid visible probe of the 4×4×4 around p. In a
-// cell of the sun level, the blend's sun is replaced by the fine lattice's (ProbeSunLevel).
+// cell of the sun level, the blend's sun is replaced by the fine lattice's (ProbeSunLevel); `sunVisibility` is
+// then the lattice's, elsewhere the blend of the probes' (or the nearest probe's).
 inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
                                     const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
   ProbeBlend out;
@@ -183,6 +186,7 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
     const float fine = sun ? g.sun.fineVisibility(g.index(base.x, base.y, base.z), t) : -1.0f;
     if (fine >= 0.0f)
       for (int k = 0; k < kShCoefficients; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * g.sun.sh[k];
+    if (sun) out.sunVisibility = fine >= 0.0f ? fine : sunBlend / out.weight;
     return out;
   }
   float best = 1e30f;
@@ -200,7 +204,22 @@ inline ProbeBlend interpolateProbes(const LightProbeGrid& g, const glm::vec3& p,
   out.corners[0] = {nearest, 1.0f};
   out.probes = 1;
   out.weight = 1.0f;
+  if (sun) out.sunVisibility = g.sun.visibility[nearest];
   return out;
+}
+
+// What a white Lambert surface with unit normal n shows (E(n)/π) under coefficients c that carry the sun level's
+// light at visibility v: the rest of the light through L2, clamped at 0 against its ringing, plus the sun as an
+// exact clamped cosine, v · irradiance · max(0, n·(−direction)). L2 alone rings on a delta: facing the sun it
+// reads 17/16 of it, at 90° from it 3/32 of it. Without a sun level: max(0, shIrradiance(c, n)). `clampSh` false
+// leaves the L2 term unclamped (`irbake probe`, whose values the bench fits).
+inline glm::vec3 shadeProbeLambert(const ShCoefficients& c, float v, const ProbeSunLevel& sun, const glm::vec3& n,
+                                   bool clampSh = true) {
+  auto clamped = [&](const glm::vec3& e) { return clampSh ? glm::max(e, glm::vec3(0.0f)) : e; };
+  if (!sun.present()) return clamped(shIrradiance(c, n));
+  ShCoefficients rest = c;
+  for (int k = 0; k < kShCoefficients; ++k) rest[k] -= v * sun.sh[k];
+  return clamped(shIrradiance(rest, n)) + v * sun.irradiance * std::max(0.0f, -glm::dot(n, sun.direction));
 }
 
 }  // namespace irbake

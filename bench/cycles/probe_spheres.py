@@ -28,7 +28,9 @@ disc (split at the projected centre, which is the image centre: the camera targe
 `worst_quarter_exact_direct` are the same figures with the L2 truncation of the direct light undone at each
 surface point (the sun, times the sphere's sunlit share, and the emitters seen from the point, as exact clamped
 cosines in place of their L2 parts; the emitters the probes export for exact shading, IRBAKE_light_probes.emitters,
-are left out: the clients already shade them so): what is left is not the SH band limit. `probe_sun_share`: the blend weight of the 8
+are left out: the clients already shade them so): what is left is not the SH band limit. A bake whose probes have
+a sun level (IRBAKE_light_probes.sun) already has its sun exact in irview's image (docs/units.md, "The sun shaded
+exactly"), so there the sun is left out too (Sponza has no emitters: the columns equal the plain ones). `probe_sun_share`: the blend weight of the 8
 probes around the centre whose own point sees the sun (a sun shadow edge between probes shows as a share below
 `sunlit`; the bake fits each probe's sun over its cube, docs/units.md, so the blended sun may differ). Rows are appended to bench/results/probe_spheres.csv.
 Every process runs under `nice -n 15`; Cycles with --threads 2.
@@ -380,6 +382,12 @@ def direct_l2_residual(eye, target, fov, size, centre, radius, dirs, weights, em
     return out.reshape(size, sub, size, sub, 3).mean(axis=(1, 3))
 
 
+def has_sun_level(gltf):
+    """Whether the bake's probes carry a sun level, whose sun the clients shade as an exact clamped cosine."""
+    with open(gltf) as f:
+        return "sun" in json.load(f).get("extensions", {}).get("IRBAKE_light_probes", {})
+
+
 def shaded_exactly(gltf, tris):
     """Per scene triangle: True where the probes export it among their exact emitters (IRBAKE_light_probes.emitters,
     matched by centroid): the clients already shade its direct light exactly, so the diagnosis leaves it out."""
@@ -503,11 +511,15 @@ def run_scene(args, name, rows):
             out = os.path.join(work, "seed%d" % seed)
             gltf = os.path.join(out, "scene.gltf")
             exact = shaded_exactly(gltf, tris)
-            if exact.tobytes() not in residuals:  # the emitters the probes left to exact shading: nothing to undo
-                residuals[exact.tobytes()] = direct_l2_residual(
-                    eye, centre, fov, args.size, centre, radius, *sun_light(centre, sunlit, name == "sponza"),
+            # The emitters the probes left to exact shading, and the sun of a sun level in irview's image: nothing to undo.
+            sun_exact = args.ours == "irview" and has_sun_level(gltf)
+            key = (exact.tobytes(), sun_exact)
+            if key not in residuals:
+                residuals[key] = direct_l2_residual(
+                    eye, centre, fov, args.size, centre, radius,
+                    *sun_light(centre, sunlit, name == "sponza" and not sun_exact),
                     emitter_points(tris, np.where(exact[:, None], 0.0, emission)))
-            residual = residuals[exact.tobytes()]
+            residual = residuals[key]
             if args.ours == "irview":
                 ours = ours_from_irview(args, gltf, eye, centre, fov, args.size, centre, radius,
                                         os.path.join(out, "sphere_%s.exr" % place))

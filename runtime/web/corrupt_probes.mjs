@@ -5,6 +5,7 @@
 // and, when the grid has a sun level (`sun`):
 //   NAME_sun_nan.gltf:        the sun's first SH coefficient NaN (in NAME_sun_nan.bin)
 //   NAME_sun_cells.gltf:      the refined cells' first two swapped (or the only one past the grid)
+//   NAME_sun_irradiance.gltf: the sun's irradiance negative
 // and, when it has exact emitters (`emitters`):
 //   NAME_emitter_positions.gltf:  the first emitter's positions pointing at the validity (FLOAT SCALAR)
 //   NAME_emitter_radiance.gltf:   its radiance [1, 1e39, 1] (not a finite float: JSON has no NaN)
@@ -38,6 +39,11 @@ fs.writeFileSync(path.join(dir, `${stem}_probe_nan.gltf`), JSON.stringify(nan));
 
 const sun = ext.sun;
 if (sun) {
+  const dark = structuredClone(doc);
+  dark.extensions.IRBAKE_light_probes.sun.irradiance = [1, -1, 1];
+  fs.writeFileSync(path.join(dir, `${stem}_sun_irradiance.gltf`), JSON.stringify(dark));
+}
+if (sun?.cells !== undefined) {
   const at = index => {
     const a = doc.accessors[index], v = doc.bufferViews[a.bufferView];
     return [(v.byteOffset ?? 0) + (a.byteOffset ?? 0), a.count, v.buffer];

@@ -115,7 +115,8 @@ function probesSurvive(inDoc, outDoc, inJson, outJson) {
   if (!inDef || !outDef) return 0;
   check(same(probeFields(inDef), probeFields(outDef)), `${IRBAKE_LIGHT_PROBES}: fields ${JSON.stringify(probeFields(outDef))}`);
   const gridA = inDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES), gridB = outDoc.getRoot().getExtension(IRBAKE_LIGHT_PROBES);
-  const keys = [...Object.keys(PROBE_ACCESSORS), ...(inDef.sun ? Object.keys(SUN_ACCESSORS).map(k => `sun_${k}`) : []),
+  const keys = [...Object.keys(PROBE_ACCESSORS),
+                ...(inDef.sun ? Object.keys(SUN_ACCESSORS).filter(k => k in inDef.sun).map(k => `sun_${k}`) : []),
                 ...(inDef.emitters ?? []).flatMap((_, i) => Object.keys(EMITTER_ACCESSORS).map(k => `emitters_${i}_${k}`))];
   for (const key of keys) {
     const a = gridA?.getAccessor(key)?.getArray(), b = gridB?.getAccessor(key)?.getArray();
@@ -179,7 +180,7 @@ async function refusals() {
     await throws('probe spacing', badGrid(e => { e.spacing = -1; }), `${IRBAKE_LIGHT_PROBES}.spacing -1`);
     await throws('probe accessor', badGrid(e => { e.valid = 9999; }), `${IRBAKE_LIGHT_PROBES}.valid`, 'does not exist');
     await throws('probe counts type', badGrid(e => { e.counts = [2, 2]; }), `${IRBAKE_LIGHT_PROBES}.counts`);
-    if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun) {
+    if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun?.cells !== undefined) {
       await throws('sun fine', badGrid(e => { e.sun.fine = e.sun.cells; }), `${IRBAKE_LIGHT_PROBES}.sun.fine`, 'the grid needs');
       await throws('sun subdivisions', badGrid(e => { e.sun.subdivisions = 0; }), `${IRBAKE_LIGHT_PROBES}.sun.subdivisions`);
     }

@@ -21,7 +21,8 @@ export const IRBAKE_LIGHT_PROBES = 'IRBAKE_light_probes';
 // The probe grid's accessors (docs/export.md, "IRBAKE_light_probes"): component type, type and elements per probe.
 export const PROBE_ACCESSORS = { coefficients: [5126, 'VEC3', 9], offsets: [5126, 'VEC3', 1], valid: [5126, 'SCALAR', 1] };
 // The optional sun level's accessors (`sun.<key>`): component type, type, and the element count for a grid of
-// `probes` probes whose level has `cells` refined cells of S subdivisions (null: any).
+// `probes` probes whose level has `cells` refined cells of S subdivisions (null: any). `cells` and `fine` are
+// omitted together when no cell is refined.
 export const SUN_ACCESSORS = {
   sh: [5126, 'VEC3', () => 9], visibility: [5125, 'SCALAR', probes => Math.ceil(probes / 4)], cells: [5125, 'SCALAR', () => null],
   fine: [5125, 'SCALAR', (probes, cells, S) => cells * Math.ceil((S + 1) ** 3 / 32)],
@@ -409,7 +410,9 @@ export function defineIrbakeExtensions(core) {
         if (!isObject(def.sun) || !(Number.isInteger(S) && S >= 1 && S <= 16))
           throw new Error(`${IRBAKE_LIGHT_PROBES}.sun.subdivisions ${JSON.stringify(S)} needs a whole number from 1 to 16`);
         let cells = 0;
+        const refined = def.sun.cells !== undefined || def.sun.fine !== undefined;
         for (const [key, [componentType, type, count]] of Object.entries(SUN_ACCESSORS)) {
+          if (!refined && (key === 'cells' || key === 'fine')) continue;
           const n = accessor(def.sun, key, `sun_${key}`, componentType, type, count(probes, cells, S));
           if (key === 'cells') cells = n;
         }
@@ -444,7 +447,8 @@ export function defineIrbakeExtensions(core) {
       for (const key of Object.keys(PROBE_ACCESSORS)) def[key] = indexOf(key);
       if (def.sun !== undefined) {
         def.sun = { ...def.sun };
-        for (const key of Object.keys(SUN_ACCESSORS)) def.sun[key] = indexOf(`sun_${key}`);
+        for (const key of Object.keys(SUN_ACCESSORS))
+          if (grid.getAccessor(`sun_${key}`) || (key !== 'cells' && key !== 'fine')) def.sun[key] = indexOf(`sun_${key}`);
       }
       if (def.emitters !== undefined)
         def.emitters = def.emitters.map((e, k) => {

@@ -10,12 +10,15 @@
 // max(0, shGetIrradianceAt(n)): the same value as irview, since three.js shades irradiance × albedo/π and the
 // material's probe term is π × E/π.
 // With the optional `sun` level (irbake_probe_sun.js), a point in one of its cells takes the blend with its sun
-// replaced by the finer lattice's, so the field over an object needs no other change. With the optional `emitters`
-// (irbake_probe_emitters.js), their exact light is added at each point, their visibility blended as the SH.
+// replaced by the finer lattice's, and the sun is shaded as an exact clamped cosine at its visibility v(p) (blended
+// and given a gradient as the coefficients), taken out of the L2 term: max(0, shGetIrradianceAt(n, c − v·sh)) +
+// v·irradiance·max(0, n·(−direction)), as irview and `irbake probe --normal` (probe_grid.h, shadeProbeLambert).
+// With the optional `emitters` (irbake_probe_emitters.js), their exact light is added at each point, their
+// visibility blended as the SH.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
 // non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
 import { Box3, SphericalHarmonics3, Vector3, Vector4 } from 'three';
-import { readSunLevel } from './irbake_probe_sun.js';
+import { readSunLevel, SUN_SHADER, sunUniforms } from './irbake_probe_sun.js';
 import { emitterGlsl, emitterUniforms, readEmitters, visibilityField } from './irbake_probe_emitters.js';
 
 export const LIGHT_PROBES = 'IRBAKE_light_probes';
@@ -38,11 +41,12 @@ export class IrbakeProbeGrid {
     return ijk.map((v, a) => this.origin[a] + this.spacing * v + this.offsets[3 * index + a]);
   }
 
-  // The SH at point p ([x, y, z]): { coefficients: Float64Array(27), probes, weight }. Trilinear over the 8 probes
-  // around p (clamped to the grid), valid ones only; where none is valid, the nearest valid probe of the 4×4×4
-  // around p; probes 0 when there is none. In a cell of the sun level, the blend's sun is the lattice's.
+  // The SH at point p ([x, y, z]): { coefficients: Float64Array(27), probes, weight, sunVisibility }. Trilinear
+  // over the 8 probes around p (clamped to the grid), valid ones only; where none is valid, the nearest valid probe
+  // of the 4×4×4 around p; probes 0 when there is none. In a cell of the sun level, the blend's sun is the
+  // lattice's; sunVisibility is the visibility the coefficients carry (0 without a sun level).
   interpolate(p) {
-    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0, corners: [] };
+    const out = { coefficients: new Float64Array(27), probes: 0, weight: 0, corners: [], sunVisibility: 0 };
     const base = [0, 0, 0], t = [0, 0, 0];
     let sunBlend = 0;
     for (let a = 0; a < 3; ++a) {
@@ -72,6 +76,7 @@ export class IrbakeProbeGrid {
       const fine = this.sun ? this.sun.fineVisibility(this.index(base[0], base[1], base[2]), t) : -1;
       if (fine >= 0)
         for (let k = 0; k < 27; ++k) out.coefficients[k] += (fine - sunBlend / out.weight) * this.sun.sh[k];
+      if (this.sun) out.sunVisibility = fine >= 0 ? fine : sunBlend / out.weight;
       return out;
     }
     let best = Infinity, nearest = -1;
@@ -88,24 +93,27 @@ export class IrbakeProbeGrid {
     out.coefficients.set(this.coefficients.subarray(27 * nearest, 27 * nearest + 27));
     out.probes = 1;
     out.weight = 1;
+    if (this.sun) out.sunVisibility = this.sun.visibility[nearest];
     out.corners = [[nearest, 1]];
     return out;
   }
 
   // The probes over an object of bounding radius r around `centre`: the blend there ({ coefficients, probes,
-  // weight }) and gradient (3 Float64Array(27): per metre along x, y, z), the secant of the blends at centre ± r;
-  // an axis whose blend at either end finds no probe keeps a zero gradient (probeFieldOver).
+  // weight, sunVisibility }) and gradient (3 Float64Array(27): per metre along x, y, z; sunGradient the same for
+  // sunVisibility), the secant of the blends at centre ± r; an axis whose blend at either end finds no probe keeps a
+  // zero gradient (probeFieldOver).
   field(centre, radius) {
     const blend = this.interpolate(centre);
-    const gradient = [0, 1, 2].map(() => new Float64Array(27));
-    if (blend.probes === 0 || !(radius > 0)) return { ...blend, gradient };
+    const gradient = [0, 1, 2].map(() => new Float64Array(27)), sunGradient = [0, 0, 0];
+    if (blend.probes === 0 || !(radius > 0)) return { ...blend, gradient, sunGradient };
     for (let a = 0; a < 3; ++a) {
       const hi = this.interpolate(centre.map((v, i) => (i === a ? v + radius : v)));
       const lo = this.interpolate(centre.map((v, i) => (i === a ? v - radius : v)));
       if (hi.probes === 0 || lo.probes === 0) continue;
       for (let k = 0; k < 27; ++k) gradient[a][k] = (hi.coefficients[k] - lo.coefficients[k]) / (2 * radius);
+      sunGradient[a] = (hi.sunVisibility - lo.sunVisibility) / (2 * radius);
     }
-    return { ...blend, gradient };
+    return { ...blend, gradient, sunGradient };
   }
 
   // Lights `mesh` (its material must be a MeshLambertMaterial, cloned here so meshes do not share probes) with
@@ -122,7 +130,8 @@ export class IrbakeProbeGrid {
     if (field.probes === 0) throw new Error(`${LIGHT_PROBES}: no valid probe near ${point.join(',')}`);
     mesh.material = mesh.material.clone();
     const emitters = this.emitters.length ? emitterUniforms(this.emitters, visibilityField(this, point, radius)) : null;
-    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient, emitters });
+    applyProbeSh(mesh.material, field.coefficients, { centre: point, gradient: field.gradient, emitters, sun: this.sun,
+                                                      sunVisibility: field.sunVisibility, sunGradient: field.sunGradient });
     return field;
   }
 }
@@ -131,6 +140,8 @@ export class IrbakeProbeGrid {
 // world normal, sh(p) = coefficients + (p − centre)·gradient at the fragment's world point p (without `field`:
 // the coefficients everywhere): three.js's own light-probe term, per material instead of per scene, clamped at 0
 // as irview; plus, with field.emitters (irbake_probe_emitters.js, emitterUniforms), the exact emitters' π × E/π.
+// With `field.sun` (a sun level) its sun is taken out of sh(p) at the visibility
+// v(p) = clamp(sunVisibility + (p − centre)·sunGradient, 0, 1) and added exactly (irbake_probe_sun.js, SUN_SHADER).
 export function applyProbeSh(material, coefficients, field = null) {
   const vec3s = (a, from) => [...Array(9)].map((_, k) => new Vector3(a[from + 3 * k], a[from + 3 * k + 1], a[from + 3 * k + 2]));
   const gradient = [];
@@ -138,6 +149,7 @@ export function applyProbeSh(material, coefficients, field = null) {
   material.userData.irbakeProbeSh = { value: vec3s(coefficients, 0) };
   material.userData.irbakeProbeGradient = { value: gradient };
   material.userData.irbakeProbeCentre = { value: new Vector3(...(field ? field.centre : [0, 0, 0])) };
+  material.userData.irbakeSun = sunUniforms(field?.sun ?? null, field?.sunVisibility ?? 0, field?.sunGradient ?? [0, 0, 0]);
   const emitters = field?.emitters?.triangles > 0 ? field.emitters : null;
   if (emitters) {
     const vectors = (a, size, Type) => [...Array(a.length / size)].map((_, i) => new Type(...a.slice(size * i, size * i + size)));
@@ -152,6 +164,7 @@ export function applyProbeSh(material, coefficients, field = null) {
         shader.uniforms[name] = material.userData[name];
     shader.uniforms.irbakeProbeGradient = material.userData.irbakeProbeGradient;
     shader.uniforms.irbakeProbeCentre = material.userData.irbakeProbeCentre;
+    Object.assign(shader.uniforms, material.userData.irbakeSun);
     const anchor = '#include <lights_fragment_maps>', vertexAnchor = '#include <project_vertex>';
     if (!shader.fragmentShader.includes(anchor)) throw new Error(`${LIGHT_PROBES}: this three.js has no ${anchor}`);
     if (!shader.vertexShader.includes(vertexAnchor)) throw new Error(`${LIGHT_PROBES}: this three.js has no ${vertexAnchor}`);
@@ -160,14 +173,17 @@ export function applyProbeSh(material, coefficients, field = null) {
       .replace(vertexAnchor, `${vertexAnchor}
   irbakeProbeOffset = ( modelMatrix * vec4( transformed, 1.0 ) ).xyz - irbakeProbeCentre;`);
     shader.fragmentShader = shader.fragmentShader
-      .replace('void main() {', 'uniform vec3 irbakeProbeSh[ 9 ];\nuniform vec3 irbakeProbeGradient[ 27 ];\nvarying vec3 irbakeProbeOffset;\nvoid main() {')
+      .replace('void main() {', `uniform vec3 irbakeProbeSh[ 9 ];\nuniform vec3 irbakeProbeGradient[ 27 ];\n${SUN_SHADER.uniforms}
+varying vec3 irbakeProbeOffset;\nvoid main() {`)
       .replace(anchor, `${anchor}
+  vec3 irbakeN = transformNormalByInverseViewMatrix( geometryNormal, viewMatrix );
+  ${SUN_SHADER.visibility}
   vec3 irbakeSh[ 9 ];
   for ( int k = 0; k < 9; ++ k )
     irbakeSh[ k ] = irbakeProbeSh[ k ] + irbakeProbeOffset.x * irbakeProbeGradient[ k ]
-                  + irbakeProbeOffset.y * irbakeProbeGradient[ 9 + k ] + irbakeProbeOffset.z * irbakeProbeGradient[ 18 + k ];
-  irradiance += PI * max( shGetIrradianceAt( transformNormalByInverseViewMatrix( geometryNormal, viewMatrix ),
-                                             irbakeSh ), vec3( 0.0 ) );`);
+                  + irbakeProbeOffset.y * irbakeProbeGradient[ 9 + k ] + irbakeProbeOffset.z * irbakeProbeGradient[ 18 + k ]
+                  - irbakeSunV * irbakeSunSh[ k ];
+  irradiance += PI * ( max( shGetIrradianceAt( irbakeN, irbakeSh ), vec3( 0.0 ) ) + ${SUN_SHADER.direct} );`);
     if (emitters)
       shader.fragmentShader = shader.fragmentShader
         .replace('void main() {', `uniform vec3 irbakeProbeCentre;\n${emitterGlsl(emitters.triangles)}\nvoid main() {`)

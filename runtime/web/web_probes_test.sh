@@ -6,8 +6,9 @@
 # Then the page must refuse three corrupted grids (too-short accessors, a zero count, a NaN coefficient) naming
 # the problem, and three bad exact emitters (the box's ceiling light is one: IRBAKE_light_probes.emitters). The
 # same with a sun level (IRBAKE_light_probes.sun): the emissive square over a plane under a sun
-# straight down, the sphere across the square's shadow edge in a refined cell; and refusals of a sun visibility
-# SH that is not finite and unsorted cells. glTF-Transform optimize (meshopt) with runtime/web's config must keep
+# straight down, the sphere across the square's shadow edge in a refined cell, its sun shaded as an exact clamped
+# cosine by both (L2 would put 3/32 of the sun on its equator); and refusals of a sun visibility SH that is not
+# finite, unsorted cells and a negative sun irradiance. glTF-Transform optimize (meshopt) with runtime/web's config must keep
 # the sun level's accessors bit for bit (gltf_transform_check.mjs survives) and its refusals of bad sun data,
 # and the Khronos validator finds no error in the bake (validate.mjs); skipped when the CLI is not installed.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
@@ -60,6 +61,15 @@ node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_nan.glt
   --expect-error "IRBAKE_light_probes.sun.sh: a non-finite coefficient"
 node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_cells.gltf" \
   --expect-error "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
+node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_irradiance.gltf" \
+  --expect-error "IRBAKE_light_probes.sun.irradiance: negative"
+
+# A sun level without refined cells (`cells` and `fine` omitted, as the bake writes it where the sun's shadow
+# crosses no cell): both clients read it, the sun still exact, and agree.
+node -e "const fs = require('fs'), d = JSON.parse(fs.readFileSync('$work/sun/scene.gltf'));
+         delete d.extensions.IRBAKE_light_probes.sun.cells; delete d.extensions.IRBAKE_light_probes.sun.fine;
+         fs.writeFileSync('$work/sun/scene_uncut.gltf', JSON.stringify(d));"
+sphere_against_irview "$work/sun/scene_uncut.gltf" 0.55,0.5,0,0.08 0.85,0.6,-0.3 0.55,0.5,0 _uncut
 
 gltf_transform="$modules/node_modules/.bin/gltf-transform"
 if [[ -x "$gltf_transform" && -d "$modules/node_modules/gltf-validator" ]]; then
@@ -69,6 +79,12 @@ if [[ -x "$gltf_transform" && -d "$modules/node_modules/gltf-validator" ]]; then
     --output "$work/sun_opt.glb" --probes
   node "$here/gltf_transform_check.mjs" refusals --modules "$modules" --input "$work/sun/scene.gltf"
   node "$here/validate.mjs" --modules "$modules" --output "$work/sun/scene.gltf"
+  # Without cells: optimize keeps the sun level as it is (its two dropped accessors pruned) and the result validates.
+  "$gltf_transform" optimize "$work/sun/scene_uncut.gltf" "$work/uncut_opt.glb" --config "$here/gltf-transform.config.mjs" \
+    >> "$work/gltf-transform.log" 2>&1
+  node "$here/gltf_transform_check.mjs" survives --modules "$modules" --input "$work/sun/scene_uncut.gltf" \
+    --output "$work/uncut_opt.glb" --probes
+  node "$here/validate.mjs" --modules "$modules" --output "$work/uncut_opt.glb"
 else
   echo "glTF-Transform or gltf-validator not installed: the sun level's optimiser and validator checks skipped"
 fi

@@ -67,6 +67,7 @@ ProbeSunLevel bakeSunLevel(const BakeInputs& in, const LightProbeGrid& g, size_t
   out.subdivisions = S;
   out.visibility = visibility;
   const PunctualContribution c = punctualDirect(sun, glm::vec3(0.0f), toward);
+  out.irradiance = c.mapValue;
   shAddDirectional(out.sh, toward, c.mapValue);
 
   FineLattice lattice;
