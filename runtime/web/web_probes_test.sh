@@ -30,24 +30,20 @@ sphere_against_irview() {
   node "$here/probe_compare.mjs" "${view[@]}" --scene "$scene" --reference "$work/irview$name.png" \
     --out "$work/web$name.png" --max-mean-abs 1
 }
+# three.js refuses SCENE with an Error whose message starts with TEXT.
+refuses() { node "$here/probe_compare.mjs" "${view[@]}" --scene "$1" --expect-error "$2"; }
 sphere_against_irview "$work/bake/scene.gltf" 0.2,0.4,0.2,0.08 0.25,0.42,-0.25 0.2,0.4,0.2 ""
 node "$here/corrupt_probes.mjs" "$work/bake/scene.gltf"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_counts.gltf" \
-  --expect-error "IRBAKE_light_probes.coefficients: "
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_zero.gltf" \
-  --expect-error "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_probe_nan.gltf" \
-  --expect-error "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
+refuses "$work/bake/scene_probe_counts.gltf" "IRBAKE_light_probes.coefficients: "
+refuses "$work/bake/scene_probe_zero.gltf" "IRBAKE_light_probes.counts: 0 is not a whole number from 1 to 10^6"
+refuses "$work/bake/scene_probe_nan.gltf" "IRBAKE_light_probes: probe 0 has a non-finite coefficient"
 # The box's ceiling light is an exact emitter (IRBAKE_light_probes.emitters): the sphere above is lit by it so in
 # both clients; each refuses a bad entry naming the field.
 node -e "const e = JSON.parse(require('fs').readFileSync('$work/bake/scene.gltf')).extensions.IRBAKE_light_probes;
          if (!(e.emitters?.length === 1)) { console.error('the ceiling light is not an exact emitter'); process.exit(1); }"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_positions.gltf" \
-  --expect-error "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR, expected 5126 VEC3"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_radiance.gltf" \
-  --expect-error "IRBAKE_light_probes.emitters[0].radiance: not finite"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/bake/scene_emitter_visibility.gltf" \
-  --expect-error "IRBAKE_light_probes.emitters[0].visibility: "
+refuses "$work/bake/scene_emitter_positions.gltf" "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR, expected 5126 VEC3"
+refuses "$work/bake/scene_emitter_radiance.gltf" "IRBAKE_light_probes.emitters[0].radiance: not finite"
+refuses "$work/bake/scene_emitter_visibility.gltf" "IRBAKE_light_probes.emitters[0].visibility: "
 
 # The sun level (with --directional, which gltf_transform_check.mjs refusals needs): probes every 0.5 m,
 # x = ..., 0.25, 0.75, ...; the shadow edge x = 0.5 crosses that cell.
@@ -57,12 +53,9 @@ node -e "const e = JSON.parse(require('fs').readFileSync('$work/sun/scene.gltf')
          if (!e.sun) { console.error('no sun level in the bake'); process.exit(1); }"
 sphere_against_irview "$work/sun/scene.gltf" 0.55,0.5,0,0.08 0.85,0.6,-0.3 0.55,0.5,0 _sun
 node "$here/corrupt_probes.mjs" "$work/sun/scene.gltf"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_nan.gltf" \
-  --expect-error "IRBAKE_light_probes.sun.sh: a non-finite coefficient"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_cells.gltf" \
-  --expect-error "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
-node "$here/probe_compare.mjs" "${view[@]}" --scene "$work/sun/scene_sun_irradiance.gltf" \
-  --expect-error "IRBAKE_light_probes.sun.irradiance: negative"
+refuses "$work/sun/scene_sun_nan.gltf" "IRBAKE_light_probes.sun.sh: a non-finite coefficient"
+refuses "$work/sun/scene_sun_cells.gltf" "IRBAKE_light_probes.sun.cells: not in ascending order at element 1"
+refuses "$work/sun/scene_sun_irradiance.gltf" "IRBAKE_light_probes.sun.irradiance: negative"
 
 # A sun level without refined cells (`cells` and `fine` omitted, as the bake writes it where the sun's shadow
 # crosses no cell): both clients read it, the sun still exact, and agree.
