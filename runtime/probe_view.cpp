@@ -31,7 +31,7 @@ ProbeSphere probeObject(const LightProbeGrid& grid, const glm::vec3& centre, flo
   s.sunGradient = field.sunGradient;
   if (!grid.emitters.empty()) {
     s.emitters = std::make_shared<const std::vector<ProbeEmitter>>(grid.emitters);
-    s.emitterVisibility = emitterVisibilityOver(grid, centre, radius, [](const glm::vec3&, const glm::vec3&) { return true; });
+    s.emitterVisibility = field.emitters;
   }
   return s;
 }

@@ -5,7 +5,6 @@
 #pragma once
 #include <algorithm>
 #include <array>
-#include <functional>
 #include <vector>
 
 #include "lightmap/polygon_irradiance.h"
@@ -49,8 +48,8 @@ inline glm::vec3 exactEmitterMean(const std::vector<ProbeEmitter>& emitters, con
   return out;
 }
 
-// The emitters' visibility over an object: at its centre and per metre along x, y, z (the secant of the blends at
-// centre ± r, zero along an axis whose blend at either end finds no probe).
+// The emitters' visibility over an object: at its centre and per metre along x, y, z (probeFieldOver: the secant
+// of the blends at centre ± r, zero along an axis whose blend at either end finds no probe).
 struct EmitterVisibilityField {
   std::vector<float> centre;
   std::array<std::vector<float>, 3> gradient;
@@ -61,23 +60,5 @@ struct EmitterVisibilityField {
     return v;
   }
 };
-
-inline EmitterVisibilityField emitterVisibilityOver(const LightProbeGrid& g, const glm::vec3& centre, float radius,
-                                                    const std::function<bool(const glm::vec3&, const glm::vec3&)>& visible = {}) {
-  EmitterVisibilityField out;
-  const ProbeBlend c = interpolateProbes(g, centre, visible);
-  out.centre = blendEmitterVisibility(g, c);
-  for (auto& gr : out.gradient) gr.assign(g.emitters.size(), 0.0f);
-  if (c.probes == 0 || !(radius > 0.0f) || g.emitters.empty()) return out;
-  for (int a = 0; a < 3; ++a) {
-    glm::vec3 step(0.0f);
-    step[a] = radius;
-    const ProbeBlend hi = interpolateProbes(g, centre + step, visible), lo = interpolateProbes(g, centre - step, visible);
-    if (hi.probes == 0 || lo.probes == 0) continue;
-    const std::vector<float> vh = blendEmitterVisibility(g, hi), vl = blendEmitterVisibility(g, lo);
-    for (size_t e = 0; e < g.emitters.size(); ++e) out.gradient[a][e] = (vh[e] - vl[e]) / (2.0f * radius);
-  }
-  return out;
-}
 
 }  // namespace irbake

@@ -10,6 +10,7 @@
 #include <array>
 #include <functional>
 
+#include "lightmap/probe_emitter_field.h"
 #include "lightmap/probe_grid.h"
 
 namespace irbake {
@@ -21,6 +22,7 @@ struct ProbeField {
   float weight = 0.0f;
   float sunVisibility = 0.0f;                // the sun level's visibility at the centre (ProbeBlend) and its
   glm::vec3 sunGradient{0.0f};               // gradient, the same secants: c carries v·sh of the sun
+  EmitterVisibilityField emitters;           // the exact emitters' visibility, the same blends (no emitters: empty)
 
   // The SH at centre + offset.
   ShCoefficients at(const glm::vec3& offset) const {
@@ -43,6 +45,8 @@ inline ProbeField probeFieldOver(const LightProbeGrid& g, const glm::vec3& centr
   out.probes = c.probes;
   out.weight = c.weight;
   out.sunVisibility = c.sunVisibility;
+  out.emitters.centre = blendEmitterVisibility(g, c);
+  for (auto& gr : out.emitters.gradient) gr.assign(g.emitters.size(), 0.0f);
   if (c.probes == 0 || !(radius > 0.0f)) return out;
   for (int a = 0; a < 3; ++a) {
     glm::vec3 step(0.0f);
@@ -52,6 +56,8 @@ inline ProbeField probeFieldOver(const LightProbeGrid& g, const glm::vec3& centr
     for (int k = 0; k < kShCoefficients; ++k)
       out.gradient[a][k] = (hi.coefficients[k] - lo.coefficients[k]) / (2.0f * radius);
     out.sunGradient[a] = (hi.sunVisibility - lo.sunVisibility) / (2.0f * radius);
+    const std::vector<float> vh = blendEmitterVisibility(g, hi), vl = blendEmitterVisibility(g, lo);
+    for (size_t e = 0; e < g.emitters.size(); ++e) out.emitters.gradient[a][e] = (vh[e] - vl[e]) / (2.0f * radius);
   }
   return out;
 }
