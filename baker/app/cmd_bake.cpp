@@ -318,7 +318,7 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->type_name("auto|off|M");
   app->add_option("--probe-box", a.probeBox, "the probes fill this box instead of the scene's bounds")
       ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
-  app->add_option("--probe-rays", o.probes.rays, "rays per probe (default 1024)")
+  app->add_option("--probe-rays", o.probes.rays, "rays per probe (default " + std::to_string(ProbeOptions{}.rays) + ")")
       ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
   app->add_option("--probe-light-fit", o.probes.lightFitSamples,
                   "the punctual lights' visibility at the probes fitted over S×S×S points per probe\n"

@@ -130,33 +130,18 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
   return out;
 }
 
-// The distance from p to the nearest surface K lattice rays meet (1e30 when none), and whether p is inside
-// geometry (back faces of single-sided surfaces in more than `tooManyBack` of them): where an object's centre
-// can be, for the volume fit's samples.
-struct Clearance {
-  float nearest = 1e30f;
-  bool inside = false;
-};
-Clearance clearanceAt(const Scene& scene, const RayTracer& rt, const glm::vec3& p, int rays, double r1, double r2,
-                      float maxBackFaceShare) {
+// Whether no surface lies within `clearance` of p along 32 short occlusion rays on a rotated lattice, the first
+// hit ending the test: where an object's centre can be, for the volume fit's samples. Inside geometry needs no
+// test of its own there: a sample is kept only where valid probes see it. Adds the rays traced to `traced`.
+bool clearOfSurfaces(const RayTracer& rt, const glm::vec3& p, float clearance, double r1, double r2, size_t& traced) {
+  if (!(clearance > 0.0f)) return true;
   constexpr int kRays = 32;
-  glm::vec3 dirs[kRays];
-  RayHit hits[kRays];
-  const int count = std::min(kRays, rays);
-  for (int k = 0; k < count; ++k) {
-    const double u = (k + 0.5) / count + r1, v = k / kGoldenRatio + r2;
-    dirs[k] = uniformSphere(u - std::floor(u), v - std::floor(v));
+  for (int k = 0; k < kRays; ++k) {
+    const double u = (k + 0.5) / kRays + r1, v = k / kGoldenRatio + r2;
+    ++traced;
+    if (rt.occluded(p, uniformSphere(u - std::floor(u), v - std::floor(v)), 0.0f, clearance)) return false;
   }
-  rt.intersectPackets(p, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Surface);
-  Clearance out;
-  int back = 0;
-  for (int k = 0; k < count; ++k)
-    if (hits[k].hit) {
-      out.nearest = std::min(out.nearest, hits[k].t);
-      if (hits[k].backFace && !doubleSided(scene, hits[k].primitive)) ++back;
-    }
-  out.inside = back > static_cast<int>(std::floor(maxBackFaceShare * count));
-  return out;
+  return true;
 }
 
 // Every punctual light as a delta from its direction, times its visibility at the probe (`visibility`, one per
@@ -247,6 +232,9 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, con
       const glm::vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
       const double r1 = rng.uniform(), r2 = rng.uniform(), r3 = rng.uniform(), r4 = rng.uniform();
       const glm::vec3 x = corner + grid.spacing * (cell + jitter) / static_cast<float>(S);
+      // Kept only where an object's centre can be: at least `clearance` from every surface (the light right
+      // beside a wall, which no object's centre reaches, would bend the blend).
+      if (!clearOfSurfaces(in.rayTracer, x, clearance, r1, r2, count)) continue;
       ++count;
       if (!probeSees(in, at, x)) continue;
       // Kept only where every probe of its blend sees it: a cell across a floor or a wall would otherwise fit
@@ -255,11 +243,6 @@ VolumeFitStats fitProbeVolume(const BakeInputs& in, const MapReader& reader, con
       bool seen = blend.corners > 0;
       for (int c = 0; c < blend.corners && seen; ++c, ++count) seen = probeSees(in, grid.position(blend.probe[c]), x);
       if (!seen) continue;
-      // Kept only where an object's centre can be: not inside geometry, and at least `clearance` from every
-      // surface (the light right beside a wall, which no object's centre reaches, would bend the blend).
-      const Clearance c = clearanceAt(in.scene, in.rayTracer, x, rays, r1, r2, options.maxBackFaceShare);
-      count += static_cast<size_t>(std::min(32, rays));
-      if (c.inside || c.nearest < clearance) continue;
       ProbeTrace t = traceProbe(reader, emitters, x, rays, r1, r2);
       count += static_cast<size_t>(rays);
       if (t.backFaces > tooManyBack) continue;  // inside geometry: no light a client would read there

@@ -42,8 +42,10 @@ struct ProbeOptions {
                                       // scene, and a blend of probes 2 m apart smears them (docs/validation.md,
                                       // "Probes against Cycles": Sponza's sunlit court read 0.86 of Cycles)
   std::optional<Bounds3> box;         // the volume the grid fills; unset: the scene's bounds
-  int rays = 1024;                    // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
-                                      // for independent rays, far less on the lattice)
+  int rays = 512;                     // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
+                                      // for independent rays, far less on the lattice): with the volume fit, a
+                                      // probe's own SH is one sample among its cube's, and its rays are better
+                                      // spent there
   float maxBackFaceShare = 0.5f;      // above this share of back-face hits (double-sided surfaces have none) a
                                       // probe is inside geometry: "mostly back faces". A quarter, the share a
                                       // probe beside a wall of two coincident opposite quads meets (makeThinWall:
@@ -53,11 +55,13 @@ struct ProbeOptions {
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
-  int volumeFitSamples = 3;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
+  int volumeFitSamples = 4;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
                                       // 0: each probe's own rays. A blend of point probes 1.64 m apart misses
                                       // the light between Sponza's gallery piers (docs/validation.md, "Probes
                                       // against Cycles")
-  int volumeFitRays = 256;            // lattice rays per volume-fit point (emitter shadow rays in proportion)
+  int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion):
+                                      // more points with fewer rays each steady the gallery over seeds (4³ × 128
+                                      // against 3³ × 256; docs/validation.md, "Probes against Cycles")
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
   float volumeFitClearance = 0.5f;    // a point is fitted only where an object's centre can be: at least this
                                       // many spacings from every surface
