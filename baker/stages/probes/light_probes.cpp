@@ -93,6 +93,20 @@ bool doubleSided(const Scene& scene, uint32_t primitive) {
   return m >= 0 && m < static_cast<int>(scene.materials.size()) && scene.materials[m].doubleSided;
 }
 
+// cos and sin of 2π i/φ for every lattice index a probe may trace (--probe-rays at most 65536): the lattice's
+// azimuths before a probe's turn, so that a ray costs a rotation instead of a sincos.
+const glm::dvec2* latticeAzimuths() {
+  static const std::vector<glm::dvec2> table = [] {
+    std::vector<glm::dvec2> t(65536);
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double a = 2.0 * kPi * (i / kGoldenRatio - std::floor(i / kGoldenRatio));
+      t[i] = glm::dvec2(std::cos(a), std::sin(a));
+    }
+    return t;
+  }();
+  return table.data();
+}
+
 ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, const glm::vec3& p, int rays, double r1,
                       double r2) {
   const Scene& scene = reader.in.scene;
@@ -101,12 +115,18 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
   constexpr int kChunk = 32;
   glm::vec3 dirs[kChunk];
   RayHit hits[kChunk];
+  // uniformSphere(u, v) of the rotated lattice u = (i + ½)/N + r1, v = i/φ + r2, its azimuth turned by 2π r2.
+  const glm::dvec2* azimuth = latticeAzimuths();
+  const double tc = std::cos(2.0 * kPi * r2), ts = std::sin(2.0 * kPi * r2);
+  rays = std::min(rays, 65536);
   for (int begin = 0; begin < rays; begin += kChunk) {
     const int count = std::min(kChunk, rays - begin);
     for (int k = 0; k < count; ++k) {
-      const double i = begin + k;
-      const double u = (i + 0.5) / rays + r1, v = i / kGoldenRatio + r2;
-      dirs[k] = uniformSphere(u - std::floor(u), v - std::floor(v));
+      const int i = begin + k;
+      const double u = (i + 0.5) / rays + r1, z = 1.0 - 2.0 * (u - std::floor(u));
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      const glm::dvec2 a = azimuth[i];
+      dirs[k] = glm::vec3(float(r * (a.x * tc - a.y * ts)), float(r * (a.y * tc + a.x * ts)), float(z));
     }
     rt.intersectPackets(p, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Full);
     for (int k = 0; k < count; ++k) {
