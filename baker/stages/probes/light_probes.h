@@ -42,7 +42,7 @@ struct ProbeOptions {
                                       // scene, and a blend of probes 2 m apart smears them (docs/validation.md,
                                       // "Probes against Cycles": Sponza's sunlit court read 0.86 of Cycles)
   std::optional<Bounds3> box;         // the volume the grid fills; unset: the scene's bounds
-  int rays = 512;                     // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
+  int rays = 256;                     // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
                                       // for independent rays, far less on the lattice): with the volume fit, a
                                       // probe's own SH is one sample among its cube's, and its rays are better
                                       // spent there
