@@ -93,19 +93,37 @@ bool doubleSided(const Scene& scene, uint32_t primitive) {
   return m >= 0 && m < static_cast<int>(scene.materials.size()) && scene.materials[m].doubleSided;
 }
 
-// cos and sin of 2π i/φ for every lattice index a probe may trace (--probe-rays at most 65536): the lattice's
-// azimuths before a probe's turn, so that a ray costs a rotation instead of a sincos.
-const glm::dvec2* latticeAzimuths() {
-  static const std::vector<glm::dvec2> table = [] {
-    std::vector<glm::dvec2> t(65536);
-    for (size_t i = 0; i < t.size(); ++i) {
-      const double a = 2.0 * kPi * (i / kGoldenRatio - std::floor(i / kGoldenRatio));
-      t[i] = glm::dvec2(std::cos(a), std::sin(a));
-    }
-    return t;
-  }();
-  return table.data();
-}
+// The spherical Fibonacci lattice of n directions turned by (r1, r2): direction i is uniformSphere(u, v) for
+// u = (i + ½)/n + r1, v = i/φ + r2, its azimuth read from a table of 2π i/φ and turned by 2π r2, so that a ray
+// costs a rotation instead of a sincos. n is at most 65536 (--probe-rays, --probe-volume-rays).
+class TurnedLattice {
+ public:
+  TurnedLattice(int n, double r1, double r2)
+      : n_(std::min(n, kMaxRays)), r1_(r1), tc_(std::cos(2.0 * kPi * r2)), ts_(std::sin(2.0 * kPi * r2)) {}
+  int size() const { return n_; }
+  glm::vec3 operator[](int i) const {
+    const double u = (i + 0.5) / n_ + r1_, z = 1.0 - 2.0 * (u - std::floor(u));
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const glm::dvec2 a = azimuths()[i];
+    return glm::vec3(float(r * (a.x * tc_ - a.y * ts_)), float(r * (a.y * tc_ + a.x * ts_)), float(z));
+  }
+
+ private:
+  static constexpr int kMaxRays = 65536;
+  static const glm::dvec2* azimuths() {
+    static const std::vector<glm::dvec2> table = [] {
+      std::vector<glm::dvec2> t(kMaxRays);
+      for (size_t i = 0; i < t.size(); ++i) {
+        const double a = 2.0 * kPi * (i / kGoldenRatio - std::floor(i / kGoldenRatio));
+        t[i] = glm::dvec2(std::cos(a), std::sin(a));
+      }
+      return t;
+    }();
+    return table.data();
+  }
+  int n_;
+  double r1_, tc_, ts_;
+};
 
 ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, const glm::vec3& p, int rays, double r1,
                       double r2) {
@@ -115,19 +133,11 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
   constexpr int kChunk = 32;
   glm::vec3 dirs[kChunk];
   RayHit hits[kChunk];
-  // uniformSphere(u, v) of the rotated lattice u = (i + ½)/N + r1, v = i/φ + r2, its azimuth turned by 2π r2.
-  const glm::dvec2* azimuth = latticeAzimuths();
-  const double tc = std::cos(2.0 * kPi * r2), ts = std::sin(2.0 * kPi * r2);
-  rays = std::min(rays, 65536);
+  const TurnedLattice lattice(rays, r1, r2);
+  rays = lattice.size();
   for (int begin = 0; begin < rays; begin += kChunk) {
     const int count = std::min(kChunk, rays - begin);
-    for (int k = 0; k < count; ++k) {
-      const int i = begin + k;
-      const double u = (i + 0.5) / rays + r1, z = 1.0 - 2.0 * (u - std::floor(u));
-      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-      const glm::dvec2 a = azimuth[i];
-      dirs[k] = glm::vec3(float(r * (a.x * tc - a.y * ts)), float(r * (a.y * tc + a.x * ts)), float(z));
-    }
+    for (int k = 0; k < count; ++k) dirs[k] = lattice[begin + k];
     rt.intersectPackets(p, dirs, static_cast<size_t>(count), hits, RayTracer::HitDetail::Full);
     for (int k = 0; k < count; ++k) {
       const RayHit& hit = hits[k];
@@ -155,11 +165,10 @@ ProbeTrace traceProbe(const MapReader& reader, const EmitterSampler& emitters, c
 // test of its own there: a sample is kept only where valid probes see it. Adds the rays traced to `traced`.
 bool clearOfSurfaces(const RayTracer& rt, const glm::vec3& p, float clearance, double r1, double r2, size_t& traced) {
   if (!(clearance > 0.0f)) return true;
-  constexpr int kRays = 32;
-  for (int k = 0; k < kRays; ++k) {
-    const double u = (k + 0.5) / kRays + r1, v = k / kGoldenRatio + r2;
+  const TurnedLattice lattice(32, r1, r2);
+  for (int k = 0; k < lattice.size(); ++k) {
     ++traced;
-    if (rt.occluded(p, uniformSphere(u - std::floor(u), v - std::floor(v)), 0.0f, clearance)) return false;
+    if (rt.occluded(p, lattice[k], 0.0f, clearance)) return false;
   }
   return true;
 }
