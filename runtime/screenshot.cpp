@@ -32,13 +32,19 @@ std::filesystem::path frameName(const std::filesystem::path& path, int frame) {
   return out;
 }
 
-void writeScreenshot(const RgbaImage& image, const std::filesystem::path& path, float exposure) {
+OutputGuard viewerOutputGuard(const ViewerScene& scene) {
+  OutputGuard guard;
+  guard.addInputs(scene.inputFiles);
+  return guard;
+}
+
+void writeScreenshot(const RgbaImage& image, const std::filesystem::path& path, float exposure, const OutputGuard& guard) {
   const ImageFormat format = imageFormatFor(path);
   for (const auto& p : image.pixels)
     if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b))
       throw Error(ErrorCode::NumericError, path.string(), "rendered image has a non-finite pixel");
   const size_t n = static_cast<size_t>(image.width) * image.height;
-  writeAtomically(path, [&](const std::filesystem::path& temp) {
+  guard.write(path, [&](const std::filesystem::path& temp) {
     imageio::Pixels px;
     px.width = image.width;
     px.height = image.height;

@@ -3,7 +3,9 @@
 #pragma once
 #include <filesystem>
 
+#include "common/output_guard.h"
 #include "view_renderer.h"
+#include "viewer_scene.h"
 
 namespace irbake::view {
 
@@ -13,7 +15,11 @@ enum class ImageFormat { Png, Exr };
 ImageFormat imageFormatFor(const std::filesystem::path& path);
 
 // Throws Error(NumericError) when a pixel is not finite, Error(Io) naming the file on write failure.
-void writeScreenshot(const RgbaImage& image, const std::filesystem::path& path, float exposure);
+// Written through `guard` (common/output_guard.h): never onto one of the scene's files.
+void writeScreenshot(const RgbaImage& image, const std::filesystem::path& path, float exposure, const OutputGuard& guard);
+
+// The guard of irview's outputs: every file the scene was loaded from is an input.
+OutputGuard viewerOutputGuard(const ViewerScene& scene);
 
 // "walk.png", 7 → "walk_0007.png": the frames of a walkthrough.
 std::filesystem::path frameName(const std::filesystem::path& path, int frame);

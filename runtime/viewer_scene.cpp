@@ -10,6 +10,7 @@
 #include "common/log.h"
 #include "export/exr_io.h"
 #include "scene/gltf_loader.h"
+#include "scene/scene_files.h"
 
 namespace irbake::view {
 
@@ -99,7 +100,12 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
     warnings.push_back(std::string(e.what()) + ": using the IRBAKE_lightmap_directional PNGs instead");
     directional = {};
   }
+  std::vector<std::filesystem::path> inputFiles = sceneInputFiles(path);
+  inputFiles.insert(inputFiles.end(), scene.lightmapExrPaths.begin(), scene.lightmapExrPaths.end());
+  for (const auto& [page, m] : materialOfPage)
+    for (int k = 0; k < 3; ++k) inputFiles.push_back(m->directionalExrPaths[k]);
   ViewerScene v = makeViewerScene(std::move(scene), std::move(pages), std::move(directional));
+  v.inputFiles = std::move(inputFiles);
   v.warnings.insert(v.warnings.begin(), warnings.begin(), warnings.end());
   for (const auto& w : v.scene.stats.warnings) v.warnings.push_back(w);
   return v;

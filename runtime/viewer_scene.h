@@ -22,6 +22,9 @@ struct ViewerScene {
   // that page has none.
   std::array<std::vector<Lightmap>, 3> directionalPages;
   std::vector<std::string> warnings;  // e.g. "no light map: showing albedo only"
+  // Every file it was loaded from (the glTF, its buffers and images, the EXR pages read): no output of
+  // irview may replace one.
+  std::vector<std::filesystem::path> inputFiles;
 };
 
 enum class LightmapSource { Page, MaterialTexture, None };

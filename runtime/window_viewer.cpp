@@ -31,14 +31,26 @@ struct WindowState {
   double lastX = 0, lastY = 0;
   int screenshotCount = 0;
   bool screenshotRequested = false;
+  OutputGuard guard;  // the scene's files are its inputs; each screenshot is declared when first taken
+  std::vector<std::filesystem::path> declared;
 };
 
 // Screenshot of what the window shows, rendered offscreen at the framebuffer size (PNG: exposure + sRGB).
 void takeScreenshot(GLFWwindow* w, WindowState& s, const std::filesystem::path& path) {
   int fw = 0, fh = 0;
   glfwGetFramebufferSize(w, &fw, &fh);
+  // A refused name (an input, a folder, one already written) is said and the window goes on.
+  try {
+    if (std::find(s.declared.begin(), s.declared.end(), path) == s.declared.end()) {
+      s.guard.addOutput(path, "screenshot");
+      s.declared.push_back(path);
+    }
+  } catch (const Error& e) {
+    log::warn(std::string("screenshot not written: ") + e.what());
+    return;
+  }
   RgbaImage img = s.renderer->render(s.fly.camera(), std::max(fw, 1), std::max(fh, 1), s.settings);
-  writeScreenshot(img, path, s.settings.exposure);
+  writeScreenshot(img, path, s.settings.exposure, s.guard);
   log::info("wrote " + path.string());
 }
 
@@ -98,6 +110,11 @@ struct GlfwSession {
 int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   ProbeSphereSun probeSun;
   std::vector<ProbeSphere> probes = probeSpheresFor(o, &probeSun);  // a bad probe grid fails before the window opens
+  OutputGuard guard = viewerOutputGuard(v);
+  if (!o.screenshot.empty()) {
+    imageFormatFor(o.screenshot);
+    guard.addOutput(o.screenshot, "--screenshot");  // a refused name fails before the window opens
+  }
   GlfwSession glfw;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -113,6 +130,8 @@ int runWindow(const ViewerScene& v, const ViewerOptions& o) {
   glfwSwapInterval(0);  // frame time shows the renderer, not the display's refresh
 
   WindowState s;
+  s.guard = std::move(guard);
+  if (!o.screenshot.empty()) s.declared.push_back(o.screenshot);
   s.scene = &v;
   s.options = &o;
   s.settings.mode = o.mode;

@@ -1,10 +1,14 @@
 #include "samples/sample_scenes.h"
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <memory>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "common/error.h"
+#include "common/output_guard.h"
 #include "export/gltf_writer.h"
 
 namespace irbake::samples {
@@ -270,16 +274,59 @@ std::vector<NamedSample> allSamples() {
   return out;
 }
 
+namespace {
+
+// True when f.finalPath is a regular file holding exactly the bytes f's writer writes.
+bool sameBytesAs(const PendingFile& f) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(f.finalPath, ec))) return false;
+  const fs::path temp = fs::temp_directory_path(ec) / tempPathFor(f.finalPath).filename();
+  if (ec) return false;
+  bool same = false;
+  try {
+    f.writer(temp);
+    auto bytes = [](const fs::path& p) {
+      std::ifstream in(p, std::ios::binary);
+      return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    };
+    same = fs::file_size(temp, ec) == fs::file_size(f.finalPath, ec) && !ec && bytes(temp) == bytes(f.finalPath);
+  } catch (const Error&) {
+  }
+  fs::remove(temp, ec);
+  return same;
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> writeSamples(const std::filesystem::path& outDir) {
   std::error_code ec;
-  std::filesystem::create_directories(outDir, ec);
-  if (ec) throw Error(ErrorCode::Io, outDir.string(), "cannot create folder: " + ec.message());
+  if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec))
+    throw Error(ErrorCode::Usage, outDir.string(), "is a file, not a folder: give OUTDIR a folder");
+  if (!std::filesystem::is_directory(outDir, ec) && !unwritableReason(outDir).empty())
+    throw Error(ErrorCode::Usage, outDir.string(), unwritableReason(outDir) + " (OUTDIR)");
+  // Every file is declared first: a file of the same name that irbake did not write there (its manifest
+  // proves which) is refused before anything is written, so a user's furnace.gltf is never replaced.
+  OutputGuard guard;
+  guard.keepManifest(outDir);
+  std::vector<std::unique_ptr<GltfDocument>> docs;  // the writers below read them
+  std::vector<PendingFile> files;
   std::vector<std::filesystem::path> written;
   for (const auto& s : allSamples()) {
-    std::filesystem::path path = outDir / (s.name + ".gltf");
-    writeGltf(s.scene, path);
+    const std::filesystem::path path = outDir / (s.name + ".gltf");
+    docs.push_back(std::make_unique<GltfDocument>(gltfFromScene(s.scene)));
+    for (PendingFile& f : docs.back()->files(path)) {
+      // A file with exactly these bytes is a sample already (an older irbake wrote it without a manifest).
+      const ExistingOutput existing = sameBytesAs(f) ? ExistingOutput::Replace : ExistingOutput::ReplaceOurs;
+      guard.addOutput(f.finalPath, "the sample " + s.name, existing);
+      files.push_back(std::move(f));
+    }
     written.push_back(path);
   }
+  std::filesystem::create_directories(outDir, ec);
+  if (!std::filesystem::is_directory(outDir, ec))
+    throw Error(ErrorCode::Io, outDir.string(), "cannot create folder: " + ec.message());
+  guard.write(files);
   return written;
 }
 

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "common/output_guard.h"
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "pipeline/bake.h"
@@ -35,7 +36,7 @@ struct BakeCommand {
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
   double checkpointSeconds = 5.0;  // --checkpoint-seconds: at most this long between checkpoints (0: every block)
   Args arguments;                  // the arguments parsed: the command line after --config's entries
-  std::vector<std::filesystem::path> inputs;  // the scene's files and --env's map (checkOutputPaths)
+  std::vector<std::filesystem::path> inputs;  // the scene's files and --env's map (bakeOutputGuard)
   std::string dumpConfig;          // --dump-config FILE ("" without it)
   std::string dumpText;            // that file's text as parsed (what the bake decides is appended after it)
   nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
@@ -51,10 +52,13 @@ Scene loadBakeScene(const BakeCommand& command);
 // The scene's identity for partials and checkpoints: hashes of its files (and of --env's map).
 std::string bakeSceneIdentity(const BakeCommand& command);
 
-// Refuses (Error(Usage), exit 2) outputs that would overwrite an input (the scene, its .bin and textures,
-// --env) or each other (--report or --portable naming the glTF, a page or each other), and a --report or
-// --portable that is a folder. Returns the inputs (BakeCommand::inputs), which the export never overwrites.
-std::vector<std::filesystem::path> checkOutputPaths(const BakeCommand& command);
+// The bake's output guard (common/output_guard.h): its inputs (the scene, its .bin and textures, --env, and
+// `moreInputs`, e.g. merge's partials) and its outputs (glTF, .bin, report, --portable, --dump-config, the page
+// and state names it picks in OUTDIR). Refuses (Error(Usage), exit 2) an output that is an input, another
+// output, a folder or a pseudo-file, before any work. Sets command.inputs, which the export never overwrites.
+std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& command, const std::vector<std::filesystem::path>& moreInputs);
+// The --dump-config file as one more file of a set the guard writes.
+PendingFile dumpedConfigFile(const std::string& file, const std::string& text);
 // Locks --report's folder when it is not OUTDIR, so a report never lands in another bake's folder while
 // that bake runs (nullptr when no second lock is needed). Throws Error(Io) when that folder is busy.
 std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& command);
@@ -64,6 +68,7 @@ std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& command);
 std::string automaticChoices(const nlohmann::json& report);
 
 // Writes a finished bake's outputs where the command says (the all-or-nothing set) and lists them.
-void writeFinishedBake(const BakeCommand& command, const BakeResult& result, TerminalProgress& progress);
+void writeFinishedBake(const BakeCommand& command, const BakeResult& result, TerminalProgress& progress,
+                       const OutputGuard& guard);
 
 }  // namespace irbake::app

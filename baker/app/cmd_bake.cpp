@@ -21,6 +21,7 @@
 #include "common/error.h"
 #include "common/file_paths.h"
 #include "common/log.h"
+#include "common/output_guard.h"
 #include "common/output_lock.h"
 #include "common/progress.h"
 #include "export/gltf_export.h"
@@ -657,17 +658,16 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
   return entries;
 }
 
-// Writes a --dump-config file atomically.
-void writeDumpedConfig(const std::string& file, const std::string& text) {
-  writeAtomically(file, [&](const std::filesystem::path& temp) {
-    std::ofstream out(temp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw Error(ErrorCode::Io, file, "cannot write the config");
-  });
-}
-
 }  // namespace
+
+PendingFile dumpedConfigFile(const std::string& file, const std::string& text) {
+  return {file, [file, text](const std::filesystem::path& temp) {
+            std::ofstream out(temp, std::ios::binary);
+            out << text;
+            out.close();
+            if (!out) throw Error(ErrorCode::Io, file, "cannot write the config");
+          }};
+}
 
 std::string automaticChoices(const nlohmann::json& report) {
   // Options whose chosen value, given explicitly, makes the same bake; the other automatic choices (the walk's
@@ -736,7 +736,6 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
     command.dumpConfig = arguments.dumpConfig;
     command.dumpText = configText(effectiveOptions(*app, arguments, command.options),
                                   "irbake bake options (read back with --config FILE)");
-    writeDumpedConfig(command.dumpConfig, command.dumpText);
   }
   return command;
 }
@@ -766,6 +765,21 @@ std::string sceneIdentity(const BakeCommand& c) {
   return hash;
 }
 
+// The checkpoint goes when the bake is done: when the folder's manifest proves irbake wrote it, or when it
+// is an irbake VPL sum file whose checksum holds (a copied shard's partial resumed from); else it stays.
+void removeCheckpoint(const fs::path& checkpoint, const OutputGuard& guard) {
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(checkpoint, ec)) || guard.removeIfOurs(checkpoint)) return;
+  try {
+    if (!fs::is_regular_file(fs::symlink_status(checkpoint, ec))) throw Error(ErrorCode::Io, "", "not a file");
+    readVplSumFile(checkpoint);
+  } catch (const Error&) {
+    log::warn("left " + checkpoint.string() + " as it is: irbake did not write it");
+    return;
+  }
+  fs::remove(checkpoint, ec);
+}
+
 }  // namespace
 
 std::string bakeSceneIdentity(const BakeCommand& c) { return sceneIdentity(c); }
@@ -781,59 +795,61 @@ bool isPageName(const std::string& name) {
   if (digits == 0) return false;
   const std::string rest = name.substr(at);
   return rest == ".exr" || rest == ".png" || rest == "_l1x.exr" || rest == "_l1y.exr" || rest == "_l1z.exr" ||
-         rest == "_shadowmask.exr" || rest == "_shadowmask.png";
+         rest == "_l1x.png" || rest == "_l1y.png" || rest == "_l1z.png" || rest == "_shadowmask.exr" ||
+         rest == "_shadowmask.png";
+}
+
+// error_<page>.exr (--error-map) is a page too.
+bool isPageOrErrorName(const std::string& name) {
+  if (isPageName(name)) return true;
+  const std::string prefix = "error_";
+  if (name.rfind(prefix, 0) != 0 || name.size() <= prefix.size() + 4) return false;
+  const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 4);
+  return name.substr(name.size() - 4) == ".exr" &&
+         digits.find_first_not_of("0123456789") == std::string::npos;
+}
+
+// The files a bake keeps in OUTDIR while it runs: its lock, its checkpoint and a shard's partial.
+bool isBakeStateName(const std::string& name) {
+  return name == OutputFolderLock::kFileName || name == ".irbake.checkpoint" ||
+         (name.rfind("partial_", 0) == 0 && name.size() > 15 && name.substr(name.size() - 7) == ".vplsum");
 }
 
 }  // namespace
 
-std::vector<fs::path> checkOutputPaths(const BakeCommand& c) {
+std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<fs::path>& moreInputs) {
+  auto guard = std::make_shared<OutputGuard>();
   const fs::path outDir = outputFolderOf(c.out);
   const bool gltfNamed = namesGltfFile(c.out);
   const fs::path gltf = gltfNamed ? fs::path(c.out) : outDir / "scene.gltf";
-  std::vector<std::pair<fs::path, std::string>> outputs;  // path, what it is
-  if (!c.noGltf) {
-    outputs.push_back({gltf, "the glTF output"});
-    if (!hasExtension(gltf, ".glb")) outputs.push_back({outDir / (gltf.stem().string() + ".bin"), "the glTF's .bin output"});
-  }
-  const fs::path report = c.report.empty() ? outDir / "report.json" : fs::path(c.report);
   std::error_code ec;
-  if (!c.report.empty() && fs::is_directory(report, ec))
+  if (!c.report.empty() && fs::is_directory(c.report, ec))
     throw Error(ErrorCode::Usage, c.report, "--report names a folder: give the report's file name (R.json)");
-  if (!c.report.empty()) {
-    for (const auto& [path, what] : outputs)
-      if (sameFile(report, path)) throw Error(ErrorCode::Usage, c.report, "--report would overwrite " + what + ": choose another name");
-    if (sameFile(folderOf(report), outDir) &&
-        (isPageName(report.filename().string()) || isIrbakeTempName(report.filename().string())))
-      throw Error(ErrorCode::Usage, c.report, "--report would overwrite a light-map page of this bake: choose another name");
-  }
-  outputs.push_back({report, "the report"});
   if (!c.portable.empty()) {
-    const fs::path portable = c.portable;
-    if (fs::is_directory(portable, ec))
+    if (fs::is_directory(c.portable, ec))
       throw Error(ErrorCode::Usage, c.portable, "--portable names a folder: give the portable file's name (P.glb)");
-    if (!hasExtension(portable, ".glb")) throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
-    for (const auto& [path, what] : outputs)
-      if (sameFile(portable, path)) throw Error(ErrorCode::Usage, c.portable, "--portable would overwrite " + what + ": choose another name");
-    if (sameFile(folderOf(portable), outDir) &&
-        isIrbakeTempName(portable.filename().string()))
-      throw Error(ErrorCode::Usage, c.portable, "--portable names a temporary file of this bake: choose another name");
-    outputs.push_back({portable, "the portable GLB"});
+    if (!hasExtension(c.portable, ".glb")) throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
   }
-  // Inputs: the scene and its files, and --env's map.
+  if (!c.dumpConfig.empty() && fs::is_directory(c.dumpConfig, ec))
+    throw Error(ErrorCode::Usage, c.dumpConfig, "--dump-config names a folder: give the config's file name (C.toml)");
+  // Inputs first: the scene and its files, --env's map, and what the command reads besides (merge's partials).
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.lights.environment.empty()) inputs.push_back(c.lights.environment);
-  for (const fs::path& input : inputs) {
-    for (const auto& [path, what] : outputs)
-      if (sameFile(input, path))
-        throw Error(ErrorCode::Usage, input.string(),
-                    "is an input of this bake and would be overwritten by " + what + ": choose another -o" +
-                        (what == "the report" ? " or --report" : what == "the portable GLB" ? " or --portable" : ""));
-    if (sameFile(folderOf(input), outDir) &&
-        isPageName(input.filename().string()))
-      throw Error(ErrorCode::Usage, input.string(),
-                  "is an input of this bake and would be overwritten by a light-map page: choose another -o");
+  inputs.insert(inputs.end(), moreInputs.begin(), moreInputs.end());
+  guard->addInputs(inputs);
+  // The names the bake picks in OUTDIR (pages, its lock, checkpoint and partials), then each named output.
+  guard->keepManifest(outDir);
+  guard->addOutputNames(outDir, isPageOrErrorName, "a light-map page of this bake");
+  guard->addOutputNames(outDir, isBakeStateName, "the bake's own state (lock, checkpoint, partials)");
+  if (!c.noGltf) {
+    guard->addOutput(gltf, "the glTF output");
+    if (!hasExtension(gltf, ".glb")) guard->addOutput(outDir / (gltf.stem().string() + ".bin"), "the glTF's .bin output");
   }
-  return inputs;
+  guard->addOutput(c.report.empty() ? outDir / "report.json" : fs::path(c.report), c.report.empty() ? "the report" : "--report");
+  if (!c.portable.empty()) guard->addOutput(c.portable, "--portable");
+  if (!c.dumpConfig.empty()) guard->addOutput(c.dumpConfig, "--dump-config");
+  c.inputs = inputs;
+  return guard;
 }
 
 std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& c) {
@@ -854,7 +870,7 @@ int runBake(const Args& args) {
     threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, c.threads);
 
   const fs::path outDir = outputFolderOf(c.out);
-  c.inputs = checkOutputPaths(c);
+  const std::shared_ptr<OutputGuard> guard = bakeOutputGuard(c, {});
   const OutputFolderLock lock(outDir);  // before any work: a second bake into OUTDIR fails at once
   const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
   removeStaleTemps(outDir);
@@ -921,7 +937,7 @@ int runBake(const Args& args) {
     h.kind = "checkpoint";
     h.endBlock = done;
     h.backendCounts = staged.backendCounts();
-    writeVplSumFile(checkpoint, h, sums);
+    writeVplSumFile(checkpoint, h, sums, guard.get());
     sinceCheckpoint.reset();
   });
 
@@ -931,8 +947,11 @@ int runBake(const Args& args) {
     header.endBlock = end;
     header.backendCounts = staged.backendCounts();
     const fs::path partial = outDir / partialName(c.shardIndex, c.shardCount);
-    writeVplSumFile(partial, header, sums);
-    fs::remove(checkpoint, ec);
+    if (c.dumpConfig.empty()) writeVplSumFile(partial, header, sums, guard.get());
+    else  // the partial and the config it was baked with, together or not at all
+      guard->write({PendingFile{partial, [&](const fs::path& temp) { writeVplSumFile(temp, header, sums); }},
+                    dumpedConfigFile(c.dumpConfig, c.dumpText)});
+    removeCheckpoint(checkpoint, *guard);
     progress.finish();
     log::info("shard " + std::to_string(c.shardIndex) + "/" + std::to_string(c.shardCount) + ": VPL blocks " +
               std::to_string(begin) + ".." + std::to_string(end) + " of " + std::to_string(blocks));
@@ -944,9 +963,8 @@ int runBake(const Args& args) {
   BakeResult result = staged.finish(std::move(sums));
   result.report["timings"]["seconds"]["load"] = loadSeconds;
   result.report["options"] = c.resultOptions;
-  writeFinishedBake(c, result, progress);
-  if (!c.dumpConfig.empty()) writeDumpedConfig(c.dumpConfig, c.dumpText + automaticChoices(result.report));
-  fs::remove(checkpoint, ec);
+  writeFinishedBake(c, result, progress, *guard);
+  removeCheckpoint(checkpoint, *guard);
   return 0;
 }
 
@@ -961,8 +979,11 @@ std::string estimatedErrorText(const nlohmann::json& report) {
   return line;
 }
 
-void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress) {
+void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress, const OutputGuard& guard) {
   OutputOptions outputOptions;
+  outputOptions.guard = &guard;
+  // --dump-config: the options, then what the bake chose where they said auto; written with the outputs.
+  if (!c.dumpConfig.empty()) outputOptions.alsoWrite.push_back(dumpedConfigFile(c.dumpConfig, c.dumpText + automaticChoices(result.report)));
   outputOptions.outDir = c.out;
   outputOptions.reportPath = c.report;
   outputOptions.writeGltf = !c.noGltf;

@@ -141,7 +141,7 @@ int runMerge(const Args& args) {
   if (c.optionsHash != first.optionsHash)
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");
 
-  c.inputs = checkOutputPaths(c);
+  const std::shared_ptr<OutputGuard> guard = bakeOutputGuard(c, files);
   const OutputFolderLock lock(outputFolderOf(out));
   const std::unique_ptr<OutputFolderLock> reportLock = lockReportFolder(c);
   removeStaleTemps(outputFolderOf(out));
@@ -171,7 +171,7 @@ int runMerge(const Args& args) {
   BakeResult result = staged.finish(std::move(sums));
   result.report["shards"] = first.shardCount;
   result.report["options"] = c.resultOptions;
-  writeFinishedBake(c, result, progress);
+  writeFinishedBake(c, result, progress, *guard);
   return 0;
 }
 

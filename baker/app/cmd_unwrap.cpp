@@ -14,9 +14,12 @@
 #include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/file_paths.h"
+#include "common/output_guard.h"
 #include "common/progress.h"
 #include "export/gltf_export.h"
 #include "scene/gltf_loader.h"
+#include "scene/scene_files.h"
 
 namespace irbake::app {
 
@@ -81,6 +84,17 @@ int runUnwrap(const Args& args) {
   if (output.empty()) throw Error(ErrorCode::Usage, "", "unwrap needs -o OUT.gltf");
   const std::string input = inputs[0];
   options.texelsPerUnit = float(tpu);
+  // Every output checked before any work: never onto the scene's files, a folder, or each other.
+  if (!namesGltfFile(output))
+    throw Error(ErrorCode::Usage, output, "unwrap writes one glTF: give -o a .gltf or .glb file name");
+  if (!report.empty() && std::filesystem::is_directory(report))
+    throw Error(ErrorCode::Usage, report, "--report names a folder: give the report's file name (R.json)");
+  OutputGuard guard;
+  guard.addInputs(sceneInputFiles(input));
+  guard.addOutput(output, "the unwrapped glTF (-o)");
+  if (hasExtension(output, ".gltf"))
+    guard.addOutput(folderOf(output) / (std::filesystem::path(output).stem().string() + ".bin"), "the glTF's .bin output");
+  if (!report.empty()) guard.addOutput(report, "--report");
 
   TerminalProgress bar;
   options.progress = bar.callback();
@@ -91,15 +105,18 @@ int runUnwrap(const Args& args) {
   ExportOptions exportOptions;
   exportOptions.output = output;
   exportOptions.writeExrPages = false;
-  exportGltf(scene, {}, exportOptions);
+  exportOptions.inputs = sceneInputFiles(input);
+  exportOptions.guard = &guard;
   if (!report.empty()) {
     const std::string text = reportJson(input, result).dump(2) + "\n";
-    writeAtomically(report, [&](const std::filesystem::path& tmp) {
-      std::ofstream out(tmp);
-      out << text;
-      if (!out) throw Error(ErrorCode::Io, report, "cannot write the report");
-    });
+    exportOptions.alsoWrite.push_back({report, [text, report](const std::filesystem::path& tmp) {
+                                         std::ofstream out(tmp, std::ios::binary);
+                                         out << text;
+                                         out.close();
+                                         if (!out) throw Error(ErrorCode::Io, report, "cannot write the report");
+                                       }});
   }
+  exportGltf(scene, {}, exportOptions);
   const AtlasStats& s = result.stats;
   std::printf("%zu charts (%zu planar, %zu LSCM), %zu page(s)", s.charts, s.planarCharts, s.lscmCharts, result.pages.size());
   for (const AtlasPage& p : result.pages) std::printf(" %dx%d", p.width, p.height);

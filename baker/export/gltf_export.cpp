@@ -566,15 +566,13 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
     }
   }
   files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
-  refuseOverwritingInputs(files, options.inputs);
-  writeAllAtomically(files);
-}
-
-void refuseOverwritingInputs(const std::vector<PendingFile>& outputs, const std::vector<std::filesystem::path>& inputs) {
-  for (const PendingFile& out : outputs)
-    for (const auto& input : inputs)
-      if (sameFile(out.finalPath, input))
-        throw Error(ErrorCode::Usage, out.finalPath.string(), "is an input of this bake: refusing to overwrite it (choose another -o)");
+  if (options.guard) {
+    options.guard->write(files);
+    return;
+  }
+  OutputGuard guard;
+  guard.addInputs(options.inputs);
+  guard.write(files);
 }
 
 nlohmann::json skyJson(const Environment& sky) {

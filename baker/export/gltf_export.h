@@ -12,6 +12,7 @@
 #include "lightmap/lightmap.h"
 #include "lightmap/probe_grid.h"
 #include "common/atomic_file.h"
+#include "common/output_guard.h"
 #include "export/gltf_writer.h"
 #include "export/lightmap_png.h"
 #include "export/shadow_mask_export.h"
@@ -36,10 +37,10 @@ struct ExportOptions {
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;
+  // The command's output guard, which writes the set (null: one that knows only `inputs`).
+  const OutputGuard* guard = nullptr;
 };
 
-// Throws Error(Usage) naming the file when one of `outputs` is one of `inputs` (same file, however named).
-void refuseOverwritingInputs(const std::vector<PendingFile>& outputs, const std::vector<std::filesystem::path>& inputs);
 
 // True when a command's -o names a glTF file (.gltf / .glb, any case) rather than an output folder.
 bool namesGltfFile(const std::filesystem::path& output);

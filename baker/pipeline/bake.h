@@ -1,5 +1,6 @@
 // The bake: every stage in order, one way — scene → atlas → texels → VPLs → backend → post.
 #pragma once
+#include "common/output_guard.h"
 #include <array>
 #include <filesystem>
 #include <functional>
@@ -88,6 +89,9 @@ struct OutputOptions {
   std::vector<std::filesystem::path> inputs;  // the bake's input files: never overwritten (Error(Usage))
   std::filesystem::path portablePath;  // also the portable GLB here (export/portable_export.h); empty: none
   PortableOptions portable;            // its exposure and texture limits
+  // The command's output guard: every file goes through it (null: one that knows only `inputs`).
+  const OutputGuard* guard = nullptr;
+  std::vector<PendingFile> alsoWrite;  // more files of the same all-or-nothing set (--dump-config)
 };
 
 // Writes the EXR pages, the glTF (through exportGltf) and the report, each atomically. Returns the

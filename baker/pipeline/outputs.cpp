@@ -30,30 +30,36 @@ std::vector<PendingFile> errorPageFiles(const BakeResult& result, const std::fil
   return files;
 }
 
-// Pages of an earlier bake into the same folder that this bake does not have (more pages, shadow masks).
-void removeStalePages(const BakeResult& result, const std::filesystem::path& outDir) {
+// A page of an earlier bake into the same folder that this bake does not have would be read as part of it
+// (irbake diff): remove it, but only when the folder's manifest proves irbake wrote it and it is unchanged.
+void removeStalePage(const std::filesystem::path& stale, const OutputGuard& guard, const std::string& why) {
+  std::error_code ec;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(stale, ec))) return;
+  if (guard.removeIfOurs(stale))
+    log::warn("removed " + stale.string() + " left by an earlier bake " + why);
+  else
+    log::warn("left " + stale.string() + " as it is: it has the name of a page this bake does not write, but "
+              "irbake did not write it (or it changed since); it is not part of this bake");
+}
+
+void removeStalePages(const BakeResult& result, const std::filesystem::path& outDir, const OutputGuard& guard) {
   namespace fs = std::filesystem;
-  // Pages of an earlier bake into the same folder that this bake does not have would be read as
-  // part of it (irbake diff, the viewer): remove them.
-  std::error_code removeError;
+  std::error_code ec;
   for (size_t page = result.maps.size();; ++page) {
-    fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
-    if (!fs::exists(stale)) break;
-    fs::remove(stale, removeError);
-    log::warn("removed " + stale.string() + " left by an earlier bake with more pages");
+    const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + ".exr");
+    if (!fs::exists(fs::symlink_status(stale, ec))) break;
+    removeStalePage(stale, guard, "with more pages");
   }
   // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
-  for (size_t page = 0;; ++page) {
+  for (size_t page = result.shadowMask.rgb.size();; ++page) {
     bool found = false;
     for (const char* ext : {".exr", ".png"}) {
       const fs::path stale = outDir / ("lightmap_" + std::to_string(page) + "_shadowmask" + ext);
-      if (!fs::exists(stale)) continue;
+      if (!fs::exists(fs::symlink_status(stale, ec))) continue;
       found = true;
-      if (page < result.shadowMask.rgb.size()) continue;
-      fs::remove(stale, removeError);
-      log::warn("removed " + stale.string() + " left by an earlier bake with shadow-mask lights");
+      removeStalePage(stale, guard, "with shadow-mask lights");
     }
-    if (!found && page >= result.shadowMask.rgb.size()) break;
+    if (!found) break;
   }
 }
 
@@ -87,6 +93,9 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     for (const Lightmap& m : result.shadowMask.rgb) l1Exrs.push_back({outDir / shadowMaskPageUri("lightmap", m.page), &m});
   }
   const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
+  OutputGuard unguarded;  // a caller without a command guard: one that knows the inputs
+  unguarded.addInputs(options.inputs);
+  const OutputGuard& guard = options.guard ? *options.guard : unguarded;
   std::vector<fs::path> written;
   if (options.writeGltf) written.push_back(gltfPath);
   written.insert(written.end(), exrs.begin(), exrs.end());
@@ -103,6 +112,7 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     portable.push_back(portableGlbFile(result.scene, result.maps, options.portablePath, options.portable, &portableSummary));
     written.push_back(options.portablePath);
   }
+  for (const PendingFile& f : options.alsoWrite) written.push_back(f.finalPath);
 
   // The report names what is written, and is written with it: glTF (+ .bin, PNG), EXR pages and report are
   // one all-or-nothing set, so a failed bake leaves the previous outputs, report included, untouched.
@@ -127,7 +137,9 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     ex.alsoWrite = {reportFile};
     ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
     ex.alsoWrite.insert(ex.alsoWrite.end(), errorPages.begin(), errorPages.end());
+    ex.alsoWrite.insert(ex.alsoWrite.end(), options.alsoWrite.begin(), options.alsoWrite.end());
     ex.inputs = options.inputs;
+    ex.guard = &guard;
     if (!result.directional[0].empty()) ex.directional = &result.directional;
     ex.probes = &result.probes;
     if (!mask.empty()) ex.shadowMask = &mask;
@@ -152,11 +164,11 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     files.push_back(reportFile);
     files.insert(files.end(), portable.begin(), portable.end());
     files.insert(files.end(), errorPages.begin(), errorPages.end());
-    refuseOverwritingInputs(files, options.inputs);
-    writeAllAtomically(files);
+    files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
+    guard.write(files);
   }
 
-  removeStalePages(result, outDir);
+  removeStalePages(result, outDir, guard);
   written.push_back(reportPath);
   return written;
 }

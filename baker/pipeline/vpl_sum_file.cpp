@@ -86,7 +86,8 @@ std::string VplSumHeader::mismatch(const VplSumHeader& o) const {
   return {};
 }
 
-void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& header, const ExactVplSums& sums) {
+void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& header, const ExactVplSums& sums,
+                     const OutputGuard* guard) {
   const nlohmann::json h = {{"kind", header.kind},
                             {"sceneHash", header.sceneHash},
                             {"optionsHash", header.optionsHash},
@@ -101,7 +102,8 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
                             {"command", header.command},
                             {"backendCounts", header.backendCounts}};
   const std::string text = h.dump();
-  writeAtomically(path, [&](const std::filesystem::path& temp) {
+  const OutputGuard unguarded;  // callers without a command (tests) write through a guard that knows no input
+  (guard ? *guard : unguarded).write(path, [&](const std::filesystem::path& temp) {
     std::ofstream file(temp, std::ios::binary);
     ChecksummedWriter out{file, {}};
     out.write(kMagic, sizeof kMagic);

@@ -3,6 +3,7 @@
 // belong to (hashes of the scene files and of the options, the seed, the backend used), so sums of
 // different bakes are never added together. Written atomically (common/atomic_file.h).
 #pragma once
+#include "common/output_guard.h"
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -40,7 +41,8 @@ struct VplSumFile {
 };
 
 // Writes header + sums to path atomically (only texels some block found valid carry sums).
-void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& header, const ExactVplSums& sums);
+void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& header, const ExactVplSums& sums,
+                     const OutputGuard* guard = nullptr);
 // Reads a file written by writeVplSumFile. Throws Error(Io) when unreadable, Error(Parse) when it is not
 // such a file, is of another version, or fails its checksum (damaged, edited, truncated), naming the file.
 VplSumFile readVplSumFile(const std::filesystem::path& path);
