@@ -71,11 +71,13 @@ void checkCameras(const nlohmann::json& root, const std::string& file) {
     const nlohmann::json& c = (*cameras)[i];
     if (!c.is_object() || c.value("type", std::string()) != "perspective") continue;
     const std::string name = c.contains("name") && c["name"].is_string() ? c["name"].get<std::string>() : "";
-    const std::string what = "camera " + std::to_string(i) + (name.empty() ? "" : " ('" + name + "')") + ": perspective.";
+    const std::string camera = "camera " + std::to_string(i) + (name.empty() ? "" : " ('" + name + "')");
+    const std::string what = camera + ": perspective.";
     const auto p = c.find("perspective");
     if (p == c.end() || !p->is_object())
-      throw Error(ErrorCode::InvalidData, file, "camera " + std::to_string(i) + ": type perspective without a perspective object");
-    // The value of `key` (NaN when absent and required, or not a number), and its text for the message.
+      throw Error(ErrorCode::InvalidData, file, camera + ": type perspective without a perspective object");
+    // Reads `key` into v: false when it is absent and optional; throws when it is absent and required, not a
+    // number or not finite (as a 32-bit float too).
     auto number = [&](const char* key, bool required, double& v) {
       const auto it = p->find(key);
       if (it == p->end()) {
