@@ -182,6 +182,64 @@ TEST(IrviewCli, DegenerateViewsAreRefused) {
   }
 }
 
+// glTF 2.0's camera rules: yfov in (0, π), znear > 0, zfar > znear when present, aspectRatio > 0 when present, all
+// finite 32-bit floats. A camera that breaks one is refused at load with exit 5, naming the file, the camera and
+// the field, whichever view is asked for; the same camera written well renders.
+TEST(IrviewCli, GltfCameraOutsideTheSpecIsRefusedNamingTheCamera) {
+  const std::string scene = sampleFile("furnace").string();
+  const fs::path shot = workDir() / "camera_rules.png";
+  auto withCamera = [&](const nlohmann::json& perspective, const std::string& name) {
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(scene));
+    doc["cameras"] = {{{"type", "perspective"}, {"name", "lens"}, {"perspective", perspective}}};
+    doc["nodes"].push_back({{"camera", 0}, {"translation", {0.1, 0.2, 0.3}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+    const fs::path file = fs::path(scene).parent_path() / ("furnace_camera_" + name + ".gltf");  // beside its .bin
+    std::ofstream(file) << doc.dump();
+    return file.string();
+  };
+  struct Case {
+    const char* name;
+    nlohmann::json perspective;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"yfov_zero", {{"yfov", 0.0}, {"znear", 0.01}}, "camera 0 ('lens'): perspective.yfov 0.0 rad: a perspective view needs 0 < yfov < π"},
+      {"yfov_negative", {{"yfov", -0.5}, {"znear", 0.01}}, "camera 0 ('lens'): perspective.yfov -0.5 rad"},
+      {"yfov_overflow", {{"yfov", 1e39}, {"znear", 0.01}}, "camera 0 ('lens'): perspective.yfov 1e+39 is not a finite number"},
+      {"yfov_string", {{"yfov", "NaN"}, {"znear", 0.01}}, "camera 0 ('lens'): perspective.yfov \"NaN\" is not a finite number"},
+      {"znear_zero", {{"yfov", 0.8}, {"znear", 0.0}}, "camera 0 ('lens'): perspective.znear 0.0 must be greater than 0"},
+      {"znear_negative", {{"yfov", 0.8}, {"znear", -1.0}}, "camera 0 ('lens'): perspective.znear -1.0 must be greater than 0"},
+      {"znear_tiny", {{"yfov", 0.8}, {"znear", 1e-50}}, "camera 0 ('lens'): perspective.znear 1e-50 must be greater than 0"},
+      {"zfar_below", {{"yfov", 0.8}, {"znear", 10.0}, {"zfar", 1.0}},
+       "camera 0 ('lens'): perspective.zfar 1.0 must be greater than znear 10.0"},
+      {"zfar_equal", {{"yfov", 0.8}, {"znear", 0.5}, {"zfar", 0.5}}, "perspective.zfar 0.5 must be greater than znear 0.5"},
+      {"aspect_zero", {{"yfov", 0.8}, {"znear", 0.01}, {"aspectRatio", 0.0}}, "perspective.aspectRatio 0.0 must be greater than 0"},
+      {"aspect_negative", {{"yfov", 0.8}, {"znear", 0.01}, {"aspectRatio", -1.5}}, "perspective.aspectRatio -1.5 must be greater than 0"},
+  };
+  for (const Case& c : cases) {
+    const std::string file = withCamera(c.perspective, c.name);
+    for (const char* view : {"--camera 0", "", "--eye 0.1,0.2,0.3 --target 0,0,0"}) {
+      fs::remove(shot);
+      RunResult r = run(file + " " + view + " --width 16 --height 16 --screenshot " + shot.string());
+      EXPECT_EQ(r.status, 5) << c.name << " " << view << ": " << r.output;
+      EXPECT_NE(r.output.find(file + ": camera 0 ('lens'): perspective."), std::string::npos) << r.output;
+      EXPECT_NE(r.output.find(c.message), std::string::npos) << c.name << ": " << r.output;
+      EXPECT_FALSE(fs::exists(shot)) << c.name;
+    }
+  }
+  // Within the rules (a finite zfar beyond znear, an aspect ratio): the view renders, and it is not black.
+  const std::string good = withCamera({{"yfov", 0.8}, {"znear", 0.01}, {"zfar", 100.0}, {"aspectRatio", 1.0}}, "good");
+  fs::remove(shot);
+  RunResult r = run(good + " --camera 0 --width 16 --height 16 --screenshot " + shot.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  int w = 0, h = 0;
+  const std::vector<float> pixels = readImage(shot, w, h);
+  ASSERT_EQ(w, 16);
+  double sum = 0.0;
+  for (float v : pixels) sum += v;
+  EXPECT_GT(sum / pixels.size(), 0.05) << "the furnace seen from inside is lit";
+}
+
 // A MOZ_lightmap irview cannot show as written is refused with exit 5 and the material named: a texture that
 // does not exist, a texCoord other than 1, an intensity that is negative or not a number (JSON has no NaN:
 // a string or null stands for it). The same extension written well renders.

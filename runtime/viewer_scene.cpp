@@ -1,6 +1,7 @@
 #include "viewer_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <map>
 #include <numeric>
@@ -10,6 +11,7 @@
 #include "common/log.h"
 #include "export/exr_io.h"
 #include "scene/gltf_loader.h"
+#include "scene/gltf_source.h"
 #include "scene/scene_files.h"
 
 namespace irbake::view {
@@ -57,10 +59,61 @@ ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages, std::array
   return v;
 }
 
+namespace {
+
+// glTF 2.0's rules for a perspective camera (camera.perspective): yfov > 0 (and < π, or there is no projection),
+// znear > 0, zfar (when present) > znear, aspectRatio (when present) > 0, each a finite 32-bit float. The loader
+// puts a default in place of a yfov or znear ≤ 0; the viewer refuses them, as any view from such a camera would be
+// a guess or black. Orthographic cameras are skipped by the loader, so their fields are not read.
+void checkCameras(const nlohmann::json& root, const std::string& file) {
+  const auto cameras = root.find("cameras");
+  if (cameras == root.end() || !cameras->is_array()) return;
+  for (size_t i = 0; i < cameras->size(); ++i) {
+    const nlohmann::json& c = (*cameras)[i];
+    if (!c.is_object() || c.value("type", std::string()) != "perspective") continue;
+    const std::string name = c.contains("name") && c["name"].is_string() ? c["name"].get<std::string>() : "";
+    const std::string camera = "camera " + std::to_string(i) + (name.empty() ? "" : " ('" + name + "')");
+    const std::string what = camera + ": perspective.";
+    const auto p = c.find("perspective");
+    if (p == c.end() || !p->is_object())
+      throw Error(ErrorCode::InvalidData, file, camera + ": type perspective without a perspective object");
+    // Reads `key` into v: false when it is absent and optional; throws when it is absent and required, not a
+    // number or not finite (as a 32-bit float too).
+    auto number = [&](const char* key, bool required, double& v) {
+      const auto it = p->find(key);
+      if (it == p->end()) {
+        if (required) throw Error(ErrorCode::InvalidData, file, what + key + " is missing (glTF requires it)");
+        return false;
+      }
+      v = it->is_number() ? it->get<double>() : std::nan("");
+      if (!std::isfinite(v) || !std::isfinite(static_cast<float>(v)))
+        throw Error(ErrorCode::InvalidData, file, what + key + " " + it->dump() + " is not a finite number");
+      return true;
+    };
+    double yfov = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;
+    number("yfov", true, yfov);
+    if (!(yfov > 0.0 && static_cast<float>(yfov) < 3.14159265f))
+      throw Error(ErrorCode::InvalidData, file,
+                  what + "yfov " + (*p)["yfov"].dump() + " rad: a perspective view needs 0 < yfov < π");
+    number("znear", true, znear);
+    if (!(znear > 0.0 && static_cast<float>(znear) > 0.0f))
+      throw Error(ErrorCode::InvalidData, file, what + "znear " + (*p)["znear"].dump() + " must be greater than 0");
+    if (number("zfar", false, zfar) && !(static_cast<float>(zfar) > static_cast<float>(znear)))
+      throw Error(ErrorCode::InvalidData, file,
+                  what + "zfar " + (*p)["zfar"].dump() + " must be greater than znear " + (*p)["znear"].dump());
+    if (number("aspectRatio", false, aspect) && !(aspect > 0.0 && static_cast<float>(aspect) > 0.0f))
+      throw Error(ErrorCode::InvalidData, file, what + "aspectRatio " + (*p)["aspectRatio"].dump() + " must be greater than 0");
+  }
+}
+
+}  // namespace
+
 ViewerScene loadViewerScene(const std::filesystem::path& path) {
   LoadOptions options;
   options.shadingMaps = true;  // the normal maps, tangents and directional maps a bake does not read
-  Scene scene = loadScene(path, options);
+  GltfSource source = readGltfSource(path);
+  checkCameras(source.json, path.string());
+  Scene scene = loadSceneFromBytes(std::move(source.bytes), path, options);
   // The viewer reads every light map through TEXCOORD_1 (docs/export.md); a map meant for another set would
   // show garbage, so it is refused.
   for (const Material& m : scene.materials)

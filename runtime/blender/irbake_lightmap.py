@@ -16,7 +16,9 @@ bl_info = {
 }
 
 import argparse
+import json
 import os
+import struct
 import sys
 import types
 import urllib.parse
@@ -27,6 +29,47 @@ ADDON_NAME = "irbake_lightmap"
 EXTENSION = "MOZ_lightmap"
 # Scene property read by the hook during import_gltf(): False reads the PNG pages even where EXR pages exist.
 PREFER_EXR_PROPERTY = "irbake_lightmap_prefer_exr"
+LIGHTMAP_TEX_COORD = 1  # irbake's light maps live in TEXCOORD_1, MOZ_lightmap's default set
+# The MOZ_lightmaps refused during the current import, one message each (main() exits 5 when there are any). The
+# importer catches and prints whatever a hook raises, so refusals are collected here instead.
+refusals = []
+
+
+class LightmapRefused(ValueError):
+    """A MOZ_lightmap that irview refuses (docs/refusals.md), with irview's message."""
+
+
+def float32_finite(value):
+    """Whether value is a number that stays finite as a 32-bit float (what irview stores): 1e39 is not."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
+        return False
+    try:
+        struct.pack("<f", value)
+    except OverflowError:
+        return False
+    return abs(value) != float("inf")
+
+
+def lightmap_of(gltf, material_index, ext):
+    """(texture index, texCoord, intensity) of material material_index's MOZ_lightmap ext, as irview reads it:
+    texCoord and intensity default to 1. Raises LightmapRefused naming the material for what irview refuses."""
+    name = gltf.data.materials[material_index].name if material_index is not None else None
+    what = "material %s%s: MOZ_lightmap" % (material_index, " ('%s')" % name if name else "")
+    if not isinstance(ext, dict):
+        raise LightmapRefused("%s is not an object" % what)
+    texture = ext.get("index")
+    if isinstance(texture, bool) or not isinstance(texture, int):
+        raise LightmapRefused("%s has no texture index" % what)
+    textures = len(gltf.data.textures or [])
+    if not 0 <= texture < textures:
+        raise LightmapRefused("%s names texture %d, which does not exist (the file has %d)" % (what, texture, textures))
+    tex_coord = ext.get("texCoord", LIGHTMAP_TEX_COORD)
+    if tex_coord != LIGHTMAP_TEX_COORD or isinstance(tex_coord, bool):
+        raise LightmapRefused("%s texCoord %s, but light maps use TEXCOORD_%d" % (what, json.dumps(tex_coord), LIGHTMAP_TEX_COORD))
+    intensity = ext.get("intensity", 1.0)
+    if not float32_finite(intensity) or intensity < 0:
+        raise LightmapRefused("%s intensity %s must be a finite number ≥ 0" % (what, json.dumps(intensity)))
+    return texture, tex_coord, float(intensity)
 
 
 def numpy_bool_alias():
@@ -180,18 +223,23 @@ class glTF2ImportUserExtension:
     """The importer calls this after creating each material (Blender 3.4's user-extension hooks: it looks for a
     class of this name in every enabled add-on)."""
 
-    def __init__(self):
+    def __init__(self):  # one per import
         self.exr_pages = None
+        del refusals[:]
 
     def gather_import_material_after_hook(self, pymaterial, vertex_color, blender_material, gltf):
-        ext = (pymaterial.extensions or {}).get(EXTENSION)
-        if not isinstance(ext, dict) or not isinstance(ext.get("index"), int):
+        extensions = pymaterial.extensions or {}
+        if EXTENSION not in extensions:
             return
-        texture = ext["index"]
-        if not 0 <= texture < len(gltf.data.textures or []):
-            print("irbake_lightmap: material %r: MOZ_lightmap names texture %d, which does not exist"
-                  % (blender_material.name, texture))
+        index = next((i for i, m in enumerate(gltf.data.materials or []) if m is pymaterial), None)
+        try:
+            texture, tex_coord, intensity = lightmap_of(gltf, index, extensions[EXTENSION])
+        except LightmapRefused as e:
+            # Left as imported: a wrong map is never shown. The command line exits 5 (main()).
+            refusals.append(str(e))
+            print("irbake_lightmap: %s: %s" % (gltf.filename, e), file=sys.stderr)
             return
+        ext = extensions[EXTENSION]
         if self.exr_pages is None:
             prefer_exr = bpy.context.scene.get(PREFER_EXR_PROPERTY, True)
             self.exr_pages = exr_pages_by_texture(gltf) if prefer_exr else {}
@@ -206,8 +254,6 @@ class glTF2ImportUserExtension:
                 return
             srgb = isinstance(ext.get("extras"), dict) and ext["extras"].get("colorSpace") == "srgb"
             image.colorspace_settings.name = "sRGB" if srgb else "Non-Color"
-        intensity = float(ext.get("intensity", 1.0))
-        tex_coord = int(ext.get("texCoord", 0))
         if not wire_lightmap(blender_material, image, tex_coord, intensity, exr is not None):
             print("irbake_lightmap: material %r has no Principled BSDF (unlit or specular-glossiness): left as imported"
                   % blender_material.name)
@@ -262,6 +308,9 @@ def main(argv):
     if import_gltf(os.path.abspath(args.scene), prefer_exr=not args.png) != {"FINISHED"}:
         print("irbake_lightmap: %s: the glTF importer failed" % args.scene, file=sys.stderr)
         return 4
+    if refusals:  # irview's class for them: InvalidData (5); each was printed when it was met
+        print("irbake_lightmap: %s: %d light map(s) refused, left as imported" % (args.scene, len(refusals)), file=sys.stderr)
+        return 5
     wired = [m.name for m in bpy.data.materials if "irbake_lightmap" in m]
     print("irbake_lightmap: %d material(s) with light maps: %s" % (len(wired), ", ".join(sorted(wired))))
     if args.save:

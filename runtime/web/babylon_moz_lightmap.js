@@ -10,9 +10,11 @@
 // (coordinatesIndex 1) and its level is the intensity. Render with an engine made with
 // useExactSrgbConversions: true, so the sRGB decode and encode are the exact curves irview uses.
 //
+// A MOZ_lightmap irview refuses (moz_lightmap_rules.js) fails the load with an Error naming the material.
 // Use: registerMozLightmap() once before loading (import '@babylonjs/loaders/glTF/index.js' too).
 import { GLTFLoader } from '@babylonjs/loaders/glTF/2.0/glTFLoader.js';
 import { registerGLTFExtension, unregisterGLTFExtension } from '@babylonjs/loaders/glTF/2.0/glTFLoaderExtensionRegistry.js';
+import { checkMozLightmap } from './moz_lightmap_rules.js';
 
 const NAME = 'MOZ_lightmap';
 
@@ -32,12 +34,13 @@ export class MozLightmapBabylon {
       await this._loader.loadMaterialPropertiesAsync(context, material, babylonMaterial);
       if (!('lightmapTexture' in babylonMaterial) || !('unlit' in babylonMaterial))
         throw new Error(`${extensionContext}: needs a PBR material (got ${babylonMaterial.getClassName()})`);
-      if (extension.index === undefined) throw new Error(`${extensionContext}/index: missing`);
-      await this._loader.loadTextureInfoAsync(extensionContext, { index: extension.index, texCoord: extension.texCoord ?? 1 },
+      // Refused as irview refuses it (a negative or NaN intensity, a texture the file lacks, another UV set).
+      const { index, texCoord, intensity } = checkMozLightmap(this._loader.gltf, material.index, extension);
+      await this._loader.loadTextureInfoAsync(extensionContext, { index, texCoord },
         texture => {
           texture.name = `${babylonMaterial.name} (MOZ_lightmap)`;
           texture.gammaSpace = extension.extras?.colorSpace === 'srgb';
-          texture.level = extension.intensity ?? 1;
+          texture.level = intensity;
           babylonMaterial.lightmapTexture = texture;
         });
       babylonMaterial.useLightmapAsShadowmap = true;

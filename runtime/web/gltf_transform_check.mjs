@@ -6,7 +6,8 @@
 //     IRBAKE_light_probes keeps its fields and every accessor value (its sun level's and exact emitters' included).
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
-//     non-numeric intensity, incomplete directional extension, a probe grid or sun level that does not fit its accessors) and bad output (no TEXCOORD_1, fewer triangles)
+//     non-numeric intensity or one not finite as a 32-bit float, incomplete directional extension, a probe grid or sun level that
+//     does not fit its accessors or whose spacing or origin is not finite, or the spacing 0, as 32-bit floats) and bad output (no TEXCOORD_1, fewer triangles)
 //     throw an Error naming the material or mesh.
 //   shadowmask --modules DIR --input BAKE.gltf   (a bake with --light-mode ...=shadowmask)
 //     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
@@ -165,6 +166,7 @@ async function refusals() {
   await throws('negative intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = -1; }), label, 'intensity -1');
   await throws('NaN intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = 'NaN'; }), label, 'intensity "NaN"');
   await throws('null intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = null; }), label, 'intensity null');
+  await throws('float-overflow intensity', bad(e => { e[MOZ_LIGHTMAP].intensity = 1e39; }), label, 'intensity 1e+39');
   await throws('two L1 pages', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1.pop(); }), label, 'l1 needs 3 entries');
   await throws('L1 texCoord 0', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[2].texCoord = 0; }), label, 'l1[2]', 'texCoord 0');
   await throws('L1 missing texture', bad(e => { e[IRBAKE_LIGHTMAP_DIRECTIONAL].l1[1].index = 42; }), label, 'texture 42 does not exist');
@@ -178,6 +180,9 @@ async function refusals() {
     const badGrid = mutate => () => { const doc = clone(); mutate(doc.json.extensions[IRBAKE_LIGHT_PROBES]); return io.readJSON(doc); };
     await throws('probe counts', badGrid(e => { e.counts[0] += 1; }), `${IRBAKE_LIGHT_PROBES}.coefficients`, 'the grid needs');
     await throws('probe spacing', badGrid(e => { e.spacing = -1; }), `${IRBAKE_LIGHT_PROBES}.spacing -1`);
+    await throws('probe spacing 0 as a float', badGrid(e => { e.spacing = 1e-50; }), `${IRBAKE_LIGHT_PROBES}.spacing 1e-50`);
+    await throws('probe spacing Infinity as a float', badGrid(e => { e.spacing = 1e39; }), `${IRBAKE_LIGHT_PROBES}.spacing 1e+39`);
+    await throws('probe origin Infinity as a float', badGrid(e => { e.origin[1] = 1e39; }), `${IRBAKE_LIGHT_PROBES}.origin`);
     await throws('probe accessor', badGrid(e => { e.valid = 9999; }), `${IRBAKE_LIGHT_PROBES}.valid`, 'does not exist');
     await throws('probe counts type', badGrid(e => { e.counts = [2, 2]; }), `${IRBAKE_LIGHT_PROBES}.counts`);
     if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun?.cells !== undefined) {

@@ -99,7 +99,8 @@ function checkTexCoord(def, what) {
 }
 
 function checkIntensity(value, what) {
-  if (typeof value !== 'number' || !Number.isFinite(value) || value < 0)
+  // Finite as a 32-bit float too, as irview reads it (1e39 would be Infinity).
+  if (typeof value !== 'number' || !Number.isFinite(Math.fround(value)) || value < 0)
     throw new Error(`${what}: intensity ${JSON.stringify(value)} (NaN when not a number) must be a finite number ≥ 0`);
 }
 
@@ -571,9 +572,11 @@ function refName(ref) {
 export function checkProbeGrid(def) {
   const what = IRBAKE_LIGHT_PROBES;
   if (!isObject(def)) throw new Error(`${what} is not an object`);
-  const numbers = (v, n) => Array.isArray(v) && v.length === n && v.every(x => typeof x === 'number' && Number.isFinite(x));
+  // Finite (and the spacing > 0) as 32-bit floats, as irview reads them: a spacing of 1e-50 is 0 as one, 1e39 Infinity.
+  const finite32 = x => typeof x === 'number' && Number.isFinite(Math.fround(x));
+  const numbers = (v, n) => Array.isArray(v) && v.length === n && v.every(finite32);
   if (!numbers(def.origin, 3)) throw new Error(`${what}.origin ${JSON.stringify(def.origin)} needs 3 finite numbers`);
-  if (!(typeof def.spacing === 'number' && Number.isFinite(def.spacing) && def.spacing > 0))
+  if (!(finite32(def.spacing) && Math.fround(def.spacing) > 0))
     throw new Error(`${what}.spacing ${JSON.stringify(def.spacing)} must be a finite number > 0`);
   if (!numbers(def.counts, 3) || !def.counts.every(c => Number.isInteger(c) && c >= 1))
     throw new Error(`${what}.counts ${JSON.stringify(def.counts)} needs 3 whole numbers ≥ 1`);

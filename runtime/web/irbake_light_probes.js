@@ -206,7 +206,7 @@ function fail(field, message) { throw new Error(`${LIGHT_PROBES}${field ? '.' + 
 function threeNumbers(ext, key) {
   const v = ext[key];
   if (!Array.isArray(v) || v.length !== 3 || !v.every(x => typeof x === 'number')) fail(key, 'needs 3 numbers');
-  if (!v.every(Number.isFinite)) fail(key, 'not finite');
+  if (!v.every(x => Number.isFinite(Math.fround(x)))) fail(key, 'not finite');  // as 32-bit floats, as irview reads them
   return v;
 }
 
@@ -220,8 +220,9 @@ export async function readProbeGrid(json, accessor) {
   for (const c of counts) if (!(c >= 1 && Number.isInteger(c) && c <= 1e6)) fail('counts', `${c} is not a whole number from 1 to 10^6`);
   const n = counts[0] * counts[1] * counts[2];
   if (n > 1e8) fail('counts', 'more than 10^8 probes');
-  const spacing = ext.spacing;
-  if (typeof spacing !== 'number' || !(spacing > 0) || !Number.isFinite(spacing)) fail('spacing', 'needs a positive finite number');
+  // A positive finite 32-bit float, as irview reads it: 1e-50 would be 0 and 1e39 Infinity.
+  const spacing = typeof ext.spacing === 'number' ? Math.fround(ext.spacing) : NaN;
+  if (!(spacing > 0) || !Number.isFinite(spacing)) fail('spacing', 'needs a positive finite number');
   // Accessor ext[key] (field `prefix + key` in messages) of componentType `component` and `type`, `count`
   // elements (null: any), as a typed array.
   const readFrom = (holder, prefix) => async (key, component, type, count) => {
@@ -266,7 +267,7 @@ export async function readProbeGrid(json, accessor) {
   }
   const sun = ext.sun === undefined ? null : await readSunLevel(ext, counts, readFrom(ext.sun ?? {}, 'sun.'));
   const emitters = ext.emitters === undefined ? [] : await readEmitters(ext, n, readFrom);
-  return new IrbakeProbeGrid({ origin, spacing: Math.fround(spacing), counts, coefficients, offsets, valid, sun, emitters });
+  return new IrbakeProbeGrid({ origin, spacing, counts, coefficients, offsets, valid, sun, emitters });
 }
 
 // The loader plugin: after the document loads, gltf.userData.irbakeLightProbes is the grid (null without the

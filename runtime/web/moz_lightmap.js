@@ -12,8 +12,10 @@
 // (2 · texel − 1) · scale, n_g the interpolated vertex normal, n the normal after three.js's normal map, both
 // taken to world space. The tangent frame: the TANGENT attribute, else per-vertex tangents generated here as
 // irview generates them (generateTangents below), not three.js's per-pixel derivative frame.
+// A MOZ_lightmap irview refuses (moz_lightmap_rules.js) fails the load with an Error naming the material.
 // Option lightmapMode 'l0' leaves the directional extension unused (the plain map), as irview --lightmap-mode l0.
 import { MeshLambertMaterial, SRGBColorSpace, NoColorSpace, BufferAttribute, ShaderChunk, Vector3 } from 'three';
+import { checkMozLightmap } from './moz_lightmap_rules.js';
 
 const DIRECTIONAL = 'IRBAKE_lightmap_directional';
 // three's lightmap term in lights_fragment_maps; the directional shader replaces this line (and fails loudly
@@ -53,10 +55,11 @@ export class MozLightmapExtension {
     if (!moz) return Promise.resolve();
     // GLTFLoader filled metallic-roughness parameters a Lambert material does not have.
     for (const key of ['metalness', 'roughness']) delete params[key];
+    // Refused as irview refuses it (a negative or NaN intensity, a texture the file lacks, another UV set).
+    const { index, texCoord, intensity } = checkMozLightmap(this.parser.json, materialIndex, moz);
     const srgb = moz.extras?.colorSpace === 'srgb';
-    params.lightMapIntensity = (moz.intensity ?? 1) * Math.PI;
-    return this.parser.assignTexture(params, 'lightMap', { index: moz.index, texCoord: moz.texCoord ?? 1 },
-                                     srgb ? SRGBColorSpace : NoColorSpace);
+    params.lightMapIntensity = intensity * Math.PI;
+    return this.parser.assignTexture(params, 'lightMap', { index, texCoord }, srgb ? SRGBColorSpace : NoColorSpace);
   }
 
   // After the scene is built: every mesh whose material carries a used directional extension gets tangents
