@@ -329,8 +329,7 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
   app->add_option("--probe-budget", o.probes.budget,
                   "at most N probes, or the bake is refused before any work (default " + shown(ProbeOptions{}.budget) +
-                      ":\n8x the automatic grid with a sun, a stage of about half a bake; up to " +
-                      shown(ProbeOptions{}.maxProbes) + ")")
+                      ",\n8x the automatic grid with a sun; up to " + shown(ProbeOptions{}.maxProbes) + ")")
       ->transform(cli::integerIn(1, static_cast<int>(ProbeOptions{}.maxProbes)))->type_name("N");
   app->add_option("--probe-rays", o.probes.rays, "rays per probe (default " + std::to_string(ProbeOptions{}.rays) + ")")
       ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
