@@ -60,13 +60,13 @@ std::string shortLength(double x) {
 // The grid's place as a bake can write it: a spacing from kMinProbeSpacing to kMaxSceneCoordinate, and every grid
 // point within kMaxSceneCoordinate of the origin (the bake's volume lies in the scene's coordinates). Beyond it the
 // readers' visibility rays would start where Embree aborts, and a spacing of 1e-30 puts every point outside the
-// grid. Relative slack for the float rounding of a grid at the limit.
+// grid.
 void checkGridPlace(const LightProbeGrid& g, const std::string& file) {
   const std::string ext = kLightProbesExtension;
   if (!(g.spacing >= kMinProbeSpacing) || !(g.spacing <= kMaxSceneCoordinate))
     throw Error(ErrorCode::InvalidData, file, ext + ".spacing: " + shortLength(g.spacing) + " m is outside the " +
                                                   "0.01 … 1e9 m a bake writes");
-  const double limit = kMaxSceneCoordinate * (1.0 + 1e-6);
+  const double limit = kMaxSceneCoordinate * (1.0 + kSceneLimitSlack);
   for (int a = 0; a < 3; ++a) {
     if (!(std::abs(static_cast<double>(g.origin[a])) <= limit))
       throw Error(ErrorCode::InvalidData, file, ext + ".origin: " + shortLength(g.origin[a]) +

@@ -49,7 +49,7 @@ constexpr double kMaxCoordinate = kMaxSceneCoordinate;
 // (and the ray tracer's offsets, which follow it) reaches a visible fraction of the scene.
 constexpr double kFarFromOriginRatio = 1e4;
 // Relative slack on those bounds, so that a scale of exactly 1e-4 or 1e9 (rounded to float) is inside.
-constexpr double kBoundSlack = 1e-6;
+constexpr double kBoundSlack = kSceneLimitSlack;
 
 // glTF extensions this loader reads (or, for KHR_mesh_quantization, whose accessor types it reads like
 // any other): the only ones a file may list in extensionsRequired.

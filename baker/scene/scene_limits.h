@@ -7,5 +7,7 @@
 namespace irbake {
 
 constexpr double kMaxSceneCoordinate = 1e9;
+// Relative slack on the scene's limits, so that a value of exactly the limit, rounded to float, is inside.
+constexpr double kSceneLimitSlack = 1e-6;
 
 }  // namespace irbake

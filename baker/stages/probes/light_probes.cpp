@@ -322,8 +322,9 @@ std::string probeCountText(double count) {
 
 LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes) {
   if (!volume.valid()) throw Error(ErrorCode::Usage, "", "the probe volume is empty");
+  const double limit = kMaxSceneCoordinate * (1.0 + kSceneLimitSlack);
   for (int a = 0; a < 3; ++a)
-    if (!(std::abs(volume.min[a]) <= kMaxSceneCoordinate) || !(std::abs(volume.max[a]) <= kMaxSceneCoordinate))
+    if (!(std::abs(volume.min[a]) <= limit) || !(std::abs(volume.max[a]) <= limit))
       throw Error(ErrorCode::Usage, "", "the probe volume reaches beyond the supported 1e9 m from the origin");
   if (!(spacing > 0.0f) || !std::isfinite(spacing))
     throw Error(ErrorCode::Usage, "", "the probe spacing must be a positive number of metres (got " + std::to_string(spacing) + ")");
