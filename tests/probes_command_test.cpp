@@ -2,9 +2,11 @@
 // the extension's presence and absence, and every refusal of a damaged file.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -154,4 +156,89 @@ TEST(ProbesCommand, OffWritesNoExtensionAndBadFilesAreRefused) {
   }
   r = runIrbakeIn(dir, {"probe", gltf.string(), "--at", "0,1,0", "--normal", "0,0,0"});
   EXPECT_EQ(r.code, 2) << r.output;
+}
+
+TEST(ProbesCommand, ProbeBoxesAndBudgetsRefusedBeforeAnyWork) {
+  const fs::path dir = scratchFolder("probes_command", "box_refusals");
+  const fs::path samples = sampleScenes("probes_command");
+  const std::string plane = (samples / "point_over_plane.gltf").string();  // a 10 × 10 m plane at y = 0
+  const std::string furnace = (samples / "furnace.gltf").string();         // a 2 m box
+  auto refused = [&](const std::string& name, const std::string& scene, std::vector<std::string> options,
+                     const std::string& expected) {
+    std::vector<std::string> args = {"bake", scene, "-o", (dir / name).string(), "--quiet"};
+    args.insert(args.end(), options.begin(), options.end());
+    const IrbakeRun r = runIrbakeIn(dir, args);
+    EXPECT_EQ(r.code, 2) << name << ": " << r.output;  // Usage, not Embree's SIGABRT (134) nor a bake
+    EXPECT_NE(r.output.find(expected), std::string::npos) << name << ": " << r.output;
+    EXPECT_FALSE(fs::exists(dir / name / "scene.gltf")) << name;
+    return r.output;
+  };
+  // Coordinates beyond the scene's supported 1e9 m: the probes' rays would start where Embree aborts.
+  refused("huge", plane, {"--probe-box=-1e30,-1e30,-1e30,1e30,1e30,1e30"}, "--probe-box needs coordinates within");
+  refused("past_float", plane, {"--probe-box=-1,-1,-1,1e300,1,1"}, "--probe-box needs coordinates within");
+  // A box more than the scene's size (10 m) from its bounds, and boxes without a size on an axis.
+  refused("far", plane, {"--probe-box=100,100,100,101,101,101"}, "does not come within the scene's size (10 m)");
+  refused("point", plane, {"--probe-box=0,0.5,0,0,0.5,0"}, "--probe-box needs a size on every axis");
+  refused("flat", plane, {"--probe-box=-1,0.5,-1,1,0.5,1"}, "--probe-box needs a size on every axis");
+  // 2e9 m per axis at 0.01 m: (2e11)³ = 8e33 probes, quoted as such rather than a wrapped 64-bit integer.
+  const std::string many = refused("many", plane, {"--probes", "0.01", "--probe-box=-1e9,-1e9,-1e9,1e9,1e9,1e9"}, "gives ");
+  const size_t at = many.find("gives ") + 6;
+  EXPECT_NEAR(std::strtod(many.c_str() + at, nullptr) / 8e33, 1.0, 1e-3) << many;
+  // The budget: 64 probes (2 m at 0.5 m) over a budget of 63 are refused, naming the count and the option that
+  // raises it; a budget of 64 bakes them.
+  refused("budget63", furnace, {"--probes", "0.5", "--probe-budget", "63"},
+          "gives 64 probes, about 0.0625 times the automatic grid's 1024, over the probe budget of 63: raise it with "
+          "--probe-budget 64");
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", furnace, "-o", (dir / "budget64").string(), "--probes", "0.5", "--probe-budget",
+                              "64", "--quiet"}).code, 0);
+  EXPECT_EQ(readJson(dir / "budget64" / "report.json")["probes"]["count"], 64);
+  // The default budget, 16384: 0.05 m over the 2 m box asks for 40³ = 64000 (about 100 s of probes).
+  refused("default_budget", furnace, {"--probes", "0.05"}, "gives 64000 probes, about 62.5 times the automatic grid's "
+                                                           "1024, over the probe budget of 16384: raise it with --probe-budget 64000");
+}
+
+TEST(ProbesCommand, HugePointsAndTamperedGridsAreRefused) {
+  const fs::path dir = scratchFolder("probes_command", "tampered");
+  const fs::path samples = sampleScenes("probes_command");
+  ASSERT_EQ(runIrbakeIn(dir, {"bake", (samples / "point_over_plane.gltf").string(), "-o", (dir / "on").string(),
+                              "--probes", "2", "--probe-box=-5,0.25,-5,5,0.75,5", "--quiet"}).code, 0);
+  const fs::path gltf = dir / "on" / "scene.gltf";
+  // --at beyond 1e9 m (1e300 is Inf in float): Usage, naming the option, where Embree aborted on the visibility rays.
+  for (const char* point : {"1e30,0.5,0.5", "1e19,0.5,0.5", "0.5,-1e300,0.5"}) {
+    const IrbakeRun r = runIrbakeIn(dir, {"probe", gltf.string(), "--at", point});
+    EXPECT_EQ(r.code, 2) << point << ": " << r.output;
+    EXPECT_NE(r.output.find("--at needs coordinates within the supported ±1e9 m"), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(probeValue(dir, gltf, "1e9,0.5,0").size(), 3u);  // the limit itself is read (the edge probe)
+  // Grids no bake writes: InvalidData (5), naming the file and the field.
+  const json good = readJson(gltf);
+  const std::string bin = fileText(dir / "on" / "scene.bin");
+  auto tampered = [&](const std::string& name, const std::function<void(json&)>& edit, std::string bytes, const std::string& field) {
+    const fs::path d = dir / name;
+    fs::create_directories(d);
+    for (const auto& e : fs::directory_iterator(dir / "on"))
+      if (e.path().extension() == ".png") fs::copy_file(e.path(), d / e.path().filename(), fs::copy_options::overwrite_existing);
+    json doc = good;
+    edit(doc["extensions"]["IRBAKE_light_probes"]);
+    std::ofstream(d / "scene.gltf") << doc.dump();
+    std::ofstream(d / "scene.bin", std::ios::binary) << bytes;
+    const IrbakeRun r = runIrbakeIn(d, {"probe", (d / "scene.gltf").string(), "--at", "0,0.5,0"});
+    EXPECT_EQ(r.code, 5) << name << ": " << r.output;
+    EXPECT_NE(r.output.find((d / "scene.gltf").string() + ": IRBAKE_light_probes." + field), std::string::npos)
+        << name << ": " << r.output;
+  };
+  tampered("origin", [](json& e) { e["origin"] = {3e38, 0.5, 0}; }, bin, "origin: 3e+38 m is beyond the supported 1e9 m");
+  tampered("spacing_huge", [](json& e) { e["spacing"] = 3e38; }, bin, "spacing: 3e+38 m is outside the 0.01 … 1e9 m");
+  tampered("spacing_tiny", [](json& e) { e["spacing"] = 1e-30; }, bin, "spacing: 1e-30 m is outside the 0.01 … 1e9 m");
+  // Every number finite and each within 1e9 m, but the grid's far corner at 9e8 + 4 · 1e8 = 1.3e9 m.
+  tampered("extent", [](json& e) { e["origin"] = {9e8, 0.5, 0}; e["spacing"] = 1e8; }, bin,
+           "counts: the grid reaches 1.3e+09 m");
+  // A probe moved 1e30 m from its grid point (a bake moves one at most half a spacing).
+  std::string far = bin;
+  const int offsets = good["extensions"]["IRBAKE_light_probes"]["offsets"];
+  const int view = good["accessors"][offsets]["bufferView"];
+  const float huge = 1e30f;
+  std::memcpy(far.data() + good["bufferViews"][view].value("byteOffset", size_t(0)) + good["accessors"][offsets].value("byteOffset", size_t(0)),
+              &huge, sizeof(float));
+  tampered("offset", [](json&) {}, far, "offsets: probe 0 is moved 1e+30 m from its grid point");
 }

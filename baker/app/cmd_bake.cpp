@@ -35,6 +35,7 @@
 #include "common/atomic_file.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_files.h"
+#include "scene/scene_limits.h"
 
 namespace irbake::app {
 
@@ -110,17 +111,25 @@ void probeArguments(const BakeArguments& a, ProbeOptions& o) {
   if (o.enabled && a.probes != "auto") {
     char* end = nullptr;
     const double spacing = std::strtod(a.probes.c_str(), &end);
-    if (a.probes.empty() || *end != '\0' || !(spacing >= 0.01) || !(spacing <= 1e6))
+    if (a.probes.empty() || *end != '\0' || !(static_cast<float>(spacing) >= kMinProbeSpacing) || !(spacing <= 1e6))
       throw Error(ErrorCode::Usage, "", "--probes needs auto, off or a spacing in metres from 0.01 to 1e6 (got '" + a.probes + "')");
     o.spacing = static_cast<float>(spacing);
   }
   if (!a.probeBox.empty()) {
+    // Checked in double before the conversion to float: 1e300 would become Inf, and a box beyond the scene's
+    // coordinates would start the probes' rays where Embree aborts.
     const std::vector<double> b = cli::parseNumberList(a.probeBox);
+    for (double v : b)
+      if (!(std::abs(v) <= kMaxSceneCoordinate))
+        throw Error(ErrorCode::Usage, "", "--probe-box needs coordinates within the supported ±1e9 m (got '" + a.probeBox + "')");
     Bounds3 box;
     box.min = glm::vec3(b[0], b[1], b[2]);
     box.max = glm::vec3(b[3], b[4], b[5]);
     if (!(box.min.x <= box.max.x && box.min.y <= box.max.y && box.min.z <= box.max.z))
       throw Error(ErrorCode::Usage, "", "--probe-box needs X0,Y0,Z0,X1,Y1,Z1 with each minimum ≤ its maximum (got '" + a.probeBox + "')");
+    if (!(box.min.x < box.max.x && box.min.y < box.max.y && box.min.z < box.max.z))
+      throw Error(ErrorCode::Usage, "", "--probe-box needs a size on every axis (got '" + a.probeBox +
+                                            "'): a size below the spacing gives one layer of probes there");
     o.box = box;
   }
 }
@@ -138,7 +147,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroup
     {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
     {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
                                               "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays",
+    {"Irradiance probes", {"probe-box", "probe-budget", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays",
                            "probe-volume-clearance", "probe-exact-emitters"}},
     {"Backends", {"backend", "cube-face", "spp"}},
     {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
@@ -319,6 +328,10 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->type_name("auto|off|M");
   app->add_option("--probe-box", a.probeBox, "the probes fill this box instead of the scene's bounds")
       ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
+  app->add_option("--probe-budget", o.probes.budget,
+                  "at most N probes, or the bake is refused before any work (default " + shown(ProbeOptions{}.budget) +
+                      ",\n8x the automatic grid with a sun; up to " + shown(ProbeOptions{}.maxProbes) + ")")
+      ->transform(cli::integerIn(1, static_cast<int>(ProbeOptions{}.maxProbes)))->type_name("N");
   app->add_option("--probe-rays", o.probes.rays, "rays per probe (default " + std::to_string(ProbeOptions{}.rays) + ")")
       ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
   app->add_option("--probe-light-fit", o.probes.lightFitSamples,

@@ -5,6 +5,7 @@
 // visibility. Trilinear
 // over the 8 probes around the point, valid ones only, and only those the point sees (the glTF's geometry is
 // loaded for the visibility rays), so light never comes through a wall.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -18,6 +19,7 @@
 #include "lightmap/probe_emitter_field.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/gltf_loader.h"
+#include "scene/scene_limits.h"
 
 namespace irbake::app {
 
@@ -34,6 +36,10 @@ int runProbe(const Args& args) {
   if (at.empty()) throw Error(ErrorCode::Usage, "", "probe needs --at X,Y,Z");
   const std::string file = files[0];
   const std::vector<double> p = cli::parseNumberList(at);
+  // In double, before float: the visibility rays start at the point, and Embree aborts on origins beyond 1.8e18 m.
+  for (double c : p)
+    if (!(std::abs(c) <= kMaxSceneCoordinate))
+      throw Error(ErrorCode::Usage, "", "--at needs coordinates within the supported ±1e9 m (got '" + at + "')");
   const glm::vec3 point(p[0], p[1], p[2]);
   glm::vec3 n(0.0f);
   if (!normal.empty()) {

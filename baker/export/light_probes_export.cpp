@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
 #include "common/error.h"
 #include "export/gltf_compact.h"
 #include "export/gltf_export.h"
+#include "scene/scene_limits.h"
 
 namespace irbake {
 namespace {
@@ -46,6 +48,34 @@ glm::vec3 vec3Of(const json& ext, const char* key, const std::string& file, cons
   if (!std::isfinite(r.x) || !std::isfinite(r.y) || !std::isfinite(r.z))
     throw Error(ErrorCode::InvalidData, file, prefix + "." + key + ": not finite");
   return r;
+}
+
+// A length in short notation for messages: "3e+38", "0.01".
+std::string shortLength(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
+// The grid's place as a bake can write it: a spacing from kMinProbeSpacing to kMaxSceneCoordinate, and every grid
+// point within kMaxSceneCoordinate of the origin (the bake's volume lies in the scene's coordinates). Beyond it the
+// readers' visibility rays would start where Embree aborts, and a spacing of 1e-30 puts every point outside the
+// grid.
+void checkGridPlace(const LightProbeGrid& g, const std::string& file) {
+  const std::string ext = kLightProbesExtension;
+  if (!(g.spacing >= kMinProbeSpacing) || !(g.spacing <= kMaxSceneCoordinate))
+    throw Error(ErrorCode::InvalidData, file, ext + ".spacing: " + shortLength(g.spacing) + " m is outside the " +
+                                                  "0.01 … 1e9 m a bake writes");
+  const double limit = kMaxSceneCoordinate * (1.0 + kSceneLimitSlack);
+  for (int a = 0; a < 3; ++a) {
+    if (!(std::abs(static_cast<double>(g.origin[a])) <= limit))
+      throw Error(ErrorCode::InvalidData, file, ext + ".origin: " + shortLength(g.origin[a]) +
+                                                    " m is beyond the supported 1e9 m");
+    const double far = static_cast<double>(g.origin[a]) + static_cast<double>(g.spacing) * (g.counts[a] - 1);
+    if (!(std::abs(far) <= limit))
+      throw Error(ErrorCode::InvalidData, file, ext + ".counts: the grid reaches " + shortLength(far) +
+                                                    " m, beyond the supported 1e9 m (origin + spacing × (counts − 1))");
+  }
 }
 
 // The sun level (ProbeSunLevel) as the extension's optional `sun` object: its SH as floats; the probes'
@@ -250,6 +280,7 @@ LightProbeGrid readLightProbes(const std::filesystem::path& path) {
       !std::isfinite((*ext)["spacing"].get<float>()))
     throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".spacing: needs a positive finite number");
   g.spacing = (*ext)["spacing"].get<float>();
+  checkGridPlace(g, file);
   const size_t n = g.size();
   const AccessorBytes c = probeAccessor(doc, *ext, "coefficients", kFloat, "VEC3", n * kShCoefficients, file);
   const AccessorBytes o = probeAccessor(doc, *ext, "offsets", kFloat, "VEC3", n, file);
@@ -267,6 +298,11 @@ LightProbeGrid readLightProbes(const std::filesystem::path& path) {
     if (!finite)
       throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ": probe " + std::to_string(i) +
                                                     " has a non-finite coefficient or offset");
+    const glm::vec3 away = glm::abs(g.offsets[i]);
+    if (std::max({away.x, away.y, away.z}) > g.spacing)
+      throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".offsets: probe " + std::to_string(i) +
+                                                    " is moved " + shortLength(std::max({away.x, away.y, away.z})) +
+                                                    " m from its grid point, more than a spacing (a bake moves it at most half)");
     if (valid[i] != 0.0f && valid[i] != 1.0f)
       throw Error(ErrorCode::InvalidData, file, std::string(kLightProbesExtension) + ".valid: probe " + std::to_string(i) +
                                                     " holds " + std::to_string(valid[i]) + " (0 or 1)");

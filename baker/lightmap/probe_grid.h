@@ -22,6 +22,8 @@
 namespace irbake {
 
 constexpr int kShCoefficients = 9;
+// The smallest spacing a bake writes (--probes, the automatic spacing's floor) and a reader accepts.
+constexpr float kMinProbeSpacing = 0.01f;
 using ShCoefficients = std::array<glm::vec3, kShCoefficients>;
 
 // three.js's real SH basis at unit direction d.

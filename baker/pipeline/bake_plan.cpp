@@ -3,6 +3,7 @@
 #include "scene/triangle_area.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "common/error.h"
 #include "common/log.h"
@@ -186,6 +187,28 @@ void settleSky(BakePlan& plan, const Scene& scene, const RayTracer& rayTracer, c
   if (plan.skyByGather) plan.gather.missRadiance = scene.environment.uniformRadiance();
 }
 
+// A length or ratio in short notation for messages: "0.01", "1e+06", "61.3".
+std::string shortNumber(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
+// --probe-box must meet the scene's bounds widened by their largest side on every axis: the probes over a flat
+// floor stand in the air above it, but a box farther than the scene's own size from it lights nothing of it.
+void checkProbeBoxMeetsScene(const Bounds3& box, const Bounds3& scene) {
+  const glm::vec3 e = scene.extent();
+  const float margin = std::max({e.x, e.y, e.z});
+  for (int a = 0; a < 3; ++a)
+    if (box.max[a] < scene.min[a] - margin || box.min[a] > scene.max[a] + margin) {
+      auto point = [](const glm::vec3& p) { return shortNumber(p.x) + "," + shortNumber(p.y) + "," + shortNumber(p.z); };
+      throw Error(ErrorCode::Usage, "", "--probe-box " + point(box.min) + "," + point(box.max) +
+                                            " does not come within the scene's size (" + shortNumber(margin) +
+                                            " m) of its bounds (" + point(scene.min) + " to " + point(scene.max) +
+                                            "): its probes would light nothing of it");
+    }
+}
+
 // The probes' grid: its volume (the box asked for, else the scene's bounds) and spacing, checked here so that a
 // spacing too small for the volume is refused before the bake rather than after it.
 void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options) {
@@ -193,10 +216,19 @@ void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options
   plan.probes.seed = options.walk.seed;
   if (!plan.probes.enabled) return;
   const Bounds3 volume = options.probes.box ? *options.probes.box : scene.bounds();
+  if (options.probes.box) checkProbeBoxMeetsScene(volume, scene.bounds());
   const bool automatic = !options.probes.spacing;
   const double count = autoProbeCount(options.probes, scene.lights);
   const float spacing = automatic ? chooseProbeSpacing(volume, count) : *options.probes.spacing;
   const LightProbeGrid grid = probeGridOver(volume, spacing, plan.probes.maxProbes);
+  if (static_cast<double>(grid.size()) > static_cast<double>(plan.probes.budget)) {
+    const std::string n = std::to_string(grid.size());
+    throw Error(ErrorCode::Usage, "", std::string(automatic ? "the automatic probe spacing" : "--probes " + shortNumber(spacing)) +
+                                          " gives " + n + " probes, about " + shortNumber(grid.size() / count) +
+                                          " times the automatic grid's " + std::to_string(static_cast<long>(count)) +
+                                          ", over the probe budget of " + std::to_string(plan.probes.budget) +
+                                          ": raise it with --probe-budget " + n + " to bake them, or choose a larger spacing");
+  }
   plan.probes.spacing = spacing;
   plan.probes.box = volume;
   const std::string n = std::to_string(static_cast<long>(count));

@@ -24,6 +24,7 @@
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
 #include "scene/runtime_lights.h"
+#include "scene/scene_limits.h"
 
 namespace irbake {
 
@@ -43,12 +44,12 @@ constexpr double kMinSceneExtent = 1e-4;
 // Above 1e9 m a triangle's squared cross product can pass float's 3.4e38: its normal vanishes and Embree
 // aborts on the rays built from it. The same bound holds for every vertex and punctual light coordinate.
 constexpr double kMaxSceneExtent = 1e9;
-constexpr double kMaxCoordinate = 1e9;
+constexpr double kMaxCoordinate = kMaxSceneCoordinate;
 // A scene farther from the origin than this many times its size gets a warning: float spacing there
 // (and the ray tracer's offsets, which follow it) reaches a visible fraction of the scene.
 constexpr double kFarFromOriginRatio = 1e4;
 // Relative slack on those bounds, so that a scale of exactly 1e-4 or 1e9 (rounded to float) is inside.
-constexpr double kBoundSlack = 1e-6;
+constexpr double kBoundSlack = kSceneLimitSlack;
 
 // glTF extensions this loader reads (or, for KHR_mesh_quantization, whose accessor types it reads like
 // any other): the only ones a file may list in extensionsRequired.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include <tbb/parallel_for.h>
@@ -10,6 +11,7 @@
 #include "common/error.h"
 #include "common/maths.h"
 #include "common/progress.h"
+#include "scene/scene_limits.h"
 #include "sampling/sampling.h"
 #include "transport/geometry_term.h"
 #include "stages/probes/blend_fit.h"
@@ -302,26 +304,42 @@ float chooseProbeSpacing(const Bounds3& volume, double probes) {
   const glm::vec3 e = volume.extent();
   const double longest = std::max({e.x, e.y, e.z}), shortest = longest / 16.0;
   const double v = std::max<double>(e.x, shortest) * std::max<double>(e.y, shortest) * std::max<double>(e.z, shortest);
-  return std::max(0.01f, static_cast<float>(std::cbrt(v / std::max(1.0, probes))));
+  return std::max(kMinProbeSpacing, static_cast<float>(std::cbrt(v / std::max(1.0, probes))));
+}
+
+double probeCountOver(const Bounds3& volume, float spacing) {
+  const glm::vec3 e = volume.extent();
+  double total = 1.0;
+  for (int a = 0; a < 3; ++a) total *= std::max(1.0, std::ceil(static_cast<double>(e[a]) / spacing - 1e-6));
+  return total;
+}
+
+std::string probeCountText(double count) {
+  char text[32];
+  std::snprintf(text, sizeof text, count < 1e15 ? "%.0f" : "%.3g", count);
+  return text;
 }
 
 LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes) {
   if (!volume.valid()) throw Error(ErrorCode::Usage, "", "the probe volume is empty");
+  const double limit = kMaxSceneCoordinate * (1.0 + kSceneLimitSlack);
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(volume.min[a]) <= limit) || !(std::abs(volume.max[a]) <= limit))
+      throw Error(ErrorCode::Usage, "", "the probe volume reaches beyond the supported 1e9 m from the origin");
   if (!(spacing > 0.0f) || !std::isfinite(spacing))
     throw Error(ErrorCode::Usage, "", "the probe spacing must be a positive number of metres (got " + std::to_string(spacing) + ")");
   LightProbeGrid g;
   g.spacing = spacing;
   const glm::vec3 e = volume.extent(), centre = 0.5f * (volume.min + volume.max);
-  double total = 1.0;
-  for (int a = 0; a < 3; ++a) {
-    const double n = std::max(1.0, std::ceil(static_cast<double>(e[a]) / spacing - 1e-6));
-    total *= n;
-    g.counts[a] = static_cast<int>(std::min(n, 1e9));
+  const double total = probeCountOver(volume, spacing);
+  if (total > static_cast<double>(maxProbes)) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", spacing);
+    throw Error(ErrorCode::Usage, "", std::string("a probe spacing of ") + text + " m gives " + probeCountText(total) +
+                                          " probes (at most " + std::to_string(maxProbes) + "): choose a larger spacing");
   }
-  if (total > static_cast<double>(maxProbes))
-    throw Error(ErrorCode::Usage, "", "a probe spacing of " + std::to_string(spacing) + " m gives " +
-                                          std::to_string(static_cast<long long>(total)) + " probes (at most " +
-                                          std::to_string(maxProbes) + "): choose a larger spacing");
+  for (int a = 0; a < 3; ++a)
+    g.counts[a] = static_cast<int>(std::max(1.0, std::ceil(static_cast<double>(e[a]) / spacing - 1e-6)));
   g.origin = centre - 0.5f * spacing * glm::vec3(g.counts - 1);
   return g;
 }

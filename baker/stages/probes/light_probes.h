@@ -23,6 +23,7 @@
 #pragma once
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -51,6 +52,10 @@ struct ProbeOptions {
                                       // probe beside a wall of two coincident opposite quads meets (makeThinWall:
                                       // the ray finds either), lost 104 of its 1024 valid lit-side probes
   size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
+  size_t budget = 16384;              // a grid with more probes is refused before the bake unless this is raised
+                                      // (--probe-budget): 8 times the automatic count with a sun, about 26 s at
+                                      // Sponza's 1.6 ms a probe on 2 cores, half its 48 s bake (docs/validation.md,
+                                      // "Irradiance probes"); --probes 0.01 over a 1 m box asked for an hour
   int emitterSamples = 128;           // shadow rays per probe to the emissive triangles (0: the lattice alone)
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
@@ -108,10 +113,18 @@ inline double autoProbeCount(const ProbeOptions& o, const std::vector<Light>& li
   return o.autoProbes;
 }
 
+// The number of probes the grid over `volume` at `spacing` holds (probeGridOver), in double: a true figure however
+// small the spacing against the volume.
+double probeCountOver(const Bounds3& volume, float spacing);
+
 // The grid over `volume` at `spacing`: ceil(extent / spacing) probes per axis (at least 1), centred in the
 // volume, so probes sit half a step in from its faces rather than on walls and floors at its border.
-// Throws Error(Usage) when it would hold more than maxProbes.
+// Throws Error(Usage) when it would hold more than maxProbes, or when the volume is not finite or reaches beyond
+// kMaxSceneCoordinate (the probes' rays would start where Embree aborts).
 LightProbeGrid probeGridOver(const Bounds3& volume, float spacing, size_t maxProbes);
+
+// `count` probes as a message quotes them: in full below 1e15, else in scientific notation.
+std::string probeCountText(double count);
 
 // Bakes every probe of `grid` (counts, origin, spacing set) from `maps`, the finished light maps (one per page of
 // in.texels); fills coefficients, offsets and valid.

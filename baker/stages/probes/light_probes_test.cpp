@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <utility>
 
 #include "common/error.h"
@@ -342,6 +344,30 @@ TEST(LightProbes, GridFollowsTheVolumeAndRefusesTooManyProbes) {
   EXPECT_NEAR(chooseProbeSpacing(flat, 2048), std::cbrt(62.5 / 2048.0), 1e-6);
   EXPECT_THROW(probeGridOver(b, 0.01f, 1000), Error);
   EXPECT_THROW(probeGridOver(b, 0.0f, 1000), Error);
+}
+
+TEST(LightProbes, CountsWithoutOverflowAndVolumesWithinTheSceneRange) {
+  Bounds3 widest;  // 2e9 m per axis: (2e11)³ = 8e33 probes at 0.01 m, past a 64-bit integer
+  widest.extend(glm::vec3(-1e9f));
+  widest.extend(glm::vec3(1e9f));
+  EXPECT_NEAR(probeCountOver(widest, 0.01f) / 8e33, 1.0, 1e-3);
+  EXPECT_EQ(probeCountText(8.0000001e33), "8e+33");
+  EXPECT_EQ(probeCountText(64000.0), "64000");
+  try {
+    probeGridOver(widest, 0.01f, 1 << 20);
+    ADD_FAILURE() << "8e33 probes accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Usage);
+    EXPECT_NE(std::string(e.what()).find("a probe spacing of 0.01 m gives 8e+33 probes (at most 1048576)"), std::string::npos) << e.what();
+  }
+  Bounds3 beyond;  // a corner at 1e30 m: probes there would start rays where Embree aborts
+  beyond.extend(glm::vec3(0.0f));
+  beyond.extend(glm::vec3(1e30f, 1.0f, 1.0f));
+  EXPECT_THROW(probeGridOver(beyond, 1e6f, 1 << 20), Error);
+  Bounds3 inf;
+  inf.extend(glm::vec3(0.0f));
+  inf.extend(glm::vec3(std::numeric_limits<float>::infinity(), 1.0f, 1.0f));
+  EXPECT_THROW(probeGridOver(inf, 1.0f, 1 << 20), Error);
 }
 
 TEST(LightProbes, AutomaticCountDoublesForADirectionalLightsShadows) {
