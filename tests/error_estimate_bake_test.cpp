@@ -2,10 +2,14 @@
 // --target-error's rounds: tighter targets give smaller errors, the estimate falls, the same seed gives the
 // same bytes.
 #include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "irbake_process.h"
 #include "pipeline/bake.h"
 #include "samples/sample_scenes.h"
 #include "stages/error_estimate/error_estimate.h"
@@ -178,6 +182,42 @@ TEST(ErrorEstimateBake, OnlyMoreStageRaysReachTheTarget) {
   EXPECT_GE(e["stageRays"].get<double>(), 2.0);
   EXPECT_GT(r.report["compensation"]["raysPerSample"].get<int>(), 2);
   for (size_t k = 0; k + 1 < e["rounds"].size(); ++k) EXPECT_EQ(e["rounds"][k]["raised"], "stageRays");
+}
+
+// The command's report and last log line say whether the target was reached: the figure at or below it,
+// "target ... reached"; a cap, the cap and that the figure is above the target.
+TEST(ErrorEstimateBake, ReportAndLastLogLineSayWhetherTheTargetWasReached) {
+  const std::filesystem::path scenes = testing::sampleScenes("error_estimate_bake");
+  ASSERT_TRUE(std::filesystem::exists(scenes / "cornell_box.gltf"));
+  const std::filesystem::path dir = testing::scratchFolder("error_estimate_bake", "log_line");
+  struct Case {
+    std::string target, maxRounds, says;
+  };
+  for (const Case& c : {Case{"0.05", "16", "(target 5.00% reached)"},
+                        Case{"0.0001", "1", "(stopped by max-rounds, above the target 0.01%)"}}) {
+    const std::filesystem::path out = dir / ("out_" + c.maxRounds);
+    const testing::IrbakeRun run = testing::runIrbakeIn(
+        dir, {"bake", (scenes / "cornell_box.gltf").string(), "-o", out.string(), "--backend", "embree",
+              "--texels-per-unit", "48", "--interleave", "1", "--paths", "256", "--no-gltf", "--target-error", c.target,
+              "--max-rounds", c.maxRounds});
+    ASSERT_EQ(run.code, 0) << run.output;
+    std::string last;  // the "baked ..." line: the last one irbake logs (the files written follow it)
+    std::istringstream lines(run.output);
+    for (std::string line; std::getline(lines, line);)
+      if (line.rfind("irbake: baked ", 0) == 0) last = line;
+    EXPECT_NE(last.find(c.says), std::string::npos) << last;
+    const nlohmann::json report = nlohmann::json::parse(testing::fileText(out / "report.json"));
+    const nlohmann::json& e = report["estimatedError"];
+    const double relative = e["relative"].get<double>(), target = std::stod(c.target);
+    if (c.maxRounds == "1") {
+      EXPECT_EQ(e["stoppedBy"], "max-rounds");
+      EXPECT_GT(relative, target);
+    } else {
+      EXPECT_EQ(e["stoppedBy"], "target");
+      EXPECT_LE(relative, target);
+    }
+    EXPECT_EQ(report["stoppedBy"], e["stoppedBy"]);
+  }
 }
 
 // A cap stops the rounds and says so; the bake without an estimate has no figure.
