@@ -415,14 +415,17 @@ void addErrorOptions(CLI::App* app, BakeCommand& command) {
                 "report the bake's estimated error (report.json estimatedError:\n"
                 "relative RMS on 4x4-texel bins, as bench/cycles/compare.py scores)");
   app->add_option("--target-error", e.targetError,
-                  "add rounds of paths until the estimated error is at most E (e.g. 0.02)")
+                  "add rounds until the estimated error, every part it reports, is at\n"
+                  "most E (e.g. 0.02): more paths where the walk's noise dominates, more\n"
+                  "compensation and final gather rays where theirs does; stopped by\n"
+                  "--max-rounds or --max-time above E, the report and log say so")
       ->transform(cli::numberIn(1e-6, 1.0))->type_name("E");
   app->add_option("--max-rounds", e.maxRounds,
-                  "--target-error: at most this many rounds (default " + shown(d.maxRounds) + ")")
+                  "--target-error: at most this many rounds, of paths or of rays\n(default " + shown(d.maxRounds) + ")")
       ->transform(cli::integerIn(1, 4096))->type_name("N");
   app->add_option("--max-time", e.maxSeconds,
-                  "--target-error: no round started that would end the VPL stage past\n"
-                  "this many seconds of bake (default 0: no cap; the result then depends on\nthe machine)")
+                  "--target-error: no round started that would end past this many\n"
+                  "seconds of bake (default 0: no cap; the result then depends on the\nmachine)")
       ->transform(cli::numberIn(0.0, 1e9))->type_name("SECONDS");
   app->add_flag("--error-map", e.errorMap,
                 "with the estimate: also each texel's standard error, OUTDIR/error_<page>.exr");
@@ -981,15 +984,27 @@ int runBake(const Args& args) {
   return 0;
 }
 
-// ", estimated error 2.10%" (and what stopped --target-error) for the final log line; "" without an estimate.
+namespace {
+// "2.00%"
+std::string percentText(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f%%", 100.0 * x);
+  return text;
+}
+}  // namespace
+
+// ", estimated error 2.10%" (and what stopped --target-error: the target, or a cap above it) for the final
+// log line; "" without an estimate.
 std::string estimatedErrorText(const nlohmann::json& report) {
   if (!report.contains("estimatedError")) return "";
   const nlohmann::json& e = report["estimatedError"];
   char text[96];
   std::snprintf(text, sizeof text, ", estimated error %.2f%%", 100.0 * e.value("relative", 0.0));
   std::string line = text;
-  if (e.contains("stoppedBy")) line += " (stopped by " + e["stoppedBy"].get<std::string>() + ")";
-  return line;
+  if (!e.contains("stoppedBy")) return line;
+  const std::string stoppedBy = e["stoppedBy"].get<std::string>();
+  if (stoppedBy == "target") return line + " (target " + percentText(e.value("targetError", 0.0)) + " reached)";
+  return line + " (stopped by " + stoppedBy + ", above the target " + percentText(e.value("targetError", 0.0)) + ")";
 }
 
 void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalProgress& progress, const OutputGuard& guard) {

@@ -5,6 +5,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 #include <future>
 #include <memory>
@@ -106,6 +107,10 @@ struct StagedBake::State {
   std::vector<Lightmap> cachedDirect;               // the punctual lights' pages, made once for the rounds
   nlohmann::json rounds = nlohmann::json::array();  // the estimate after each round
   std::string stoppedBy;
+  double roundSeconds = 0.0;                        // the last round of paths' blocks (the time cap's forecast)
+  double stageRays = 1.0;                           // --target-error: the ray stages' rays over the plan's
+  ClampCompensationOptions planCompensation;        // the plan's ray stages, before the target raised their rays
+  FinalGatherOptions planGather;
   nlohmann::json stageNoise = nlohmann::json::object();  // a stage's own ray noise (RMS on bins, map units)
   nlohmann::json stageNoiseInterior = nlohmann::json::object();  // the same on interior bins (BinTexels)
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
@@ -251,7 +256,8 @@ struct StagedBake::State {
     if (e.targetError > 0.0)
       plan.settle("target-error", e.targetError,
                   "asked for: rounds of " + std::to_string(replicateWalk(0).paths) + " + " +
-                      std::to_string(replicateWalk(1).paths) + " paths until the estimate is at most it, at most " +
+                      std::to_string(replicateWalk(1).paths) + " paths, or of more compensation and final gather "
+                      "rays where their noise dominates, until the estimate is at most it, at most " +
                       std::to_string(e.maxRounds) + " rounds" +
                       (e.maxSeconds > 0.0 ? ", " + std::to_string(e.maxSeconds) + " s" : ""),
                   false);
@@ -337,21 +343,34 @@ struct StagedBake::State {
     rayNoise(plan.compensate ? "compensationAndGatherRays" : "finalGatherRays", after, before);
   }
 
-  // The finished bake's estimate (before post, on the map as the stages left it) into the report.
-  std::vector<Lightmap> finalEstimate(const std::vector<Lightmap>& maps, nlohmann::json& report) const {
+  // The finished bake's figure (before post, on the map as the stages left it): the walk's noise and the
+  // ray stages' own, on every valid texel's bins and on the interior ones.
+  struct Figure {
+    BinnedError whole, interior;
+    nlohmann::json breakdown, interiorBreakdown;  // each part relative to the same signal
+    std::vector<Lightmap> errorPages;             // with --error-map: each texel's standard error
+  };
+  Figure figure;  // the last one measured
+
+  void measureFigure(const std::vector<Lightmap>& maps) {
     std::vector<std::vector<Lightmap>> reps = plan.finalGather ? gatheredHalves()
                                                                : std::vector<std::vector<Lightmap>>{halves[0], halves[1]};
     const int bin = options.errorEstimate.bin;
-    nlohmann::json breakdown;
-    BinnedError e = withStages(replicateError(reps, &maps, bin), stageNoise, breakdown);
-    nlohmann::json interiorBreakdown;
-    const BinnedError interior =
-        withStages(replicateError(reps, &maps, bin, 1.0, BinTexels::Interior), stageNoiseInterior, interiorBreakdown);
+    figure = Figure{};
+    figure.whole = withStages(replicateError(reps, &maps, bin), stageNoise, figure.breakdown);
+    figure.interior = withStages(replicateError(reps, &maps, bin, 1.0, BinTexels::Interior), stageNoiseInterior,
+                                 figure.interiorBreakdown);
+    if (options.errorEstimate.errorMap) figure.errorPages = standardErrorPages(reps);
+  }
+
+  // The last figure into the report and the log.
+  void reportFigure(nlohmann::json& report) const {
+    const BinnedError& e = figure.whole;
     nlohmann::json& j = report["estimatedError"] = e.toJson();
     j["replicates"] = replicates.size();
-    j["breakdown"] = breakdown;
-    j["interior"] = interior.toJson();
-    j["interior"]["breakdown"] = interiorBreakdown;
+    j["breakdown"] = figure.breakdown;
+    j["interior"] = figure.interior.toJson();
+    j["interior"]["breakdown"] = figure.interiorBreakdown;
     j["interior"]["texels"] = "valid texels whose four neighbours are valid: the chart-border ring left out, as "
                               "bench/cycles/compare.py scores a map";
     j["binTexels"] = options.errorEstimate.bin;
@@ -362,12 +381,70 @@ struct StagedBake::State {
     if (options.errorEstimate.targetError > 0.0) {
       j["targetError"] = options.errorEstimate.targetError;
       j["stoppedBy"] = stoppedBy;
+      j["stageRays"] = stageRays;
       report["stoppedBy"] = stoppedBy;
     }
     log::info("estimated error " + percent(e.relative) + " (relative RMS on " + std::to_string(options.errorEstimate.bin) +
               "x" + std::to_string(options.errorEstimate.bin) + "-texel bins, " + std::to_string(replicates.size()) +
-              " replicates)");
-    return standardErrorPages(reps);
+              " replicates" + (stageRays > 1.0 ? ", the ray stages' rays x" + shortNumber(stageRays) : std::string()) +
+              ")");
+  }
+
+  // The map from the VPL sums (moved in: freed page by page as they are rounded), with the sky's light.
+  void mapsFromSums(ExactVplSums sums, BakeResult& r, nlohmann::json& report) {
+    timed("backend", [&] {
+      part("maps", [&] { r.maps = backendMaps(sums, report, plan.directional ? &r.directional : nullptr); });
+    });
+    StageContext ctx = stageContext(report);
+    skyStage(ctx, r.maps, directMaps);
+  }
+
+  // The stages that trace rays of their own, on r's maps (and L1 pages): the clamp compensation and the final
+  // gather; when estimating, each run a second time with another seed, then the figure (into `figure`).
+  void rayStages(BakeResult& r, nlohmann::json& report, bool estimate) {
+    StageContext ctx = stageContext(report);
+    L1Pages* l1 = plan.directional ? &r.directional : nullptr;
+    std::vector<Lightmap> beforeStage = estimate && plan.compensate ? r.maps : std::vector<Lightmap>{};
+    compensationStage(ctx, r.maps, l1, gather.valid() ? gather.get() : nullptr);
+    // Under the final gather the map the gather reads is not written: the compensation's second run is
+    // gathered again (with another gather seed), so both stages' ray noise is measured where it shows.
+    if (!beforeStage.empty()) timed("errorEstimate", [&] { compensationRayNoise(beforeStage, r.maps); });
+    if (estimate && plan.finalGather && beforeStage.empty()) beforeStage = r.maps;
+    finalGatherStage(ctx, directMaps, l1 ? &directL1 : nullptr, r.maps, l1);
+    if (plan.finalGather && !beforeStage.empty()) timed("errorEstimate", [&] { gatherRayNoise(std::move(beforeStage), r.maps); });
+    if (estimate) timed("errorEstimate", [&] { measureFigure(r.maps); });
+  }
+
+  bool targeting() const {
+    return estimating() && !halfB.pages.empty() && options.errorEstimate.targetError > 0.0;
+  }
+
+  // A round's entry in estimatedError.rounds, before its figures.
+  nlohmann::json roundEntry() const {
+    return {{"round", rounds.size() + 1}, {"replicates", replicates.size()}, {"vpls", vpls.vpls.size()},
+            {"stageRays", stageRays}};
+  }
+
+  // The compensation's and the final gather's rays (per sample, and their budgets) `factor` times more.
+  void raiseStageRays(double factor) {
+    if (stageRays == 1.0) {
+      planCompensation = plan.compensation;
+      planGather = plan.gather;
+    }
+    stageRays *= factor;
+    auto scaled = [this](auto n) { return static_cast<decltype(n)>(std::llround(static_cast<double>(n) * stageRays)); };
+    plan.compensation.rays = scaled(planCompensation.rays);
+    plan.compensation.refineRays = scaled(planCompensation.refineRays);
+    plan.compensation.rayBudget = scaled(planCompensation.rayBudget);  // 0 (no cap) stays 0
+    plan.gather.rays = scaled(planGather.rays);
+    plan.gather.preRays = scaled(planGather.preRays);  // 0 (no pre-pass) stays 0
+    plan.gather.rayBudget = scaled(planGather.rayBudget);
+  }
+
+  static std::string shortNumber(double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", x);
+    return text;
   }
 
   // The walk's figure with the stages' own ray noise added (independent of the walk's: the variances add),
@@ -708,24 +785,91 @@ void StagedBake::evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
 void StagedBake::refineToTarget(ExactVplSums& sums, const std::function<void(size_t next)>& afterBlock) {
   State& s = *state_;
   const ErrorEstimateOptions& o = s.options.errorEstimate;
-  if (!s.estimating() || s.halfB.pages.empty() || !(o.targetError > 0.0)) return;
-  double roundSeconds = s.seconds.value("backend", 0.0);  // the first round's: its blocks
-  for (int round = 1;; ++round) {
+  if (!s.targeting()) return;
+  s.roundSeconds = s.seconds.value("backend", 0.0);  // the first round's: its blocks
+  for (;;) {
     double estimate = 0.0;
     s.timed("errorEstimate", [&] { estimate = s.roundEstimate(sums); });
-    s.rounds.push_back({{"round", round}, {"replicates", s.replicates.size()}, {"vpls", s.vpls.vpls.size()},
-                        {"estimatedError", estimate}});
-    log::info("round " + std::to_string(round) + ": " + std::to_string(s.replicates.size()) + " replicates, " +
-              std::to_string(s.vpls.vpls.size()) + " VPLs, estimated error " + State::percent(estimate));
-    if (estimate <= o.targetError) s.stoppedBy = "target";
-    else if (round >= o.maxRounds) s.stoppedBy = "max-rounds";
-    else if (o.maxSeconds > 0.0 && s.total.seconds() + roundSeconds > o.maxSeconds) s.stoppedBy = "max-time";
+    s.rounds.push_back(s.roundEntry());
+    s.rounds.back()["walkError"] = estimate;
+    log::info("round " + std::to_string(s.rounds.size()) + ": " + std::to_string(s.replicates.size()) + " replicates, " +
+              std::to_string(s.vpls.vpls.size()) + " VPLs, the walk's estimated error " + State::percent(estimate));
+    // The walk's figure is no lower than the finished one's walk part, and the ray stages add their own noise:
+    // at most the target, the finished figure decides (finish).
+    if (estimate <= o.targetError) return;
+    if (static_cast<int>(s.rounds.size()) >= o.maxRounds) s.stoppedBy = "max-rounds";
+    else if (o.maxSeconds > 0.0 && s.total.seconds() + s.roundSeconds > o.maxSeconds) s.stoppedBy = "max-time";
     if (!s.stoppedBy.empty()) return;
     Stopwatch watch;
     const size_t begin = s.blocks.size();
     s.addRound();
     evaluateBlocks(begin, s.blocks.size(), sums, afterBlock);
-    roundSeconds = watch.seconds();
+    s.roundSeconds = watch.seconds();
+  }
+}
+
+namespace {
+// --target-error aims a raised part at this fraction of the target (the next figure is itself an estimate,
+// and aiming at the target itself would often miss it by a hair and cost another round).
+constexpr double kTargetAim = 0.9;
+// At most this many times the rays per round, and the ray stages' rays at most this many times the plan's.
+constexpr double kMaxStageRaysPerRound = 16.0;
+constexpr double kMaxStageRays = 1024.0;
+}  // namespace
+
+// After the walk's rounds: the ray stages and the finished figure; while it is above the target, another round
+// of what dominates it, more of the compensation's and final gather's rays (the stages run again on the same
+// input) or more paths (another two replicates, the map made again), until the figure is at most the target
+// (stoppedBy "target") or a cap stops it.
+void StagedBake::stagesToTarget(ExactVplSums& sums, BakeResult& r) {
+  State& s = *state_;
+  const ErrorEstimateOptions& o = s.options.errorEstimate;
+  if (s.rounds.empty()) s.rounds.push_back(s.roundEntry());
+  for (;;) {
+    std::vector<Lightmap> input = r.maps;  // the ray stages' input: more rays run them again on it
+    L1Pages inputL1 = r.directional;
+    Stopwatch watch;
+    s.rayStages(r, r.report, true);
+    const double stageSeconds = watch.seconds();
+    const double total = s.figure.whole.relative, walk = s.figure.breakdown.value("vpls", 0.0);
+    nlohmann::json& round = s.rounds.back();
+    round["estimatedError"] = total;
+    round["breakdown"] = s.figure.breakdown;
+    if (total <= o.targetError) {
+      s.stoppedBy = "target";
+      return;
+    }
+    if (!s.stoppedBy.empty()) return;  // a cap stopped the walk's rounds
+    const double aim2 = (kTargetAim * o.targetError) * (kTargetAim * o.targetError);
+    const double walk2 = walk * walk, stages2 = std::max(0.0, total * total - walk2);
+    // The larger part is raised: to what the other leaves of the aim, or to half the aim where the other
+    // needs more than half (the other is raised next).
+    const bool rays = stages2 > walk2;
+    const double factor = !rays ? 1.0
+                                : std::min({std::max(2.0, stages2 / (walk2 < aim2 / 2 ? aim2 - walk2 : aim2 / 2)),
+                                            kMaxStageRaysPerRound, kMaxStageRays / s.stageRays});
+    const double forecast = rays ? stageSeconds * factor : s.roundSeconds + stageSeconds;
+    if (static_cast<int>(s.rounds.size()) >= o.maxRounds) s.stoppedBy = "max-rounds";
+    else if (rays && factor <= 1.0) s.stoppedBy = "max-rays";
+    else if (o.maxSeconds > 0.0 && s.total.seconds() + forecast > o.maxSeconds) s.stoppedBy = "max-time";
+    if (!s.stoppedBy.empty()) return;
+    round["raised"] = rays ? "stageRays" : "paths";
+    log::info("round " + std::to_string(s.rounds.size()) + ": estimated error " + State::percent(total) + " (walk " +
+              State::percent(walk) + ", ray stages " + State::percent(std::sqrt(stages2)) + "), above the target: " +
+              (rays ? "the ray stages' rays x" + State::shortNumber(factor) : std::string("another round of paths")));
+    if (rays) {
+      s.raiseStageRays(factor);
+      r.maps = std::move(input);
+      r.directional = std::move(inputL1);
+    } else {
+      Stopwatch paths;
+      const size_t begin = s.blocks.size();
+      s.addRound();
+      evaluateBlocks(begin, s.blocks.size(), sums);
+      s.roundSeconds = paths.seconds();
+      s.mapsFromSums(sums, r, r.report);  // a copy: the next round adds to them
+    }
+    s.rounds.push_back(s.roundEntry());
   }
 }
 
@@ -746,27 +890,22 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   BakeResult r;
   nlohmann::json& report = r.report;
   s.classPages = {};
-  s.timed("backend", [&] {
-    s.part("maps", [&] { r.maps = s.backendMaps(sums, report, s.plan.directional ? &r.directional : nullptr); });
-  });
-  sums = {};  // rounded into the maps (freed page by page already): not needed at the peak (compensation)
-  StageContext ctx = s.stageContext(report);
-  L1Pages* l1 = s.plan.directional ? &r.directional : nullptr;
-  skyStage(ctx, r.maps, s.directMaps);
+  s.pagesClass = -1;
+  // With a target the sums are kept for more rounds (a copy made into the map); otherwise they are rounded
+  // into the maps and freed page by page: not needed at the peak (compensation).
+  const bool targeting = s.targeting();
+  if (targeting) s.mapsFromSums(sums, r, report);
+  else s.mapsFromSums(std::move(sums), r, report);
   const bool estimate = !s.halves[0].empty();
-  std::vector<Lightmap> beforeStage = estimate && s.plan.compensate ? r.maps : std::vector<Lightmap>{};
-  compensationStage(ctx, r.maps, l1, s.gather.valid() ? s.gather.get() : nullptr);
-  // Under the final gather the map the gather reads is not written: the compensation's second run is
-  // gathered again (with another gather seed), so both stages' ray noise is measured where it shows.
-  if (!beforeStage.empty()) s.timed("errorEstimate", [&] { s.compensationRayNoise(beforeStage, r.maps); });
-  if (estimate && s.plan.finalGather && beforeStage.empty()) beforeStage = r.maps;
-  finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
-  if (s.plan.finalGather && !beforeStage.empty()) s.timed("errorEstimate", [&] { s.gatherRayNoise(std::move(beforeStage), r.maps); });
+  if (targeting && estimate) stagesToTarget(sums, r);
+  else s.rayStages(r, report, estimate);
+  sums = {};
   if (estimate) s.timed("errorEstimate", [&] {
-      std::vector<Lightmap> errorPages = s.finalEstimate(r.maps, report);
-      if (s.options.errorEstimate.errorMap) r.standardError = std::move(errorPages);
+      s.reportFigure(report);
+      r.standardError = std::move(s.figure.errorPages);
     });
   s.halves = {};
+  StageContext ctx = s.stageContext(report);
   leaveOutDirect(r.maps, s.leftOutDirect);
   s.leftOutDirect = {};
   r.shadowMask = shadowMaskStage(ctx);

@@ -67,8 +67,11 @@ class StagedBake {
   void evaluateBlocks(size_t begin, size_t end, ExactVplSums& sums,
                       const std::function<void(size_t next)>& afterBlock = {});
   // With an error estimate and a target (BakeOptions::errorEstimate): rounds of two walk replicates added,
-  // their blocks evaluated into sums, until the estimate is at most the target or a cap stops it; the
-  // report's estimatedError says which. Deterministic for a seed unless the time cap stops it.
+  // their blocks evaluated into sums, until the walk's own figure is at most the target or a cap stops it.
+  // finish then runs the ray stages and, while the finished figure (walk and stages) is above the target,
+  // raises the part that dominates it (the stages' rays, or more rounds of paths into the same sums); the
+  // report's estimatedError says what stopped it ("target" only at or below it). Deterministic for a seed
+  // unless the time cap stops it.
   void refineToTarget(ExactVplSums& sums, const std::function<void(size_t next)>& afterBlock = {});
   // Backend counts of the blocks evaluated so far (report "gl"), for a partial to carry to the merge;
   // addBackendCounts adds a shard's.
@@ -80,6 +83,8 @@ class StagedBake {
  private:
   struct State;
   std::unique_ptr<State> state_;
+  // finish's part under a target: the ray stages and the figure, raised round by round until it is met.
+  void stagesToTarget(ExactVplSums& sums, BakeResult& r);
 };
 
 struct OutputOptions {

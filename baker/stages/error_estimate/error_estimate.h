@@ -13,9 +13,9 @@ namespace irbake {
 
 struct ErrorEstimateOptions {
   bool enabled = false;       // the walk as independent replicates (two per round), their spread the estimate
-  double targetError = 0.0;   // > 0: rounds added until the estimate is at most this (relative, 4×4 bins)
+  double targetError = 0.0;   // > 0: rounds (paths or stage rays) until the whole estimate (relative, 4×4 bins) ≤ this
   double maxSeconds = 0.0;    // with a target: no round started that would end past this bake time (0: no cap)
-  int maxRounds = 16;         // with a target: at most this many rounds (each the plan's paths)
+  int maxRounds = 16;         // with a target: at most this many rounds (each the plan's paths or more stage rays)
   int bin = 4;                // bin side in texels (compare.py's rel_rmse_4)
   bool errorMap = false;      // also each texel's standard error, as pages (BakeResult::standardError)
 };
