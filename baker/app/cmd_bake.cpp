@@ -308,7 +308,7 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
       ->transform(cli::integerIn(0, 16))->type_name("S");
   app->add_option("--env", a.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
-  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, kLargestLight))->type_name("S");
   app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default " + shown(LightAdditions{}.environmentRotation) + ")")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
