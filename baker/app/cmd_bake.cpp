@@ -19,6 +19,7 @@
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/error.h"
+#include "common/excerpt.h"
 #include "common/file_paths.h"
 #include "common/log.h"
 #include "common/output_guard.h"
@@ -49,6 +50,7 @@ struct BakeArguments {
   std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
   std::string probes = "auto", probeBox;  // --probes auto|off|SPACING, --probe-box as given
   std::vector<std::string> lightModes;  // --light-mode NAME=MODE as given
+  std::string lightModeOrigin;          // "FILE: line N: key 'light-mode'" when the config file gave them
   double envIntensity = 1.0, envRotation = 0.0;
   bool helpAll = false;
   CLI::Option* shardOption = nullptr;
@@ -310,15 +312,17 @@ void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments
                   "a punctual light's bake mode: baked (default), indirect (its bounces\n"
                   "only) or shadowmask (indirect plus its visibility in a mask page);\n"
                   "NAME: the glTF light's name, sun (--sun), #I (KHR light I) or *\n"
-                  "(every punctual light); repeatable, beats extras.irbake.mode")
-      ->type_name("NAME=MODE");
+                  "(every punctual light); name:TEXT, index:I and option:sun never\n"
+                  "mean another light; repeatable, beats extras.irbake.mode")
+      ->type_name("NAME=MODE")
+      ->allow_extra_args(false);  // one NAME=MODE per --light-mode: never the SCENE after it
   app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
                   "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
                       shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)")
       ->transform(cli::integerIn(0, 16))->type_name("S");
   app->add_option("--env", a.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
       ->type_name("FILE");
-  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, 1e30))->type_name("S");
+  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, kLargestLight))->type_name("S");
   app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default " + shown(LightAdditions{}.environmentRotation) + ")")
       ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
   app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
@@ -486,8 +490,10 @@ nlohmann::json resultOptions(const CLI::App& app) {
   return options;
 }
 
-// The parsed arguments as options; throws Error(Usage) for combinations CLI11 cannot check.
-void applyArguments(BakeCommand& command, const BakeArguments& a) {
+// The checks of single option values that CLI11 cannot make (--shard, --clamp, --sun, --sky, --probes,
+// --probe-box, --light-mode), their results into the command. Throws Error(Usage) naming the option; a config
+// file's entry is checked with them on its own, so that its refusal names the file, the line and the key.
+void checkOptionValues(BakeCommand& command, const BakeArguments& a) {
   BakeOptions& o = command.options;
   if (a.shardOption->count() > 0) {
     long long k = 0, n = 0;
@@ -503,16 +509,23 @@ void applyArguments(BakeCommand& command, const BakeArguments& a) {
     throw Error(ErrorCode::Usage, "", "--clamp needs 0 (no clamp) or a bound in [1e-30, 1e30] 1/m² (got " + a.clampText() + ")");
   command.lights = lightArguments(a);
   probeArguments(a, o.probes);
-  if (command.noGltf) o.probes.enabled = false;  // the probes live in the glTF: none to write them to
   for (const std::string& entry : a.lightModes) {
     const size_t eq = entry.rfind('=');
     LightModeRequest request;
     if (eq == std::string::npos || eq == 0 || !parseLightMode(entry.substr(eq + 1), request.mode))
-      throw Error(ErrorCode::Usage, "", "--light-mode needs NAME=MODE with MODE baked, indirect or shadowmask (got '" +
-                                            entry + "')");
+      throw Error(ErrorCode::Usage, "", "--light-mode needs NAME=MODE with MODE baked, indirect or shadowmask (got " +
+                                            quotedExcerpt(entry) + ")");
     request.light = entry.substr(0, eq);
+    request.origin = a.lightModeOrigin;
     o.lightModes.push_back(request);
   }
+}
+
+// The parsed arguments as options; throws Error(Usage) for values and combinations CLI11 cannot check.
+void applyArguments(BakeCommand& command, const BakeArguments& a) {
+  BakeOptions& o = command.options;
+  checkOptionValues(command, a);
+  if (command.noGltf) o.probes.enabled = false;  // the probes live in the glTF: none to write them to
   if (a.scenes.size() != 1)
     throw Error(ErrorCode::Usage, "", "bake needs exactly one SCENE (got " + std::to_string(a.scenes.size()) +
                                           "); see 'irbake bake --help'");
@@ -585,10 +598,27 @@ void applyQuality(const CLI::App& app, const BakeArguments& a, BakeOptions& o) {
   o.atlas.targetPageSize = p.autoPageSize;  // read only where --texels-per-unit is auto
 }
 
-// Arguments for a config file's entries, each checked alone against the options (unknown keys, wrong types
-// and out-of-range values name the file, the line and the key); entries the command line also sets are left
-// out (the command line wins).
-Args configArguments(const std::filesystem::path& file, const Args& commandLine) {
+// Options a config file may give as an array of strings, one --name=item per item.
+const std::vector<std::string> kRepeatableOptions = {"light-mode"};
+
+// A message about a config value, the value in it shown as a short escaped excerpt.
+std::string withExcerpt(std::string message, const std::string& value) {
+  const std::string shown = quotedExcerpt(value);
+  if (!value.empty() && shown != "'" + value + "'")
+    for (size_t at = message.find(value); at != std::string::npos; at = message.find(value, at)) {
+      size_t begin = at, end = at + value.size();
+      if (begin > 0 && message[begin - 1] == '\'' && end < message.size() && message[end] == '\'') --begin, ++end;
+      message.replace(begin, end - begin, shown);
+      at = begin + shown.size();
+    }
+  return printableExcerpt(message, 400);
+}
+
+// Arguments for a config file's entries, each checked alone against the options and irbake's own checks of
+// their values (unknown keys, wrong types, out-of-range and refused values name the file, the line and the
+// key); entries the command line also sets are left out (the command line wins). lightModeOrigin: where the
+// file's light-mode entry is, when it is used.
+Args configArguments(const std::filesystem::path& file, const Args& commandLine, std::string& lightModeOrigin) {
   const std::vector<ConfigEntry> entries = readConfigFile(file);
   BakeCommand probeCommand;
   BakeArguments probeArguments;
@@ -597,34 +627,40 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine)
   const std::filesystem::path folder = file.parent_path();
   Args out;
   for (const ConfigEntry& e : entries) {
-    auto fail = [&](const std::string& what) {
-      throw Error(ErrorCode::Usage, file.string(), "line " + std::to_string(e.line) + ": key '" + e.key + "': " + what);
-    };
+    const std::string line = "line " + std::to_string(e.line) + ": key " + quotedExcerpt(e.key);
+    auto fail = [&](const std::string& what) { throw Error(ErrorCode::Usage, file.string(), line + ": " + what); };
     const bool positional = e.key == "scene";
     const std::string name = positional ? "SCENE" : "--" + e.key;
     const CLI::Option* option = given->get_option_no_throw(name);
     if (!option || e.key == "config" || e.key == "help" || e.key == "help-all")
       fail("not an option of 'irbake bake' (see 'irbake bake --help-all')");
     if (option->count() > 0) continue;
+    const bool repeatable = std::find(kRepeatableOptions.begin(), kRepeatableOptions.end(), e.key) != kRepeatableOptions.end();
+    if (e.array && !repeatable) fail("takes one value, not an array (only light-mode is repeated)");
     Args words;
-    std::string value = e.value;
-    if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config" ||
-        e.key == "portable")
-      if (!value.empty() && std::filesystem::path(value).is_relative()) value = (folder / value).lexically_normal().string();
-    if (option->get_expected_min() == 0) {  // a flag
-      if (value != "true" && value != "false") fail("a flag takes true or false, got '" + value + "'");
-      if (value == "true") words = {name};
-    } else {
-      words = positional ? Args{value} : Args{name, value};
+    for (std::string value : e.array ? e.items : std::vector<std::string>{e.value}) {
+      if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config" ||
+          e.key == "portable")
+        if (!value.empty() && std::filesystem::path(value).is_relative()) value = (folder / value).lexically_normal().string();
+      if (option->get_expected_min() == 0) {  // a flag
+        if (value != "true" && value != "false") fail("a flag takes true or false, got " + quotedExcerpt(value));
+        if (value == "true") words.push_back(name);
+      } else {
+        words.push_back(positional ? value : name + "=" + value);  // one word: a value may start with '-'
+      }
     }
     BakeCommand checkCommand;
     BakeArguments checkArguments;
     std::unique_ptr<CLI::App> check = bakeApp(checkCommand, checkArguments);
     try {
       cli::parse(*check, words);
+      checkOptionValues(checkCommand, checkArguments);
     } catch (const Error& error) {
-      fail(error.what());
+      std::string message = error.what();
+      for (const std::string& value : e.array ? e.items : std::vector<std::string>{e.value}) message = withExcerpt(message, value);
+      fail(message);
     }
+    if (e.key == "light-mode") lightModeOrigin = file.string() + ": " + line;
     out.insert(out.end(), words.begin(), words.end());
   }
   return out;
@@ -650,12 +686,17 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
     const bool flag = option->get_expected_min() == 0;
     std::string value;
     if (option->count() > 0) {
+      if (std::find(kRepeatableOptions.begin(), kRepeatableOptions.end(), name) != kRepeatableOptions.end()) {
+        ConfigEntry repeated{name, "", 0, true, option->results()};  // one item per time it was given
+        entries.push_back(repeated);
+        continue;
+      }
       if (flag) value = "true";
       else
         for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
       if (name == "SCENE" || name == "output" || name == "report" || name == "env" || name == "portable")
         value = std::filesystem::absolute(value).lexically_normal().string();
-      entries.push_back({name == "SCENE" ? "scene" : name, value, 0});
+      entries.push_back({name == "SCENE" ? "scene" : name, value, 0, false, {}});
       continue;
     }
     CLI::Option* plain = defaults->get_option_no_throw(option->get_name());
@@ -669,7 +710,7 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArgumen
     for (const auto& [knob, v] : fromPreset)
       if (knob == name) value = v + " (--quality " + preset.name + ")";
     if (value.empty()) value = "none";
-    entries.push_back({"# " + name, value, 0});
+    entries.push_back({"# " + name, value, 0, false, {}});
   }
   return entries;
 }
@@ -699,9 +740,9 @@ std::string automaticChoices(const nlohmann::json& report) {
     const nlohmann::json& v = choice["value"];
     const std::string value = v.is_string() ? v.get<std::string>() : v.is_number_float() ? cli::canonicalNumber(v.get<double>()) : v.dump();
     if (std::find(kReplayable.begin(), kReplayable.end(), key) != kReplayable.end())
-      entries.push_back({key, value, 0});
+      entries.push_back({key, value, 0, false, {}});
     else
-      comments.push_back({"# " + key, "auto (chose " + value + ": " + choice.value("reason", "") + ")", 0});
+      comments.push_back({"# " + key, "auto (chose " + value + ": " + choice.value("reason", "") + ")", 0, false, {}});
   }
   std::string text = "# what this bake chose where its options said auto (the same scene and options choose the same):\n";
   const std::string body = configText(entries, "") + configText(comments, "");
@@ -718,8 +759,9 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
   const bool help = helpAll || std::find(args.begin(), args.end(), "--help") != args.end() ||
                     std::find(args.begin(), args.end(), "-h") != args.end();
   const std::string config = argumentValue(args, "--config");
+  std::string lightModeOrigin;
   if (!config.empty() && !help) {
-    Args fromFile = configArguments(config, args);
+    Args fromFile = configArguments(config, args, lightModeOrigin);
     fromFile.insert(fromFile.end(), args.begin(), args.end());
     args = fromFile;
   }
@@ -746,6 +788,7 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
     if (args[i].rfind("--config=", 0) == 0 || args[i].rfind("--dump-config=", 0) == 0) continue;
     command.arguments.push_back(args[i]);
   }
+  arguments.lightModeOrigin = lightModeOrigin;
   applyArguments(command, arguments);
   applyQuality(*app, arguments, command.options);
   if (!arguments.dumpConfig.empty()) {

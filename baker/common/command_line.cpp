@@ -25,7 +25,7 @@ bool parseFinite(const std::string& text, double& value) {
   if (text.empty()) return false;
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
-  return *end == 0 && std::isfinite(value);
+  return end == text.c_str() + text.size() && std::isfinite(value);  // a NUL inside (a config's "1\u0000x") is not the end
 }
 
 std::string formatNumber(double v) {

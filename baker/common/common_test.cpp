@@ -11,6 +11,7 @@
 #include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/excerpt.h"
 #include "common/output_lock.h"
 
 namespace fs = std::filesystem;
@@ -201,4 +202,19 @@ TEST(AtomicFile, RenameFailingHalfWayLeavesNoFile) {
   EXPECT_THROW(writeAllAtomically(files), Error);
   EXPECT_FALSE(fs::exists(dir / "a.bin")) << "first file of a failed set left behind";
   EXPECT_EQ(filesIn(dir), 1u) << "temp files left behind";  // only the blocker folder
+}
+
+// A user's text in a message: printable UTF-8 as it is, every other byte and the invisible marks escaped, a
+// backslash doubled, long text cut with its size.
+TEST(Excerpt, EscapesWhatDoesNotPrintAndCutsLongText) {
+  EXPECT_EQ(quotedExcerpt("lamp"), "'lamp'");
+  EXPECT_EQ(quotedExcerpt("gr\xC3\xB6\xC3\x9F" "e"), "'gr\xC3\xB6\xC3\x9F" "e'");  // größe
+  EXPECT_EQ(quotedExcerpt(std::string("a\x01\0b\x7F", 5)), "'a\\x01\\x00b\\x7F'");
+  EXPECT_EQ(quotedExcerpt("\xEF\xBB\xBFseed"), "'\\u{FEFF}seed'");
+  EXPECT_EQ(quotedExcerpt("\xC2\x85 \xE2\x80\x8B"), "'\\u{0085} \\u{200B}'");
+  EXPECT_EQ(quotedExcerpt("\xFF\xFE \xC0\xAF \xC3"), "'\\xFF\\xFE \\xC0\\xAF \\xC3'");  // invalid, overlong, cut
+  EXPECT_EQ(quotedExcerpt("C:\\x41"), "'C:\\\\x41'");
+  EXPECT_EQ(quotedExcerpt(std::string(100, 'x'), 10), "'xxxxxxxxxx…' (100 bytes)");
+  EXPECT_EQ(printableExcerpt("C:\\dir \x1B[2J", 100), "C:\\dir \\x1B[2J");
+  EXPECT_EQ(printableExcerpt(std::string(100, 'y'), 4), "yyyy… (100 bytes)");
 }

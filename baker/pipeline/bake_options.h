@@ -46,11 +46,12 @@ enum class FinalGatherMode {
          // see-through one (the gather reads the glass's own map, not what lies behind it)
 };
 
-// One --light-mode NAME=MODE: light is a punctual light's name, "sun" for --sun's, "#i" for KHR light i, or
-// "*" for every punctual light.
+// One --light-mode NAME=MODE: light is a selector of pipeline/light_modes.h ("*", "sun", "#i", a glTF light's
+// name, or the explicit name:TEXT, index:I, option:sun).
 struct LightModeRequest {
   std::string light;
   LightMode mode = LightMode::Baked;
+  std::string origin;  // where it was given, for refusals: "" for the command line, "FILE: line N: key 'light-mode'"
 };
 
 // The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).

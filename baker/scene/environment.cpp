@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "common/error.h"
@@ -112,8 +113,8 @@ double Environment::pdf(const glm::vec3& d) const {
 Environment loadEnvironment(const std::filesystem::path& file, float intensity, float rotationDegrees) {
   const std::string name = file.string();
   if (!std::filesystem::exists(file)) throw Error(ErrorCode::Io, name, "environment image not found");
-  if (!(intensity >= 0.0f) || !std::isfinite(intensity))
-    throw Error(ErrorCode::Usage, name, "--env-intensity must be a finite number ≥ 0");
+  if (!(intensity >= 0.0f) || !(intensity <= kLargestSkyRadiance))
+    throw Error(ErrorCode::Usage, name, "--env-intensity must be a number in [0, 1e20]");
   // Read through the imageio plugin (OpenImageIO, loaded on first use: imageio/image_io.h).
   imageio::Pixels px;
   try {
@@ -128,10 +129,17 @@ Environment loadEnvironment(const std::filesystem::path& file, float intensity, 
   for (size_t i = 0; i < texels.size(); ++i) {
     const float* p = &px.f32[i * px.channels];
     texels[i] = px.channels >= 3 ? glm::vec3(p[0], p[1], p[2]) : glm::vec3(p[0]);
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
+      const std::string pixel = "environment pixel " + std::to_string(i % px.width) + "," + std::to_string(i / px.width);
       if (!std::isfinite(texels[i][c]) || texels[i][c] < 0.0f)
-        throw Error(ErrorCode::InvalidData, name, "environment pixel " + std::to_string(i % px.width) + "," +
-                                                      std::to_string(i / px.width) + " is negative or not finite");
+        throw Error(ErrorCode::InvalidData, name, pixel + " is negative or not finite");
+      if (double(texels[i][c]) * intensity > kLargestSkyRadiance) {
+        char amount[96];
+        std::snprintf(amount, sizeof amount, "%g W/(m² sr) × --env-intensity %g", double(texels[i][c]), double(intensity));
+        throw Error(ErrorCode::InvalidData, name,
+                    pixel + " is " + amount + ", above the 1e20 W/(m² sr) whose sums a bake keeps finite in float");
+      }
+    }
   }
   // One pixel is a constant sky: exactly uniform (an equirect of one row would integrate sinθ at θ = π/2 only).
   if (texels.size() == 1) return Environment::uniform(texels[0] * intensity);

@@ -60,8 +60,13 @@ class Environment {
   glm::dvec3 integral_{0.0};
 };
 
+// The largest radiance (W/(m² sr)) a sky or an environment pixel (× its intensity) may have: beyond it the sums
+// of a bake leave single precision (the bound --sky has).
+constexpr double kLargestSkyRadiance = 1e20;
+
 // Reads an equirectangular EXR/HDR (any size; 1×1 is a uniform sky; one channel is grey) with OpenImageIO. Throws
-// Error(Io/InvalidData) naming the file (missing, unreadable, negative or non-finite radiance).
+// Error(Io/InvalidData) naming the file (missing, unreadable, negative or non-finite radiance, or a pixel that
+// times intensity exceeds kLargestSkyRadiance) and Error(Usage) for an intensity outside [0, kLargestSkyRadiance].
 Environment loadEnvironment(const std::filesystem::path& file, float intensity = 1.0f, float rotationDegrees = 0.0f);
 
 }  // namespace irbake
