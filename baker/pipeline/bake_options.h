@@ -51,7 +51,7 @@ enum class FinalGatherMode {
 struct LightModeRequest {
   std::string light;
   LightMode mode = LightMode::Baked;
-  std::string origin;  // where it was given, for refusals: "" for the command line, "FILE: line N: key 'light-mode'"
+  std::string origin = {};  // where it was given, for refusals: "" for the command line, "FILE: line N: key 'light-mode'"
 };
 
 // The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
