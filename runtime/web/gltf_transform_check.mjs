@@ -7,8 +7,10 @@
 //   refusals --modules DIR --input BAKE.gltf   (a --directional bake)
 //     read → write keeps both extensions' JSON exactly (and IRBAKE_light_probes' fields); bad input (missing texture, texCoord ≠ 1, negative or
 //     non-numeric intensity or one not finite as a 32-bit float, incomplete directional extension, a probe grid or sun level that
-//     does not fit its accessors or whose spacing or origin is not finite, or the spacing 0, as 32-bit floats) and bad output (no TEXCOORD_1, fewer triangles)
-//     throw an Error naming the material or mesh.
+//     does not fit its accessors or whose spacing or origin is not finite, or the spacing 0, as 32-bit floats; a grid no
+//     bake writes: a spacing of 0.005 or 2e9 m, an origin of 2e9 m, a far corner beyond 1e9 m, a probe moved 2 spacings,
+//     with irview's message) and bad output (no TEXCOORD_1, fewer triangles) throw an Error naming the material, mesh or
+//     field; a probe moved exactly one spacing (the limit) reads.
 //   shadowmask --modules DIR --input BAKE.gltf   (a bake with --light-mode ...=shadowmask)
 //     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
 //     light → channel map exactly; a missing texture, texCoord ≠ 1, a channel outside 0..3 and a material mask
@@ -185,6 +187,36 @@ async function refusals() {
     await throws('probe origin Infinity as a float', badGrid(e => { e.origin[1] = 1e39; }), `${IRBAKE_LIGHT_PROBES}.origin`);
     await throws('probe accessor', badGrid(e => { e.valid = 9999; }), `${IRBAKE_LIGHT_PROBES}.valid`, 'does not exist');
     await throws('probe counts type', badGrid(e => { e.counts = [2, 2]; }), `${IRBAKE_LIGHT_PROBES}.counts`);
+    // A grid no bake writes, with irview's message (probe_grid_rules.js).
+    const outside = 'm is outside the 0.01 … 1e9 m a bake writes';
+    await throws('probe spacing below a bake\'s', badGrid(e => { e.spacing = 0.005; }), `${IRBAKE_LIGHT_PROBES}.spacing: 0.005 ${outside}`);
+    await throws('probe spacing above a bake\'s', badGrid(e => { e.spacing = 2e9; }), `${IRBAKE_LIGHT_PROBES}.spacing: 2e+09 ${outside}`);
+    await throws('probe origin beyond 1e9 m', badGrid(e => { e.origin[1] = 2e9; }),
+                 `${IRBAKE_LIGHT_PROBES}.origin: 2e+09 m is beyond the supported 1e9 m`);
+    const grid = original.json.extensions[IRBAKE_LIGHT_PROBES], axis = grid.counts.findIndex(c => c >= 3);
+    check(axis >= 0 && grid.counts[axis] <= 90, `${args.input}: needs a probe axis of 3 to 90 probes (counts ${grid.counts})`);
+    // On the first axis of 3 or more probes, 9e8 + 1e8 × (counts − 1) ≥ 1.1e9 m, exact as floats.
+    const far = 9e8 + 1e8 * (grid.counts[axis] - 1);
+    await throws('probe far corner beyond 1e9 m', badGrid(e => { e.origin[axis] = 9e8; e.spacing = 1e8; }),
+                 `${IRBAKE_LIGHT_PROBES}.counts: the grid reaches ${Number((far / 1e9).toPrecision(3))}e+09 m, beyond the supported 1e9 m`);
+    // The middle probe's x offset set to `spacings` spacings, in a copy of its buffer.
+    const probe = Math.floor(grid.counts.reduce((x, y) => x * y, 1) / 2);
+    const moved = spacings => Math.fround(spacings * Math.fround(grid.spacing));
+    const movedProbe = spacings => () => {
+      const doc = clone(), accessor = doc.json.accessors[grid.offsets], view = doc.json.bufferViews[accessor.bufferView];
+      const uri = doc.json.buffers[view.buffer].uri, bytes = original.resources[uri].slice();
+      new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength)
+        .setFloat32((view.byteOffset ?? 0) + (accessor.byteOffset ?? 0) + 12 * probe, moved(spacings), true);
+      doc.resources = { ...original.resources, [uri]: bytes };
+      return io.readJSON(doc);
+    };
+    await throws('probe moved 2 spacings', movedProbe(2),
+                 `${IRBAKE_LIGHT_PROBES}.offsets: probe ${probe} is moved ${Number(moved(2).toPrecision(3))} m from its grid point, more than a spacing`);
+    try {
+      await movedProbe(1)();
+    } catch (e) {
+      failures.push(`probe moved 1 spacing (the limit): refused: ${e.message}`);
+    }
     if (original.json.extensions[IRBAKE_LIGHT_PROBES].sun?.cells !== undefined) {
       await throws('sun fine', badGrid(e => { e.sun.fine = e.sun.cells; }), `${IRBAKE_LIGHT_PROBES}.sun.fine`, 'the grid needs');
       await throws('sun subdivisions', badGrid(e => { e.sun.subdivisions = 0; }), `${IRBAKE_LIGHT_PROBES}.sun.subdivisions`);

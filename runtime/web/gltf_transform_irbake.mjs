@@ -4,7 +4,8 @@
 // keep TEXCOORD_1. Reading refuses what irbake's viewers would show wrongly (a missing texture, a texCoord other
 // than 1, a negative or non-numeric intensity, an incomplete directional extension) with an Error naming the
 // material. IRBAKE_light_probes (on the root) keeps its accessors as Accessor references; reading refuses a grid
-// whose fields or accessors do not fit, naming the field. Writing refuses an output on which the bake no longer fits its geometry: a light-mapped primitive
+// whose fields or accessors do not fit, naming the field, or that lies where no bake writes one (probe_grid_rules.js,
+// with irview's message). Writing refuses an output on which the bake no longer fits its geometry: a light-mapped primitive
 // without TEXCOORD_1, or fewer light-mapped triangles than were read (simplification).
 //
 // The classes must extend the very @gltf-transform/core the caller (the CLI) uses, so they are made from it:
@@ -14,6 +15,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
+import { checkProbeGridPlace, checkProbeOffset } from './probe_grid_rules.js';
 
 export const MOZ_LIGHTMAP = 'MOZ_lightmap';
 export const IRBAKE_LIGHTMAP_DIRECTIONAL = 'IRBAKE_lightmap_directional';
@@ -406,6 +408,8 @@ export function defineIrbakeExtensions(core) {
       };
       for (const [key, [componentType, type, per]] of Object.entries(PROBE_ACCESSORS))
         accessor(def, key, key, componentType, type, probes * per);
+      const offsets = vec3Elements(context, def.offsets), spacing = Math.fround(def.spacing);
+      for (let i = 0; i < probes; ++i) checkProbeOffset(offsets, i, spacing);
       if (def.sun !== undefined) {
         const S = def.sun?.subdivisions;
         if (!isObject(def.sun) || !(Number.isInteger(S) && S >= 1 && S <= 16))
@@ -563,12 +567,35 @@ export function defineIrbakeExtensions(core) {
            LightProbeGrid };
 }
 
-// The probe count of an IRBAKE_light_probes definition, or an Error naming the field that is wrong.
 // A reference's field name in messages: sun_sh → sun.sh, emitters_0_positions → emitters[0].positions.
 function refName(ref) {
   return ref.replace(/^emitters_(\d+)_/, 'emitters[$1].').replace('_', '.');
 }
 
+// The elements of FLOAT VEC3 accessor `index` (a Float32Array) as the reader holds them once it is done: its
+// buffer view's values, zeros without one, with its sparse substitutions applied. Extensions read before the reader
+// fills in sparse and zero-filled accessors, and optimize writes the mostly-zero probe offsets sparse, so the
+// substitutions are applied here (sparse indices and values are tightly packed: glTF 2.0, 3.6.2.3).
+function vec3Elements(context, index) {
+  const def = context.jsonDoc.json.accessors[index];
+  const out = new Float32Array(3 * def.count);
+  if (def.bufferView !== undefined) out.set(context.accessors[index].getArray());
+  const sparse = def.sparse;
+  if (sparse) {
+    const bytes = (at, length) => {
+      const view = context.bufferViews[at.bufferView];
+      return new DataView(view.buffer, view.byteOffset + (at.byteOffset ?? 0), length);
+    };
+    const indexSize = { 5121: 1, 5123: 2, 5125: 4 }[sparse.indices.componentType];
+    const indices = bytes(sparse.indices, sparse.count * indexSize), values = bytes(sparse.values, sparse.count * 12);
+    const indexAt = { 1: k => indices.getUint8(k), 2: k => indices.getUint16(2 * k, true), 4: k => indices.getUint32(4 * k, true) }[indexSize];
+    for (let k = 0; k < sparse.count; ++k)
+      for (let c = 0; c < 3; ++c) out[3 * indexAt(k) + c] = values.getFloat32(12 * k + 4 * c, true);
+  }
+  return out;
+}
+
+// The probe count of an IRBAKE_light_probes definition, or an Error naming the field that is wrong.
 export function checkProbeGrid(def) {
   const what = IRBAKE_LIGHT_PROBES;
   if (!isObject(def)) throw new Error(`${what} is not an object`);
@@ -580,6 +607,7 @@ export function checkProbeGrid(def) {
     throw new Error(`${what}.spacing ${JSON.stringify(def.spacing)} must be a finite number > 0`);
   if (!numbers(def.counts, 3) || !def.counts.every(c => Number.isInteger(c) && c >= 1))
     throw new Error(`${what}.counts ${JSON.stringify(def.counts)} needs 3 whole numbers ≥ 1`);
+  checkProbeGridPlace(def.origin.map(Math.fround), Math.fround(def.spacing), def.counts);
   return def.counts[0] * def.counts[1] * def.counts[2];
 }
 

@@ -16,12 +16,15 @@
 // With the optional `emitters` (irbake_probe_emitters.js), their exact light is added at each point, their
 // visibility blended as the SH.
 // A grid that does not fit (counts or spacing out of range, an accessor of the wrong type or count, a
-// non-finite value, validity other than 0 or 1) is refused: loading throws an Error naming the field.
+// non-finite value, validity other than 0 or 1) or lies where no bake writes one (probe_grid_rules.js: a spacing
+// outside 0.01 … 1e9 m, an origin or far corner beyond 1e9 m, a probe moved more than a spacing) is refused:
+// loading throws an Error naming the field, with irview's message.
 import { Box3, SphericalHarmonics3, Vector3, Vector4 } from 'three';
+import { checkProbeGridPlace, checkProbeOffset, LIGHT_PROBES } from './probe_grid_rules.js';
 import { readSunLevel, SUN_SHADER, sunUniforms } from './irbake_probe_sun.js';
 import { emitterGlsl, emitterUniforms, readEmitters, visibilityField } from './irbake_probe_emitters.js';
 
-export const LIGHT_PROBES = 'IRBAKE_light_probes';
+export { LIGHT_PROBES };
 const FLOAT = 5126;
 const COMPONENTS = { SCALAR: 1, VEC3: 3 };
 
@@ -223,6 +226,7 @@ export async function readProbeGrid(json, accessor) {
   // A positive finite 32-bit float, as irview reads it: 1e-50 would be 0 and 1e39 Infinity.
   const spacing = typeof ext.spacing === 'number' ? Math.fround(ext.spacing) : NaN;
   if (!(spacing > 0) || !Number.isFinite(spacing)) fail('spacing', 'needs a positive finite number');
+  checkProbeGridPlace(origin, spacing, counts);
   // Accessor ext[key] (field `prefix + key` in messages) of componentType `component` and `type`, `count`
   // elements (null: any), as a typed array.
   const readFrom = (holder, prefix) => async (key, component, type, count) => {
@@ -262,6 +266,7 @@ export async function readProbeGrid(json, accessor) {
     let finite = Number.isFinite(offsets[3 * i]) && Number.isFinite(offsets[3 * i + 1]) && Number.isFinite(offsets[3 * i + 2]);
     for (let k = 0; k < 27; ++k) finite = finite && Number.isFinite(coefficients[27 * i + k]);
     if (!finite) fail('', `probe ${i} has a non-finite coefficient or offset`);
+    checkProbeOffset(offsets, i, spacing);
     if (validity[i] !== 0 && validity[i] !== 1) fail('valid', `probe ${i} holds ${validity[i]} (0 or 1)`);
     valid[i] = validity[i];
   }

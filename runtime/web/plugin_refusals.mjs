@@ -1,9 +1,11 @@
 // The clients refuse what irview refuses: writes broken copies of a baked glTF beside it (a MOZ_lightmap intensity
 // of -1, "NaN", null or 1e39, a texture index the file lacks, texCoord 0; an IRBAKE_light_probes spacing of 1e-50
-// or 1e39, an origin of 1e39: not finite as 32-bit floats) and requires irview (exit 5), three.js (moz_lightmap.js,
-// irbake_light_probes.js) and Babylon.js (babylon_moz_lightmap.js, MOZ_lightmap only) in headless Chromium to refuse
-// each with the same message, naming the material or the field. The bake as written, and copies without texCoord
-// or intensity (defaults 1), must load in all three, with their light maps.
+// or 1e39, an origin of 1e39: not finite as 32-bit floats; a grid no bake writes: a spacing of 0.005 or 2e9 m, an
+// origin of 2e9 m, a far corner beyond 1e9 m, a probe moved 2 spacings) and requires irview (exit 5), three.js
+// (moz_lightmap.js, irbake_light_probes.js) and Babylon.js (babylon_moz_lightmap.js, MOZ_lightmap only) in headless
+// Chromium to refuse each with the same message, naming the material or the field. The bake as written, and copies
+// without texCoord or intensity (defaults 1), must load in all three, with their light maps; a probe moved exactly
+// one spacing (the limit) in irview and three.js.
 // Usage: node plugin_refusals.mjs --modules DIR --irview EXE --scene BAKE.gltf (a bake with probes)
 import fs from 'node:fs';
 import path from 'node:path';
@@ -26,6 +28,28 @@ const material = `material ${m}${name ? ` ('${name}')` : ''}: MOZ_lightmap`;
 const moz = f => d => f(d.materials[m].extensions.MOZ_lightmap);
 const probes = f => d => f(d.extensions.IRBAKE_light_probes);
 const all = ['irview', 'three', 'babylon'], threeAndIrview = ['irview', 'three'];
+const grid = doc.extensions.IRBAKE_light_probes;
+// The far corner: on the first axis of 3 or more probes (the axes before it have at most 2), an origin of 9e8 m
+// and a spacing of 1e8 m, each within the limits, reach 9e8 + 1e8 × (counts − 1) ≥ 1.1e9 m (all exact as floats).
+const axis = grid.counts.findIndex(c => c >= 3);
+if (axis < 0 || grid.counts[axis] > 90) fail(`${args.scene}: needs a probe axis of 3 to 90 probes (counts ${grid.counts})`);
+const far = 9e8 + 1e8 * (grid.counts[axis] - 1);
+// A copy of the buffer that holds the probe offsets with the middle probe's x offset set to `spacings` spacings
+// (as a 32-bit float), beside the bake; the mutation points the copy's buffer at it. Returns [mutation, metres].
+const probe = Math.floor(grid.counts.reduce((x, y) => x * y, 1) / 2);
+function movedProbe(spacings, file) {
+  const accessor = doc.accessors[grid.offsets], view = doc.bufferViews[accessor.bufferView];
+  const bytes = fs.readFileSync(path.join(dir, doc.buffers[view.buffer].uri));
+  const moved = Math.fround(spacings * Math.fround(grid.spacing));
+  bytes.writeFloatLE(moved, (view.byteOffset ?? 0) + (accessor.byteOffset ?? 0) + 12 * probe);
+  fs.writeFileSync(path.join(dir, file), bytes);
+  return [d => { d.buffers[view.buffer].uri = file; }, moved];
+}
+const [twoSpacings, twoSpacingsMetres] = movedProbe(2, `${stem}_offset_two_spacings.bin`);
+// The expected text below writes it as printf's %.3g does in this range (no exponent).
+if (!(twoSpacingsMetres >= 1e-4 && twoSpacingsMetres < 1e3)) fail(`${args.scene}: spacing ${grid.spacing} m out of the test's range`);
+const [oneSpacing] = movedProbe(1, `${stem}_offset_one_spacing.bin`);
+const outside = 'm is outside the 0.01 … 1e9 m a bake writes', beyond = 'm is beyond the supported 1e9 m';
 const cases = {
   as_baked: [() => {}, null, all],
   no_texcoord: [moz(e => { delete e.texCoord; }), null, all],
@@ -40,6 +64,16 @@ const cases = {
   spacing_tiny: [probes(e => { e.spacing = 1e-50; }), 'IRBAKE_light_probes.spacing: needs a positive finite number', threeAndIrview],
   spacing_huge: [probes(e => { e.spacing = 1e39; }), 'IRBAKE_light_probes.spacing: needs a positive finite number', threeAndIrview],
   origin_huge: [probes(e => { e.origin[1] = 1e39; }), 'IRBAKE_light_probes.origin: not finite', threeAndIrview],
+  spacing_below_bakes: [probes(e => { e.spacing = 0.005; }), `IRBAKE_light_probes.spacing: 0.005 ${outside}`, threeAndIrview],
+  spacing_above_bakes: [probes(e => { e.spacing = 2e9; }), `IRBAKE_light_probes.spacing: 2e+09 ${outside}`, threeAndIrview],
+  origin_beyond_bakes: [probes(e => { e.origin[1] = 2e9; }), `IRBAKE_light_probes.origin: 2e+09 ${beyond}`, threeAndIrview],
+  far_corner_beyond_bakes: [probes(e => { e.origin[axis] = 9e8; e.spacing = 1e8; }),
+                            `IRBAKE_light_probes.counts: the grid reaches ${Number((far / 1e9).toPrecision(3))}e+09 m, ` +
+                            'beyond the supported 1e9 m (origin + spacing × (counts − 1))', threeAndIrview],
+  offset_two_spacings: [twoSpacings, `IRBAKE_light_probes.offsets: probe ${probe} is moved ` +
+                        `${Number(twoSpacingsMetres.toPrecision(3))} m from its grid point, more than a spacing ` +
+                        '(a bake moves it at most half)', threeAndIrview],
+  offset_one_spacing: [oneSpacing, null, threeAndIrview],
 };
 // A probe-lit sphere makes irview read the probes; three.js reads them on every load.
 const sphere = '0.2,0.4,0.2,0.08';
