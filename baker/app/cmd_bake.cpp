@@ -419,10 +419,7 @@ void addErrorOptions(CLI::App* app, BakeCommand& command) {
                 "report the bake's estimated error (report.json estimatedError:\n"
                 "relative RMS on 4x4-texel bins, as bench/cycles/compare.py scores)");
   app->add_option("--target-error", e.targetError,
-                  "add rounds until the estimated error, every part it reports, is at\n"
-                  "most E (e.g. 0.02): more paths where the walk's noise dominates, more\n"
-                  "compensation and final gather rays where theirs does; stopped by\n"
-                  "--max-rounds or --max-time above E, the report and log say so")
+                  "add paths or stage rays until the estimated error is at most E (e.g. 0.02)")
       ->transform(cli::numberIn(1e-6, 1.0))->type_name("E");
   app->add_option("--max-rounds", e.maxRounds,
                   "--target-error: at most this many rounds, of paths or of rays\n(default " + shown(d.maxRounds) + ")")
@@ -778,7 +775,7 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
   }
   if (!cli::parse(*app, args)) return std::nullopt;
   command.resultOptions = resultOptions(*app);
-  command.optionsHash = hashText(command.resultOptions.dump());
+  command.optionsHash = hashText(command.resultOptions.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   // What a merge or resume re-parses: the config's entries are in `args` already, so the file is not needed.
   for (size_t i = 0; i < args.size(); ++i) {
     if ((args[i] == "--config" || args[i] == "--dump-config") && i + 1 < args.size()) {

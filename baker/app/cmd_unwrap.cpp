@@ -108,7 +108,7 @@ int runUnwrap(const Args& args) {
   exportOptions.inputs = sceneInputFiles(input);
   exportOptions.guard = &guard;
   if (!report.empty()) {
-    const std::string text = reportJson(input, result).dump(2) + "\n";
+    const std::string text = reportJson(input, result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     exportOptions.alsoWrite.push_back({report, [text, report](const std::filesystem::path& tmp) {
                                          std::ofstream out(tmp, std::ios::binary);
                                          out << text;

@@ -122,7 +122,8 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   report["outputs"] = nlohmann::json::array();
   for (const auto& p : written) report["outputs"].push_back(p.string());
   if (!portable.empty()) report["portable"] = portableSummary;
-  const std::string text = report.dump(2) + "\n";
+  // A path is bytes, not always UTF-8: a name JSON cannot hold is written with U+FFFD in its place.
+  const std::string text = report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   PendingFile reportFile{reportPath, [&text, reportPath](const fs::path& temp) {
                            std::ofstream out(temp, std::ios::binary);
                            out << text;

@@ -101,7 +101,7 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
                             {"shardCount", header.shardCount},
                             {"command", header.command},
                             {"backendCounts", header.backendCounts}};
-  const std::string text = h.dump();
+  const std::string text = h.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // paths need not be UTF-8
   const OutputGuard unguarded;  // callers without a command (tests) write through a guard that knows no input
   (guard ? *guard : unguarded).write(path, [&](const std::filesystem::path& temp) {
     std::ofstream file(temp, std::ios::binary);
