@@ -92,11 +92,11 @@ def cycles_rows(files, modes=("map", "view")):
         for r in sorted(current, key=lambda r: (int(seed_of(r["our_options"])), r["mode"], r["view"])):
             view = "page 0" if r["mode"] == "map" else f"view {r['view']}"
             size = f"{int(r['texels']) / 1e3:.0f}k texels" if r["mode"] == "map" else f"{r['width']}×{r['height']}"
-            out.append([SCENES[name], f"{r['mode']} ({size})", view, seed_of(r["our_options"]), f"`{r['commit']}`",
+            out.append([SCENES[name], f"{r['mode']} ({size})", view, seed_of(r["our_options"]),
                         num(r["our_wall_s"], 1), num(r["mean_ratio"], 3), pct(r["rel_rmse_4"]),
                         pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**",
                         pct(r["rel_rmse_4_with_edges"]), r["ref_spp"]])
-    return table(["scene", "compared", "where", "seed", "baker", "our bake, wall (s)", "mean ours/Cycles",
+    return table(["scene", "compared", "where", "seed", "our bake, wall (s)", "mean ours/Cycles",
                   "rel. RMSE 4×4", "Cycles' noise", "noise removed", "edges kept", "Cycles spp"], out)
 
 
@@ -114,10 +114,10 @@ def t_seed_spread():
                and r["options"] == sm["options"]]
         ratios = [float(r["total_ratio"]) for r in per]
         noise = [float(r["seed_noise_4"]) for r in per]
-        out.append([sm["scene"], f"`{sm['options']}`" if sm["options"] else "default", f"`{sm['commit']}`", len(per),
+        out.append([sm["scene"], f"`{sm['options']}`" if sm["options"] else "default", len(per),
                     f"{min(ratios):.4f} … {max(ratios):.4f}", f"**{pct(sm['spread'])}**", pct(sm["noise_rms"]),
                     pct(max(noise)), num(sm["wall_s"], 1), num(sm["load_1min"], 1)])
-    return table(["scene", "options", "baker", "seeds", "total / seeds' mean", "spread of the total",
+    return table(["scene", "options", "seeds", "total / seeds' mean", "spread of the total",
                   "seed noise 4×4, RMS", "worst seed", "median wall (s)", "1-min load (largest)"], out)
 
 
@@ -157,11 +157,11 @@ def t_every_seed():
         errors = [float(r["rel_rmse_4_corrected"]) for r in current]
         ratios = [float(r["mean_ratio"]) for r in current]
         scene = SCENES.get(name, name)
-        out.append([scene, label, f"`{commit}`", ", ".join(seed_of(r["our_options"]) for r in current),
+        out.append([scene, label, ", ".join(seed_of(r["our_options"]) for r in current),
                     " / ".join(pct(e) for e in errors), f"**{pct(max(errors))}**",
                     f"{min(ratios):.4f} … {max(ratios):.4f}", f"**{pct(max(ratios) - min(ratios))}**",
                     num(median(r["our_wall_s"] for r in current), 1), current[0]["ref_spp"]])
-    return table(["scene", "options", "baker", "seeds", "rel. RMSE 4×4, noise removed, per seed", "worst seed",
+    return table(["scene", "options", "seeds", "rel. RMSE 4×4, noise removed, per seed", "worst seed",
                   "mean ours/Cycles", "spread of the mean", "median wall (s)", "Cycles spp"], out)
 
 
@@ -179,18 +179,18 @@ def t_cycles_ladder():
                  "cycles_sponza_sun_x4.csv"]:
         rows = [r for r in read(name) if r["mode"] == "map-cycles"]
         for r in sorted(latest(rows, lambda r: r["cycles_spp"]), key=lambda r: int(r["cycles_spp"])):
-            out.append([SCENES[name], f"`{r['commit']}`", r["cycles_spp"], num(r["cycles_s"], 1),
+            out.append([SCENES[name], r["cycles_spp"], num(r["cycles_s"], 1),
                         pct(r["rel_rmse_4_corrected"])])
-    return table(["scene (map, our atlas)", "run at", "Cycles samples per texel", "Cycles' bake (s)",
+    return table(["scene (map, our atlas)", "Cycles samples per texel", "Cycles' bake (s)",
                   "rel. RMSE 4×4, noise removed"], out)
 
 
 def t_equal_error_time():
     out = []
     for r in latest(read("equal_error_time.csv"), lambda r: r["scene"]):
-        out.append([r["scene"], r["date"], f"`{r['commit']}`", num(r["our_wall_s_median"], 2), r["runs"],
+        out.append([r["scene"], r["date"], num(r["our_wall_s_median"], 2), r["runs"],
                     r["cycles_spp"], num(r["cycles_bake_s"], 1), f"**{num(r['ratio'], 2)}×**", r["load_avg"]])
-    return table(["scene", "date", "baker", "our bake, median wall (s)", "runs", "Cycles spp at our error",
+    return table(["scene", "date", "our bake, median wall (s)", "runs", "Cycles spp at our error",
                   "Cycles' bake (s)", "Cycles / ours", "load average"], out)
 
 
@@ -253,10 +253,10 @@ def t_levels():
     for scene, (date, _, commit) in last.items():
         g = [r for r in rows if r["scene"] == scene and r["commit"] == commit and r["date"] == date]
         r = g[0]
-        out.append([scene, f"`{r['options']}`", date, f"`{commit}`", r["backend"], len(g),
+        out.append([scene, f"`{r['options']}`", date, r["backend"], len(g),
                     f"{int(r['texels_valid']) / 1e6:.2f} M", r["vpls"], num(median(x["wall_s"] for x in g), 1),
                     f"{median(x['peak_mib'] for x in g):.0f}", num(median(x["load_avg"] for x in g), 1)])
-    return table(["scene", "options", "date", "baker", "backend (auto)", "runs", "texels", "VPLs",
+    return table(["scene", "options", "date", "backend (auto)", "runs", "texels", "VPLs",
                   "median wall (s)", "peak memory (MiB)", "load average"], out)
 
 
@@ -265,8 +265,7 @@ def t_memory():
     label = rows[-1]["label"]
     out = [[r["case"], r["triangles"], r["texels"], r["runs"], num(r["peak_rss_mib"], 0), num(r["bake_peak_mib"], 0)]
            for r in rows if r["label"] == label]
-    return f"Baker: `{label}`.\n\n" + table(["case", "triangles", "texels", "runs", "peak RSS (MiB)",
-                                            "bake's own peak (MiB)"], out)
+    return table(["case", "triangles", "texels", "runs", "peak RSS (MiB)", "bake's own peak (MiB)"], out)
 
 
 def gpu_table(name):
@@ -307,25 +306,19 @@ ESTIMATE_SCENES = {"cornell_sample": "Cornell sample", "cornell_published": "Cor
 
 
 def t_error_estimate():
+    """Per scene and options, the latest run of each seed summarised: the estimate against the measured error."""
     rows = latest(read("error_estimate.csv"), lambda r: (r["scene"], r["our_options"], r["seed"]))
     out = []
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        group = [r for r in rows if r["scene"] == scene]
-        for r in group:
-            opts = " ".join(t for t in r["our_options"].replace("--estimate-error true", "").split())
-            out.append([ESTIMATE_SCENES.get(scene, scene), f"`{opts}`" if opts else "default", r["seed"], f"`{r['commit']}`",
-                        f"{int(r['texels']) / 1e3:.0f}k", pct(r["est_vpls"]), pct(r["est_compensation_rays"]),
-                        pct(r["est_gather_rays"]), f"**{pct(r['estimated'])}**", pct(r.get("estimated_all_bins") or r["estimated"]),
-                        pct(r["rel_rmse_4"]), pct(r["ref_noise_4"]), f"**{pct(r['rel_rmse_4_corrected'])}**",
-                        num(r["ratio"], 2), r["ref_spp"]])
+    for key in dict.fromkeys((r["scene"], r["our_options"]) for r in rows):
+        group = [r for r in rows if (r["scene"], r["our_options"]) == key]
+        opts = " ".join(key[1].replace("--estimate-error true", "").split())
         rms = lambda k: math.sqrt(sum(float(r[k]) ** 2 for r in group) / len(group))
-        out.append([ESTIMATE_SCENES.get(scene, scene), "RMS over seeds", len(group), "", "", "", "", "",
-                    f"**{pct(rms('estimated'))}**", "", "", "", f"**{pct(rms('rel_rmse_4_corrected'))}**",
-                    f"**{num(rms('estimated') / rms('rel_rmse_4_corrected'), 2)}**", ""])
-    return table(["scene", "options", "seed", "baker", "texels", "estimate: walk", "compensation rays",
-                  "final-gather rays (and the compensation's under it)", "estimate (interior bins)",
-                  "estimate (every valid bin)", "measured", "Cycles' noise", "measured, noise removed",
-                  "estimate / measured", "Cycles spp"], out)
+        out.append([ESTIMATE_SCENES.get(key[0], key[0]), f"`{opts}`" if opts else "default", len(group),
+                    f"{int(group[0]['texels']) / 1e3:.0f}k", f"**{pct(rms('estimated'))}**",
+                    pct(rms("rel_rmse_4")), pct(group[0]["ref_noise_4"]), f"**{pct(rms('rel_rmse_4_corrected'))}**",
+                    f"**{num(rms('estimated') / rms('rel_rmse_4_corrected'), 2)}**", group[0]["ref_spp"]])
+    return table(["scene", "options", "seeds", "texels", "estimate (interior bins), RMS", "measured, RMS",
+                  "Cycles' noise", "measured, noise removed, RMS", "estimate / measured", "Cycles spp"], out)
 
 
 def t_error_estimate_seeds():
@@ -334,10 +327,10 @@ def t_error_estimate_seeds():
     out = []
     for r in rows:
         est, spread, sys_, meas = (float(r[k]) for k in ("estimated_rms", "seed_noise", "systematic", "measured_rms"))
-        out.append([ESTIMATE_SCENES.get(r["scene"], r["scene"]), f"`{r['commit']}`", r["seeds"], r["bins"], pct(est),
+        out.append([ESTIMATE_SCENES.get(r["scene"], r["scene"]), r["seeds"], r["bins"], pct(est),
                     pct(spread), f"**{num(est / spread, 2)}**", pct(sys_), f"{r['worst_bins']}: {pct(r['worst_share'], 0)}",
                     pct(r["systematic_without_worst"]), pct(meas), f"**{num(math.sqrt(est ** 2 + sys_ ** 2) / meas, 2)}**"])
-    return table(["scene", "baker", "seeds", "bins scored", "estimate, RMS over seeds", "one bake's spread over the seeds",
+    return table(["scene", "seeds", "bins scored", "estimate, RMS over seeds", "one bake's spread over the seeds",
                   "estimate / spread", "systematic against Cycles", "worst 1% of bins: share of its square",
                   "systematic without them", "measured, noise removed, RMS", "√(estimate² + systematic²) / measured"], out)
 
@@ -366,25 +359,22 @@ def t_directional():
 
 
 def t_probe_spheres():
-    """A white sphere lit by our probes (irview --probe-object) against Cycles (bench/cycles/probe_spheres.py):
-    the latest row per scene, place, seed and shading path."""
-    rows = latest(read("probe_spheres.csv"), lambda r: (r["scene"], r["place"], r["our_seed"], r["ours"],
-                                                             r["cycles_sphere"], r["our_options"]))
+    """A white sphere lit by our probes in a default bake (irview --probe-object) against Cycles
+    (bench/cycles/probe_spheres.py): per scene, place and Cycles' sphere, the latest row of each seed."""
+    rows = latest([r for r in read("probe_spheres.csv") if r["our_options"] == "" and r["ours"] == "irview"],
+                  lambda r: (r["scene"], r["place"], r["cycles_sphere"], r["our_seed"]))
     out = []
-    for r in sorted(rows, key=lambda r: (r["scene"], r["cycles_sphere"] != "camera", r["our_options"],
-                                         int(r["our_seed"]), r["ours"])):
-        quarters = " / ".join(num(r[q], 3) for q in ("q_upper_left", "q_upper_right", "q_lower_left", "q_lower_right"))
-        ok = abs(float(r["ratio"]) - 1) <= 0.03 and float(r["worst_quarter"]) <= 0.05
-        out.append([r["scene"], r["place"], r["centre"], r["radius"], num(r["sunlit"], 2),
-                    num(r["probe_sun_share"], 2), r["cycles_sphere"],
-                    r["our_seed"], r["our_options"] or "default" if r["ours"] == "irview" else f"{r['our_options']} (irbake probe)",
-                    f"`{r['commit']}`", f"**{num(r['ratio'], 3)}**", quarters, pct(r["worst_quarter"], 1),
-                    "yes" if ok else "**no**", num(r["ratio_exact_direct"], 3), pct(r["worst_quarter_exact_direct"], 1),
-                    pct(r["ref_noise"]), pct(r["ref_noise_quarter_max"]), r["ref_spp"]])
-    return table(["scene", "place", "centre (m)", "R (m)", "sunlit", "probes' sun share", "Cycles' sphere", "seed", "our options", "baker",
-                  "ours/Cycles", "quarters UL / UR / LL / LR", "worst quarter", "within 3% / 5%",
-                  "exact direct: ours/Cycles", "exact direct: worst quarter", "Cycles' noise", "noise, quarters",
-                  "Cycles spp"], out)
+    for key in sorted(dict.fromkeys((r["scene"], r["cycles_sphere"], r["place"]) for r in rows)):
+        g = [r for r in rows if (r["scene"], r["cycles_sphere"], r["place"]) == key]
+        ratios = [float(r["ratio"]) for r in g]
+        worst = max(float(r["worst_quarter"]) for r in g)
+        ok = sum(abs(float(r["ratio"]) - 1) <= 0.03 and float(r["worst_quarter"]) <= 0.05 for r in g)
+        r = g[0]
+        out.append([r["scene"], r["place"], r["centre"], r["radius"], num(r["sunlit"], 2), r["cycles_sphere"], len(g),
+                    f"**{min(ratios):.3f} … {max(ratios):.3f}**", pct(worst, 1), f"{ok} of {len(g)}",
+                    pct(r["ref_noise"]), r["ref_spp"]])
+    return table(["scene", "place", "centre (m)", "R (m)", "sunlit", "Cycles' sphere", "seeds", "ours/Cycles",
+                  "worst quarter, worst seed", "seeds within 3% / 5%", "Cycles' noise", "Cycles spp"], out)
 
 
 def t_export_meshes():
@@ -405,13 +395,13 @@ def t_atlas():
 
 
 def t_atlas_threads():
-    """The atlas stage by thread count (bench/atlas_threads.py): the latest row of each machine, baker, scene and
-    thread count."""
-    rows = latest(read("atlas_threads.csv"), lambda r: (r["machine"], r["baker"], r["scene"], r["threads"]))
-    out = [[r["machine"], f"`{r['baker']}`", r["scene"], r["charts"], r["threads"], r["runs"], num(r["median_atlas_s"], 2),
+    """The atlas stage by thread count (bench/atlas_threads.py): the latest row of each machine, scene and thread
+    count."""
+    rows = latest(read("atlas_threads.csv"), lambda r: (r["machine"], r["scene"], r["threads"]))
+    out = [[r["machine"], r["scene"], r["charts"], r["threads"], r["runs"], num(r["median_atlas_s"], 2),
             num(r["median_pack_s"], 2), num(r["median_cpu_s"], 2), r["load_average"], f"`{r['output_md5']}`"]
            for r in rows]
-    return table(["machine", "baker", "scene", "charts", "threads", "runs", "atlas median (s)", "of it packing (s)",
+    return table(["machine", "scene", "charts", "threads", "runs", "atlas median (s)", "of it packing (s)",
                   "process CPU (s)", "load (1 min)", "unwrapped file (md5)"], out)
 
 
@@ -483,10 +473,10 @@ def t_quality_presets():
             compared = "views " + " / ".join(r["view"] for r in e)
             error = f"**{pct(statistics.fmean(values))}** ({' / '.join(f'{100 * v:.2f}' for v in values)}%)"
             ratio = f"{min(ratios):.3f}…{max(ratios):.3f}"
-        out.append([t["scene"], f"`{t['options']}`" if t["options"] else "", f"`{t['preset']}`", f"`{t['commit']}`",
+        out.append([t["scene"], f"`{t['options']}`" if t["options"] else "", f"`{t['preset']}`",
                     f"{int(t['page_texels']) / 1e3:.0f}k", t["runs"], t["median_wall_s"], t["peak_memory_mib"],
                     t.get("load_before_runs") or "", t["load_average"], compared, error, ratio])
-    return table(["scene", "options", "preset", "baker", "page texels", "runs", "median wall (s)", "peak memory (MiB)",
+    return table(["scene", "options", "preset", "page texels", "runs", "median wall (s)", "peak memory (MiB)",
                   "load before runs", "load after", "compared with Cycles", "rel. RMSE 4×4, noise removed",
                   "mean ours/Cycles"], out)
 

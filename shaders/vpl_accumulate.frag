@@ -11,8 +11,8 @@
 // - LAYERS: the S×S supersample count as a constant (1: no layer loop). Invalid texels never run: the
 //   pass is depth-tested against the page's validity mask (gl_backend.cpp).
 // - The VPLs come from a buffer texture and the per-bake constants are compiled in (see below).
-// Measured and dropped: unrolling the batch (constant VPL indices from a uniform block: 2× slower), a
-// cube-map-array sampler doing the face selection (no faster).
+// The batch loop is not unrolled (constant VPL indices from a uniform block) and the face is chosen by hand,
+// not by a cube-map-array sampler: on llvmpipe neither alternative is cheaper.
 layout(binding = BAKE_UNIT_POSITION_WEIGHT) uniform sampler2DArray gPositionWeight;  // xyz world position, w coverage weight
 layout(binding = BAKE_UNIT_NORMAL) uniform sampler2DArray gNormal;          // xyz unit shading normal
 layout(binding = BAKE_UNIT_GEOMETRIC_NORMAL) uniform sampler2DArray gGeomNormal;      // xyz unit normal of the sample's triangle

@@ -17,7 +17,7 @@ struct ParamOptions {
   double stretchHigh = 1.12;    // ... and p95 ≤ this
   double minAreaRatio = 1e-3;   // a face whose relative UV area is below this counts as zero-area
   double arapHopeless = 10.0;   // skip ARAP when the conformal map's p95/p5 area ratio exceeds this (it will be split)
-  double maxAbsCurvature = 60.0;  // radians of Σ|angle deficit|; above it a chart is split unsolved (bunny: none above 53 passed)
+  double maxAbsCurvature = 60.0;  // radians of Σ|angle deficit|; above it a chart is split unsolved (so curved a chart seldom flattens validly)
   int arapIterations = 5;       // as-rigid-as-possible rounds after LSCM (0: conformal only)
 };
 

@@ -1,9 +1,8 @@
 // A probe-lit object's light as a linear field over its extent: the probes blended at its centre c plus their
 // gradient, so that a surface point p takes c_k + (p − c)·∇c_k instead of the centre's SH alone. One blend for
-// the whole object misses how a near light changes across it: the Cornell box's ceiling light, 1.1 m from a
-// sphere of radius 0.1 m, meets the sphere's surface at other angles than its centre, and near the light's
-// terminator that is 17% of the direct light (docs/validation.md, "Probes against Cycles"). The gradient along each axis is the secant of the blends
-// at c ± r (r the object's bounding radius): exact for light that is linear across the object, and the grid's
+// the whole object misses how a near light changes across it: a ceiling light above a small sphere meets the
+// sphere's surface at other angles than its centre, which shows most near the light's terminator
+// (docs/validation.md, "Probes against Cycles"). The gradient along each axis is the secant of the blends at c ± r (r the object's bounding radius): exact for light that is linear across the object, and the grid's
 // own trilinear variation otherwise.
 #pragma once
 #include <algorithm>

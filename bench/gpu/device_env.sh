@@ -1,4 +1,4 @@
-# Sourced by device_run.sh and device_scenes.sh on the lent machine: the bundle's paths and bake().
+# Sourced by device_run.sh and device_scenes.sh on the GPU machine: the bundle's paths and bake().
 # R (the results folder) is set by the caller before sourcing.
 G=/tmp/g
 mkdir -p "$R"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run on a lent GPU machine after device_run.sh's set-up (bench/gpu/README.md): every stage's wall time of
+# Run on a GPU machine after device_run.sh's set-up (bench/gpu/README.md): every stage's wall time of
 # the default bake (Cornell, Sponza sun + sky, Sibenik sky + lamp) with the GL backend and with Embree, the
 # GPU memory peak of each bake (nvidia-smi sampled every 50 ms), and Sponza with more VPLs in place of the
 # final gather. Writes logs and every report.json into $OUT/gpu_profile_<label>.tar.gz.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run on a lent GPU machine (bench/gpu/README.md), after unpacking the bundle into /tmp/g and the glvnd
+# Run on a GPU machine (bench/gpu/README.md), after unpacking the bundle into /tmp/g and the glvnd
 # packages into /: the GL backend on the GPU against Embree on the same machine's CPUs, same VPLs.
 # Writes logs and every report.json into $OUT/gpu_results.tar.gz.
 set -uo pipefail

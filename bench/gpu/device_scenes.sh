@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run on a lent GPU machine after device_run.sh's set-up (bench/gpu/README.md): GL against Embree on scenes
+# Run on a GPU machine after device_run.sh's set-up (bench/gpu/README.md): GL against Embree on scenes
 # of other sizes and at other CPU counts, to place --backend auto's rule on a hardware renderer.
 # Writes logs and every report.json into $OUT/gpu_scenes.tar.gz.
 set -uo pipefail

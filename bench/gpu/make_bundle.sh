@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Packs what a lent GPU machine needs to bake (bench/gpu/README.md): irbake and the GL test binaries from a
-# Release build, the libraries they link that a bare CUDA image lacks, the minimal image plugin (no
+# Packs what a GPU machine needs to bake (bench/gpu/README.md): irbake and the GL test binaries from a
+# Release build, the libraries they link (a GPU machine need not have them), the minimal image plugin (no
 # OpenImageIO there) and the third-party scenes from ../shared. Writes .gpu/bundle.tar.xz (ignored).
 #   bash bench/gpu/make_bundle.sh [BUILD]
 set -euo pipefail

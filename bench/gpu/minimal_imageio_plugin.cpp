@@ -1,5 +1,5 @@
-// A stand-in for libirbake_imageio_oiio.so on machines without OpenImageIO (a lent GPU node: OpenImageIO
-// and its ~260 libraries are 355 MB, far over what travels there). Bench use only, built by
+// A stand-in for libirbake_imageio_oiio.so on machines without OpenImageIO (a GPU machine that gets only the
+// bundle: OpenImageIO and its libraries are far larger than the rest of it). Bench use only, built by
 // bench/gpu/make_bundle.sh; the project's plugin stays the OpenImageIO one.
 //   decode: PNG, JPEG (8-bit) and Radiance HDR through Debian's libstb (stb_image), declared below since
 //           Debian ships the library without headers;

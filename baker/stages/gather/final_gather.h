@@ -41,8 +41,8 @@ struct FinalGatherOptions {
   uint32_t seed = 0;           // rotates the per-sample ray lattices
   int preRays = 2;             // a first, cheaper gather (these rays per sample, preFilterRadius) whose map the
                                // final pass reads instead of M: the walk's blotches averaged once more before the
-                               // final rays see them, which lowers the error against Cycles for a few
-                               // seconds of rays. 0: off
+                               // final rays see them, which lowers the error against Cycles for few rays
+                               // more. 0: off
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
 };
 

@@ -1,6 +1,6 @@
 // Emitters the probes leave to the clients' exact shading (lightmap/probe_emitters.h; docs/units.md, "Irradiance
-// probes"): a small emitter near an object varies over its surface faster than L2 follows (the Cornell box's
-// ceiling light: the sphere's worst quarter 11–32% off Cycles through the SH). The rule: an emissive primitive
+// probes"): a small emitter near an object varies over its surface faster than L2 follows (a ceiling light
+// close above an object: through the SH its near side reads too dark and its far side too bright). The rule: an emissive primitive
 // whose emission is uniform (no emissive texture) and that is planar (every vertex within 0.1% of its extent of
 // one plane, every triangle facing the same side) or small (its bounds' diagonal at most half a probe spacing),
 // brightest by power first, while the kept triangles total at most `maxTriangles`.

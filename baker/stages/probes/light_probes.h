@@ -40,8 +40,8 @@ struct ProbeOptions {
   std::optional<float> spacing;       // metres; unset: automatic (chooseProbeSpacing)
   double autoProbes = 1024;           // about this many probes at the automatic spacing, whatever the scale
   double autoProbesSun = 2048;        // with a directional light: its shadows are sharp and cross the whole
-                                      // scene, and a blend of probes 2 m apart smears them (docs/validation.md,
-                                      // "Probes against Cycles": Sponza's sunlit court read 0.86 of Cycles)
+                                      // scene, and a blend of probes metres apart smears them (docs/validation.md,
+                                      // "Probes against Cycles")
   std::optional<Bounds3> box;         // the volume the grid fills; unset: the scene's bounds
   int rays = 256;                     // lattice rays per probe (relative noise of a constant sky ≈ 1.28/√rays
                                       // for independent rays, far less on the lattice): with the volume fit, a
@@ -50,23 +50,23 @@ struct ProbeOptions {
   float maxBackFaceShare = 0.5f;      // above this share of back-face hits (double-sided surfaces have none) a
                                       // probe is inside geometry: "mostly back faces". A quarter, the share a
                                       // probe beside a wall of two coincident opposite quads meets (makeThinWall:
-                                      // the ray finds either), lost 104 of its 1024 valid lit-side probes
+                                      // the ray finds either), would drop valid probes on the lit side
   size_t maxProbes = 1u << 20;        // a grid with more probes is refused (Error Usage: a spacing too small)
   size_t budget = 16384;              // a grid with more probes is refused before the bake unless this is raised
-                                      // (--probe-budget): 8 times the automatic count with a sun, about 26 s at
-                                      // Sponza's 1.6 ms a probe on 2 cores, half its 48 s bake (docs/validation.md,
-                                      // "Irradiance probes"); --probes 0.01 over a 1 m box asked for an hour
+                                      // (--probe-budget): 8 times the automatic count with a sun, so a spacing
+                                      // typed too small (--probes 0.01 over a level) is refused at once instead
+                                      // of costing more than the bake (docs/validation.md, "Irradiance probes")
   int emitterSamples = 128;           // shadow rays per probe to the emissive triangles (0: the lattice alone)
   uint32_t seed = 0;                  // turns each probe's lattice and emitter samples
   int lightFitSamples = 4;            // S: the punctual lights' visibility fitted over S³ points per probe
                                       // (light_visibility_fit.h); 0: each probe's own shadow ray
   int volumeFitSamples = 4;           // S: the rest of the light fitted over S³ points per probe (blend_fit.h);
-                                      // 0: each probe's own rays. A blend of point probes 1.64 m apart misses
-                                      // the light between Sponza's gallery piers (docs/validation.md, "Probes
-                                      // against Cycles")
+                                      // 0: each probe's own rays. A blend of point probes a spacing apart misses
+                                      // light that changes within a cell, such as between a gallery's piers
+                                      // (docs/validation.md, "Probes against Cycles")
   int volumeFitRays = 128;            // lattice rays per volume-fit point (emitter shadow rays in proportion):
-                                      // more points with fewer rays each steady the gallery over seeds (4³ × 128
-                                      // against 3³ × 256; docs/validation.md, "Probes against Cycles")
+                                      // more points with fewer rays each vary less over seeds than fewer points
+                                      // with more rays (docs/validation.md, "Probes against Cycles")
   double volumeFitAnchor = 1.0;       // λ: the weight of each probe's own SH among its cube's samples
   float volumeFitClearance = 0.5f;    // a point is fitted only where an object's centre can be: at least this
                                       // many spacings from every surface
@@ -102,8 +102,8 @@ struct ProbeStats {
 
 // The automatic spacing: about `probes` probes over the volume (autoProbeCount), cbrt(V / probes) with each side
 // of V held to at least 1/16 of the longest (a flat scene keeps two layers), never below 1 cm. A fixed count
-// follows the scene's scale and keeps the cost small beside the bake: the longest side / 16 gave a cube 4096
-// probes, 21% of a DamagedHelmet bake's time.
+// follows the scene's scale and keeps the cost small beside the bake: the longest side / 16 gives a cube 16³ =
+// 4096 probes, a large share of a small model's bake.
 float chooseProbeSpacing(const Bounds3& volume, double probes);
 
 // The automatic count: ProbeOptions::autoProbes, or autoProbesSun when the scene has a directional light.

@@ -1,7 +1,7 @@
 // The sun's visibility on a finer lattice where its shadow crosses the probe grid (lightmap/probe_grid.h,
 // ProbeSunLevel). A directional light's shadow edge is sharp, and a blend of probes a spacing apart smears it
-// over the whole cell even after the visibility fit (light_visibility_fit.h): Sponza's sunlit court read 0.86
-// of the sun. Here the light's visibility is traced at every point of a lattice S times finer than the grid
+// over the whole cell even after the visibility fit (light_visibility_fit.h), so a sunlit floor beside a
+// shadow reads darker than the sun it gets. Here the light's visibility is traced at every point of a lattice S times finer than the grid
 // (one shadow ray each, shared by neighbouring cells), and a cell is refined where that lattice differs from
 // the blend of the probes' fitted visibilities by more than a tolerance at some point; the clients then replace
 // the blend's sun by the lattice's there. Point visibility is binary (see-through surfaces: lit when at least
