@@ -109,11 +109,15 @@ std::vector<Case> cases(const Fixture& f) {
   const std::string folderJson = (f.root / "folder.json").string();
   const std::string fresh = (f.root / "fresh").string(), freshGlb = (f.root / "fresh.glb").string();
   std::vector<Case> out;
-  auto bake = [&](std::string option, std::string target, std::vector<std::string> extra, std::string named) {
-    std::vector<std::string> args = {"bake", box, "--quality", "preview", "--probes", "off"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    out.push_back({"bake", option, target, args, named});
+  // The cases of one command: its leading arguments, then each case's option, target, arguments and name.
+  auto command = [&out](std::string name, std::vector<std::string> lead) {
+    return [&out, name, lead](std::string option, std::string target, std::vector<std::string> extra, std::string named) {
+      std::vector<std::string> args = lead;
+      args.insert(args.end(), extra.begin(), extra.end());
+      out.push_back({name, option, target, args, named});
+    };
   };
+  auto bake = command("bake", {"bake", box, "--quality", "preview", "--probes", "off"});
   bake("-o", "input", {"-o", box}, box);
   bake("-o", "other output", {"-o", (f.root / "x.glb").string(), "--report", (f.root / "x.glb").string()}, "x.glb");
   bake("-o", "/proc", {"-o", procGlb}, procGlb);
@@ -131,11 +135,7 @@ std::vector<Case> cases(const Fixture& f) {
   bake("--dump-config", "a page", {"-o", baked, "--dump-config", page}, page);
   bake("--dump-config", "folder", {"-o", fresh, "--dump-config", folderJson}, folderJson);
   bake("--dump-config", "/proc", {"-o", fresh, "--dump-config", proc}, proc);
-  auto merge = [&](std::string option, std::string target, std::vector<std::string> extra, std::string named) {
-    std::vector<std::string> args = {"merge", f.shards.string()};
-    args.insert(args.end(), extra.begin(), extra.end());
-    out.push_back({"merge", option, target, args, named});
-  };
+  auto merge = command("merge", {"merge", f.shards.string()});
   merge("-o", "input", {"-o", box}, box);
   merge("-o", "a partial", {"-o", f.shards.string(), "--report", partial}, partial);
   merge("-o", "/proc", {"-o", procGlb}, procGlb);
@@ -148,11 +148,7 @@ std::vector<Case> cases(const Fixture& f) {
   merge("--portable", "folder", {"-o", fresh, "--portable", folderGlb}, folderGlb);
   merge("--portable", "/proc", {"-o", fresh, "--portable", procGlb}, procGlb);
   const std::string u = (f.unwrapped / "u.gltf").string();
-  auto unwrap = [&](std::string option, std::string target, std::vector<std::string> extra, std::string named) {
-    std::vector<std::string> args = {"unwrap", box};
-    args.insert(args.end(), extra.begin(), extra.end());
-    out.push_back({"unwrap", option, target, args, named});
-  };
+  auto unwrap = command("unwrap", {"unwrap", box});
   unwrap("-o", "input", {"-o", box}, box);
   unwrap("-o", "other output", {"-o", u, "--report", u}, u);
   unwrap("-o", "folder", {"-o", folderGlb}, folderGlb);
@@ -165,20 +161,16 @@ std::vector<Case> cases(const Fixture& f) {
   out.push_back({"samples", "OUTDIR", "a file", {"samples", box}, box});
   out.push_back({"samples", "OUTDIR", "/proc", {"samples", "/proc/irbake"}, "/proc/irbake"});
 #ifdef IRVIEW_EXE
-  const std::string scene = (f.baked / "scene.gltf").string();
-  auto view = [&](std::string option, std::string target, std::vector<std::string> extra, std::string named) {
-    std::vector<std::string> args = {option == "--walkthrough" ? (f.frames / "scene.gltf").string() : scene, "--width", "16", "--height", "16"};
-    args.insert(args.end(), extra.begin(), extra.end());
-    out.push_back({"irview", option, target, args, named});
-  };
+  auto view = command("irview", {(f.baked / "scene.gltf").string(), "--width", "16", "--height", "16"});
+  auto walk = command("irview", {(f.frames / "scene.gltf").string(), "--width", "16", "--height", "16"});
   view("--screenshot", "input page (PNG)", {"--screenshot", (f.baked / "lightmap_0.png").string()}, "lightmap_0.png");
   view("--screenshot", "input page (EXR)", {"--screenshot", page}, page);
   view("--screenshot", "folder", {"--screenshot", folderPng}, folderPng);
   view("--screenshot", "/proc", {"--screenshot", procPng}, procPng);
-  view("--walkthrough", "input (frame 1)", {"--walkthrough", "2", "--screenshot", (f.frames / "walk.png").string()}, "walk_0001.png");
-  view("--walkthrough", "folder (frame 0)", {"--walkthrough", "2", "--screenshot", (f.root / "folder.png").string()},
+  walk("--walkthrough", "input (frame 1)", {"--walkthrough", "2", "--screenshot", (f.frames / "walk.png").string()}, "walk_0001.png");
+  walk("--walkthrough", "folder (frame 0)", {"--walkthrough", "2", "--screenshot", (f.root / "folder.png").string()},
        "folder_0000.png");
-  view("--walkthrough", "/proc", {"--walkthrough", "2", "--screenshot", procPng}, "/proc/irbake_0000.png");
+  walk("--walkthrough", "/proc", {"--walkthrough", "2", "--screenshot", procPng}, "/proc/irbake_0000.png");
 #endif
   return out;
 }

@@ -7,13 +7,8 @@
 # Blender or its numpy.
 # Usage (from ctest): blender_test.sh IRBAKE IRVIEW WORK_DIR
 set -euo pipefail
-irbake="$1" irview="$2" work="$3"
 here="$(cd "$(dirname "$0")" && pwd)"
-skip() { echo "SKIPPED: $*"; exit 77; }
-command -v blender >/dev/null 2>&1 || skip "blender not found (scripts/install-deps.sh installs Debian blender)"
-blender --background --factory-startup --python-expr "import numpy" >/dev/null 2>&1 \
-  || skip "Blender's Python cannot import numpy, which its glTF importer needs (Debian python3-numpy)"
-rm -rf "$work" && mkdir -p "$work"
+source "$here/blender_tests_common.sh"
 "$irbake" samples "$work/samples" --quiet > "$work/samples.log"
 # The textured plane has no camera: one 2 m above it, looking straight down (-90° about x).
 python3 - "$work/samples/textured_plane.gltf" "$work/samples/textured_plane_camera.gltf" <<'PY'

@@ -6,13 +6,8 @@
 # UVMap.001) and one without intensity at intensity 1 (wiring_check.py). Skips (77) without Blender or its numpy.
 # Usage (from ctest): refusals_test.sh IRBAKE IRVIEW WORK_DIR
 set -euo pipefail
-irbake="$1" irview="$2" work="$3"
 here="$(cd "$(dirname "$0")" && pwd)"
-skip() { echo "SKIPPED: $*"; exit 77; }
-command -v blender >/dev/null 2>&1 || skip "blender not found (scripts/install-deps.sh installs Debian blender)"
-blender --background --factory-startup --python-expr "import numpy" >/dev/null 2>&1 \
-  || skip "Blender's Python cannot import numpy, which its glTF importer needs (Debian python3-numpy)"
-rm -rf "$work" && mkdir -p "$work"
+source "$here/blender_tests_common.sh"
 "$irbake" samples "$work/samples" --quiet > "$work/samples.log"
 "$irbake" bake "$work/samples/cornell_box.gltf" -o "$work/bake" --vpls 64 --texels-per-unit 20 --probes off --quiet \
   > "$work/bake.log" 2>&1
