@@ -4,9 +4,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
+#include "common/error.h"
 #include "export/map_encoding.h"
 #include "scene/image_codec.h"
 
@@ -240,4 +243,24 @@ TEST(MapEncoding, FromStoredIsDecodeAfterTheUnpacking) {
   EXPECT_EQ(f.map.texels[0], glm::vec3(-1.5f, 0.0f, 7.25f));
   EXPECT_EQ(f.map.texels[1], glm::vec3(1e-8f, 3.0f, 0.0f));
   EXPECT_EQ(f.alpha, (std::vector<float>{0.5f, 1.0f}));
+}
+
+// The file path every encoding shares: writeFile writes encode()'s bytes, readFile decodes them back.
+TEST(MapEncoding, Png8FileIsTheEncodedBytes) {
+  const Lightmap m = ramp(3.7f, false);
+  MapEncodeOptions o;
+  o.percentile = 100.0;
+  const EncodedMap e = png8().encode(m, o);
+  const std::filesystem::path file = "map_encoding_png8_ramp.png";
+  png8().writeFile(m, o, file, file);
+  std::ifstream in(file, std::ios::binary);
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  EXPECT_EQ(bytes, e.bytes);
+  const DecodedMap back = png8().readFile(file, e.metadata);
+  std::filesystem::remove(file);
+  const DecodedMap direct = png8().decode(e.bytes.data(), e.bytes.size(), e.metadata, "ramp");
+  ASSERT_EQ(back.map.texels.size(), direct.map.texels.size());
+  for (size_t i = 0; i < direct.map.texels.size(); ++i) EXPECT_EQ(back.map.texels[i], direct.map.texels[i]) << i;
+  EXPECT_THROW(png8().readFile("map_encoding_no_such_file.png", e.metadata), Error);
 }
