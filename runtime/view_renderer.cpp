@@ -11,6 +11,7 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "export/map_encoding.h"
 #include "mixed_lights.h"
 #include "screenshot.h"
 #include "glcontext/gl_program.h"
@@ -304,16 +305,18 @@ struct ViewRenderer::Impl {
     return colorTextures[index] = uploadColorTexture(t);
   }
 
-  // An IRBAKE_lightmap_directional PNG as values, (2·texel − 1)·scale (docs/export.md), decoded once per
-  // (texture, scale): the shader then reads float pages and PNGs alike, and bilinear filtering commutes with
-  // the affine decode.
+  // An IRBAKE_lightmap_directional PNG as values, (2·texel − 1)·scale (docs/export.md: png8, signed), decoded
+  // once per (texture, scale): the shader then reads float pages and PNGs alike, and bilinear filtering
+  // commutes with the affine decode.
   GLuint directionalPng(int index, float scale) {
     auto it = directionalPngs.find({index, scale});
     if (it != directionalPngs.end()) return it->second;
     const Texture& t = scene.textures.at(index);
-    std::vector<glm::vec4> values(t.texels.size());
-    for (size_t i = 0; i < values.size(); ++i) values[i] = glm::vec4((2.0f * glm::vec3(t.texels[i]) - 1.0f) * scale, 1.0f);
-    return directionalPngs[{index, scale}] = uploadLightmap(t.width, t.height, GL_RGBA, values.data());
+    MapMetadata md;
+    md.intensity = scale;
+    md.signedValues = true;
+    const DecodedMap d = mapEncoding(MapEncodingKind::Png8).fromStored(t, md);
+    return directionalPngs[{index, scale}] = uploadLightmap(t.width, t.height, GL_RGB, d.map.texels.data());
   }
 
   void ensureFramebuffer(int w, int h) {
@@ -390,6 +393,8 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
         break;
       }
       case LightmapSource::MaterialTexture: {
+        // MOZ_lightmap's png8 decode split in two: the loader applied the transfer curve, the shader multiplies
+        // by the intensity, so the half-float texture holds [0, 1] whatever the intensity.
         const Texture& t = v.scene.textures[m.lightmapTexture];
         auto it = I.textureLightmaps.find(m.lightmapTexture);
         if (it == I.textureLightmaps.end())

@@ -9,7 +9,7 @@
 
 #include "common/error.h"
 #include "common/log.h"
-#include "export/exr_io.h"
+#include "export/map_encoding.h"
 #include "scene/gltf_loader.h"
 #include "scene/gltf_source.h"
 #include "scene/scene_files.h"
@@ -124,9 +124,10 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
   std::vector<Lightmap> pages;
   std::vector<std::string> warnings;
   // The float pages carry the full range; if one cannot be read the PNG × intensity still shows.
+  const MapEncoding& exr = mapEncoding(MapEncodingKind::Exr);
   for (size_t i = 0; i < scene.lightmapExrPaths.size(); ++i) {
     try {
-      Lightmap m = readExr(scene.lightmapExrPaths[i]);
+      Lightmap m = exr.readFile(scene.lightmapExrPaths[i], {}).map;
       m.page = static_cast<int>(i);
       pages.push_back(std::move(m));
     } catch (const Error& e) {
@@ -146,7 +147,7 @@ ViewerScene loadViewerScene(const std::filesystem::path& path) {
     for (const auto& [page, m] : materialOfPage)
       for (int k = 0; k < 3; ++k) {
         if (directional[k].size() <= static_cast<size_t>(page)) directional[k].resize(page + 1);
-        directional[k][page] = readExr(m->directionalExrPaths[k]);
+        directional[k][page] = exr.readFile(m->directionalExrPaths[k], {}).map;
         directional[k][page].page = page;
       }
   } catch (const Error& e) {

@@ -1,31 +1,15 @@
 #include "export/directional_export.h"
 
-#include <algorithm>
-#include <cmath>
 #include <map>
-
-#include "scene/image_codec.h"
 
 namespace irbake {
 
-DirectionalPng encodeDirectionalPng(const Lightmap& page, const std::string& name) {
-  DirectionalPng p;
-  float largest = 0.0f;
-  for (size_t i = 0; i < page.texels.size(); ++i) {
-    if (i < page.valid.size() && !page.valid[i]) continue;
-    const glm::vec3 a = glm::abs(page.texels[i]);
-    largest = std::max(largest, std::max(a.x, std::max(a.y, a.z)));
-  }
-  p.scale = largest > 0.0f && std::isfinite(largest) ? largest : 1.0f;
-  p.texture.name = name;
-  p.texture.width = page.width;
-  p.texture.height = page.height;
-  p.texture.wrapS = p.texture.wrapT = WrapMode::ClampToEdge;
-  p.texture.texels.resize(page.texels.size());
-  for (size_t i = 0; i < page.texels.size(); ++i)
-    p.texture.texels[i] = glm::vec4(glm::clamp((page.texels[i] / p.scale + 1.0f) * 0.5f, 0.0f, 1.0f), 1.0f);
-  p.png = encodePng(p.texture, false);
-  return p;
+MapEncodeOptions directionalEncoding(const std::string& name) {
+  MapEncodeOptions o;
+  o.srgb = false;
+  o.range = MapRange::SignedMax;
+  o.name = name;
+  return o;
 }
 
 std::string directionalPageUri(const std::string& prefix, int page, int axis) {
@@ -61,10 +45,11 @@ void addDirectionalExtension(GltfDocument& doc, const std::array<std::vector<Lig
     json ext = {{"l1", json::array()}};
     for (int k = 0; k < 3; ++k) {
       const std::string name = "lightmap_" + std::to_string(page) + "_l1" + "xyz"[k];
-      const DirectionalPng png = encodeDirectionalPng(l1[k][index], name);
-      const int image = doc.addPngImage(png.png, name);
+      const MapEncoding& png8 = mapEncoding(MapEncodingKind::Png8);
+      const EncodedMap encoded = png8.encode(l1[k][index], directionalEncoding(name));
+      const int image = doc.addImage(encoded.bytes, name, png8.mimeType());
       const int texture = doc.addTexture(image, doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
-      ext["l1"].push_back({{"index", texture}, {"texCoord", 1}, {"scale", png.scale}});
+      ext["l1"].push_back({{"index", texture}, {"texCoord", 1}, {"scale", encoded.metadata.intensity}});
     }
     if (!exrPrefix.empty()) {
       ext["exr"] = json::array();

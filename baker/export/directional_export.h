@@ -8,20 +8,17 @@
 
 #include "lightmap/lightmap.h"
 #include "export/gltf_writer.h"
+#include "export/map_encoding.h"
 #include "scene/scene.h"
 
 namespace irbake {
 
 constexpr const char* kDirectionalExtension = "IRBAKE_lightmap_directional";
 
-// The 8-bit PNG of one L1 page: value = (2 · decode(PNG) − 1) · scale, decode linear (no sRGB curve),
-// scale = the page's largest |value| over its valid texels (1 when all are 0), so 0 codes as 128/255 ≈ 0.502.
-struct DirectionalPng {
-  Texture texture;           // (value / scale + 1) / 2 in [0, 1]
-  float scale = 1.0f;        // the decode's scale
-  std::vector<uint8_t> png;  // the encoded file
-};
-DirectionalPng encodeDirectionalPng(const Lightmap& page, const std::string& name);
+// The 8-bit image of one L1 page: png8 with MapRange::SignedMax, linear (export/map_encoding.h):
+// value = (2 · decode(PNG) − 1) · scale, scale = the page's largest |value| over its valid texels (1 when
+// all are 0), so 0 codes as 128/255 ≈ 0.502.
+MapEncodeOptions directionalEncoding(const std::string& name);
 
 // EXR file name of axis k (0 x, 1 y, 2 z) of a page: <prefix>_<page>_l1<x|y|z>.exr.
 std::string directionalPageUri(const std::string& prefix, int page, int axis);

@@ -1,4 +1,4 @@
-// Float EXR pages through OpenImageIO (RGB half or float, linear), written atomically.
+// Float EXR pages (the exr map encoding, export/map_encoding.h): RGB float, linear, written atomically.
 #pragma once
 #include <filesystem>
 

@@ -86,8 +86,8 @@ TEST(GltfCompact, DropsWhatNothingUsesAndRenumbersTheRest) {
   const int times = doc.addVec2({{0, 1}});                        // accessor 3: an animation's
   const int target = doc.addVec3({{0, 0, 1}, {0, 0, 1}, {0, 0, 1}});  // accessor 4: a morph target's
   const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
-  const int unusedImage = doc.addPngImage(std::vector<uint8_t>(png, png + 8), "orphan");
-  const int usedImage = doc.addPngImage(std::vector<uint8_t>(png, png + 8), "used");
+  const int unusedImage = doc.addImage(std::vector<uint8_t>(png, png + 8), "orphan");
+  const int usedImage = doc.addImage(std::vector<uint8_t>(png, png + 8), "used");
   doc.addTexture(unusedImage, doc.addSampler(WrapMode::Repeat, WrapMode::Repeat, false));  // texture 0: no material
   const int tex = doc.addTexture(usedImage, doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
   doc.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", tex}}}}}});
@@ -136,11 +136,11 @@ TEST(GltfCompact, ExternalizedImagesGetUniqueNamesWhateverTheirCase) {
   GltfDocument doc;
   const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
   for (int i = 0; i < 5; ++i) {
-    const int image = doc.addPngImage(std::vector<uint8_t>(png, png + 8), "");
+    const int image = doc.addImage(std::vector<uint8_t>(png, png + 8), "");
     doc.root["images"][image][kSourceUriKey] = "folder" + std::to_string(i) + "/tex.png";
   }
-  doc.addPngImage(std::vector<uint8_t>(png, png + 8), "Tex");
-  doc.addPngImage(std::vector<uint8_t>(png, png + 8), "");
+  doc.addImage(std::vector<uint8_t>(png, png + 8), "Tex");
+  doc.addImage(std::vector<uint8_t>(png, png + 8), "");
   const auto files = externalizeImages(doc, {"baked.gltf", "TEX_2.png"});
   std::vector<std::string> names;
   for (const auto& [name, bytes] : files) {

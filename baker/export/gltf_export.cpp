@@ -24,11 +24,10 @@
 #include "common/error.h"
 #include "common/file_paths.h"
 #include "common/log.h"
-#include "export/exr_io.h"
 #include "export/gltf_compact.h"
 #include "export/directional_export.h"
 #include "export/light_probes_export.h"
-#include "export/lightmap_png.h"
+#include "export/map_encoding.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
@@ -168,6 +167,9 @@ GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t 
 
 namespace {
 
+// The encoding of the MOZ_lightmap image (the float pages beside it are MapEncodingKind::Exr).
+constexpr MapEncodingKind kLightmapImageEncoding = MapEncodingKind::Png8;
+
 std::string pageUri(const ExportOptions& options, int page) { return options.exrPrefix + "_" + std::to_string(page) + ".exr"; }
 
 // The light-map record of one output primitive (extras.lightmap), kept beside the source extras.
@@ -179,9 +181,9 @@ void setLightmapRecord(json& prim, const LightmapRef& ref) {
 
 // MOZ_lightmap of one page: the texture, TEXCOORD_1, the intensity, and our documented extra saying the
 // PNG is sRGB-encoded (docs/export.md).
-json mozLightmap(int texture, const LightmapPng& png) {
-  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", png.intensity}};
-  if (png.srgb) moz["extras"] = {{"colorSpace", "srgb"}};
+json mozLightmap(int texture, const EncodedMap& image) {
+  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", image.metadata.intensity}};
+  if (image.metadata.srgb) moz["extras"] = {{"colorSpace", "srgb"}};
   return moz;
 }
 
@@ -201,19 +203,19 @@ bool readsTexcoord1(const json& j) {
 // About what SourceExport appends to buffer 0: per vertex the gathered source attributes (96 bytes
 // covers position, normal, tangent, two UV sets and a colour) and TEXCOORD_1, per corner an index,
 // and the light-map PNGs. Only a reservation: more just grows the buffer.
-size_t appendedBytes(const Scene& scene, const std::vector<LightmapPng>& pngs) {
+size_t appendedBytes(const Scene& scene, const std::vector<EncodedMap>& images) {
   size_t bytes = 0;
   for (const Primitive& p : scene.primitives) bytes += p.positions.size() * (96 + 8) + p.indices.size() * 4 + 64;
-  for (const LightmapPng& png : pngs) bytes += png.png.size() + 4;
+  for (const EncodedMap& image : images) bytes += image.bytes.size() + 4;
   return bytes;
 }
 
 // The source document with only the light-map data added (see the file comment).
 class SourceExport {
  public:
-  SourceExport(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<LightmapPng>& pngs, const std::string& file)
-      : scene_(scene), pngs_(pngs), file_(file), doc_(documentFromSource(scene.sourcePath, appendedBytes(scene, pngs))) {
-    for (size_t i = 0; i < maps.size(); ++i) pngOfPage_[maps[i].page] = i;
+  SourceExport(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<EncodedMap>& images, const std::string& file)
+      : scene_(scene), images_(images), file_(file), doc_(documentFromSource(scene.sourcePath, appendedBytes(scene, images))) {
+    for (size_t i = 0; i < maps.size(); ++i) imageOfPage_[maps[i].page] = i;
     sourceMaterials_ = doc_.root.value("materials", json::array());
     sourceMeshes_ = doc_.root.value("meshes", json::array());
   }
@@ -243,7 +245,7 @@ class SourceExport {
         nodes[node]["mesh"] = doc_.append("meshes", std::move(rewritten));
       }
     }
-    if (!pngs_.empty()) doc_.useExtension("MOZ_lightmap");
+    if (!images_.empty()) doc_.useExtension("MOZ_lightmap");
     repairEmissiveFactors();
     compactDocument(doc_);
     const std::string generator = doc_.root["asset"].value("generator", std::string("unknown"));
@@ -358,7 +360,7 @@ class SourceExport {
     return accessorCache_.emplace(index, readAccessor(doc_, index, file_)).first->second;
   }
 
-  int pageWithMap(const Primitive& p) const { return pngOfPage_.count(p.lightmap.page) ? p.lightmap.page : -1; }
+  int pageWithMap(const Primitive& p) const { return imageOfPage_.count(p.lightmap.page) ? p.lightmap.page : -1; }
 
   // Material of a part: its source material with MOZ_lightmap for the part's page. The first page a
   // source material meets is written into it in place (same index, same name); further pages get a
@@ -374,7 +376,7 @@ class SourceExport {
     json mat = source >= 0 ? sourceMaterials_[source] : json::object({{"name", "default"}});
     if (page >= 0) {
       if (!mat.contains("extensions") || !mat["extensions"].is_object()) mat["extensions"] = json::object();
-      mat["extensions"]["MOZ_lightmap"] = mozLightmap(lightmapTexture(page), pngs_[pngOfPage_.at(page)]);
+      mat["extensions"]["MOZ_lightmap"] = mozLightmap(lightmapTexture(page), images_[imageOfPage_.at(page)]);
     }
     int index;
     if (source >= 0 && sourceMaterialsTaken_.insert(source).second) {
@@ -390,18 +392,18 @@ class SourceExport {
   int lightmapTexture(int page) {
     auto it = pageTexture_.find(page);
     if (it != pageTexture_.end()) return it->second;
-    const LightmapPng& png = pngs_[pngOfPage_.at(page)];
-    const int image = doc_.addPngImage(png.png, png.texture.name);
+    const EncodedMap& encoded = images_[imageOfPage_.at(page)];
+    const int image = doc_.addImage(encoded.bytes, encoded.stored.name, mapEncoding(kLightmapImageEncoding).mimeType());
     const int tex = doc_.addTexture(image, doc_.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
     return pageTexture_[page] = tex;
   }
 
   const Scene& scene_;
-  const std::vector<LightmapPng>& pngs_;
+  const std::vector<EncodedMap>& images_;
   const std::string file_;
   GltfDocument doc_;
   json sourceMaterials_, sourceMeshes_;
-  std::map<int, size_t> pngOfPage_;
+  std::map<int, size_t> imageOfPage_;
   std::map<int, AccessorBytes> accessorCache_;
   std::map<std::pair<int, int>, int> materialFor_;
   std::set<int> sourceMaterialsTaken_;
@@ -411,17 +413,16 @@ class SourceExport {
 };
 
 // Generated scene (no source document): our writer from a copy whose materials carry the light maps.
-GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<LightmapPng>& pngs,
+GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& maps, const std::vector<EncodedMap>& images,
                                const std::vector<std::string>& pageUris) {
-  std::map<int, size_t> pngOfPage;
-  for (size_t i = 0; i < maps.size(); ++i) pngOfPage[maps[i].page] = i;
+  std::map<int, size_t> imageOfPage;
+  for (size_t i = 0; i < maps.size(); ++i) imageOfPage[maps[i].page] = i;
   Scene copy = scene;
   copy.materials.clear();
   std::map<std::pair<int, int>, int> materialFor;
   std::map<int, int> pageTexture;
-  std::vector<const LightmapPng*> pngOfTexture;  // scene texture → its light-map PNG (nullptr: none)
   for (auto& prim : copy.primitives) {
-    const int page = pngOfPage.count(prim.lightmap.page) ? prim.lightmap.page : -1;
+    const int page = imageOfPage.count(prim.lightmap.page) ? prim.lightmap.page : -1;
     auto key = std::make_pair(prim.material, page);
     if (!materialFor.count(key)) {
       Material m = scene.materials.at(prim.material);
@@ -429,10 +430,10 @@ GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& 
       if (page >= 0) {
         if (!pageTexture.count(page)) {
           pageTexture[page] = static_cast<int>(copy.textures.size());
-          copy.textures.push_back(pngs[pngOfPage.at(page)].texture);
+          copy.textures.push_back(images[imageOfPage.at(page)].stored);
         }
         m.lightmapTexture = pageTexture[page];
-        m.lightmapIntensity = pngs[pngOfPage.at(page)].intensity;
+        m.lightmapIntensity = images[imageOfPage.at(page)].metadata.intensity;
         m.name += "_lightmap" + std::to_string(page);
       }
       materialFor[key] = static_cast<int>(copy.materials.size());
@@ -457,12 +458,12 @@ GltfDocument documentFromScene(const Scene& scene, const std::vector<Lightmap>& 
       if (m.lightmapTexture < 0) continue;
       json& moz = doc.root["materials"][i]["extensions"]["MOZ_lightmap"];
       const int tex = moz["index"].get<int>();
-      const LightmapPng& png = pngs[pngOfPage.at(pageOfTexture.at(m.lightmapTexture))];
+      const EncodedMap& encoded = images[imageOfPage.at(pageOfTexture.at(m.lightmapTexture))];
       if (lastMaterialOfTexture.at(m.lightmapTexture) == i) {
         const int image = doc.root["textures"][tex]["source"].get<int>();
-        doc.root["images"][image]["bufferView"] = doc.addBufferView(png.png.data(), png.png.size());
+        doc.root["images"][image]["bufferView"] = doc.addBufferView(encoded.bytes.data(), encoded.bytes.size());
       }
-      moz = mozLightmap(tex, png);
+      moz = mozLightmap(tex, encoded);
     }
   }
   compactDocument(doc);
@@ -484,14 +485,15 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   const std::string file = options.output.string();
   if (options.output.empty()) throw Error(ErrorCode::Usage, "", "export needs an output path");
   checkMaps(maps, file);
-  std::vector<LightmapPng> pngs;
-  for (const auto& m : maps) pngs.push_back(encodeLightmapPng(m, options.png));
+  const MapEncoding& encoding = mapEncoding(kLightmapImageEncoding);
+  std::vector<EncodedMap> images;
+  for (const auto& m : maps) images.push_back(encoding.encode(m, options.lightmapEncoding));
   std::vector<std::string> pageUris;
   if (options.writeExrPages)
     for (const auto& m : maps) pageUris.push_back(pageUri(options, m.page));
 
   const bool fromSource = !scene.sourcePath.empty() && std::filesystem::exists(scene.sourcePath);
-  GltfDocument doc = fromSource ? SourceExport(scene, maps, pngs, file).run() : documentFromScene(scene, maps, pngs, pageUris);
+  GltfDocument doc = fromSource ? SourceExport(scene, maps, images, file).run() : documentFromScene(scene, maps, images, pageUris);
   // glTF allows extras of any type: a source's non-object root extras is kept as it is, without our records.
   const bool rootExtrasIsObject = !doc.root.contains("extras") || doc.root["extras"].is_object();
   if (!rootExtrasIsObject && ((fromSource && !pageUris.empty()) || scene.environment.present()))
@@ -547,17 +549,18 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   std::vector<PendingFile> docFiles = doc.files(options.output);
   files.insert(files.begin(), docFiles.begin(), docFiles.end());
   if (options.writeExrPages) {
+    const MapEncoding* exr = &mapEncoding(MapEncodingKind::Exr);
     for (size_t i = 0; i < maps.size(); ++i) {
       const Lightmap* map = &maps[i];
       const std::filesystem::path finalPath = folder / pageUris[i];
-      files.push_back({finalPath, [map, finalPath](const std::filesystem::path& temp) { writeExrFile(*map, temp, finalPath); }});
+      files.push_back({finalPath, [exr, map, finalPath](const std::filesystem::path& temp) { exr->writeFile(*map, {}, temp, finalPath); }});
     }
     if (directional)
       for (int k = 0; k < 3; ++k)
         for (const Lightmap& m : (*options.directional)[k]) {
           const Lightmap* map = &m;
           const std::filesystem::path finalPath = folder / directionalPageUri(options.exrPrefix, m.page, k);
-          files.push_back({finalPath, [map, finalPath](const std::filesystem::path& temp) { writeExrFile(*map, temp, finalPath); }});
+          files.push_back({finalPath, [exr, map, finalPath](const std::filesystem::path& temp) { exr->writeFile(*map, {}, temp, finalPath); }});
         }
     for (size_t i = 0; masked && i < options.shadowMask->rgb->size(); ++i) {
       const ShadowMaskExport* mask = options.shadowMask;

@@ -14,7 +14,7 @@
 #include "common/atomic_file.h"
 #include "common/output_guard.h"
 #include "export/gltf_writer.h"
-#include "export/lightmap_png.h"
+#include "export/map_encoding.h"
 #include "export/shadow_mask_export.h"
 #include "scene/scene.h"
 
@@ -24,7 +24,7 @@ struct ExportOptions {
   std::filesystem::path output;       // .gltf (JSON + .bin beside) or .glb (one file), chosen by extension
   bool writeExrPages = true;          // float EXR pages beside the glTF, listed in root extras
   std::string exrPrefix = "lightmap"; // EXR names: <prefix>_<page>.exr
-  LightmapPngOptions png;             // the 8-bit MOZ_lightmap PNG's encoding (sRGB, range at a percentile)
+  MapEncodeOptions lightmapEncoding;  // the 8-bit MOZ_lightmap image's encoding (png8: sRGB, range at a percentile)
   std::vector<PendingFile> alsoWrite; // more files of the same all-or-nothing set (the bake's report)
   // Directional maps' L1 pages (x, y, z; export/directional_export.h), or null: no extension, no files.
   const std::array<std::vector<Lightmap>, 3>* directional = nullptr;

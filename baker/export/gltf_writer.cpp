@@ -117,9 +117,9 @@ int GltfDocument::addIndices(const std::vector<uint32_t>& v) {
   return append("accessors", {{"bufferView", view}, {"componentType", kUnsignedInt}, {"count", v.size()}, {"type", "SCALAR"}});
 }
 
-int GltfDocument::addPngImage(const std::vector<uint8_t>& png, const std::string& name) {
-  int view = addBufferView(png.data(), png.size());
-  json image = {{"bufferView", view}, {"mimeType", "image/png"}};
+int GltfDocument::addImage(const std::vector<uint8_t>& bytes, const std::string& name, const std::string& mimeType) {
+  int view = addBufferView(bytes.data(), bytes.size());
+  json image = {{"bufferView", view}, {"mimeType", mimeType}};
   if (!name.empty()) image["name"] = name;
   return append("images", std::move(image));
 }
@@ -199,7 +199,7 @@ json materialJson(const Scene& scene, const Material& m, GltfDocument& doc, std:
     auto it = cache.find(key);
     if (it != cache.end()) return it->second;
     const Texture& t = scene.textures.at(sceneTexture);
-    int image = doc.addPngImage(encodePng(t, srgb), t.name);
+    int image = doc.addImage(encodePng(t, srgb), t.name);
     int index = doc.addTexture(image, doc.addSampler(t.wrapS, t.wrapT, !srgb));
     cache[key] = index;
     return index;

@@ -30,7 +30,8 @@ class GltfDocument {
   int addVec3(const std::vector<glm::vec3>& v);
   int addVec2(const std::vector<glm::vec2>& v);
   int addIndices(const std::vector<uint32_t>& v);     // UNSIGNED_INT scalar
-  int addPngImage(const std::vector<uint8_t>& png, const std::string& name);
+  // An encoded image in buffer 0 (a PNG unless mimeType says otherwise).
+  int addImage(const std::vector<uint8_t>& bytes, const std::string& name, const std::string& mimeType = "image/png");
   int addSampler(WrapMode s, WrapMode t, bool linearNoMips);
   int addTexture(int image, int sampler);
   int append(const char* arrayKey, nlohmann::json element);  // returns the new element's index

@@ -4,8 +4,7 @@
 #include <map>
 
 #include "common/error.h"
-#include "imageio/image_io.h"
-#include "scene/image_codec.h"
+#include "export/map_encoding.h"
 
 namespace irbake {
 
@@ -44,19 +43,36 @@ int documentLightIndex(const Scene* scene, const Light& l) {
   return -1;
 }
 
-Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name) {
+ShadowMaskPage shadowMaskPage(const ShadowMaskExport& mask, size_t i) {
   const Lightmap& rgb = (*mask.rgb)[i];
   const Lightmap* alpha = mask.alpha && i < mask.alpha->size() ? &(*mask.alpha)[i] : nullptr;
-  Texture t;
-  t.name = name;
-  t.width = rgb.width;
-  t.height = rgb.height;
-  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
-  t.texels.resize(rgb.texels.size());
-  for (size_t k = 0; k < rgb.texels.size(); ++k)
-    t.texels[k] = glm::clamp(glm::vec4(rgb.texels[k], alpha ? alpha->texels[k].x : 1.0f), 0.0f, 1.0f);
-  return t;
+  ShadowMaskPage p;
+  p.rgb.page = p.alpha.page = rgb.page;
+  p.rgb.width = p.alpha.width = rgb.width;
+  p.rgb.height = p.alpha.height = rgb.height;
+  p.rgb.texels.resize(rgb.texels.size());
+  p.alpha.texels.resize(rgb.texels.size());
+  for (size_t k = 0; k < rgb.texels.size(); ++k) {
+    const glm::vec4 v = glm::clamp(glm::vec4(rgb.texels[k], alpha ? alpha->texels[k].x : 1.0f), 0.0f, 1.0f);
+    p.rgb.texels[k] = glm::vec3(v);
+    p.alpha.texels[k] = glm::vec3(v.a);
+  }
+  return p;
 }
+
+namespace {
+
+// The mask's encoding (png8 or exr): linear, values in [0, 1] as they are, four channels.
+MapEncodeOptions shadowMaskEncoding(const ShadowMaskPage& page, const std::string& name) {
+  MapEncodeOptions o;
+  o.srgb = false;
+  o.range = MapRange::Unit;
+  o.alpha = &page.alpha;
+  o.name = name;
+  return o;
+}
+
+}  // namespace
 
 std::string shadowMaskPageUri(const std::string& prefix, int page) {
   return prefix + "_" + std::to_string(page) + "_shadowmask.exr";
@@ -64,16 +80,13 @@ std::string shadowMaskPageUri(const std::string& prefix, int page) {
 
 void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::filesystem::path& file,
                         const std::filesystem::path& finalPath) {
-  const Texture t = shadowMaskTexture(mask, i, finalPath.string());
-  for (const glm::vec4& v : t.texels)
+  const ShadowMaskPage page = shadowMaskPage(mask, i);
+  for (size_t k = 0; k < page.rgb.texels.size(); ++k) {
+    const glm::vec4 v(page.rgb.texels[k], page.alpha.texels[k].x);
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w))
       throw Error(ErrorCode::NumericError, finalPath.string(), "shadow-mask page holds NaN/Inf");
-  imageio::Pixels px;
-  px.width = t.width;
-  px.height = t.height;
-  px.channels = 4;
-  px.f32.assign(&t.texels[0].x, &t.texels[0].x + t.texels.size() * 4);
-  imageio::api().writeFile(file.string(), "openexr", px, (*mask.rgb)[i].page, finalPath.string());
+  }
+  mapEncoding(MapEncodingKind::Exr).writeFile(page.rgb, shadowMaskEncoding(page, finalPath.string()), file, finalPath);
 }
 
 void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, const std::string& exrPrefix) {
@@ -88,8 +101,10 @@ void addShadowMaskExtension(GltfDocument& doc, const ShadowMaskExport& mask, con
       const std::string name = "lightmap_" + std::to_string(page) + "_shadowmask";
       // Linear 8-bit: a mask is a visibility in [0, 1], so steps of 1/255 are finer than the 1/64 of its
       // 8×8 edge rays and invisible on a light's direct term.
-      const std::vector<uint8_t> png = encodePng(shadowMaskTexture(mask, i, name), false);
-      const int texture = doc.addTexture(doc.addPngImage(png, name),
+      const ShadowMaskPage maskPage = shadowMaskPage(mask, i);
+      const MapEncoding& png8 = mapEncoding(MapEncodingKind::Png8);
+      const EncodedMap encoded = png8.encode(maskPage.rgb, shadowMaskEncoding(maskPage, name));
+      const int texture = doc.addTexture(doc.addImage(encoded.bytes, name, png8.mimeType()),
                                          doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true));
       json ext = {{"index", texture}, {"texCoord", 1}};
       if (!exrPrefix.empty()) ext["exr"] = shadowMaskPageUri(exrPrefix, page);

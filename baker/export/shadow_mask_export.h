@@ -33,13 +33,17 @@ struct ShadowMaskExport {
 // light the document does not have (the command line's --sun over a source file).
 int documentLightIndex(const Scene* scene, const Light& l);
 
-// Page i of the mask as RGBA in [0, 1].
-Texture shadowMaskTexture(const ShadowMaskExport& mask, size_t i, const std::string& name);
+// Page i of the mask clamped to [0, 1]: the first three channels, and the fourth as a page of its own (its
+// texels' x; 1 when the mask has no fourth channel).
+struct ShadowMaskPage {
+  Lightmap rgb, alpha;
+};
+ShadowMaskPage shadowMaskPage(const ShadowMaskExport& mask, size_t i);
 
 // EXR file name of a page's mask: <prefix>_<page>_shadowmask.exr.
 std::string shadowMaskPageUri(const std::string& prefix, int page);
 
-// Writes page i's mask as a 4-channel float EXR.
+// Writes page i's mask as a 4-channel float EXR (the exr map encoding).
 void writeShadowMaskExr(const ShadowMaskExport& mask, size_t i, const std::filesystem::path& file,
                         const std::filesystem::path& finalPath);
 

@@ -24,7 +24,7 @@ GltfDocument richDocument() {
   Texture t;
   t.width = t.height = 2;
   t.texels.assign(4, glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
-  int tex = doc.addTexture(doc.addPngImage(encodePng(t, true), "t"), -1);
+  int tex = doc.addTexture(doc.addImage(encodePng(t, true), "t"), -1);
   doc.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", tex}}}}}, {"emissiveFactor", {1, 1, 1}}});
   doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "spot"}, {"intensity", 2}, {"spot", {{"outerConeAngle", 0.5}}}}});
   doc.append("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}});

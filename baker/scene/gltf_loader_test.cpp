@@ -225,7 +225,7 @@ TEST(GltfLoader, MaterialsTexturesAndEmissiveStrength) {
   t.width = 2;
   t.height = 1;
   t.texels = {glm::vec4(188 / 255.0f, 188 / 255.0f, 188 / 255.0f, 1.0f), glm::vec4(1.0f)};
-  int image = doc.addPngImage(encodePng(t, false), "tex");
+  int image = doc.addImage(encodePng(t, false), "tex");
   int tex = doc.addTexture(image, doc.addSampler(WrapMode::ClampToEdge, WrapMode::MirroredRepeat, false));
   doc.append("materials", {{"name", "m"},
                            {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 1, 1}}, {"baseColorTexture", {{"index", tex}}}}},
@@ -346,7 +346,7 @@ TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   Texture t;
   t.width = t.height = 1;
   t.texels = {glm::vec4(0.5f, 0.25f, 1.0f, 1.0f)};
-  int tex = doc.addTexture(doc.addPngImage(encodePng(t, false), "lm"), -1);
+  int tex = doc.addTexture(doc.addImage(encodePng(t, false), "lm"), -1);
   doc.append("materials", {{"extensions", {{"MOZ_lightmap", {{"index", tex}, {"texCoord", 1}, {"intensity", 3.5}}}}}});
   doc.root["extras"]["lightmapPages"] = {"pages/lightmap_0.exr"};
   auto dir = testFolder("loader_moz");
@@ -382,7 +382,7 @@ TEST(GltfLoader, ShadingMapsTangentsNormalTextureAndDirectionalExtension) {
   Texture t;
   t.width = t.height = 1;
   t.texels = {glm::vec4(128 / 255.0f, 64 / 255.0f, 1.0f, 1.0f)};
-  auto texture = [&](const char* name) { return doc.addTexture(doc.addPngImage(encodePng(t, false), name), -1); };
+  auto texture = [&](const char* name) { return doc.addTexture(doc.addImage(encodePng(t, false), name), -1); };
   const int normal = texture("normal");
   json l1 = json::array();
   for (int k = 0; k < 3; ++k) l1.push_back({{"index", texture("l1")}, {"texCoord", 1}, {"scale", 0.25 * (k + 1)}});
