@@ -63,12 +63,21 @@ inline std::filesystem::path scratchFolder(const std::string& group, const std::
   return d;
 }
 
-// The sample scenes (`irbake samples`), written once per process into test_scratch/<group>/samples.
+// The sample scenes (`irbake samples`) in test_scratch/<group>/samples. Tests of one group may start at once in
+// parallel processes: each writes its own copy beside it and renames it into place, so the folder appears whole
+// and nothing writes into it afterwards (a copy made while another `samples` run replaced files in it failed).
 inline std::filesystem::path sampleScenes(const std::string& group) {
-  const std::filesystem::path d = std::filesystem::current_path() / "test_scratch" / group / "samples";
-  if (!std::filesystem::exists(d / "cornell_box.gltf")) {
-    std::filesystem::create_directories(d);
-    runIrbakeLogged({"samples", d.string(), "--quiet"}, d.parent_path() / "samples_log.txt");
+  namespace fs = std::filesystem;
+  const fs::path d = fs::current_path() / "test_scratch" / group / "samples";
+  if (!fs::exists(d / "cornell_box.gltf")) {
+    const std::string pid = std::to_string(getpid());
+    const fs::path mine = d.parent_path() / ("samples.writing." + pid);
+    fs::remove_all(mine);
+    fs::create_directories(mine);
+    runIrbakeLogged({"samples", mine.string(), "--quiet"}, d.parent_path() / ("samples_log." + pid + ".txt"));
+    std::error_code ec;
+    fs::rename(mine, d, ec);  // fails when another process's copy is there already: then that one is used
+    if (ec) fs::remove_all(mine, ec);
   }
   return d;
 }
