@@ -121,14 +121,6 @@ std::vector<Case> cases(const Fixture& f) {
   bake("-o", "input", {"-o", box}, box);
   bake("-o", "other output", {"-o", (f.root / "x.glb").string(), "--report", (f.root / "x.glb").string()}, "x.glb");
   bake("-o", "/proc", {"-o", procGlb}, procGlb);
-  bake("--report", "input", {"-o", fresh, "--report", bin}, bin);
-  bake("--report", "other output", {"-o", baked, "--report", gltfOut}, gltfOut);
-  bake("--report", "folder", {"-o", fresh, "--report", folderJson}, folderJson);
-  bake("--report", "/proc", {"-o", fresh, "--report", proc}, proc);
-  bake("--portable", "input", {"-o", fresh, "--portable", box}, box);
-  bake("--portable", "other output", {"-o", freshGlb, "--portable", freshGlb}, freshGlb);
-  bake("--portable", "folder", {"-o", fresh, "--portable", folderGlb}, folderGlb);
-  bake("--portable", "/proc", {"-o", fresh, "--portable", procGlb}, procGlb);
   bake("--dump-config", "input", {"-o", fresh, "--dump-config", box}, box);
   bake("--dump-config", "input .bin", {"-o", fresh, "--dump-config", bin}, bin);
   bake("--dump-config", "other output", {"-o", baked, "--dump-config", report}, report);
@@ -139,14 +131,17 @@ std::vector<Case> cases(const Fixture& f) {
   merge("-o", "input", {"-o", box}, box);
   merge("-o", "a partial", {"-o", f.shards.string(), "--report", partial}, partial);
   merge("-o", "/proc", {"-o", procGlb}, procGlb);
-  merge("--report", "input", {"-o", fresh, "--report", bin}, bin);
-  merge("--report", "other output", {"-o", baked, "--report", gltfOut}, gltfOut);
-  merge("--report", "folder", {"-o", fresh, "--report", folderJson}, folderJson);
-  merge("--report", "/proc", {"-o", fresh, "--report", proc}, proc);
-  merge("--portable", "input", {"-o", fresh, "--portable", box}, box);
-  merge("--portable", "other output", {"-o", freshGlb, "--portable", freshGlb}, freshGlb);
-  merge("--portable", "folder", {"-o", fresh, "--portable", folderGlb}, folderGlb);
-  merge("--portable", "/proc", {"-o", fresh, "--portable", procGlb}, procGlb);
+  // --report and --portable are the same options in bake and merge: the same cases for both.
+  for (const auto& add : {bake, merge}) {
+    add("--report", "input", {"-o", fresh, "--report", bin}, bin);
+    add("--report", "other output", {"-o", baked, "--report", gltfOut}, gltfOut);
+    add("--report", "folder", {"-o", fresh, "--report", folderJson}, folderJson);
+    add("--report", "/proc", {"-o", fresh, "--report", proc}, proc);
+    add("--portable", "input", {"-o", fresh, "--portable", box}, box);
+    add("--portable", "other output", {"-o", freshGlb, "--portable", freshGlb}, freshGlb);
+    add("--portable", "folder", {"-o", fresh, "--portable", folderGlb}, folderGlb);
+    add("--portable", "/proc", {"-o", fresh, "--portable", procGlb}, procGlb);
+  }
   const std::string u = (f.unwrapped / "u.gltf").string();
   auto unwrap = command("unwrap", {"unwrap", box});
   unwrap("-o", "input", {"-o", box}, box);

@@ -37,4 +37,19 @@ DecodedMap MapEncoding::readFile(const std::filesystem::path& path, const MapMet
   return decode(bytes.data(), bytes.size(), metadata, path.string());
 }
 
+DecodedMap decodedFromTexture(const Texture& stored, int page, const std::function<glm::vec3(glm::vec3)>& value) {
+  DecodedMap d;
+  d.map.page = page;
+  d.map.width = stored.width;
+  d.map.height = stored.height;
+  d.map.texels.resize(stored.texels.size());
+  d.alpha.resize(stored.texels.size());
+  for (size_t i = 0; i < stored.texels.size(); ++i) {
+    d.map.texels[i] = value(glm::vec3(stored.texels[i]));
+    d.alpha[i] = stored.texels[i].a;
+  }
+  d.map.valid.assign(d.map.texels.size(), 1);
+  return d;
+}
+
 }  // namespace irbake

@@ -11,6 +11,7 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,9 @@ struct DecodedMap {
   Lightmap map;                // linear values (valid = 1 everywhere)
   std::vector<float> alpha;    // the fourth channel, empty when the file has none
 };
+
+// A stored texture as a decoded page: each texel's RGB through `value`, its alpha as stored, every texel valid.
+DecodedMap decodedFromTexture(const Texture& stored, int page, const std::function<glm::vec3(glm::vec3)>& value);
 
 class MapEncoding {
  public:

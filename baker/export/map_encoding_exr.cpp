@@ -70,18 +70,7 @@ class ExrEncoding final : public MapEncoding {
 
   // Float values are stored as they are: the texture's RGB and alpha.
   DecodedMap fromStored(const Texture& t, const MapMetadata& md) const override {
-    DecodedMap d;
-    d.map.page = md.page;
-    d.map.width = t.width;
-    d.map.height = t.height;
-    d.map.texels.resize(t.texels.size());
-    d.alpha.resize(t.texels.size());
-    for (size_t i = 0; i < t.texels.size(); ++i) {
-      d.map.texels[i] = glm::vec3(t.texels[i]);
-      d.alpha[i] = t.texels[i].a;
-    }
-    d.map.valid.assign(d.map.texels.size(), 1);
-    return d;
+    return decodedFromTexture(t, md.page, [](glm::vec3 v) { return v; });
   }
 
   void writeFile(const Lightmap& map, const MapEncodeOptions& options, const std::filesystem::path& file,

@@ -108,19 +108,7 @@ class Png8Encoding final : public MapEncoding {
   }
 
   DecodedMap fromStored(const Texture& t, const MapMetadata& md) const override {
-    DecodedMap d;
-    d.map.page = md.page;
-    d.map.width = t.width;
-    d.map.height = t.height;
-    d.map.texels.resize(t.texels.size());
-    d.alpha.resize(t.texels.size());
-    for (size_t i = 0; i < t.texels.size(); ++i) {
-      const glm::vec3 s = glm::vec3(t.texels[i]);
-      d.map.texels[i] = (md.signedValues ? 2.0f * s - 1.0f : s) * md.intensity;
-      d.alpha[i] = t.texels[i].a;
-    }
-    d.map.valid.assign(d.map.texels.size(), 1);
-    return d;
+    return decodedFromTexture(t, md.page, [&md](glm::vec3 s) { return (md.signedValues ? 2.0f * s - 1.0f : s) * md.intensity; });
   }
 };
 
