@@ -878,16 +878,8 @@ std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<f
   const fs::path outDir = outputFolderOf(c.out);
   const bool gltfNamed = namesGltfFile(c.out);
   const fs::path gltf = gltfNamed ? fs::path(c.out) : outDir / "scene.gltf";
-  std::error_code ec;
-  if (!c.report.empty() && fs::is_directory(c.report, ec))
-    throw Error(ErrorCode::Usage, c.report, "--report names a folder: give the report's file name (R.json)");
-  if (!c.portable.empty()) {
-    if (fs::is_directory(c.portable, ec))
-      throw Error(ErrorCode::Usage, c.portable, "--portable names a folder: give the portable file's name (P.glb)");
-    if (!hasExtension(c.portable, ".glb")) throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
-  }
-  if (!c.dumpConfig.empty() && fs::is_directory(c.dumpConfig, ec))
-    throw Error(ErrorCode::Usage, c.dumpConfig, "--dump-config names a folder: give the config's file name (C.toml)");
+  if (!c.portable.empty() && !hasExtension(c.portable, ".glb"))
+    throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
   // Inputs first: the scene and its files, --env's map, and what the command reads besides (merge's partials).
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.lights.environment.empty()) inputs.push_back(c.lights.environment);

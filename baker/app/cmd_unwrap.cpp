@@ -87,10 +87,9 @@ int runUnwrap(const Args& args) {
   // Every output checked before any work: never onto the scene's files, a folder, or each other.
   if (!namesGltfFile(output))
     throw Error(ErrorCode::Usage, output, "unwrap writes one glTF: give -o a .gltf or .glb file name");
-  if (!report.empty() && std::filesystem::is_directory(report))
-    throw Error(ErrorCode::Usage, report, "--report names a folder: give the report's file name (R.json)");
+  const std::vector<std::filesystem::path> sceneFiles = sceneInputFiles(input);
   OutputGuard guard;
-  guard.addInputs(sceneInputFiles(input));
+  guard.addInputs(sceneFiles);
   guard.addOutput(output, "the unwrapped glTF (-o)");
   if (hasExtension(output, ".gltf"))
     guard.addOutput(folderOf(output) / (std::filesystem::path(output).stem().string() + ".bin"), "the glTF's .bin output");
@@ -105,7 +104,7 @@ int runUnwrap(const Args& args) {
   ExportOptions exportOptions;
   exportOptions.output = output;
   exportOptions.writeExrPages = false;
-  exportOptions.inputs = sceneInputFiles(input);
+  exportOptions.inputs = sceneFiles;
   exportOptions.guard = &guard;
   if (!report.empty()) {
     const std::string text = reportJson(input, result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";

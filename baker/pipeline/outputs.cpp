@@ -33,8 +33,6 @@ std::vector<PendingFile> errorPageFiles(const BakeResult& result, const std::fil
 // A page of an earlier bake into the same folder that this bake does not have would be read as part of it
 // (irbake diff): remove it, but only when the folder's manifest proves irbake wrote it and it is unchanged.
 void removeStalePage(const std::filesystem::path& stale, const OutputGuard& guard, const std::string& why) {
-  std::error_code ec;
-  if (!std::filesystem::exists(std::filesystem::symlink_status(stale, ec))) return;
   if (guard.removeIfOurs(stale))
     log::warn("removed " + stale.string() + " left by an earlier bake " + why);
   else
