@@ -481,7 +481,7 @@ int stagesBench(const std::vector<std::string>& args) {
     }
   t.primitive.assign(t.slotCount(), 0);
   t.triangle.assign(t.slotCount(), 0);
-  // --covered f < 1: only a disc of that fraction of the page is valid (atlas pages are 60–85% covered).
+  // --covered f < 1: only a disc of that fraction of the page is valid (atlas pages are partly covered).
   t.covered.assign(t.layerSize(), 1);
   t.valid.assign(t.layerSize(), 1);
   if (coveredFraction < 1.0f) {

@@ -343,7 +343,7 @@ def view_mode(args, out, row, rows):
         ours = read_exr(big)[..., :3].reshape(h, ss, w, ss, 3).mean(axis=(1, 3))
         ours4 = read_exr(small)[..., :3].reshape(h, 4, w, 4, 3).mean(axis=(1, 3))
         if ss != 4:
-            os.remove(big)  # large (16x: 65 MB for 160x100); the 4x render stays for a look
+            os.remove(big)  # the 16x render is large; the 4x render stays for a look
         ch = read_exr(charts)[..., :3]
         edge = np.zeros((h, w), bool)
         d0 = np.any(np.abs(ch[1:] - ch[:-1]) > 1e-4, axis=2)
