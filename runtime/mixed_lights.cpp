@@ -7,18 +7,19 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "lights/light_kind.h"
 #include "view_renderer.h"
 
 namespace irbake::view {
 
 glm::vec3 runtimeLightIrradiance(const Light& light, const glm::vec3& p, const glm::vec3& n) {
-  if (light.type == LightType::Directional)
-    return light.color * light.intensity * std::max(0.0f, glm::dot(n, -light.direction));
-  const glm::vec3 d = light.position - p;
+  const LightKind& kind = lightKind(light.type);
+  const glm::vec3 d = kind.toward(light, p);
+  if (kind.atInfinity()) return light.color * light.intensity * std::max(0.0f, glm::dot(n, d));
   const float r2 = std::max(glm::dot(d, d), 1e-20f), r = std::sqrt(r2);
   if (light.rangeWindow(r) == 0.0f) return glm::vec3(0.0f);
   const glm::vec3 l = d / r;
-  return light.intensityToward(-l) * (std::max(0.0f, glm::dot(n, l)) / r2);
+  return kind.intensityToward(light, -l) * (std::max(0.0f, glm::dot(n, l)) / r2);
 }
 
 MixedLights::MixedLights(const ViewerScene& v) : scene_(v), lights_(v.scene.runtimeLights) {
@@ -61,13 +62,12 @@ void MixedLights::setUniforms(unsigned program, int unit) const {
   glUniform1i(glGetUniformLocation(program, "uShadowMask"), unit);
   for (size_t i = 0; i < lights_.size(); ++i) {
     const Light& l = lights_[i].light;
-    const float type = l.type == LightType::Point ? 0.0f : l.type == LightType::Spot ? 1.0f : 2.0f;
-    const glm::vec3 I = l.color * l.intensity;
-    const float cosOuter = std::cos(l.outerConeAngle), cosInner = std::cos(l.innerConeAngle);
+    const ShaderLight s = lightKind(l.type).shaderLight(l);
+    const float type = static_cast<float>(s.code);
     glUniform4f(at("uMixedPosition", i), l.position.x, l.position.y, l.position.z, type);
     glUniform4f(at("uMixedDirection", i), l.direction.x, l.direction.y, l.direction.z, l.range);
-    glUniform3f(at("uMixedIntensity", i), I.x, I.y, I.z);
-    glUniform2f(at("uMixedCone", i), cosOuter, 1.0f / std::max(0.001f, cosInner - cosOuter));
+    glUniform3f(at("uMixedIntensity", i), s.intensity.x, s.intensity.y, s.intensity.z);
+    glUniform2f(at("uMixedCone", i), s.cosOuter, s.spotScale);
     glUniform1i(at("uMixedChannel", i), lights_[i].maskChannel);
   }
 }

@@ -17,7 +17,7 @@ namespace irbake::view {
 constexpr int kMaxMixedLights = 16;
 
 // The direct irradiance (W/m², RGB) of a runtime light at point p with unit normal n, unshadowed: what the
-// shader computes before the mask (KHR_lights_punctual units; spot falloff as Light::intensityToward).
+// shader computes before the mask (KHR_lights_punctual units; spot falloff as the spot kind's intensityToward).
 glm::vec3 runtimeLightIrradiance(const Light& light, const glm::vec3& p, const glm::vec3& n);
 
 class MixedLights {

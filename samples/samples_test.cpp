@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lights/light_kind.h"
 #include "samples/sample_scenes.h"
 #include "scene/gltf_loader.h"
 #include "testing/gltf_builder.h"
@@ -193,7 +194,7 @@ TEST(Samples, CornerAndSpotLight) {
   EXPECT_EQ(spot.type, LightType::Spot);
   // Aimed at (0.5, 0, 1.5): the wall point (0, 1, 1.5) is inside the inner cone (26.6° < 30°).
   glm::vec3 toWall = glm::normalize(glm::vec3(0, 1, 1.5f) - spot.position);
-  EXPECT_NEAR(spot.intensityToward(toWall).x, 20.0f, 1e-4f);
+  EXPECT_NEAR(lightKind(spot).intensityToward(spot, toWall).x, 20.0f, 1e-4f);
   EXPECT_NEAR(faceNormal(part(s, "wall"), 0).x, 1.0f, 1e-6f);
   EXPECT_NEAR(faceNormal(part(s, "floor"), 0).y, 1.0f, 1e-6f);
   EXPECT_NEAR(area(part(s, "wall")), 9.0, 1e-5);

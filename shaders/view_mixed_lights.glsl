@@ -1,11 +1,11 @@
 // irview's mixed lights (runtime/mixed_lights.h): the direct irradiance of the lights an export leaves to the
 // client, in glTF's units (KHR_lights_punctual): E = I cosθ / r² for point and spot (spot falloff as the
-// baker's Light::intensityToward), E = I cosθ for directional; times the light's shadow-mask channel.
+// baker's spot light kind, baker/lights/spot_light.cpp), E = I cosθ for directional; times the light's shadow-mask channel.
 // Concatenated before view_mesh.frag; compiled in only where MIXED_LIGHTS is 1.
 #if defined(MIXED_LIGHTS) && MIXED_LIGHTS
 #define MAX_MIXED_LIGHTS 16
 uniform int uMixedCount;
-uniform vec4 uMixedPosition[MAX_MIXED_LIGHTS];   // xyz world position (point, spot); w: 0 point, 1 spot, 2 directional
+uniform vec4 uMixedPosition[MAX_MIXED_LIGHTS];   // xyz world position (point, spot); w: the kind's code (BAKE_LIGHT_*)
 uniform vec4 uMixedDirection[MAX_MIXED_LIGHTS];  // xyz unit direction the light travels (spot, directional); w range (0: none)
 uniform vec3 uMixedIntensity[MAX_MIXED_LIGHTS];  // colour × intensity: W/sr (point, spot) or W/m² (directional)
 uniform vec2 uMixedCone[MAX_MIXED_LIGHTS];       // spot: cos(outer), 1 / max(0.001, cos(inner) − cos(outer))

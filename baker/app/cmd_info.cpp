@@ -8,20 +8,12 @@
 #include "common/command_line.h"
 #include "common/error.h"
 #include "common/progress.h"
+#include "lights/light_kind.h"
 #include "scene/gltf_loader.h"
 
 namespace irbake::app {
 
 namespace {
-
-const char* lightTypeName(LightType t) {
-  switch (t) {
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
-  }
-  return "?";
-}
 
 void printVec(const char* label, const glm::vec3& v) { std::printf("%s(%.6g, %.6g, %.6g)", label, v.x, v.y, v.z); }
 
@@ -66,12 +58,13 @@ int runInfo(const Args& args) {
   for (const auto& t : scene.textures) std::printf("  %s: %dx%d\n", t.name.c_str(), t.width, t.height);
   std::printf("lights: %zu\n", scene.lights.size());
   for (const auto& l : scene.lights) {
-    std::printf("  %s %s: intensity %.6g × colour (%.4g, %.4g, %.4g)", lightTypeName(l.type), l.name.c_str(), l.intensity,
+    const LightKind& kind = lightKind(l.type);
+    std::printf("  %s %s: intensity %.6g × colour (%.4g, %.4g, %.4g)", kind.name(), l.name.c_str(), l.intensity,
                 l.color.r, l.color.g, l.color.b);
-    if (l.type != LightType::Directional) printVec(", at ", l.position);
-    if (l.type != LightType::Point) printVec(", towards ", l.direction);
-    if (l.type == LightType::Directional) std::printf(", irradiance %.6g W/m²\n", l.intensity);
-    else printVec(", power W ", l.power()), std::printf("\n");
+    if (!kind.atInfinity()) printVec(", at ", l.position);
+    if (kind.aimed()) printVec(", towards ", l.direction);
+    if (kind.atInfinity()) std::printf(", irradiance %.6g W/m²\n", l.intensity);
+    else printVec(", power W ", kind.power(l)), std::printf("\n");
   }
   size_t emitters = 0;
   for (const auto& p : scene.primitives)

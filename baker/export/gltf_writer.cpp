@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "common/file_paths.h"
+#include "lights/light_kind.h"
 #include "scene/image_codec.h"
 
 namespace irbake {
@@ -284,12 +285,8 @@ GltfDocument gltfFromScene(const Scene& scene, const GltfWriteOptions& options) 
   for (const auto& l : scene.lights) {
     json light = {{"color", vec(l.color)}, {"intensity", l.intensity}};
     if (!l.name.empty()) light["name"] = l.name;
-    if (l.type == LightType::Point) light["type"] = "point";
-    if (l.type == LightType::Directional) light["type"] = "directional";
-    if (l.type == LightType::Spot) {
-      light["type"] = "spot";
-      light["spot"] = {{"innerConeAngle", l.innerConeAngle}, {"outerConeAngle", l.outerConeAngle}};
-    }
+    const LightKind& kind = lightKind(l.type);
+    kind.describeGltf(l, light);
     if (l.range > 0.0f) light["range"] = l.range;
     if (!doc.root["extensions"]["KHR_lights_punctual"].contains("lights"))
       doc.root["extensions"]["KHR_lights_punctual"]["lights"] = json::array();
@@ -297,8 +294,8 @@ GltfDocument gltfFromScene(const Scene& scene, const GltfWriteOptions& options) 
     lights.push_back(light);
     json node = {{"extensions", {{"KHR_lights_punctual", {{"light", lights.size() - 1}}}}}};
     if (!l.name.empty()) node["name"] = l.name;
-    if (l.type != LightType::Directional) node["translation"] = vec(l.position);
-    if (l.type != LightType::Point) node["rotation"] = rotationJson(rotationFromMinusZ(glm::normalize(l.direction)));
+    if (!kind.atInfinity()) node["translation"] = vec(l.position);
+    if (kind.aimed()) node["rotation"] = rotationJson(rotationFromMinusZ(glm::normalize(l.direction)));
     roots.push_back(doc.append("nodes", std::move(node)));
     doc.useExtension("KHR_lights_punctual");
   }

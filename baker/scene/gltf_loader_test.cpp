@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "export/exr_io.h"
+#include "lights/light_kind.h"
 #include "scene/environment.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_codec.h"
@@ -280,7 +281,7 @@ TEST(GltfLoader, PunctualLightsTakeNodeTransforms) {
   expectNear(s.lights[0].color, {1, 0.5f, 0.25f});
   EXPECT_FLOAT_EQ(s.lights[0].range, 4.0f);
   // Point power = 4π I colour.
-  EXPECT_NEAR(s.lights[0].power().x, 4.0 * M_PI * 10.0, 1e-3);
+  EXPECT_NEAR(lightKind(s.lights[0]).power(s.lights[0]).x, 4.0 * M_PI * 10.0, 1e-3);
   EXPECT_EQ(s.lights[1].type, LightType::Spot);
   expectNear(s.lights[1].direction, {0, -1, 0});
   EXPECT_FLOAT_EQ(s.lights[1].outerConeAngle, 0.6f);

@@ -74,32 +74,6 @@ glm::vec4 sampleBilinear(const Texture& tex, glm::vec2 uv) {
   return (at(xa, ya) * (1.0f - fx) + at(xb, ya) * fx) * (1.0f - fy) + (at(xa, yb) * (1.0f - fx) + at(xb, yb) * fx) * fy;
 }
 
-glm::vec3 Light::intensityToward(const glm::vec3& dirFromLight) const {
-  glm::vec3 I = color * intensity;
-  if (type != LightType::Spot) return I;
-  float cosOuter = std::cos(outerConeAngle), cosInner = std::cos(innerConeAngle);
-  float scale = 1.0f / std::max(0.001f, cosInner - cosOuter);
-  float t = std::clamp((glm::dot(direction, dirFromLight) - cosOuter) * scale, 0.0f, 1.0f);
-  return I * (t * t);
-}
-
-glm::vec3 Light::power() const {
-  glm::vec3 I = color * intensity;
-  switch (type) {
-    case LightType::Point: return 4.0f * kPiF * I;
-    case LightType::Spot: {
-      // ∫ over the cone of t(cosθ)² dω with t linear in cosθ: full inside the inner cone,
-      // (cosI − cosO)/3 of the band between the cones (exact when cosI − cosO ≥ 0.001).
-      double cosO = std::cos(outerConeAngle), cosI = std::cos(innerConeAngle);
-      double band = std::max(0.0, cosI - cosO);
-      double solid = 2.0 * kPi * ((1.0 - cosI) + band / 3.0);
-      return static_cast<float>(solid) * I;
-    }
-    case LightType::Directional: return glm::vec3(0.0f);
-  }
-  return glm::vec3(0.0f);
-}
-
 Bounds3 Scene::bounds() const {
   Bounds3 b;
   for (const auto& p : primitives)

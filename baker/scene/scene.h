@@ -113,7 +113,8 @@ const char* toString(LightMode mode);
 bool parseLightMode(const std::string& text, LightMode& mode);
 
 // KHR_lights_punctual. intensity is radiant intensity (W/sr) for point/spot, irradiance (W/m²) for
-// directional, so a point light gives E = I cosθ / r² and a directional light E = I cosθ.
+// directional, so a point light gives E = I cosθ / r² and a directional light E = I cosθ. What a light of a
+// type emits, gives and looks like in real time is its kind's (lights/light_kind.h).
 struct Light {
   std::string name;
   LightType type = LightType::Point;
@@ -128,13 +129,8 @@ struct Light {
   int gltfLight = -1;                  // index in KHR_lights_punctual's lights (-1: from the command line)
   bool hasExtrasMode = false;          // the glTF light's extras.irbake.mode was given (then extrasMode holds it)
   LightMode extrasMode = LightMode::Baked;
-  // Radiant intensity (W/sr, RGB) towards a direction leaving the light (unit vector), spot falloff
-  // included (glTF's recommended smooth falloff, linear in cosθ between outer and inner cone).
-  glm::vec3 intensityToward(const glm::vec3& dirFromLight) const;
   // glTF: intensity is zero beyond range (inverse-square inside it). 1 inside, 0 beyond; range 0 = infinite.
   float rangeWindow(float distance) const { return (range > 0.0f && distance > range) ? 0.0f : 1.0f; }
-  // Total emitted power (W, RGB): 4πI point; spot integrates its falloff; directional: 0 (infinite).
-  glm::vec3 power() const;
 };
 
 struct Camera {

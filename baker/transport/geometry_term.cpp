@@ -1,33 +1,10 @@
 #include "transport/geometry_term.h"
 #include "scene/triangle_area.h"
 
-#include <cmath>
-#include <limits>
-
 namespace irbake {
 
 PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, const glm::vec3& nx) {
-  PunctualContribution c;
-  if (light.type == LightType::Directional) {
-    glm::vec3 l = -glm::normalize(light.direction);
-    float cosX = glm::dot(nx, l);
-    if (cosX <= 0.0f) return c;
-    c.toLight = l;
-    c.distance = std::numeric_limits<float>::infinity();
-    c.mapValue = light.color * light.intensity * (cosX / kPiF);
-    return c;
-  }
-  glm::vec3 d = light.position - x;
-  float r2 = glm::dot(d, d);
-  if (!(r2 > 0.0f)) return c;
-  float r = std::sqrt(r2);
-  glm::vec3 l = d / r;
-  float cosX = glm::dot(nx, l);
-  if (cosX <= 0.0f || light.rangeWindow(r) == 0.0f) return c;
-  c.toLight = l;
-  c.distance = r;
-  c.mapValue = light.intensityToward(-l) * (cosX / (r2 * kPiF));
-  return c;
+  return lightKind(light.type).direct(light, x, nx);
 }
 
 float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMean) {

@@ -11,7 +11,7 @@
 //   map value = E / π = Φ · Gc · V / π²
 //
 // Punctual lights (exact; no VPL at bounce 0), d = light position − x, r = |d|, l = d / r:
-//   point/spot:   E = I(−l) · max(0, n_x·l) / r² · window(r) · V   (I(−l): Light::intensityToward, spot falloff)
+//   point/spot:   E = I(−l) · max(0, n_x·l) / r² · window(r) · V   (I(−l): the kind's intensityToward, spot falloff)
 //   directional:  E = I · max(0, −n_x·dir) · V                     (shadow ray towards −dir, to infinity)
 //   map value = E / π
 #pragma once
@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "common/maths.h"
+#include "lights/light_kind.h"
 #include "scene/scene.h"
 #include "vpl/vpl.h"
 
@@ -42,12 +43,7 @@ inline float clampGeometryTerm(float g, float bound) { return bound > 0.0f ? glm
 // Map value (irradiance / π) that a visible VPL of power Φ gives through the (clamped) geometry term.
 inline glm::vec3 vplMapValue(const glm::vec3& power, float geometryTerm) { return power * (geometryTerm * kInvPi2F); }
 
-// A punctual light at a receiver, before the shadow test.
-struct PunctualContribution {
-  glm::vec3 mapValue{0.0f};     // irradiance / π if visible (0: nothing to trace)
-  glm::vec3 toLight{0.0f};      // unit direction from the receiver towards the light
-  float distance = 0.0f;        // to the light; infinity for directional lights
-};
+// A punctual light at a receiver, before the shadow test: its kind's direct term (lights/light_kind.h).
 PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, const glm::vec3& nx);
 
 // The clamp bound B (1/m²) derived from the scene and the VPL set:

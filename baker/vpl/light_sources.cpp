@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/maths.h"
+#include "lights/light_kind.h"
 
 namespace irbake {
 
@@ -47,9 +48,7 @@ LightSources collectLightSources(const Scene& scene) {
   }
   areaWeights = weights;
   for (const Light& l : scene.lights) {
-    glm::dvec3 power = l.type == LightType::Directional
-                           ? glm::dvec3(l.color * l.intensity) * (kPi * out.sceneRadius * out.sceneRadius)
-                           : glm::dvec3(l.power());
+    glm::dvec3 power = lightKind(l.type).walkPower(l, out.sceneRadius);
     out.lightPower.push_back(power);
     weights.push_back(channelMean(power));
     out.totalPower += power;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "lights/light_kind.h"
 #include "vpl/light_sources.h"
 #include "sampling/sampling.h"
 #include "vpl/vpl.h"
@@ -247,7 +248,7 @@ TEST(Walk, SpotPathsFollowTheFalloffAndDirectionalCoversTheScene) {
     ++n;
   }
   EXPECT_NEAR(double(in) / n, inner, 0.01);
-  EXPECT_NEAR(set.emittedPower.x, spot.power().x, 1e-5);
+  EXPECT_NEAR(set.emittedPower.x, lightKind(spot).power(spot).x, 1e-5);
 
   // Directional light onto an open floor: the flux reaching the floor is I · area (the disc covers it).
   Scene d;

@@ -23,6 +23,7 @@
 
 #include "common/error.h"
 #include "common/maths.h"
+#include "lights/light_kind.h"
 #include "vpl/light_sources.h"
 #include "vpl/resample.h"
 #include "sampling/sampling.h"
@@ -31,31 +32,6 @@
 namespace irbake {
 
 namespace {
-
-// Direction from a spot light distributed like its intensity t(cosθ)² (t linear in cosθ between the
-// outer and inner cone, 1 inside), so every path carries the same power.
-glm::vec3 spotDirection(const Light& l, double u, double v) {
-  double cosO = std::cos(l.outerConeAngle), cosI = std::cos(l.innerConeAngle);
-  double band = std::max(0.0, cosI - cosO);
-  if (band < 0.001) {  // matches Light::intensityToward's minimum band
-    band = 0.001;
-    cosI = cosO + band;
-  }
-  double massBand = band / 3.0, massInner = std::max(0.0, 1.0 - cosI);
-  double c;
-  if (u * (massBand + massInner) < massBand) {
-    double s = u * (massBand + massInner) / massBand;  // CDF ∝ x³ over the band
-    c = cosO + band * std::cbrt(s);
-  } else {
-    double s = (u * (massBand + massInner) - massBand) / std::max(massInner, 1e-300);
-    c = cosI + (1.0 - cosI) * std::min(s, 1.0);
-  }
-  c = std::clamp(c, -1.0, 1.0);
-  double sn = std::sqrt(std::max(0.0, 1.0 - c * c)), phi = 2.0 * kPi * v;
-  glm::vec3 t, b, d = glm::normalize(l.direction);
-  orthonormalBasis(d, t, b);
-  return glm::normalize(t * float(sn * std::cos(phi)) + b * float(sn * std::sin(phi)) + d * float(c));
-}
 
 // M_j = ⌊N ρ̄^j⌋: the paths still walking at bounce j.
 uint64_t survivorCount(uint64_t N, double rho, int j) {
@@ -98,29 +74,11 @@ struct PathStart {
   bool onSurface = false;  // starts on a surface (origin inset): rays leave along the normal
 };
 
-// Where a ray leaves punctual light l for the random numbers (u0..u3): its origin and direction. A
-// directional light's rays start on a disc covering the scene's bounding sphere, upstream of it.
+// Where a ray leaves punctual light l for the random numbers (u0..u3): its origin and direction, as its kind
+// emits (a light at infinity: on a disc covering the scene's bounding sphere, upstream of it).
 void lightRay(const Light& l, const LightSources& sources, double u0, double u1, double u2, double u3, glm::vec3& origin,
               glm::vec3& dir) {
-  switch (l.type) {
-    case LightType::Point:
-      origin = l.position;
-      dir = uniformSphere(u2, u3);
-      break;
-    case LightType::Spot:
-      origin = l.position;
-      dir = spotDirection(l, u2, u3);
-      break;
-    case LightType::Directional: {
-      dir = glm::normalize(l.direction);
-      glm::vec3 t, b;
-      orthonormalBasis(dir, t, b);
-      const double r = sources.sceneRadius * std::sqrt(u0), phi = 2.0 * kPi * u1;
-      origin = sources.sceneCentre - dir * (1.01f * sources.sceneRadius) + t * float(r * std::cos(phi)) +
-               b * float(r * std::sin(phi));
-      break;
-    }
-  }
+  lightKind(l.type).emit(l, sources.sceneCentre, sources.sceneRadius, u0, u1, u2, u3, origin, dir);
 }
 
 // The sky's ray: a direction towards the sky by radiance (u2, u3; its density in `pdf`) and a point on a

@@ -20,6 +20,7 @@
 #include "common/progress.h"
 #include "glcontext/gl_context.h"
 #include "glcontext/gl_program.h"
+#include "lights/light_kind.h"
 
 namespace irbake {
 
@@ -27,22 +28,12 @@ namespace {
 
 constexpr int kFaces = 6;
 
-// The direct-light shader's light and shadow-map codes (shaders/bake_interface.glsl).
-enum class ShaderLightType : int { Point = BAKE_LIGHT_POINT, Spot = BAKE_LIGHT_SPOT, Directional = BAKE_LIGHT_DIRECTIONAL };
+// The direct-light shader's shadow-map codes (shaders/bake_interface.glsl); its light codes are the light kinds'.
 enum class ShadowKind : int {
   Cube = BAKE_SHADOW_CUBE,                  // six faces (points, wide spots)
   Perspective = BAKE_SHADOW_PERSPECTIVE,    // one perspective map (spots), reversed-Z
   Orthographic = BAKE_SHADOW_ORTHOGRAPHIC,  // one orthographic box (directional)
 };
-
-ShaderLightType shaderLightType(LightType type) {
-  switch (type) {
-    case LightType::Point: return ShaderLightType::Point;
-    case LightType::Spot: return ShaderLightType::Spot;
-    case LightType::Directional: return ShaderLightType::Directional;
-  }
-  return ShaderLightType::Directional;
-}
 
 // Process CPU time (every thread, so llvmpipe's rasteriser threads count): comparable across machine load.
 double processCpuSeconds() {
@@ -310,9 +301,11 @@ const GlProgram& GlBaker::vplProgram(int layers) {
 void GlBaker::bakeDirect(const Light& light) {
   const Bounds3 bounds = in_.scene.bounds();
   StageClock sw;
-  // Shadow map: full cube for points and wide spots, perspective map for spots, ortho box for directional.
-  const bool cube = light.type == LightType::Point ||
-                    (light.type == LightType::Spot && light.outerConeAngle > opt_.maxSpotPerspectiveAngle);
+  // Shadow map as the light's kind asks: full cube for points and wide spots, perspective map for spots, ortho box
+  // for directional.
+  const LightKind& kind = lightKind(light.type);
+  const ShadowProjection projection = kind.shadowProjection(light, opt_.maxSpotPerspectiveAngle);
+  const bool cube = projection == ShadowProjection::Cube;
   std::unique_ptr<DepthTargets> maps;
   std::optional<ShadowView> view2d;
   float texelAngle = 0.0f, orthoRange = 0.0f;
@@ -328,7 +321,7 @@ void GlBaker::bakeDirect(const Light& light) {
       drawView(*cubeFaceView(light.position, identity, face, maps->size, scale_.nearPlane, false), maps->fbos[face],
                maps->size, true);
     texelAngle = 2.0f / maps->size;
-  } else if (light.type == LightType::Spot) {
+  } else if (projection == ShadowProjection::Perspective) {
     maps = std::make_unique<DepthTargets>(GL_TEXTURE_2D, opt_.lightMapSize, 1);
     float tanHalf = 0.0f;
     view2d = spotView(light.position, light.direction, light.outerConeAngle, opt_.lightMapSize, scale_.nearPlane,
@@ -366,16 +359,15 @@ void GlBaker::bakeDirect(const Light& light) {
   lightMapPassState();  // blended: added to the VPL partial sums not yet folded
   directProgram_->use();
   const GlProgram& p = *directProgram_;
-  glUniform1i(p.uniform("lightType"), static_cast<int>(shaderLightType(light.type)));
+  const ShaderLight shaderLight = kind.shaderLight(light);
+  glUniform1i(p.uniform("lightType"), shaderLight.code);
   glUniform1i(p.uniform("shadowKind"), static_cast<int>(shadowKind));
   glUniform3fv(p.uniform("lightPosition"), 1, &light.position[0]);
   glUniform3fv(p.uniform("lightDirection"), 1, &light.direction[0]);
-  const glm::vec3 intensity = light.color * light.intensity;
-  glUniform3fv(p.uniform("lightIntensity"), 1, &intensity[0]);
+  glUniform3fv(p.uniform("lightIntensity"), 1, &shaderLight.intensity[0]);
   glUniform1f(p.uniform("lightRange"), light.range);
-  const float cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
-  glUniform1f(p.uniform("cosOuter"), cosOuter);
-  glUniform1f(p.uniform("spotScale"), 1.0f / std::max(0.001f, cosInner - cosOuter));
+  glUniform1f(p.uniform("cosOuter"), shaderLight.cosOuter);
+  glUniform1f(p.uniform("spotScale"), shaderLight.spotScale);
   const glm::mat4 clip = view2d ? view2d->clip : glm::mat4(1.0f);
   glUniformMatrix4fv(p.uniform("shadowClip"), 1, GL_FALSE, &clip[0][0]);
   const glm::mat4 clipInverse = glm::inverse(clip);

@@ -12,6 +12,7 @@
 #include "common/error.h"
 #include "glcontext/gl_context.h"
 #include "glcontext/gl_program.h"
+#include "lights/light_kind.h"
 #include "raytrace/ray_tracer.h"
 #include "testing/scenes.h"
 
@@ -477,7 +478,7 @@ double pointLightCpu(const Light& L, glm::vec3 x, glm::vec3 n, const RayTracer& 
   float r = glm::length(d);
   float c = glm::dot(n, d / r);
   if (c <= 0 || rt.occluded(x + n * rt.epsilon(), d / r, 0.0f, r - rt.epsilon())) return 0.0;
-  return L.intensityToward(-d / r).x * c / (r * r) / kPi;
+  return lightKind(L).intensityToward(L, -d / r).x * c / (r * r) / kPi;
 }
 
 TEST(GlBackend, PointAndSpotLightsAreExactWithShadowMaps) {

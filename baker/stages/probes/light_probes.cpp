@@ -180,10 +180,8 @@ bool clearOfSurfaces(const RayTracer& rt, const glm::vec3& p, float clearance, d
 void addPunctualLights(const BakeInputs& in, const glm::vec3& p, const float* visibility, ShCoefficients& sh) {
   for (size_t l = 0; l < in.scene.lights.size(); ++l) {
     const Light& light = in.scene.lights[l];
-    const glm::vec3 toward = light.type == LightType::Directional ? -glm::normalize(light.direction)
-                                                                  : light.position - p;
-    if (!(glm::dot(toward, toward) > 0.0f) || !(visibility[l] > 0.0f)) continue;
-    const PunctualContribution c = punctualDirect(light, p, glm::normalize(toward));  // at normal incidence
+    if (!(visibility[l] > 0.0f)) continue;
+    const PunctualContribution c = lightKind(light.type).atNormalIncidence(light, p);
     if (c.mapValue == glm::vec3(0.0f)) continue;
     glm::vec3 colour(1.0f);
     const float own = punctualVisibility(in, light, p, &colour);

@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include "evaluators/bake_inputs.h"
+#include "lights/light_kind.h"
 #include "lightmap/lightmap.h"
 #include "lightmap/lightmap_read.h"
 #include "lightmap/probe_grid.h"
@@ -106,10 +107,10 @@ struct ProbeStats {
 // 4096 probes, a large share of a small model's bake.
 float chooseProbeSpacing(const Bounds3& volume, double probes);
 
-// The automatic count: ProbeOptions::autoProbes, or autoProbesSun when the scene has a directional light.
+// The automatic count: ProbeOptions::autoProbes, or autoProbesSun when the scene has a light at infinity (a sun).
 inline double autoProbeCount(const ProbeOptions& o, const std::vector<Light>& lights) {
   for (const Light& l : lights)
-    if (l.type == LightType::Directional) return o.autoProbesSun;
+    if (lightKind(l.type).atInfinity()) return o.autoProbesSun;
   return o.autoProbes;
 }
 

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/maths.h"
+#include "lights/light_kind.h"
 #include "sampling/sampling.h"
 #include "stages/probes/blend_fit.h"
 
@@ -22,8 +23,9 @@ constexpr double kConverged = 1e-5;    // largest change of a sweep
 
 float punctualVisibility(const BakeInputs& in, const Light& light, const glm::vec3& x, glm::vec3* colour) {
   if (colour) *colour = glm::vec3(1.0f);
-  const bool directional = light.type == LightType::Directional;
-  const glm::vec3 toward = directional ? -light.direction : light.position - x;
+  const LightKind& kind = lightKind(light.type);
+  const bool directional = kind.atInfinity();
+  const glm::vec3 toward = kind.toward(light, x);
   const float len = std::sqrt(glm::dot(toward, toward));
   if (!(len > 0.0f)) return 1.0f;
   const glm::vec3 w = toward / len;

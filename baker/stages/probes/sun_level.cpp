@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/maths.h"
+#include "lights/light_kind.h"
 #include "stages/probes/light_visibility_fit.h"
 #include "transport/geometry_term.h"
 
@@ -48,7 +49,8 @@ int strongestDirectionalLight(const std::vector<Light>& lights) {
   int best = -1;
   double strongest = 0.0;
   for (size_t l = 0; l < lights.size(); ++l) {
-    if (lights[l].type != LightType::Directional || !(glm::dot(lights[l].direction, lights[l].direction) > 0.0f)) continue;
+    if (!lightKind(lights[l].type).atInfinity() || !(glm::dot(lights[l].direction, lights[l].direction) > 0.0f))
+      continue;
     const glm::vec3 toward = -glm::normalize(lights[l].direction);
     const double e = channelMean(punctualDirect(lights[l], glm::vec3(0.0f), toward).mapValue);
     if (e > strongest) strongest = e, best = static_cast<int>(l);

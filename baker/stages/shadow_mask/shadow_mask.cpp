@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "common/progress.h"
+#include "lights/light_kind.h"
 #include "stages/shadow_edges/texel_square.h"
 
 namespace irbake {
@@ -19,12 +20,13 @@ float channelMax(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z));
 
 // Unit direction from x towards the light and the distance to it (infinite for a directional light).
 void towardLight(const Light& light, const glm::vec3& x, glm::vec3& dir, float& distance) {
-  if (light.type == LightType::Directional) {
-    dir = -light.direction;
+  const LightKind& kind = lightKind(light.type);
+  const glm::vec3 d = kind.toward(light, x);
+  if (kind.atInfinity()) {
+    dir = d;
     distance = INFINITY;
     return;
   }
-  const glm::vec3 d = light.position - x;
   distance = glm::length(d);
   dir = distance > 0.0f ? d / distance : glm::vec3(0.0f, 0.0f, 1.0f);
 }
@@ -101,17 +103,7 @@ void refineEdges(const BakeInputs& in, const TexelSamples& ts, const Light& ligh
 }  // namespace
 
 bool lightInfluences(const Light& light, const glm::vec3& x, float threshold) {
-  if (light.type == LightType::Directional) return true;
-  const glm::vec3 d = x - light.position;
-  const float r2 = glm::dot(d, d);
-  const float peak = channelMax(light.color) * light.intensity;  // W/sr on the axis
-  if (!(peak > 0.0f)) return false;
-  float reach2 = threshold > 0.0f ? peak / (3.14159265f * threshold) : INFINITY;
-  if (light.range > 0.0f) reach2 = std::min(reach2, light.range * light.range);
-  if (r2 > reach2) return false;
-  if (light.type == LightType::Spot && r2 > 0.0f)
-    return glm::dot(d, light.direction) >= std::cos(light.outerConeAngle) * std::sqrt(r2);
-  return true;
+  return lightKind(light.type).influences(light, x, threshold);
 }
 
 int ShadowMaskChannels::used() const {
