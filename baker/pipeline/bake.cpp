@@ -16,13 +16,10 @@
 #include "stages/gather/final_gather.h"
 #include "transport/geometry_term.h"
 #include "transport/vpl_importance.h"
-#include "evaluators/gl/gl_backend.h"
 #include "stages/interleave/interleaved_sampling.h"
-#include "glcontext/gl_context.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "common/progress.h"
-#include "evaluators/gl/shadow_views.h"
 #include "common/maths.h"
 #include "pipeline/evaluator_factory.h"
 #include "post/post.h"
@@ -95,7 +92,6 @@ struct StagedBake::State {
   VplSet vpls;
   BakePlan plan;              // every automatic choice, settled once
   VplImportanceStats importanceStats;
-  std::unique_ptr<GlContext> glContext;
   std::vector<std::vector<VplSet>> classVpls;       // per replicate of the walk, per interleave class
   // The error estimate (stages/error_estimate): the walk as independent replicates, each a whole estimate of
   // the VPL light; the even ones form half A, the odd ones half B, and their spread is the estimate.
@@ -116,9 +112,8 @@ struct StagedBake::State {
   int pagesClass = -1;                     // the class classPages holds (blocks run class by class, so one
   std::vector<TexelSamples> classPages;    // class's texel copy at a time: 1/n² of the samples' memory)
   std::vector<VplBlock> blocks;
-  GlBakeStats glStats;        // the GL evaluator adds every call's figures here (and a merge its shards' counts)
-  std::unique_ptr<Evaluator> contactEvaluator;  // Embree: where the GL evaluator sends its contact texels
-  std::unique_ptr<Evaluator> vplEvaluator;      // GL or Embree, made on the first call (after planBlocks)
+  EvaluatorDevices devices;                // the GL context, while the plan may choose GL
+  std::unique_ptr<Evaluator> evaluator;    // the plan's, made once it is chosen (it keeps its own figures)
   InterleaveStats interleaveStats;
   std::unique_ptr<FootprintAlbedo> footprintAlbedo;  // hit albedo for the compensation and the gather (one for both)
   std::unique_ptr<BakeInputs> wholeInputs;          // every page and VPL: the sky and the gather read them
@@ -547,36 +542,28 @@ struct StagedBake::State {
         blocks.push_back({static_cast<int>(c), b0, std::min(classVpls[r][c].vpls.size(), b0 + blockSize), r});
   }
 
-  // The plan (the GL context is made here where GL may run: its time counts to the backend).
+  // The plan and its evaluator (a GL context is made here where GL may run: its time counts to the backend).
   void chooseBackend() {
-    if (options.backend == BackendKind::Gl) part("context", [&] { glContext = std::make_unique<GlContext>(); });
     plan = planBake(scene, *rayTracer, options, [&] {
       GlProbe probe;
-      try {
-        if (!glContext) part("context", [&] { glContext = std::make_unique<GlContext>(); });
-        probe.softwareRenderer = glContext->softwareRenderer();
-      } catch (const Error& e) {
-        probe.error = e.what();
-      }
+      part("context", [&] { probe = devices.probeGl(); });
       return probe;
     });
-    if (plan.backend != BackendKind::Gl) {
-      glContext.reset();
-      return;
-    }
-    log::info("GL backend: " + glContext->description());
-    // On a CPU rasteriser the shadow pass costs every triangle once per VPL cube face (docs/validation.md).
-    if (glContext->softwareRenderer() && scene.triangleCount() > kGlTriangleHint && options.eval.includeVpls)
-      log::warn("GL backend on a software renderer with " + std::to_string(scene.triangleCount()) +
-                " triangles: its shadow pass draws them for every VPL cube (on the 2-core bench machine the Embree "
-                "backend baked a 58k-triangle room 4-17x faster); consider --backend embree");
+    EvaluatorSettings settings;
+    settings.gl = options.gl;
+    settings.reference.spp = options.referenceSpp;
+    settings.reference.seed = options.walk.seed;
+    part("context", [&] { evaluator = makeEvaluator(plan.backend, settings, &devices); });
+    devices.release();
   }
 
   // Interleave classes and the fixed blocks of each class's VPLs: the units shards and checkpoints split.
   void planBlocks() {
     if (plan.backend == BackendKind::Reference || !plan.eval.includeVpls || vpls.vpls.empty()) return;
-    settleBlocks(plan, options, texels, surfaceFilters.get(),
-                 [this](int c) -> const std::vector<TexelSamples>& { return pagesOf(c); }, vpls);
+    settleBlocks(plan, options, texels, surfaceFilters.get());
+    // Once for every block, from the first class's pages (the first blocks' own).
+    for (const EvaluatorChoice& c : evaluator->settle(inputs(pagesOf(0), vpls, plan.eval)))
+      plan.settle(c.key, c.value, c.reason);
     for (size_t r = 0; r < std::max<size_t>(1, replicates.size()); ++r) appendBlocks(r);
     interleaveStats.classes = static_cast<int>(classVpls[0].size());
   }
@@ -591,19 +578,11 @@ struct StagedBake::State {
     return classPages;
   }
 
-  // One call of the GL or Embree evaluator; with l1, the same pass also gives the L1 pages (--directional).
+  // One call of the VPL evaluator; with l1, the same pass also gives the L1 pages (--directional).
   std::vector<Lightmap> runVplBackend(const BakeInputs& in, L1Pages* l1 = nullptr) {
-    if (!vplEvaluator) {
-      EvaluatorSettings settings;
-      settings.gl = plan.gl;
-      settings.gl.context = glContext.get();
-      settings.gl.stats = &glStats;
-      if (plan.backend == BackendKind::Gl) contactEvaluator = makeEvaluator(BackendKind::Embree);
-      vplEvaluator = makeEvaluator(plan.backend, settings, contactEvaluator.get());
-    }
     EvaluationRequest request;
     request.directional = l1;
-    std::vector<Lightmap> maps = vplEvaluator->evaluate(in, request);
+    std::vector<Lightmap> maps = evaluator->evaluate(in, request);
     ++interleaveStats.backendCalls;
     return maps;
   }
@@ -678,21 +657,13 @@ struct StagedBake::State {
     return maps;
   }
 
-  std::vector<Lightmap> referenceStage(nlohmann::json& report) {
-    EvaluatorSettings settings;
-    settings.reference.spp = options.referenceSpp;
-    settings.reference.seed = options.walk.seed;
-    const std::unique_ptr<Evaluator> reference = makeEvaluator(BackendKind::Reference, settings);
-    std::vector<Lightmap> maps = reference->evaluate(inputs(texels, vpls, plan.eval));
-    report["reference"] = reference->stats();  // its paths per sample and how converged it is
-    return maps;
-  }
+  std::vector<Lightmap> referenceStage() { return evaluator->evaluate(inputs(texels, vpls, plan.eval)); }
 
   // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference). With
   // l1 (--directional) the L1 pages alike, each coefficient mixed on its own. Each page's sums are freed
   // once rounded: with four coefficients they are the largest thing alive here.
   std::vector<Lightmap> backendMaps(ExactVplSums& sums, nlohmann::json& report, L1Pages* l1) {
-    if (plan.backend == BackendKind::Reference) return referenceStage(report);
+    if (plan.backend == BackendKind::Reference) return referenceStage();
     if (!replicates.empty() && !halfB.pages.empty()) halves = mixedHalves(sums);
     std::vector<Lightmap> maps;
     part("direct", [&] { maps = cachedDirect.empty() || l1 ? directStage(l1) : std::move(cachedDirect); });
@@ -874,14 +845,13 @@ void StagedBake::stagesToTarget(ExactVplSums& sums, BakeResult& r) {
 }
 
 nlohmann::json StagedBake::backendCounts() const {
-  nlohmann::json counts = state_->glStats.toJson();
-  counts["texelsEvaluated"] = state_->glStats.texelsEvaluated;
+  nlohmann::json counts = state_->evaluator->counts();
   counts["backendCalls"] = state_->interleaveStats.backendCalls;
   return counts;
 }
 
 void StagedBake::addBackendCounts(const nlohmann::json& counts) {
-  state_->glStats.addCounts(counts);
+  state_->evaluator->addCounts(counts);
   state_->interleaveStats.backendCalls += counts.value("backendCalls", 0);
 }
 
@@ -919,7 +889,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   probeStage(ctx, r.maps, r.probes);
   if (!r.shadowMask.empty()) shadowMaskPostStage(ctx, r.shadowMask);
   s.seconds["bake"] = s.total.seconds();
-  describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, s.glStats, s.interleaveStats,
+  describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, *s.evaluator, s.interleaveStats,
                          s.blocks.size(), s.importanceStats, post},
                report);
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,

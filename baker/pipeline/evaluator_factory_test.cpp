@@ -12,7 +12,7 @@ TEST(EvaluatorFactory, MakesEachKindWithItsSettings) {
   EvaluatorSettings settings;
   settings.reference.spp = 12;
   const auto embree = makeEvaluator(BackendKind::Embree, settings);
-  const auto gl = makeEvaluator(BackendKind::Gl, settings, embree.get());  // no context until it evaluates
+  const auto gl = makeEvaluator(BackendKind::Gl, settings);  // no devices: no context until it evaluates
   const auto reference = makeEvaluator(BackendKind::Reference, settings);
   EXPECT_STREQ(embree->name(), "embree");
   EXPECT_STREQ(gl->name(), "gl");
