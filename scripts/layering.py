@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """layering.py [ROOT]: the evaluators are peers. Fails (exit 1, one "file:line: why" per offence) when a
 file under baker/evaluators/X includes "evaluators/Y/..." for another evaluator Y, or a file under
-baker/stages includes an evaluator implementation (evaluators/{gl,embree,reference}/...): both may include
-only the interface (evaluators/evaluator.h, evaluators/bake_inputs.h), and whoever builds the evaluators
-(baker/pipeline) wires them together. Tests (*_test.cpp) may compare or combine evaluators and are left out;
+baker/stages or baker/pipeline includes an evaluator implementation (evaluators/{gl,embree,reference}/...):
+they may include only the interface (evaluators/evaluator.h, evaluators/bake_inputs.h). The one exception is
+the evaluator factory (baker/pipeline/evaluator_factory.cpp), which makes the evaluators and wires them
+together. Tests (*_test.cpp) may compare or combine evaluators and are left out;
 their shared helpers live in baker/testing, outside both folders. Also fails when docs/architecture.md does not
 name a module folder (baker/X, baker/stages/X, baker/evaluators/X, written out or as baker/evaluators/{a,b}) or
 names one that is gone. ROOT: the repository (default: the folder above this script)."""
@@ -31,14 +32,21 @@ def evaluator_of(include, path, root, evaluators_dir):
     return parts[0] if len(parts) > 1 else None
 
 
+# The one file outside baker/evaluators that may include the implementations: it makes them.
+FACTORY = pathlib.Path("baker/pipeline/evaluator_factory.cpp")
+
+
 def offences(root):
     evaluators_dir = root / "baker" / "evaluators"
     stages_dir = root / "baker" / "stages"
+    pipeline_dir = root / "baker" / "pipeline"
     evaluators = sorted(p.name for p in evaluators_dir.iterdir() if p.is_dir())
     found = []
-    for top, owner in [(evaluators_dir, "evaluator"), (stages_dir, "stage")]:
+    for top, owner in [(evaluators_dir, "evaluator"), (stages_dir, "stage"), (pipeline_dir, "pipeline")]:
         for path in sorted(top.rglob("*")):
             if path.suffix not in SOURCES or not path.is_file() or is_test(path):
+                continue
+            if path.relative_to(root) == FACTORY:
                 continue
             rel = path.relative_to(top)
             own = rel.parts[0] if owner == "evaluator" and len(rel.parts) > 1 else None
@@ -49,8 +57,10 @@ def offences(root):
                     continue
                 why = (f"the {own} evaluator includes the {other} one" if own
                        else f"includes the {other} evaluator's implementation")
+                fix = ("make it in pipeline/evaluator_factory.cpp" if owner == "pipeline"
+                       else "be handed the evaluator")
                 found.append(f"{path.relative_to(root)}:{number}: {why} ({line.strip()}); "
-                             "include evaluators/evaluator.h and be handed the evaluator instead")
+                             f"include evaluators/evaluator.h and {fix} instead")
     return found
 
 
@@ -87,7 +97,8 @@ def main():
     for line in found + layout:
         print(line)
     if not found:
-        print("evaluators are peers: no evaluator includes another, no stage includes one")
+        print("evaluators are peers: no evaluator includes another, no stage includes one, and in the pipeline "
+              "only the evaluator factory does")
     if not layout:
         print("docs/architecture.md names every module folder and none that is gone")
     found += layout

@@ -3,11 +3,13 @@
 // contact texels).
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "evaluators/bake_inputs.h"
+#include "evaluators/evaluator_options.h"
 #include "lightmap/lightmap.h"
 
 namespace irbake {
@@ -20,6 +22,13 @@ struct EvaluationRequest {
   L1Pages* directional = nullptr;
 };
 
+// A choice an evaluator settles for itself; the bake's plan records it under `key` with its reason.
+struct EvaluatorChoice {
+  std::string key;
+  nlohmann::json value;
+  std::string reason;
+};
+
 class Evaluator {
  public:
   virtual ~Evaluator() = default;
@@ -29,6 +38,20 @@ class Evaluator {
   virtual const char* name() const = 0;
   // What the evaluator measured over its evaluations, as JSON (each implementation lists its fields).
   virtual nlohmann::json stats() const = 0;
+
+  // What its options leave automatic, settled once before its first evaluation from inputs like the ones it
+  // will get (the bake hands the first interleave class's pages, every VPL, the clamp settled). Returns the
+  // choices made, for the plan. Default: none.
+  virtual std::vector<EvaluatorChoice> settle(const BakeInputs& inputs) {
+    (void)inputs;
+    return {};
+  }
+  // Its own objects in the bake's report (its wall-clock figures under report["timings"]). Default: none.
+  virtual void describe(nlohmann::json& report) const { (void)report; }
+  // Its counts over the evaluations so far (the same every run), for a shard to carry to the merge, and a
+  // shard's counts added to its own. Default: none.
+  virtual nlohmann::json counts() const { return nlohmann::json::object(); }
+  virtual void addCounts(const nlohmann::json& counts) { (void)counts; }
 };
 
 }  // namespace irbake

@@ -23,6 +23,8 @@
 
 namespace irbake {
 
+struct BakeState;  // what the stages produced so far (pipeline/bake_state.h)
+
 struct BakeResult {
   Scene scene;                       // with the atlas applied (uv1, lightmap pages)
   AtlasResult atlas;
@@ -81,8 +83,7 @@ class StagedBake {
   BakeResult finish(ExactVplSums sums);
 
  private:
-  struct State;
-  std::unique_ptr<State> state_;
+  std::unique_ptr<BakeState> state_;
   // finish's part under a target: the ray stages and the figure, raised round by round until it is met.
   void stagesToTarget(ExactVplSums& sums, BakeResult& r);
 };

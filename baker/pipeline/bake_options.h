@@ -8,7 +8,7 @@
 #include "atlas/atlas.h"
 #include "common/progress.h"
 #include "evaluators/bake_inputs.h"
-#include "evaluators/gl/gl_backend.h"
+#include "evaluators/evaluator.h"
 #include "pipeline/backend_choice.h"
 #include "stages/error_estimate/error_estimate.h"
 #include "stages/compensation/clamp_compensation.h"

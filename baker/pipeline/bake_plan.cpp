@@ -7,7 +7,6 @@
 
 #include "common/error.h"
 #include "common/log.h"
-#include "evaluators/gl/shadow_views.h"
 #include "pipeline/light_modes.h"
 #include "stages/interleave/interleaved_sampling.h"
 #include "transport/geometry_term.h"
@@ -259,7 +258,6 @@ BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOpti
   plan.post.dilate = options.postDilate;
   plan.post.stitchSeams = options.postSeams;
   plan.eval = options.eval;
-  plan.gl = options.gl;
   return plan;
 }
 
@@ -290,18 +288,11 @@ void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene,
 }
 
 void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,
-                  SurfaceFilterCache* filters, const std::function<const std::vector<TexelSamples>&(int)>& pagesOf,
-                  const VplSet& vpls) {
+                  SurfaceFilterCache* filters) {
   plan.interleave = options.interleave ? *options.interleave : chooseInterleave(texels, plan.eval.clampBound, filters);
   plan.settle("interleave", plan.interleave,
               options.interleave ? "asked for" : "from the texel spacing and the clamp radius", !options.interleave);
   plan.compensation.classMix = plan.interleave;  // the residual mixed like the classes' VPL sum it completes
-  if (plan.backend != BackendKind::Gl || plan.gl.cubeFaceSize) return;
-  // Once for every block, from the first class's pages.
-  plan.gl.cubeFaceSize = chooseCubeFaceSize(vpls.vpls, pagesOf(0), plan.eval.clampBound, plan.gl.cubeFootprintPerTexel,
-                                            plan.gl.minCubeFaceSize, plan.gl.maxCubeFaceSize)
-                             .size;
-  plan.settle("cube-face", *plan.gl.cubeFaceSize, "a shadow texel's footprint held to the light-map texel spacing");
 }
 
 void checkLightModes(const BakeOptions& options, const Scene& scene) {

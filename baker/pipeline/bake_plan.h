@@ -10,7 +10,6 @@
 #include <nlohmann/json.hpp>
 
 #include "evaluators/bake_inputs.h"
-#include "evaluators/gl/gl_backend.h"
 #include "pipeline/backend_choice.h"
 #include "pipeline/bake_options.h"
 #include "post/post.h"
@@ -58,7 +57,6 @@ struct BakePlan {
   bool clampDerived = false;
   double importanceFactor = 1.0;            // candidates per kept VPL (1: the plain walk)
   int interleave = 1;                       // n×n texel classes
-  GlBackendOptions gl;                      // the GL evaluator's options, cube face size settled
 
   std::map<std::string, PlanChoice> choices;  // by option name ("backend", "paths", ...) or rule name
 
@@ -89,10 +87,8 @@ void checkLightModes(const BakeOptions& options, const Scene& scene);
 // The clamp: fixed, off, or derived from the scene and these VPLs (sets plan.eval.clampBound).
 void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls);
 
-// The interleave classes and the GL cube face size, from the texels, the clamp and the VPLs.
-// pagesOf(c): the texel samples of interleave class c as pages of their own.
+// The interleave classes, from the texels and the clamp (the evaluator settles its own options after it).
 void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,
-                  SurfaceFilterCache* filters, const std::function<const std::vector<TexelSamples>&(int)>& pagesOf,
-                  const VplSet& vpls);
+                  SurfaceFilterCache* filters);
 
 }  // namespace irbake

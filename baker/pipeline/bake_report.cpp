@@ -17,11 +17,6 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
                              {"reason", f.plan.choices.at("backend").reason}};
   report["compensationOverlapped"] = f.plan.overlapCompensation;
   report["backend"] = toString(f.plan.backend);
-  if (f.plan.backend == BackendKind::Gl) {
-    report["renderer"] = f.gl.renderer;
-    report["gl"] = f.gl.toJson();
-    report["timings"]["gl"] = f.gl.timingsJson();
-  }
   if (f.plan.backend != BackendKind::Reference) {
     report["interleave"] = f.interleave.toJson();
     report["interleave"]["vplBlocks"] = f.vplBlocks;
@@ -46,9 +41,9 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
                     {"clampVplsPerMean", f.plan.clampK},
                     {"clampDerived", f.plan.clampDerived},
                     {"biasCompensation", f.plan.eval.biasCompensation}};
-  if (f.plan.backend == BackendKind::Reference) report["eval"]["referenceSpp"] = f.options.referenceSpp;
   report["post"] = f.post.toJson();
   report["plan"] = f.plan.toJson();
+  f.evaluator.describe(report);
 }
 
 }  // namespace irbake

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atlas/atlas.h"
-#include "evaluators/gl/gl_backend.h"
+#include "evaluators/evaluator.h"
 #include "pipeline/bake_options.h"
 #include "pipeline/bake_plan.h"
 #include "post/post.h"
@@ -26,7 +26,7 @@ struct BakeFacts {
   const VplSet& vpls;
   const BakeOptions& options;
   const BakePlan& plan;
-  const GlBakeStats& gl;
+  const Evaluator& evaluator;  // adds its own objects (Evaluator::describe)
   const InterleaveStats& interleave;
   size_t vplBlocks = 0;
   const VplImportanceStats& importance;

@@ -1,6 +1,8 @@
 // Writing a finished bake: EXR pages, glTF with the maps attached, the portable GLB when asked, the JSON report.
 #include <fstream>
+#include <memory>
 #include <string>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -61,6 +63,97 @@ void removeStalePages(const BakeResult& result, const std::filesystem::path& out
   }
 }
 
+// Shadow masks: lightmap_<page>_shadowmask.exr beside the pages (and PNGs in the glTF), appended to exrs.
+ShadowMaskExport shadowMaskExport(const BakeResult& result, const std::filesystem::path& outDir,
+                                  std::vector<std::pair<std::filesystem::path, const Lightmap*>>& exrs) {
+  ShadowMaskExport mask;
+  if (result.shadowMask.empty()) return mask;
+  mask.rgb = &result.shadowMask.rgb;
+  mask.alpha = &result.shadowMask.alpha;
+  mask.scene = &result.scene;
+  for (size_t i = 0; i < result.maskChannels.channel.size(); ++i)
+    if (result.maskChannels.channel[i] >= 0)
+      mask.lights.push_back({&result.scene.lights[i], lightModeName(result.scene.lights[i]), result.maskChannels.channel[i]});
+  for (const Lightmap& m : result.shadowMask.rgb) exrs.push_back({outDir / shadowMaskPageUri("lightmap", m.page), &m});
+  return mask;
+}
+
+// The portable GLB, built now (its report entry, summary, says how) and written with the rest; none without
+// a path.
+std::vector<PendingFile> portableFiles(const BakeResult& result, const OutputOptions& options,
+                                       nlohmann::json& summary) {
+  namespace fs = std::filesystem;
+  if (options.portablePath.empty()) return {};
+  std::error_code ec;
+  const fs::path folder = options.portablePath.parent_path();
+  if (!folder.empty()) fs::create_directories(folder, ec);
+  if (!folder.empty() && !fs::is_directory(folder))
+    throw Error(ErrorCode::Io, folder.string(), "cannot create the portable GLB's folder");
+  return {portableGlbFile(result.scene, result.maps, options.portablePath, options.portable, &summary)};
+}
+
+// The report, naming what is written: glTF (+ .bin, PNG), EXR pages and report are one all-or-nothing set,
+// so a failed bake leaves the previous outputs, report included, untouched.
+PendingFile reportFile(const BakeResult& result, const std::vector<std::filesystem::path>& written,
+                       const nlohmann::json* portableSummary, const std::filesystem::path& reportPath) {
+  nlohmann::json report = result.report;
+  report["reportSchema"] = 2;  // bumped when a field changes meaning or goes away (2: timings in one object)
+  report["irbakeVersion"] = versionLine("irbake");
+  report["outputs"] = nlohmann::json::array();
+  for (const auto& p : written) report["outputs"].push_back(p.string());
+  if (portableSummary) report["portable"] = *portableSummary;
+  // A path is bytes, not always UTF-8: a name JSON cannot hold is written with U+FFFD in its place.
+  const auto text =
+      std::make_shared<const std::string>(report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  return {reportPath, [text, reportPath](const std::filesystem::path& temp) {
+            std::ofstream out(temp, std::ios::binary);
+            out << *text;
+            out.close();
+            if (!out) throw Error(ErrorCode::Io, reportPath.string(), "cannot write the report");
+          }};
+}
+
+// Without the glTF: the EXR pages, the L1 and shadow-mask pages (extraExrs, the mask's last), then `more`.
+void writeExrPages(const BakeResult& result, const std::vector<std::filesystem::path>& exrs,
+                   const std::vector<std::pair<std::filesystem::path, const Lightmap*>>& extraExrs,
+                   const ShadowMaskExport& mask, const std::vector<PendingFile>& more, const OutputGuard& guard) {
+  namespace fs = std::filesystem;
+  std::vector<PendingFile> files;
+  for (size_t i = 0; i < result.maps.size(); ++i) {
+    const Lightmap* map = &result.maps[i];
+    const fs::path finalPath = exrs[i];
+    files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
+  }
+  const size_t l1Count = extraExrs.size() - (mask.empty() ? 0 : mask.rgb->size());
+  for (size_t i = 0; i < extraExrs.size(); ++i) {
+    const Lightmap* map = extraExrs[i].second;
+    const fs::path finalPath = extraExrs[i].first;
+    const ShadowMaskExport* m = &mask;
+    const size_t page = i - l1Count;
+    if (i < l1Count) files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
+    else files.push_back({finalPath, [m, page, finalPath](const fs::path& temp) { writeShadowMaskExr(*m, page, temp, finalPath); }});
+  }
+  files.insert(files.end(), more.begin(), more.end());
+  guard.write(files);
+}
+
+// The glTF with the maps attached (exportGltf writes the EXR pages too), then `more` in the same set.
+void writeGltfAndPages(const BakeResult& result, const std::filesystem::path& gltfPath, const ShadowMaskExport& mask,
+                       const std::vector<PendingFile>& more, const OutputOptions& options, const OutputGuard& guard) {
+  ExportOptions ex;
+  ex.output = gltfPath;
+  ex.writeExrPages = true;
+  ex.exrPrefix = "lightmap";
+  ex.alsoWrite = more;
+  ex.inputs = options.inputs;
+  ex.guard = &guard;
+  if (!result.directional[0].empty()) ex.directional = &result.directional;
+  ex.probes = &result.probes;
+  if (!mask.empty()) ex.shadowMask = &mask;
+  ex.lightModes = &result.lightModes;
+  exportGltf(result.scene, result.maps, ex);
+}
+
 }  // namespace
 
 std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, const OutputOptions& options) {
@@ -74,22 +167,12 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
     throw Error(ErrorCode::Io, outDir.string(), "cannot create the output folder");
   std::vector<fs::path> exrs;
   for (const Lightmap& m : result.maps) exrs.push_back(outDir / ("lightmap_" + std::to_string(m.page) + ".exr"));
-  // Directional bakes: the L1 pages beside them (lightmap_<page>_l1x.exr, …).
+  // Directional bakes: the L1 pages beside them (lightmap_<page>_l1x.exr, …), then the shadow-mask pages.
   std::vector<std::pair<fs::path, const Lightmap*>> l1Exrs;
   for (int k = 0; k < 3; ++k)
     for (const Lightmap& m : result.directional[k])
       l1Exrs.push_back({outDir / directionalPageUri("lightmap", m.page, k), &m});
-  // Shadow masks: lightmap_<page>_shadowmask.exr beside the pages (and PNGs in the glTF).
-  ShadowMaskExport mask;
-  if (!result.shadowMask.empty()) {
-    mask.rgb = &result.shadowMask.rgb;
-    mask.alpha = &result.shadowMask.alpha;
-    mask.scene = &result.scene;
-    for (size_t i = 0; i < result.maskChannels.channel.size(); ++i)
-      if (result.maskChannels.channel[i] >= 0)
-        mask.lights.push_back({&result.scene.lights[i], lightModeName(result.scene.lights[i]), result.maskChannels.channel[i]});
-    for (const Lightmap& m : result.shadowMask.rgb) l1Exrs.push_back({outDir / shadowMaskPageUri("lightmap", m.page), &m});
-  }
+  const ShadowMaskExport mask = shadowMaskExport(result, outDir, l1Exrs);
   const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   OutputGuard unguarded;  // a caller without a command guard: one that knows the inputs
   unguarded.addInputs(options.inputs);
@@ -99,73 +182,18 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   written.insert(written.end(), exrs.begin(), exrs.end());
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
   const std::vector<PendingFile> errorPages = errorPageFiles(result, outDir, written);
-  // The portable GLB is built now (its report entry says how), written with the rest.
-  std::vector<PendingFile> portable;
   nlohmann::json portableSummary;
-  if (!options.portablePath.empty()) {
-    const fs::path folder = options.portablePath.parent_path();
-    if (!folder.empty()) fs::create_directories(folder, ec);
-    if (!folder.empty() && !fs::is_directory(folder))
-      throw Error(ErrorCode::Io, folder.string(), "cannot create the portable GLB's folder");
-    portable.push_back(portableGlbFile(result.scene, result.maps, options.portablePath, options.portable, &portableSummary));
-    written.push_back(options.portablePath);
-  }
+  const std::vector<PendingFile> portable = portableFiles(result, options, portableSummary);
+  if (!portable.empty()) written.push_back(options.portablePath);
   for (const PendingFile& f : options.alsoWrite) written.push_back(f.finalPath);
 
-  // The report names what is written, and is written with it: glTF (+ .bin, PNG), EXR pages and report are
-  // one all-or-nothing set, so a failed bake leaves the previous outputs, report included, untouched.
-  nlohmann::json report = result.report;
-  report["reportSchema"] = 2;  // bumped when a field changes meaning or goes away (2: timings in one object)
-  report["irbakeVersion"] = versionLine("irbake");
-  report["outputs"] = nlohmann::json::array();
-  for (const auto& p : written) report["outputs"].push_back(p.string());
-  if (!portable.empty()) report["portable"] = portableSummary;
-  // A path is bytes, not always UTF-8: a name JSON cannot hold is written with U+FFFD in its place.
-  const std::string text = report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-  PendingFile reportFile{reportPath, [&text, reportPath](const fs::path& temp) {
-                           std::ofstream out(temp, std::ios::binary);
-                           out << text;
-                           out.close();
-                           if (!out) throw Error(ErrorCode::Io, reportPath.string(), "cannot write the report");
-                         }};
-  if (options.writeGltf) {
-    ExportOptions ex;
-    ex.output = gltfPath;
-    ex.writeExrPages = true;
-    ex.exrPrefix = "lightmap";
-    ex.alsoWrite = {reportFile};
-    ex.alsoWrite.insert(ex.alsoWrite.end(), portable.begin(), portable.end());
-    ex.alsoWrite.insert(ex.alsoWrite.end(), errorPages.begin(), errorPages.end());
-    ex.alsoWrite.insert(ex.alsoWrite.end(), options.alsoWrite.begin(), options.alsoWrite.end());
-    ex.inputs = options.inputs;
-    ex.guard = &guard;
-    if (!result.directional[0].empty()) ex.directional = &result.directional;
-    ex.probes = &result.probes;
-    if (!mask.empty()) ex.shadowMask = &mask;
-    ex.lightModes = &result.lightModes;
-    exportGltf(result.scene, result.maps, ex);
-  } else {
-    std::vector<PendingFile> files;
-    for (size_t i = 0; i < result.maps.size(); ++i) {
-      const Lightmap* map = &result.maps[i];
-      const fs::path finalPath = exrs[i];
-      files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
-    }
-    const size_t l1Count = l1Exrs.size() - (mask.empty() ? 0 : mask.rgb->size());
-    for (size_t i = 0; i < l1Exrs.size(); ++i) {
-      const Lightmap* map = l1Exrs[i].second;
-      const fs::path finalPath = l1Exrs[i].first;
-      const ShadowMaskExport* m = &mask;
-      const size_t page = i - l1Count;
-      if (i < l1Count) files.push_back({finalPath, [map, finalPath](const fs::path& temp) { writeExrFile(*map, temp, finalPath); }});
-      else files.push_back({finalPath, [m, page, finalPath](const fs::path& temp) { writeShadowMaskExr(*m, page, temp, finalPath); }});
-    }
-    files.push_back(reportFile);
-    files.insert(files.end(), portable.begin(), portable.end());
-    files.insert(files.end(), errorPages.begin(), errorPages.end());
-    files.insert(files.end(), options.alsoWrite.begin(), options.alsoWrite.end());
-    guard.write(files);
-  }
+  // The report first, then the portable GLB, the error pages and the caller's files, with the pages.
+  std::vector<PendingFile> more = {reportFile(result, written, portable.empty() ? nullptr : &portableSummary, reportPath)};
+  more.insert(more.end(), portable.begin(), portable.end());
+  more.insert(more.end(), errorPages.begin(), errorPages.end());
+  more.insert(more.end(), options.alsoWrite.begin(), options.alsoWrite.end());
+  if (options.writeGltf) writeGltfAndPages(result, gltfPath, mask, more, options, guard);
+  else writeExrPages(result, exrs, l1Exrs, mask, more, guard);
 
   removeStalePages(result, outDir, guard);
   written.push_back(reportPath);

@@ -130,6 +130,64 @@ void writeVplSumFile(const std::filesystem::path& path, const VplSumHeader& head
   });
 }
 
+namespace {
+
+// The header's JSON (Error(Parse) naming path when a field is missing or of the wrong type).
+VplSumHeader parseHeader(const std::string& text, const std::filesystem::path& path) {
+  VplSumHeader hd;
+  try {
+    const nlohmann::json h = nlohmann::json::parse(text);
+    hd.kind = h.at("kind").get<std::string>();
+    hd.sceneHash = h.at("sceneHash").get<std::string>();
+    hd.optionsHash = h.at("optionsHash").get<std::string>();
+    hd.options = h.value("options", nlohmann::json::object());
+    hd.seed = h.at("seed").get<uint32_t>();
+    hd.backend = h.at("backend").get<std::string>();
+    hd.blockCount = h.at("blockCount").get<uint64_t>();
+    hd.firstBlock = h.at("firstBlock").get<uint64_t>();
+    hd.endBlock = h.at("endBlock").get<uint64_t>();
+    hd.shardIndex = h.at("shardIndex").get<int>();
+    hd.shardCount = h.at("shardCount").get<int>();
+    hd.command = h.at("command");
+    hd.backendCounts = h.at("backendCounts");
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(ErrorCode::Parse, path.string(), std::string("bad VPL sum header: ") + e.what());
+  }
+  return hd;
+}
+
+// The pages after the header: per page its texel count, each texel's state and the sums of the valid ones.
+void readPages(Reader& in, size_t fileSize, const std::filesystem::path& path, ExactVplSums& sums) {
+  const uint64_t pageCount = in.get<uint64_t>();
+  if (pageCount > fileSize) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
+  const uint64_t coefficients = in.get<uint64_t>();
+  if (coefficients != 1 && coefficients != uint64_t(ExactVplSums::kMaxCoefficients))
+    throw Error(ErrorCode::Parse, path.string(),
+                "VPL sum file is damaged (" + std::to_string(coefficients) + " coefficients per texel)");
+  sums.coefficients = static_cast<int>(coefficients);
+  const size_t channels = sums.channels();
+  for (uint64_t p = 0; p < pageCount; ++p) {
+    const uint64_t texels = in.get<uint64_t>();
+    if (texels > fileSize) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
+    std::vector<uint8_t> state(texels);
+    in.take(state.data(), texels);
+    std::vector<uint8_t> receivers(texels);
+    for (size_t t = 0; t < texels; ++t) {
+      if (state[t] > 2) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is damaged (bad texel state)");
+      receivers[t] = state[t] != 0;
+    }
+    ExactVplSums::Page page = std::move(ExactVplSums::zeros({receivers}, sums.coefficients).pages[0]);
+    for (size_t t = 0; t < texels; ++t) {
+      if (state[t] != 2) continue;
+      in.take(&page.values[channels * page.slot[t]], channels * sizeof(ExactInt));
+      page.valid[t] = 1;
+    }
+    sums.pages.push_back(std::move(page));
+  }
+}
+
+}  // namespace
+
 VplSumFile readVplSumFile(const std::filesystem::path& path) {
   std::string bytes;
   if (!readFile(path, bytes)) throw Error(ErrorCode::Io, path.string(), "cannot read the VPL sum file");
@@ -152,51 +210,8 @@ VplSumFile readVplSumFile(const std::filesystem::path& path) {
   std::string text(textSize, '\0');
   in.take(text.data(), textSize);
   VplSumFile file;
-  try {
-    const nlohmann::json h = nlohmann::json::parse(text);
-    VplSumHeader& hd = file.header;
-    hd.kind = h.at("kind").get<std::string>();
-    hd.sceneHash = h.at("sceneHash").get<std::string>();
-    hd.optionsHash = h.at("optionsHash").get<std::string>();
-    hd.options = h.value("options", nlohmann::json::object());
-    hd.seed = h.at("seed").get<uint32_t>();
-    hd.backend = h.at("backend").get<std::string>();
-    hd.blockCount = h.at("blockCount").get<uint64_t>();
-    hd.firstBlock = h.at("firstBlock").get<uint64_t>();
-    hd.endBlock = h.at("endBlock").get<uint64_t>();
-    hd.shardIndex = h.at("shardIndex").get<int>();
-    hd.shardCount = h.at("shardCount").get<int>();
-    hd.command = h.at("command");
-    hd.backendCounts = h.at("backendCounts");
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(ErrorCode::Parse, path.string(), std::string("bad VPL sum header: ") + e.what());
-  }
-  const uint64_t pageCount = in.get<uint64_t>();
-  if (pageCount > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
-  const uint64_t coefficients = in.get<uint64_t>();
-  if (coefficients != 1 && coefficients != uint64_t(ExactVplSums::kMaxCoefficients))
-    throw Error(ErrorCode::Parse, path.string(),
-                "VPL sum file is damaged (" + std::to_string(coefficients) + " coefficients per texel)");
-  file.sums.coefficients = static_cast<int>(coefficients);
-  const size_t channels = file.sums.channels();
-  for (uint64_t p = 0; p < pageCount; ++p) {
-    const uint64_t texels = in.get<uint64_t>();
-    if (texels > bytes.size()) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is truncated");
-    std::vector<uint8_t> state(texels);
-    in.take(state.data(), texels);
-    std::vector<uint8_t> receivers(texels);
-    for (size_t t = 0; t < texels; ++t) {
-      if (state[t] > 2) throw Error(ErrorCode::Parse, path.string(), "VPL sum file is damaged (bad texel state)");
-      receivers[t] = state[t] != 0;
-    }
-    ExactVplSums::Page page = std::move(ExactVplSums::zeros({receivers}, file.sums.coefficients).pages[0]);
-    for (size_t t = 0; t < texels; ++t) {
-      if (state[t] != 2) continue;
-      in.take(&page.values[channels * page.slot[t]], channels * sizeof(ExactInt));
-      page.valid[t] = 1;
-    }
-    file.sums.pages.push_back(std::move(page));
-  }
+  file.header = parseHeader(text, path);
+  readPages(in, bytes.size(), path, file.sums);
   char end[sizeof kEnd];
   in.take(end, sizeof end);
   if (std::memcmp(end, kEnd, sizeof kEnd) != 0 || in.at != bytes.size())

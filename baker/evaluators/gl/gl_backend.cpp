@@ -618,4 +618,27 @@ nlohmann::json GlEvaluator::stats() const {
   return {{"renderer", stats_->renderer}, {"counts", stats_->toJson()}, {"timings", stats_->timingsJson()}};
 }
 
+std::vector<EvaluatorChoice> GlEvaluator::settle(const BakeInputs& inputs) {
+  if (options_.cubeFaceSize) return {};
+  options_.cubeFaceSize = chooseCubeFaceSize(inputs.vpls.vpls, inputs.texels, inputs.eval.clampBound,
+                                             options_.cubeFootprintPerTexel, options_.minCubeFaceSize,
+                                             options_.maxCubeFaceSize)
+                              .size;
+  return {{"cube-face", *options_.cubeFaceSize, "a shadow texel's footprint held to the light-map texel spacing"}};
+}
+
+void GlEvaluator::describe(nlohmann::json& report) const {
+  report["renderer"] = stats_->renderer;
+  report["gl"] = stats_->toJson();
+  report["timings"]["gl"] = stats_->timingsJson();
+}
+
+nlohmann::json GlEvaluator::counts() const {
+  nlohmann::json counts = stats_->toJson();
+  counts["texelsEvaluated"] = stats_->texelsEvaluated;
+  return counts;
+}
+
+void GlEvaluator::addCounts(const nlohmann::json& counts) { stats_->addCounts(counts); }
+
 }  // namespace irbake

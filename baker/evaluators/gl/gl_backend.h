@@ -95,39 +95,6 @@ struct GlBakeStats {
   }
 };
 
-struct GlBackendOptions {
-  int vplsPerPass = 16;          // K: VPLs (depth cubes, 5 tiles each of one depth atlas) evaluated per accumulation pass
-  std::optional<int> cubeFaceSize;  // VPL depth-cube face size (texels, > 0); unset: from the light map (chooseCubeFaceSize)
-  float cubeFootprintPerTexel = 1.0f;  // automatic face size: face texel footprint at the median VPL distance, in texel spacings
-  int minCubeFaceSize = 128;     // automatic face size: lower bound (occluder detail the light map cannot see; docs/validation.md)
-  int maxCubeFaceSize = 256;     // automatic face size: upper bound
-  int pointFaceSize = 1024;      // point-light depth-cube face size (texels)
-  int lightMapSize = 4096;       // spot / directional shadow map size (texels; 64 MiB): smaller maps miss sub-texel
-                                 // slivers of occluders that rays hit (docs/validation.md)
-  int shadowFlushTriangles = 32768;  // VPL shadow pass: glFlush after this many triangles drawn into the depth atlas (0: once per batch)
-  int foldEveryPasses = 8;       // float passes summed on the GPU before folding into double
-  int clusterTriangles = 64;     // triangles per culling cluster (CPU per-face culling: smaller clusters cull more)
-  float maxSpotPerspectiveAngle = 1.05f;  // spots with a wider outer cone (rad) get a cube instead of one map
-  float nearPlaneScale = 1e-5f;  // shadow near plane = scale × scene diagonal (reversed-Z float depth)
-  float constantBiasScale = 2e-5f;  // constant depth bias = scale × scene diagonal
-  float slopeBias = 1.0f;        // depth bias in shadow texel footprints × (tanθ + 1.5): the 2×2 filter reads one texel around the lookup
-  float normalOffset = 0.0f;     // lookup point pushed along the receiver normal, in texel footprints
-  bool shadowPcf = true;         // VPL cubes: 2×2 percentage-closer filtering (fractional shadow edges)
-  bool shadowCompare = true;     // PCF by the sampler's depth comparison (GL_LINEAR, one lookup) instead of 4 fetches
-  bool skipInvalidTexels = true; // early depth test against a per-page validity mask: invalid texels are not shaded
-  // Contact texels: a shadow lookup that the depth bias counts as lit although the stored surface lies in
-  // front of the receiver's plane cannot tell a contact (a box on a floor, a lamp 0.1 mm under a ceiling)
-  // from the receiver itself. Texels where such lookups carry more than contactLeakFraction of the
-  // texel's light go to the contact evaluator (same inputs, those texels only), so an unresolved texel is
-  // off by at most that fraction from such lookups. Without a contact evaluator this is off.
-  bool resolveContacts = true;
-  float contactLeakFraction = 0.01f;
-  bool stageTimings = false;     // glFinish between stages so GlBakeStats splits shadow/accumulation time
-  bool gpuTimers = false;        // GL_TIME_ELAPSED queries per pass kind (GlBakeStats::gpu*Seconds)
-  const GlContext* context = nullptr;  // an existing context, made current per call; null: one made per call
-  GlBakeStats* stats = nullptr;  // where every call's figures are added (null: the evaluator keeps its own)
-};
-
 // L1 pages (EvaluationRequest::directional) come from the same passes, three more float targets per page
 // (contact texels: from the contact evaluator's L1 pages). A texel subset is rendered whole and then cut
 // (no time saved). stats(): {"renderer", "counts" (the report's "gl"), "timings" (its "timings.gl")}.
@@ -142,6 +109,13 @@ class GlEvaluator final : public Evaluator {
   std::vector<Lightmap> evaluate(const BakeInputs& inputs, const EvaluationRequest& request = {}) const override;
   const char* name() const override { return "gl"; }
   nlohmann::json stats() const override;
+  // The cube face size when unset (chooseCubeFaceSize on the inputs' pages, VPLs and clamp).
+  std::vector<EvaluatorChoice> settle(const BakeInputs& inputs) override;
+  // report "renderer", "gl" (the counts) and "timings.gl".
+  void describe(nlohmann::json& report) const override;
+  // The report's "gl" counts and the texels evaluated (GlBakeStats::addCounts).
+  nlohmann::json counts() const override;
+  void addCounts(const nlohmann::json& counts) override;
 
  private:
   GlBackendOptions options_;

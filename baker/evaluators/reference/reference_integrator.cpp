@@ -221,4 +221,9 @@ nlohmann::json ReferenceEvaluator::stats() const {
   return {{"spp", options_.spp}, {"relativeStandardError", relativeStandardError_}};
 }
 
+void ReferenceEvaluator::describe(nlohmann::json& report) const {
+  report["reference"] = stats();  // its paths per sample and how converged it is
+  report["eval"]["referenceSpp"] = options_.spp;
+}
+
 }  // namespace irbake

@@ -16,13 +16,6 @@
 
 namespace irbake {
 
-struct ReferenceOptions {
-  int spp = 256;           // paths per texel sample
-  uint32_t seed = 0;       // every texel sample gets its own stream derived from (seed, page, slot)
-  int maxDepth = 256;      // hard cap on bounces (roulette ends paths long before in practice)
-  int rouletteStart = 2;   // bounces before Russian roulette may stop a path
-};
-
 // One Lightmap per TexelSamples page (inputs.vpls and inputs.eval are not used: the reference is the
 // full solution). standardError (optional) receives per texel the standard error of the mean, same layout.
 // request.texelSubset traces those texels only; it makes no L1 pages (request.directional: Error(Usage)).
@@ -38,6 +31,8 @@ class ReferenceEvaluator final : public Evaluator {
   std::vector<Lightmap> evaluate(const BakeInputs& inputs, const EvaluationRequest& request = {}) const override;
   const char* name() const override { return "reference"; }
   nlohmann::json stats() const override;
+  // report "reference" (stats()) and eval.referenceSpp.
+  void describe(nlohmann::json& report) const override;
 
  private:
   ReferenceOptions options_;
