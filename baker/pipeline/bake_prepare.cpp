@@ -33,7 +33,9 @@ void chooseBackend(BakeState& s) {
   settings.gl = s.options.gl;
   settings.reference.spp = s.options.referenceSpp;
   settings.reference.seed = s.options.walk.seed;
-  part(s, "context", [&] { s.evaluator = makeEvaluator(s.plan.backend, settings, &s.devices); });
+  const auto make = [&] { s.evaluator = makeEvaluator(s.plan.backend, settings, &s.devices); };
+  if (s.plan.backend == BackendKind::Gl) part(s, "context", make);  // GL's context counts to the backend
+  else make();
   s.devices.release();
 }
 
