@@ -15,6 +15,7 @@
 
 #include "app/bake_command.h"
 #include "app/bake_config.h"
+#include "app/bake_option_table.h"
 #include "app/quality.h"
 #include "app/commands.h"
 #include "common/command_line.h"
@@ -42,44 +43,8 @@ namespace irbake::app {
 
 namespace {
 
-// What CLI11 writes that is not a BakeCommand field as such (turned into options by applyArguments).
-struct BakeArguments {
-  std::vector<std::string> scenes;
-  std::string backend = "auto", shard, finalGather = "auto", quality = "default";
-  std::string config, dumpConfig;  // --config FILE (read before parsing), --dump-config FILE
-  std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
-  std::string probes = "auto", probeBox;  // --probes auto|off|SPACING, --probe-box as given
-  std::vector<std::string> lightModes;  // --light-mode NAME=MODE as given
-  std::string lightModeOrigin;          // "FILE: line N: key 'light-mode'" when the config file gave them
-  double envIntensity = 1.0, envRotation = 0.0;
-  bool helpAll = false;
-  CLI::Option* shardOption = nullptr;
-  long long seed = 0;
-  double tpu = 0.0, clamp = 0.0, vplImportance = 0.0;  // 0: auto
-  int bounces = -1, interleave = 0, cubeFace = 0, compFilter = -1, walkSplit = 0, paths = 0;  // "auto" as cli::integerOrAuto writes it (kept for the options hash)
-  bool noLeakControl = false, noDilate = false, noSeams = false;
-  bool noBiasCompensation = false, biasCompensation = false;
-  CLI::Option* clampOption = nullptr;
-  std::string clampText() const { return clampOption && !clampOption->results().empty() ? clampOption->results()[0] : ""; }
-};
-
 // The smallest --clamp bound: below it the bound is 0 in single precision.
 constexpr double kSmallestClamp = 1e-30;
-// Light from the command line: at most this much (W/m², W/(m² sr)), so sums over the bake stay finite in float.
-constexpr double kLargestLight = 1e20;
-
-// A default as the help quotes it, read from where the default is defined: integers in full, others as %g.
-template <typename T>
-std::string shown(T value) {
-  if constexpr (std::is_integral_v<T>) {
-    return std::to_string(value);
-  } else {
-    std::ostringstream s;
-    s << value;
-    return s.str();
-  }
-}
-
 // --sun, --sky and --env as light a bake can use: a direction that is not zero (any length), amounts in
 // [0, kLargestLight], not both a sky and a map. Throws Error(Usage) naming the option.
 LightAdditions lightArguments(const BakeArguments& a) {
@@ -136,323 +101,6 @@ void probeArguments(const BakeArguments& a, ProbeOptions& o) {
   }
 }
 
-// The options a user sets, shown by --help; the rest by --help-all, in groups by stage.
-const std::vector<std::string> kCommonOptions = {"SCENE", "output", "quality", "config", "sun", "sky", "env",
-                                                 "texels-per-unit", "directional", "probes", "seed", "target-error",
-                                                 "threads", "report",
-                                                 "quiet", "portable", "help", "help-all"};
-const std::vector<std::pair<std::string, std::vector<std::string>>> kOptionGroups = {
-    {"Light paths and VPLs", {"paths", "bounces", "walk-split", "vpl-importance", "vpl-probes", "vpl-keep", "vpl-block"}},
-    {"Texels", {"max-texels", "supersample", "interleave"}},
-    {"Clamp and its compensation", {"clamp", "clamp-k", "no-bias-compensation", "bias-compensation", "comp-rays",
-                                    "comp-refine", "comp-ray-budget", "comp-filter"}},
-    {"Final gather", {"final-gather", "gather-rays", "gather-pre-rays", "gather-ray-budget", "gather-filter"}},
-    {"Sky, environment and punctual lights", {"sky-rays", "sky-ray-budget", "env-intensity", "env-rotation",
-                                              "shadow-edge-samples", "light-mode"}},
-    {"Irradiance probes", {"probe-box", "probe-budget", "probe-rays", "probe-light-fit", "probe-volume-fit", "probe-volume-rays",
-                           "probe-volume-clearance", "probe-exact-emitters"}},
-    {"Backends", {"backend", "cube-face", "spp"}},
-    {"Outputs", {"no-gltf", "portable-exposure", "dump-config", "verbose"}},
-    {"Distributed and resumable bakes", {"shard", "resume", "checkpoint-seconds"}},
-    {"Estimated error", {"estimate-error", "max-time", "max-rounds", "error-map"}},
-    {"Diagnostics", {"no-leak-control", "no-dilate", "no-seams", "gpu-timers"}},
-};
-
-void groupOptions(CLI::App& app) {
-  for (CLI::Option* option : app.get_options()) {
-    const std::string name = option->get_single_name();
-    if (std::find(kCommonOptions.begin(), kCommonOptions.end(), name) != kCommonOptions.end()) {
-      option->group("Options");
-      continue;
-    }
-    for (const auto& [group, names] : kOptionGroups)
-      if (std::find(names.begin(), names.end(), name) != names.end()) option->group(group);
-  }
-}
-
-// The scene, the output, the backend, the walk and the texels.
-void addWalkOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
-  BakeOptions& o = command.options;
-  const BakeOptions d;
-  const QualityPreset& q = defaultQualityPreset();
-  app->add_option("SCENE", a.scenes, "the glTF/GLB scene to bake");
-  app->add_option("-o,--output", command.out, "output folder (OUTDIR), or OUT.glb / OUT.gltf: that glTF, the rest beside it")->type_name("OUTDIR");
-  app->add_option("--backend", a.backend,
-                  "evaluator (default auto: GL on a GPU or for scenes ≤ " + shown(kGlTriangleHint / 1000) + "k triangles,\n"
-                  "else embree; embree: ray-traced; reference: path traced)")
-      ->check(CLI::IsMember({"auto", "gl", "embree", "reference"}));
-  app->add_option("--paths,--vpls", a.paths,
-                  "light paths of the quasi-random walk (default auto: by --quality;\n" + shown(q.pathsUnderGather) +
-                      " under the final gather, which reads their map averaged; without it\n" + shown(q.paths / 2) +
-                      " evaluated, from 8x as many walked, forked past bounce 1 and resampled;\n" +
-                      "or " + shown(q.paths) + " with --walk-split N and no final gather)")
-      ->transform(cli::integerOrAuto(1, 1 << 26, 0))->type_name("N|auto");
-  app->add_option("--bounces", a.bounces, "diffuse bounces (default auto: follow the energy left)")
-      ->transform(cli::integerOrAuto(0, 64, -1))->type_name("N|auto");
-  app->add_option("--walk-split", a.walkSplit,
-                  "paths fork into N where they leave bounce 1, each child carrying 1/N\n"
-                  "(default auto: 1/(share of that light meeting the scene again), at most " +
-                      shown(d.walk.maxAutoSplit) + ";\n"
-                  "1 in closed scenes, but at least 4 where the final gather does not run;\n"
-                  "1 = Keller's plain walk)")
-      ->transform(cli::integerOrAuto(1, 64, 0))->type_name("N|auto");
-  app->add_option("--vpl-importance", a.vplImportance,
-                  "importance-driven VPLs: the walk places F times the VPLs and --vpl-keep of\n"
-                  "the plain walk's count is kept, chosen by what they add to dim texels\n"
-                  "(default auto: where the final gather runs and a pilot finds them uneven,\n"
-                  "F up to " + shown(d.vplImportance.maxFactor) + " while probes × candidates ≤ " +
-                      shown(d.vplImportance.pairBudget / 1e6) + "M; 1: the plain walk)")
-      ->transform(cli::numberOrAuto(1.0, 64.0, 0.0))->type_name("F|auto");
-  app->add_option("--vpl-probes", o.vplImportance.probes,
-                  "importance-driven VPLs: texel samples the candidates are measured at (default " +
-                      shown(d.vplImportance.probes) + ")")
-      ->transform(cli::integerIn(16, 65536))->type_name("N");
-  app->add_option("--vpl-keep", o.vplImportance.keepShare,
-                  "importance-driven VPLs: VPLs kept, as a share of the plain walk's count (default " +
-                      shown(d.vplImportance.keepShare) + ")")
-      ->transform(cli::numberIn(0.05, 4.0))->type_name("S");
-  app->add_option("--texels-per-unit", a.tpu, "texels per metre (default: about one " + shown(q.autoPageSize) + "² page, ≥ " +
-                                                   shown(d.atlas.texelsPerTriangle) + " per triangle)")
-      ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
-  app->add_option("--max-texels", o.atlas.maxTexels,
-                  "texel budget of all pages together (default " + shown(d.atlas.maxTexels) + " = " +
-                      shown(d.atlas.maxTexels >> 20) + "M);\n"
-                  "a denser atlas fails at once, naming the density that fits;\n0 = no limit")
-      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
-  app->add_option("--supersample", o.texels.supersample, "S×S samples per texel (default " + shown(d.texels.supersample) + ")")
-      ->transform(cli::integerIn(1, 8))->type_name("S");
-}
-
-// The clamp and its compensation, the final gather, interleaving, the GL backend's cubes.
-void addStageOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
-  BakeOptions& o = command.options;
-  const BakeOptions d;
-  const QualityPreset& q = defaultQualityPreset();
-  a.clampOption =
-      app->add_option("--clamp", a.clamp, "geometry-term bound (1/m²); 0 = no clamp\n(default: derived from the scene)")
-          ->transform(cli::numberIn(0.0, 1e30))
-          ->type_name("B");
-  app->add_option("--clamp-k", o.clampVplsPerMean,
-                  "derived clamp: no VPL adds more than 1/K of the mean\n"
-                  "(default with bias compensation: " + shown(kCompensatedClampVplsPerMean) + ", or " +
-                      shown(kCompensatedClampVplsPerMeanNoEmitters) + " in a scene\nwithout small emissive surfaces (under half the surface); " +
-                      shown(kClampVplsPerMean) + " without; 0 = automatic)")
-      ->transform(cli::numberIn(0.0, 1e6))->type_name("K");
-  app->add_flag("--no-bias-compensation", a.noBiasCompensation,
-               "keep the clamp's bias (default: recovered by a gather into\nthe map, after Kollig & Keller 2004)");
-  app->add_flag("--bias-compensation", a.biasCompensation, "the default (kept for old scripts)");
-  app->add_option("--comp-rays", o.compensation.rays,
-                  "bias compensation: rays per texel sample, first round (default " + shown(q.compensationRays) + ")")
-      ->transform(cli::integerIn(1, 4096))->type_name("N");
-  app->add_option("--comp-refine", o.compensation.refineRays,
-                  "bias compensation: extra rays where needed (default " + shown(q.compensationRefine) + ")")
-      ->transform(cli::integerIn(0, 65536))->type_name("N");
-  app->add_option("--comp-ray-budget", o.compensation.rayBudget,
-                  "bias compensation: first-round rays over all samples (default " + shown(q.compensationBudget) +
-                      ";\na large page gets fewer per sample, never below " + shown(d.compensation.minRays) + "; 0 = no cap)")
-      ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
-  app->add_option("--comp-filter", a.compFilter,
-                  "bias compensation: the residual averaged over (2R+1)² texels on\n"
-                  "the same surface (default auto: up to 4 where the rays per sample are\n"
-                  "few and R texels stay within 1/20 of the clamp radius; 0 = none)")
-      ->transform(cli::integerOrAuto(0, 8, -1))->type_name("R|auto");
-  app->add_option("--final-gather", a.finalGather,
-                  "bounced light gathered from the baked map one bounce away instead of\n"
-                  "read from the VPLs that reach each texel (docs/units.md): on, off,\n"
-                  "or auto (default: on in scenes without emissive or see-through surfaces)")
-      ->check(CLI::IsMember({"off", "on", "auto"}))->type_name("off|on|auto");
-  app->add_option("--gather-rays", o.gather.rays, "final gather: cosine rays per texel sample (default " + shown(q.gatherRays) + ")")
-      ->transform(cli::integerIn(1, 4096))->type_name("N");
-  app->add_option("--gather-pre-rays", o.gather.preRays,
-                  "final gather: rays per sample of a first, cheaper gather whose map\nthe final rays read (default " +
-                      shown(d.gather.preRays) + "; 0 = none)")
-      ->transform(cli::integerIn(0, 4096))->type_name("N");
-  app->add_option("--gather-ray-budget", o.gather.rayBudget,
-                  "final gather: rays over all samples (default " + shown(q.gatherRayBudget) + "; a large\n"
-                  "page gets fewer per sample, never below " + shown(d.gather.minRays) + "; 0 = no cap)")
-      ->transform(cli::integerIn(0, 1LL << 34))->type_name("N");
-  app->add_option("--gather-filter", o.gather.filterRadius,
-                  "final gather: the gathered light averaged over (2R+1)² texels on\nthe same surface (default " +
-                      shown(d.gather.filterRadius) + "; 0 = none)")
-      ->transform(cli::integerIn(0, 8))->type_name("R");
-  app->add_option("--interleave", a.interleave,
-                  "interleaved sampling: each texel of an N×N block sees 1/N²\n"
-                  "of the VPLs, then a filter on the surface mixes them\n"
-                  "(default auto: 1.." + shown(kMaxAutoInterleave) + " from the texel size and the clamp radius;\n"
-                  "1 = every VPL everywhere)")
-      ->transform(cli::integerOrAuto(1, 8, 0))->type_name("N|auto");
-  app->add_option("--cube-face", a.cubeFace,
-                  "GL backend: VPL depth-cube face size in texels\n"
-                  "(default auto: a shadow texel's footprint held to the\nlight-map texel spacing, " +
-                      shown(d.gl.minCubeFaceSize) + ".." + shown(d.gl.maxCubeFaceSize) + ")")
-      ->transform(cli::integerOrAuto(16, 2048, 0))->type_name("N|auto");
-}
-
-// The seed, light from the command line, and what is written.
-void addLightAndOutputOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
-  BakeOptions& o = command.options;
-  const BakeOptions d;
-  const BakeCommand dc;
-  const QualityPreset& q = defaultQualityPreset();
-  app->add_option("--seed", a.seed, "walk seed (default 0)")->transform(cli::integerIn(0, 1 << 30))->type_name("K");
-  app->add_option("--spp", o.referenceSpp, "reference backend: paths per texel sample (default " + shown(d.referenceSpp) + ")")
-      ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
-  app->add_option("--sun", a.sun, "add a directional light travelling along D with irradiance E (W/m²)")
-      ->transform(cli::numberList(4))->type_name("DX,DY,DZ,E");
-  app->add_option("--sky", a.sky, "a uniform sky of that radiance (W/(m² sr))")
-      ->transform(cli::numberList(3))->type_name("R,G,B");
-  app->add_option("--sky-rays", o.sky.raysPerSample, "sky and environment: rays per texel sample (default " + shown(q.skyRays) + ")")
-      ->transform(cli::integerIn(8, 4096))->type_name("N");
-  app->add_option("--sky-ray-budget", o.sky.maxRays,
-                  "sky and environment: rays over all samples (default " + shown(q.skyRayBudget) + "; a large\n"
-                  "page gets fewer per sample, never below " + shown(d.sky.minRays) + ", or 4 where the final\n"
-                  "gather counts a uniform sky itself)")
-      ->transform(cli::integerIn(1, 1 << 30))->type_name("N");
-  app->add_option("--light-mode", a.lightModes,
-                  "a punctual light's bake mode: baked (default), indirect (its bounces\n"
-                  "only) or shadowmask (indirect plus its visibility in a mask page);\n"
-                  "NAME: the glTF light's name, sun (--sun), #I (KHR light I) or *\n"
-                  "(every punctual light); name:TEXT, index:I and option:sun never\n"
-                  "mean another light; repeatable, beats extras.irbake.mode")
-      ->type_name("NAME=MODE")
-      ->allow_extra_args(false);  // one NAME=MODE per --light-mode: never the SCENE after it
-  app->add_option("--shadow-edge-samples", o.shadowEdges.subSamples,
-                  "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
-                      shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)")
-      ->transform(cli::integerIn(0, 16))->type_name("S");
-  app->add_option("--env", a.env, "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky")
-      ->type_name("FILE");
-  app->add_option("--env-intensity", a.envIntensity, "scales --env (default " + shown(LightAdditions{}.environmentIntensity) + ")")->transform(cli::numberIn(0.0, kLargestLight))->type_name("S");
-  app->add_option("--env-rotation", a.envRotation, "turns --env about +Y (degrees, default " + shown(LightAdditions{}.environmentRotation) + ")")
-      ->transform(cli::numberIn(-36000.0, 36000.0))->type_name("DEG");
-  app->add_option("--report", command.report, "report path (default OUTDIR/report.json)")->type_name("R.json");
-  app->add_option("--probes", a.probes,
-                  "irradiance probes for moving objects (IRBAKE_light_probes): auto (default: about\n"
-                  "1024 probes over the scene, 2048 with a sun), off, or a spacing in metres")
-      ->type_name("auto|off|M");
-  app->add_option("--probe-box", a.probeBox, "the probes fill this box instead of the scene's bounds")
-      ->transform(cli::numberList(6))->type_name("X0,Y0,Z0,X1,Y1,Z1");
-  app->add_option("--probe-budget", o.probes.budget,
-                  "at most N probes, or the bake is refused before any work (default " + shown(ProbeOptions{}.budget) +
-                      ",\n8x the automatic grid with a sun; up to " + shown(ProbeOptions{}.maxProbes) + ")")
-      ->transform(cli::integerIn(1, static_cast<int>(ProbeOptions{}.maxProbes)))->type_name("N");
-  app->add_option("--probe-rays", o.probes.rays, "rays per probe (default " + std::to_string(ProbeOptions{}.rays) + ")")
-      ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
-  app->add_option("--probe-light-fit", o.probes.lightFitSamples,
-                  "the punctual lights' visibility at the probes fitted over S×S×S points per probe\n"
-                  "(default " + std::to_string(ProbeOptions{}.lightFitSamples) + "; 0: each probe's own shadow ray)")
-      ->transform(cli::integerIn(0, 8))->type_name("S");
-  app->add_option("--probe-volume-fit", o.probes.volumeFitSamples,
-                  "the rest of the probes' light fitted over S×S×S points per probe, " +
-                      std::to_string(ProbeOptions{}.volumeFitRays) + " rays each\n(default " +
-                      std::to_string(ProbeOptions{}.volumeFitSamples) + "; 0: each probe's own rays)")
-      ->transform(cli::integerIn(0, 8))->type_name("S");
-  app->add_option("--probe-volume-rays", o.probes.volumeFitRays,
-                  "lattice rays per point of the volume fit (default " + std::to_string(ProbeOptions{}.volumeFitRays) + ")")
-      ->transform(cli::integerIn(16, 1 << 16))->type_name("N");
-  app->add_option("--probe-volume-clearance", o.probes.volumeFitClearance,
-                  "the volume fit's points at least this many spacings from every surface (default " +
-                      shown(ProbeOptions{}.volumeFitClearance) + ";\n0: every point the probes see)")
-      ->transform(cli::numberIn(0.0, 8.0))->type_name("C");
-  app->add_option("--probe-exact-emitters", o.probes.exactEmitterTriangles,
-                  "uniform planar or small emitters of at most N triangles in all (brightest first) left out of the\n"
-                  "probes' SH for the clients' exact shading (default " + std::to_string(ProbeOptions{}.exactEmitterTriangles) +
-                      "; 0: every emitter in the SH)")
-      ->transform(cli::integerIn(0, kMaxExactEmitterTriangles))->type_name("N");
-  app->add_flag("--directional", o.directional,
-                "also bake directional (L1) maps (docs/export.md)");
-  app->add_flag("--no-gltf", command.noGltf, "write only the EXR pages and the report");
-  app->add_option("--portable", command.portable,
-                  "also write FILE.glb for viewers without MOZ_lightmap: base colour × light\n"
-                  "map + emission baked into unlit textures (KHR_materials_unlit; docs/export.md)")
-      ->type_name("FILE.glb");
-  app->add_option("--portable-exposure", command.portableExposure,
-                  "--portable: scale on the shown values before the 8-bit sRGB encode\n"
-                  "(default " + shown(dc.portableExposure) + ": the map as it is; values above 1 clip)")
-      ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
-}
-
-// Diagnostics, threads and logging, distributed and resumable bakes, presets and config files.
-void addRunOptions(CLI::App* app, BakeCommand& command, BakeArguments& a) {
-  BakeOptions& o = command.options;
-  const BakeOptions d;
-  const BakeCommand dc;
-  app->add_flag("--no-leak-control", a.noLeakControl, "diagnostics: texel samples may sit behind walls");
-  app->add_flag("--no-dilate", a.noDilate, "diagnostics: no dilation into the padding");
-  app->add_flag("--no-seams", a.noSeams, "diagnostics: no seam stitching");
-  app->add_flag("--gpu-timers", o.gl.gpuTimers,
-                "diagnostics: the GL passes' GPU time in the report (timings.gl.gpu*Seconds;\n"
-                "timer queries, which some drivers serialise)");
-  app->add_option("--threads", command.threads, "worker threads (default 0: every core; same bytes for any count)")
-      ->transform(cli::integerIn(0, 1024))->type_name("N");
-  app->add_flag("--quiet", command.quiet, "warnings and errors only, no progress bars");
-  app->add_flag("--verbose", command.verbose, "also the stages' debug lines (e.g. the compensation's sweeps)");
-  a.shardOption = app->add_option("--shard", a.shard,
-                  "evaluate share K of N of the VPL blocks and write the exact partial\n"
-                  "sums to OUTDIR/partial_K_of_N.vplsum for 'irbake merge' (docs/distributed.md)")
-      ->type_name("K/N");
-  app->add_flag("--resume", command.resume,
-                "continue from OUTDIR's checkpoint (left by a bake that was killed);\n"
-                "the outputs are byte-identical to an uninterrupted bake");
-  app->add_option("--checkpoint-seconds", command.checkpointSeconds,
-                  "at most this long between checkpoints of the VPL sums (default " + shown(dc.checkpointSeconds) +
-                      ";\n0: after every VPL block)")
-      ->transform(cli::numberIn(0.0, 1e9))->type_name("S");
-  app->add_option("--vpl-block", o.vplBlock,
-                  "VPLs per block of the exact VPL sum, the unit of shards and\ncheckpoints (default " + shown(d.vplBlock) + ")")
-      ->transform(cli::integerIn(1, 1 << 20))->type_name("N");
-  app->add_option("--quality", a.quality,
-                  "paths and rays together (default: default; docs/validation.md)")
-      ->check(CLI::IsMember({"preview", "default", "high", "production"}))->type_name("Q");
-  app->add_option("--config", a.config, "options from a TOML file (key = value); the command line wins")
-      ->type_name("FILE");
-  app->add_option("--dump-config", a.dumpConfig, "write every option of this bake as such a file")->type_name("FILE");
-  app->add_flag("--help-all", a.helpAll, "every option, grouped by stage");
-}
-
-// The bake's own error (stages/error_estimate) and the target that adds rounds until it is met.
-void addErrorOptions(CLI::App* app, BakeCommand& command) {
-  ErrorEstimateOptions& e = command.options.errorEstimate;
-  const ErrorEstimateOptions d;
-  app->add_flag("--estimate-error", e.enabled,
-                "walk the paths as two independent halves (seeds of their own) and\n"
-                "report the bake's estimated error (report.json estimatedError:\n"
-                "relative RMS on 4x4-texel bins, as bench/cycles/compare.py scores)");
-  app->add_option("--target-error", e.targetError,
-                  "add paths or stage rays until the estimated error is at most E (e.g. 0.02)")
-      ->transform(cli::numberIn(1e-6, 1.0))->type_name("E");
-  app->add_option("--max-rounds", e.maxRounds,
-                  "--target-error: at most this many rounds, of paths or of rays\n(default " + shown(d.maxRounds) + ")")
-      ->transform(cli::integerIn(1, 4096))->type_name("N");
-  app->add_option("--max-time", e.maxSeconds,
-                  "--target-error: no round started that would end past this many\n"
-                  "seconds of bake (default 0: no cap; the result then depends on the\nmachine)")
-      ->transform(cli::numberIn(0.0, 1e9))->type_name("SECONDS");
-  app->add_flag("--error-map", e.errorMap,
-                "with the estimate: also each texel's standard error, OUTDIR/error_<page>.exr");
-}
-
-// Every option of `irbake bake`, with its range and help.
-std::unique_ptr<CLI::App> bakeApp(BakeCommand& command, BakeArguments& a) {
-  auto app = cli::makeApp("irbake bake",
-                          "Bakes light maps (EXR, irradiance/pi, linear) and exports glTF with MOZ_lightmap.\n"
-                          "Writes OUTDIR/lightmap_<page>.exr, OUTDIR/scene.gltf and the report.");
-  addWalkOptions(app.get(), command, a);
-  addStageOptions(app.get(), command, a);
-  addLightAndOutputOptions(app.get(), command, a);
-  addRunOptions(app.get(), command, a);
-  addErrorOptions(app.get(), command);
-  groupOptions(*app);
-  return app;
-}
-
-// Options that only say where and how fast to write: not part of the result.
-const std::vector<std::string> kNotResult = {"SCENE", "output", "report", "threads", "quiet", "verbose", "no-gltf",
-                                             "portable", "portable-exposure", "shard", "resume", "checkpoint-seconds",
-                                             "help", "help-all", "config", "dump-config"};
-// Options whose presence changes the result even at the default value (--clamp 0: no clamp; none: derived).
-const std::vector<std::string> kPresenceMatters = {"clamp"};
-
 bool sameValue(const std::string& a, const std::string& b) {
   if (a == b) return true;
   char* endA = nullptr;
@@ -465,24 +113,13 @@ bool sameValue(const std::string& a, const std::string& b) {
 // canonically), less any option given at its default, so "--seed 0" or "--vpls auto" is the bake without
 // it. Partials and checkpoints carry it and its hash; a refused resume names the options that differ.
 nlohmann::json resultOptions(const CLI::App& app) {
-  BakeCommand freshCommand;
-  BakeArguments freshArguments;
-  const std::unique_ptr<CLI::App> defaults = bakeApp(freshCommand, freshArguments);
   nlohmann::json options = nlohmann::json::object();
-  for (const CLI::Option* option : app.get_options()) {
-    const std::string name = option->get_single_name();
-    if (option->count() == 0 || std::find(kNotResult.begin(), kNotResult.end(), name) != kNotResult.end()) continue;
-    std::string value;
-    if (option->get_expected_min() == 0) {
-      value = "true";  // a flag
-    } else {
-      for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
-    }
-    const CLI::Option* plain = defaults->get_option_no_throw(option->get_name());
-    const std::string fallback = plain ? const_cast<CLI::Option*>(plain)->capture_default_str()->get_default_str() : "";
-    const bool presence = std::find(kPresenceMatters.begin(), kPresenceMatters.end(), name) != kPresenceMatters.end();
-    if (!presence && option->get_expected_min() != 0 && sameValue(value, fallback)) continue;
-    options[name] = value;
+  for (const OptionDescriptor& d : bakeOptionTable()) {
+    const CLI::Option* option = givenOption(app, d);
+    if (option->count() == 0 || d.has(kNotResult)) continue;
+    const std::string value = d.isFlag() ? "true" : joinedResults(*option);
+    if (!d.has(kPresence) && !d.isFlag() && sameValue(value, defaultText(d))) continue;
+    options[d.name] = value;
   }
   return options;
 }
@@ -580,25 +217,6 @@ std::string argumentValue(const Args& args, const std::string& name) {
   return {};
 }
 
-// The knobs a --quality preset sets, where their own option is not given.
-void applyQuality(const CLI::App& app, const BakeArguments& a, BakeOptions& o) {
-  const QualityPreset& p = *findQualityPreset(a.quality);
-  auto unset = [&](const char* name) { return app.get_option(name)->count() == 0; };
-  if (unset("--gather-rays")) o.gather.rays = p.gatherRays;
-  if (unset("--gather-ray-budget")) o.gather.rayBudget = p.gatherRayBudget;
-  if (unset("--comp-rays")) o.compensation.rays = p.compensationRays;
-  if (unset("--comp-refine")) o.compensation.refineRays = p.compensationRefine;
-  if (unset("--comp-ray-budget")) o.compensation.rayBudget = p.compensationBudget;
-  if (unset("--sky-rays")) o.sky.raysPerSample = p.skyRays;
-  if (unset("--sky-ray-budget")) o.sky.maxRays = p.skyRayBudget;
-  if (unset("--shadow-edge-samples")) o.shadowEdges.subSamples = p.shadowEdgeSamples;
-  o.atlas.targetPageSize = p.autoPageSize;  // read only where --texels-per-unit is auto
-}
-
-// Options a config file may give as an array of strings, one --name=item per item.
-const std::vector<std::string> kRepeatableOptions = {"light-mode"};
-
-// A message about a config value, the value in it shown as a short escaped excerpt.
 std::string withExcerpt(std::string message, const std::string& value) {
   const std::string shown = quotedExcerpt(value);
   if (!value.empty() && shown != "'" + value + "'")
@@ -626,20 +244,17 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine,
   for (const ConfigEntry& e : entries) {
     const std::string line = "line " + std::to_string(e.line) + ": key " + quotedExcerpt(e.key);
     auto fail = [&](const std::string& what) { throw Error(ErrorCode::Usage, file.string(), line + ": " + what); };
-    const bool positional = e.key == "scene";
-    const std::string name = positional ? "SCENE" : "--" + e.key;
-    const CLI::Option* option = given->get_option_no_throw(name);
-    if (!option || e.key == "config" || e.key == "help" || e.key == "help-all")
-      fail("not an option of 'irbake bake' (see 'irbake bake --help-all')");
-    if (option->count() > 0) continue;
-    const bool repeatable = std::find(kRepeatableOptions.begin(), kRepeatableOptions.end(), e.key) != kRepeatableOptions.end();
-    if (e.array && !repeatable) fail("takes one value, not an array (only light-mode is repeated)");
+    const OptionDescriptor* d = findBakeOption(e.key);
+    if (!d || d->has(kNotInConfig)) fail("not an option of 'irbake bake' (see 'irbake bake --help-all')");
+    if (givenOption(*given, *d)->count() > 0) continue;
+    if (e.array && d->kind != OptionKind::Repeated) fail("takes one value, not an array (only light-mode is repeated)");
+    const bool positional = d->name == "SCENE";
+    const std::string name = positional ? d->name : "--" + d->name;
     Args words;
     for (std::string value : e.array ? e.items : std::vector<std::string>{e.value}) {
-      if (positional || e.key == "output" || e.key == "report" || e.key == "env" || e.key == "dump-config" ||
-          e.key == "portable")
-        if (!value.empty() && std::filesystem::path(value).is_relative()) value = (folder / value).lexically_normal().string();
-      if (option->get_expected_min() == 0) {  // a flag
+      if (d->has(kPath) && !value.empty() && std::filesystem::path(value).is_relative())
+        value = (folder / value).lexically_normal().string();
+      if (d->isFlag()) {
         if (value != "true" && value != "false") fail("a flag takes true or false, got " + quotedExcerpt(value));
         if (value == "true") words.push_back(name);
       } else {
@@ -657,57 +272,54 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine,
       for (const std::string& value : e.array ? e.items : std::vector<std::string>{e.value}) message = withExcerpt(message, value);
       fail(message);
     }
-    if (e.key == "light-mode") lightModeOrigin = file.string() + ": " + line;
+    if (d->kind == OptionKind::Repeated) lightModeOrigin = file.string() + ": " + line;
     out.insert(out.end(), words.begin(), words.end());
   }
   return out;
 }
 
+// An option not given, as a dump's comment shows it: the value the bake uses, "auto" where it decides.
+std::string unsetValue(const OptionDescriptor& d, const QualityPreset& preset, BakeCommand& command, BakeArguments& a) {
+  if (d.name == "paths")
+    return "auto (" + std::to_string(preset.paths) + ", or " + std::to_string(preset.pathsUnderGather) +
+           " under the final gather, or " + std::to_string(preset.paths / 2) + " evaluated of 8x as many walked without it)";
+  if (d.name == "clamp") return "derived from the scene (0: no clamp)";
+  if (d.preset) {
+    std::string value;
+    std::visit(
+        [&value](auto* target) {
+          using T = std::remove_pointer_t<decltype(target)>;
+          if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) value = std::to_string(*target);
+        },
+        d.field(command, a));
+    return value + " (--quality " + preset.name + ")";
+  }
+  if (d.has(kAutomatic)) return "auto";
+  if (d.isFlag()) return "false";
+  const std::string value = defaultText(d);
+  return value.empty() ? "none" : value;
+}
+
 // Every option of the parsed bake as config entries: the given ones as entries (paths absolute), the rest
 // as comments with the value the bake uses ("auto" where it decides, the --quality preset's knobs), so the
 // file reads back to the same bake and still shows every knob.
-std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, const BakeArguments& a, const BakeOptions& o) {
-  BakeCommand freshCommand;
-  BakeArguments freshArguments;
-  const std::unique_ptr<CLI::App> defaults = bakeApp(freshCommand, freshArguments);
+std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, BakeCommand& command, BakeArguments& a) {
   const QualityPreset& preset = *findQualityPreset(a.quality);
-  const std::vector<std::pair<std::string, std::string>> fromPreset = {
-      {"gather-rays", std::to_string(o.gather.rays)},          {"gather-ray-budget", std::to_string(o.gather.rayBudget)},
-      {"comp-rays", std::to_string(o.compensation.rays)},     {"comp-refine", std::to_string(o.compensation.refineRays)},
-      {"comp-ray-budget", std::to_string(o.compensation.rayBudget)}, {"sky-rays", std::to_string(o.sky.raysPerSample)},
-      {"sky-ray-budget", std::to_string(o.sky.maxRays)},     {"shadow-edge-samples", std::to_string(o.shadowEdges.subSamples)}};
   std::vector<ConfigEntry> entries;
-  for (const CLI::Option* option : app.get_options()) {
-    std::string name = option->get_single_name();
-    if (name == "help" || name == "help-all" || name == "config" || name == "dump-config") continue;
-    const bool flag = option->get_expected_min() == 0;
-    std::string value;
+  for (const OptionDescriptor& d : bakeOptionTable()) {
+    if (d.has(kNotInConfig) || d.has(kNotDumped)) continue;
+    const CLI::Option* option = givenOption(app, d);
     if (option->count() > 0) {
-      if (std::find(kRepeatableOptions.begin(), kRepeatableOptions.end(), name) != kRepeatableOptions.end()) {
-        ConfigEntry repeated{name, "", 0, true, option->results()};  // one item per time it was given
-        entries.push_back(repeated);
+      if (d.kind == OptionKind::Repeated) {
+        entries.push_back({d.configKey(), "", 0, true, option->results()});  // one item per time it was given
         continue;
       }
-      if (flag) value = "true";
-      else
-        for (const std::string& r : option->results()) value += (value.empty() ? "" : ",") + r;
-      if (name == "SCENE" || name == "output" || name == "report" || name == "env" || name == "portable")
-        value = std::filesystem::absolute(value).lexically_normal().string();
-      entries.push_back({name == "SCENE" ? "scene" : name, value, 0, false, {}});
+      std::string value = d.isFlag() ? "true" : joinedResults(*option);
+      if (d.has(kPath)) value = std::filesystem::absolute(value).lexically_normal().string();
+      entries.push_back({d.configKey(), value, 0, false, {}});
       continue;
     }
-    CLI::Option* plain = defaults->get_option_no_throw(option->get_name());
-    value = plain ? plain->capture_default_str()->get_default_str() : "";
-    if (flag) value = "false";
-    if (option->get_type_name().find("auto") != std::string::npos) value = "auto";
-    if (name == "paths") value = "auto (" + std::to_string(preset.paths) + ", or " + std::to_string(preset.pathsUnderGather) +
-                                 " under the final gather, or " + std::to_string(preset.paths / 2) +
-                                 " evaluated of 8x as many walked without it)";
-    if (name == "clamp") value = "derived from the scene (0: no clamp)";
-    for (const auto& [knob, v] : fromPreset)
-      if (knob == name) value = v + " (--quality " + preset.name + ")";
-    if (value.empty()) value = "none";
-    entries.push_back({"# " + name, value, 0, false, {}});
+    entries.push_back({"# " + d.name, unsetValue(d, preset, command, a), 0, false, {}});
   }
   return entries;
 }
@@ -724,10 +336,9 @@ PendingFile dumpedConfigFile(const std::string& file, const std::string& text) {
 }
 
 std::string automaticChoices(const nlohmann::json& report) {
-  // Options whose chosen value, given explicitly, makes the same bake; the other automatic choices (the walk's
-  // depth and split, the compensation's per-page filter) follow the scene and stay auto, with what they chose.
-  static const std::vector<std::string> kReplayable = {"backend",    "final-gather",   "paths",          "interleave",
-                                                       "cube-face",  "clamp-k",        "vpl-importance", "texels-per-unit"};
+  // Options whose chosen value, given explicitly, makes the same bake (kReplayable); the other automatic choices
+  // (the walk's depth and split, the compensation's per-page filter) follow the scene and stay auto, with what
+  // they chose.
   std::vector<ConfigEntry> entries, comments;
   const nlohmann::json plan = report.value("plan", nlohmann::json::object());
   for (auto it = plan.begin(); it != plan.end(); ++it) {
@@ -736,7 +347,8 @@ std::string automaticChoices(const nlohmann::json& report) {
     if (!choice.value("automatic", false)) continue;
     const nlohmann::json& v = choice["value"];
     const std::string value = v.is_string() ? v.get<std::string>() : v.is_number_float() ? cli::canonicalNumber(v.get<double>()) : v.dump();
-    if (std::find(kReplayable.begin(), kReplayable.end(), key) != kReplayable.end())
+    const OptionDescriptor* option = findBakeOption(key);
+    if (option && option->has(kReplayable))
       entries.push_back({key, value, 0, false, {}});
     else
       comments.push_back({"# " + key, "auto (chose " + value + ": " + choice.value("reason", "") + ")", 0, false, {}});
@@ -787,10 +399,10 @@ std::optional<BakeCommand> parseBakeCommand(const Args& givenArgs) {
   }
   arguments.lightModeOrigin = lightModeOrigin;
   applyArguments(command, arguments);
-  applyQuality(*app, arguments, command.options);
+  applyQuality(*app, *findQualityPreset(arguments.quality), command, arguments);
   if (!arguments.dumpConfig.empty()) {
     command.dumpConfig = arguments.dumpConfig;
-    command.dumpText = configText(effectiveOptions(*app, arguments, command.options),
+    command.dumpText = configText(effectiveOptions(*app, command, arguments),
                                   "irbake bake options (read back with --config FILE)");
   }
   return command;

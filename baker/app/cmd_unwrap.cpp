@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
+#include "app/bake_option_table.h"
 #include "app/commands.h"
 #include "atlas/atlas.h"
 #include "common/command_line.h"
@@ -62,10 +63,9 @@ int runUnwrap(const Args& args) {
                               "primitive.");
   app->add_option("IN", inputs, "the glTF/GLB scene to unwrap");
   app->add_option("-o,--output", output, "the unwrapped scene")->type_name("OUT.gltf|OUT.glb");
-  app->add_option("--texels-per-unit", tpu, "texel density per metre (default: fit the charts into about\none target page, or 64 texels per triangle where that is more, at most 4M)")
-      ->transform(cli::numberIn(0.0, 1e6))->type_name("T");
-  app->add_option("--max-texels", options.maxTexels, "texel budget of all pages together (default 16M; 0 = no limit)")
-      ->transform(cli::integerIn(0, 1LL << 40))->type_name("N");
+  // Shared with `irbake bake`: the density, the texel budget and the threads.
+  addOption(*app, *findBakeOption("texels-per-unit"), &tpu)->group("Options");
+  addOption(*app, *findBakeOption("max-texels"), &options.maxTexels)->group("Options");
   app->add_option("--padding", options.padding, "empty texels between charts (default 2)")
       ->transform(cli::integerIn(0, 256))->type_name("P");
   app->add_option("--max-page", options.maxPageSize, "largest page edge in texels (default 2048); more pages when full")
@@ -74,8 +74,7 @@ int runUnwrap(const Args& args) {
       ->transform(cli::integerIn(16, 16384))->type_name("S");
   app->add_flag("--keep-uv1", options.keepUv1, "keep an input TEXCOORD_1 and only repack its islands");
   app->add_option("--report", report, "write the atlas statistics")->type_name("R.json");
-  app->add_option("--threads", threads, "worker threads (default 0: every core; same bytes for any count)")
-      ->transform(cli::integerIn(0, 1024))->type_name("N");
+  addOption(*app, *findBakeOption("threads"), &threads);
   if (!cli::parse(*app, args)) return 0;
   std::unique_ptr<tbb::global_control> threadLimit;
   if (threads > 0)
