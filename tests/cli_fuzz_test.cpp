@@ -289,7 +289,11 @@ std::string mutatedConfig(const std::string& text, const std::vector<std::string
   for (const std::string& l : lines) out += l + "\n";
   if (rng() % 4 == 0 && !out.empty()) {
     const size_t byte = rng() % out.size();
-    out[byte] = static_cast<char>(out[byte] ^ (1 + rng() % 255));
+    const char flip = static_cast<char>(1 + rng() % 255);
+    // Not inside the output's path: a flipped byte there could name a folder outside the test's scratch folder.
+    const size_t output = out.find("output =");
+    const bool inOutput = output != std::string::npos && byte >= output && byte < out.find('\n', output);
+    if (!inOutput) out[byte] = static_cast<char>(out[byte] ^ flip);
   }
   if (rng() % 8 == 0) out.resize(rng() % out.size());
   return out;
