@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "export/exr_io.h"
 #include "scene/environment.h"
 #include "scene/gltf_loader.h"
@@ -365,6 +366,34 @@ TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   EXPECT_NEAR(s.textures[m.lightmapTexture].texels[0].r, 128.0f / 255.0f, 1e-5f);
   ASSERT_EQ(s.lightmapExrPaths.size(), 1u);
   EXPECT_EQ(std::filesystem::path(s.lightmapExrPaths[0]), dir / "pages/lightmap_0.exr");
+}
+
+// MOZ_lightmap's units: a file marked extras.irbake.mozLightmap = "irradiance" has intensity × texel = E, read
+// as the map value E/π (intensity / π); an older bake's, without the marker, is E/π already; another marker
+// value is not the marker.
+TEST(GltfLoader, MozLightmapIntensityIsReadInTheUnitsItsMarkerNames) {
+  auto intensityOf = [](const json& extras, const char* name) {
+    GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+    auto& prim = doc.root["meshes"][0]["primitives"][0];
+    prim["attributes"]["TEXCOORD_1"] = doc.addVec2({{0.1f, 0.1f}, {0.9f, 0.1f}, {0.1f, 0.9f}});
+    prim["material"] = 0;
+    Texture t;
+    t.width = t.height = 1;
+    t.texels = {glm::vec4(0.5f, 0.25f, 1.0f, 1.0f)};
+    const int tex = doc.addTexture(doc.addImage(encodePng(t, true), "lm"), -1);
+    json moz = {{"index", tex}, {"texCoord", 1}, {"intensity", 3.5}};
+    if (!extras.is_null()) moz["extras"] = extras;
+    doc.append("materials", {{"extensions", {{"MOZ_lightmap", moz}}}});
+    auto dir = testFolder(name);
+    writeDocument(doc, dir / "m.gltf");
+    return loadScene(dir / "m.gltf").materials[0].lightmapIntensity;
+  };
+  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}, {"irbake", {{"mozLightmap", "irradiance"}}}}, "loader_moz_marked"),
+                  static_cast<float>(3.5 / kPi));
+  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}}, "loader_moz_unmarked"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_no_extras"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"irbake", {{"mozLightmap", "radiance"}}}}, "loader_moz_other"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"irbake", "irradiance"}}, "loader_moz_not_object"), 3.5f);
 }
 
 // The viewer's maps (LoadOptions::shadingMaps): TANGENT to world space (w flipped by a mirroring node),
