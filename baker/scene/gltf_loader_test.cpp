@@ -369,11 +369,16 @@ TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
 }
 
 // MOZ_lightmap's units: a file marked extras.irbake.mozLightmap = "irradiance" has intensity × texel = E, read
-// as the map value E/π (intensity / π); an older bake's, without the marker, is E/π already; another marker
-// value is not the marker.
-TEST(GltfLoader, MozLightmapIntensityIsReadInTheUnitsItsMarkerNames) {
-  auto intensityOf = [](const json& extras, const char* name) {
+// as the map value E/π (intensity / π); an older irbake's (generator "irbake…", no marker) is E/π already;
+// another marker value is not the marker. Another tool's file, or one naming no generator, is read per the
+// specification whether or not it has the marker.
+TEST(GltfLoader, MozLightmapIsReadPerSpecUnlessAnOlderIrbakeWroteIt) {
+  auto intensityOf = [](const json& extras, const char* name, const json& generator = "irbake") {
     GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+    if (generator.is_null())
+      doc.root["asset"].erase("generator");
+    else
+      doc.root["asset"]["generator"] = generator;
     auto& prim = doc.root["meshes"][0]["primitives"][0];
     prim["attributes"]["TEXCOORD_1"] = doc.addVec2({{0.1f, 0.1f}, {0.9f, 0.1f}, {0.1f, 0.9f}});
     prim["material"] = 0;
@@ -388,12 +393,19 @@ TEST(GltfLoader, MozLightmapIntensityIsReadInTheUnitsItsMarkerNames) {
     writeDocument(doc, dir / "m.gltf");
     return loadScene(dir / "m.gltf").materials[0].lightmapIntensity;
   };
-  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}, {"irbake", {{"mozLightmap", "irradiance"}}}}, "loader_moz_marked"),
-                  static_cast<float>(3.5 / kPi));
+  const json marker = {{"colorSpace", "srgb"}, {"irbake", {{"mozLightmap", "irradiance"}}}};
+  const float spec = static_cast<float>(3.5 / kPi);
+  EXPECT_FLOAT_EQ(intensityOf(marker, "loader_moz_marked"), spec);
   EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}}, "loader_moz_unmarked"), 3.5f);
   EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_no_extras"), 3.5f);
   EXPECT_FLOAT_EQ(intensityOf({{"irbake", {{"mozLightmap", "radiance"}}}}, "loader_moz_other"), 3.5f);
   EXPECT_FLOAT_EQ(intensityOf({{"irbake", "irradiance"}}, "loader_moz_not_object"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}}, "loader_moz_irbake_from", "irbake (from Blender)"), 3.5f);
+  // Other tools' files carry no marker and follow the specification.
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_other_tool", "Khronos glTF Blender I/O"), spec);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_other_tool_prefix", "THREE.GLTFExporter irbake"), spec);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_no_generator", json()), spec);
+  EXPECT_FLOAT_EQ(intensityOf(marker, "loader_moz_other_tool_marked", "glTF-Transform"), spec);
 }
 
 // The viewer's maps (LoadOptions::shadingMaps): TANGENT to world space (w flipped by a mirroring node),

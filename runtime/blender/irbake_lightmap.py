@@ -1,6 +1,6 @@
 # irbake light maps in Blender: wires MOZ_lightmap into the materials that Blender's glTF importer creates, so the
 # bake shows unlit (baseColor x irradiance/pi + emissive) in the viewport and in renders: irradiance/pi is
-# the EXR page, or the PNG x intensity / pi (x intensity for an older bake without the units marker).
+# the EXR page, or the PNG x intensity / pi (x intensity for an older irbake's: generator irbake, no units marker).
 # docs/export.md, "Blender".
 #
 # As an add-on (Edit > Preferences > Add-ons > Install..., enable "irbake light maps"): every File > Import >
@@ -53,17 +53,24 @@ def float32_finite(value):
 
 
 def is_irradiance(ext):
-    """Whether a MOZ_lightmap carries irbake's marker extras.irbake.mozLightmap = "irradiance": intensity x texel
-    is then the irradiance E, MOZ_lightmap's own rule; without it (an older bake) it is irradiance/pi."""
+    """Whether a MOZ_lightmap carries irbake's marker extras.irbake.mozLightmap = "irradiance"."""
     extras = ext.get("extras") if isinstance(ext, dict) else None
     marker = extras.get("irbake") if isinstance(extras, dict) else None
     return isinstance(marker, dict) and marker.get("mozLightmap") == "irradiance"
 
 
+def is_older_irbake(gltf, ext):
+    """Whether a MOZ_lightmap is in the older irbake convention, intensity x texel = irradiance/pi: the file's
+    asset.generator starts with "irbake" and the marker is absent. Every other file follows MOZ_lightmap's own
+    rule, intensity x texel = the irradiance E."""
+    generator = getattr(getattr(gltf.data, "asset", None), "generator", None)
+    return isinstance(generator, str) and generator.startswith("irbake") and not is_irradiance(ext)
+
+
 def lightmap_of(gltf, material_index, ext):
     """(texture index, texCoord, scale) of material material_index's MOZ_lightmap ext, as irview reads it: the
-    scale makes the decoded texel irradiance/pi, the value shown as baseColor x value (intensity / pi for a
-    marked extension, the intensity for an older bake's); texCoord and intensity default to 1. Raises
+    scale makes the decoded texel irradiance/pi, the value shown as baseColor x value (intensity / pi per the
+    specification, the intensity for an older irbake's); texCoord and intensity default to 1. Raises
     LightmapRefused naming the material for what irview refuses."""
     name = gltf.data.materials[material_index].name if material_index is not None else None
     what = "material %s%s: MOZ_lightmap" % (material_index, " ('%s')" % name if name else "")
@@ -81,7 +88,7 @@ def lightmap_of(gltf, material_index, ext):
     intensity = ext.get("intensity", 1.0)
     if not float32_finite(intensity) or intensity < 0:
         raise LightmapRefused("%s intensity %s must be a finite number ≥ 0" % (what, json.dumps(intensity)))
-    return texture, tex_coord, float(intensity) / (math.pi if is_irradiance(ext) else 1.0)
+    return texture, tex_coord, float(intensity) / (1.0 if is_older_irbake(gltf, ext) else math.pi)
 
 
 def numpy_bool_alias():

@@ -3,8 +3,9 @@
 # multiplies by. The scenes given: the bake as written (TEXCOORD_1, intensity / pi: the units marker says
 # intensity x texel is the irradiance), a copy without texCoord (MOZ_lightmap's default set 1: UVMap.001), one
 # without intensity (1 / pi), one with intensity -1 (refused: the material left as imported, one refusal
-# recorded), and an older bake's without the marker (its intensity as written). Exits 1 naming what differs.
-#   blender --background --factory-startup --python wiring_check.py -- BAKE.gltf NO_TEXCOORD.gltf NO_INTENSITY.gltf NEGATIVE.gltf UNMARKED.gltf
+# recorded), an older bake's without the marker (generator irbake: its intensity as written), and another tool's
+# without the marker (MOZ_lightmap's own rule: intensity / pi). Exits 1 naming what differs.
+#   blender --background --factory-startup --python wiring_check.py -- BAKE.gltf NO_TEXCOORD.gltf NO_INTENSITY.gltf NEGATIVE.gltf UNMARKED.gltf OTHER_TOOL.gltf
 import json
 import math
 import os
@@ -38,7 +39,7 @@ def wiring(scene):
 
 
 arguments = sys.argv[sys.argv.index("--") + 1:]
-baked, no_texcoord, no_intensity, negative, unmarked = arguments
+baked, no_texcoord, no_intensity, negative, unmarked, other_tool = arguments
 
 
 def first_intensity(scene):
@@ -52,7 +53,8 @@ expected = [(baked, {"uv_map": "UVMap.001", "intensity": intensity / math.pi}),
             (no_texcoord, {"uv_map": "UVMap.001", "intensity": intensity / math.pi}),
             (no_intensity, {"uv_map": "UVMap.001", "intensity": 1.0 / math.pi}),
             (negative, None),
-            (unmarked, {"uv_map": "UVMap.001", "intensity": first_intensity(unmarked)})]
+            (unmarked, {"uv_map": "UVMap.001", "intensity": first_intensity(unmarked)}),
+            (other_tool, {"uv_map": "UVMap.001", "intensity": first_intensity(other_tool) / math.pi})]
 errors = []
 for scene, want in expected:
     name, got, refused = wiring(scene)

@@ -1,8 +1,8 @@
 // A Babylon.js glTF loader extension for MOZ_lightmap as irbake writes it (docs/export.md):
 //   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity,
 //                                         extras: { colorSpace: "srgb", irbake: { mozLightmap: "irradiance" } } }
-// decode(PNG) × intensity is the irradiance E when the extension carries the irradiance marker (MOZ_lightmap's
-// own rule), irradiance/π for an older bake (moz_lightmap_rules.js); decode the sRGB curve when
+// decode(PNG) × intensity is the irradiance E (MOZ_lightmap's own rule), irradiance/π for an older irbake's
+// (generator irbake, no irradiance marker; moz_lightmap_rules.js); decode the sRGB curve when
 // extras.colorSpace says so. irview shows baseColour × E/π + emissive.
 //
 // Babylon's PBR shader (pbrBlockFinalColorComposition) adds a light map to the lit colour unless

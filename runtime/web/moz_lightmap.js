@@ -3,8 +3,8 @@
 //                                         extras: { colorSpace: "srgb", irbake: { mozLightmap: "irradiance" } } }
 // The 8-bit PNG is sRGB-encoded when extras.colorSpace says so (current irbake exports), linear otherwise.
 // three.js treats lightMap as irradiance and shades it with BRDF_Lambert = albedo/π, so lightMapIntensity is
-// the factor that makes decode(PNG) the irradiance E: the intensity itself when the extension carries the
-// irradiance marker (MOZ_lightmap's own rule), intensity × π for an older bake, whose value was irradiance/π
+// the factor that makes decode(PNG) the irradiance E: the intensity itself (MOZ_lightmap's own rule), intensity × π
+// for an older irbake's (generator irbake, no irradiance marker), whose value was irradiance/π
 // (moz_lightmap_rules.js). Materials with a light map become MeshLambertMaterial (a physical material would
 // add a specular term the bake does not have).
 //

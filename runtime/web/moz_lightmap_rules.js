@@ -2,8 +2,9 @@
 // plugins: a map is shown as irview shows it or not at all, never negative, NaN, on the wrong UVs or from a
 // texture the file does not have. A missing texCoord is 1 and a missing intensity 1 (MOZ_lightmap's defaults).
 // Units (docs/export.md): MOZ_lightmap's own rule, E = intensity × sRGBToLinear(texel) the irradiance, holds for
-// an extension marked extras.irbake.mozLightmap = "irradiance" (current irbake exports); an older bake's has no
-// marker and its intensity × texel is irradiance/π.
+// every file but an older irbake's: asset.generator starting with "irbake" and no marker
+// extras.irbake.mozLightmap = "irradiance" (which current irbake exports carry); its intensity × texel is
+// irradiance/π.
 export const LIGHTMAP_TEXCOORD = 1;  // irbake's light maps live in TEXCOORD_1; irview reads no other set
 
 // Whether a MOZ_lightmap extension carries irbake's irradiance marker.
@@ -11,9 +12,16 @@ export function mozLightmapIsIrradiance(ext) {
   return ext?.extras?.irbake?.mozLightmap === 'irradiance';
 }
 
+// Whether MOZ_lightmap `ext` of glTF document `json` is in the older irbake convention (intensity × texel =
+// irradiance/π): an irbake generator and no marker.
+export function mozLightmapIsOlderIrbake(json, ext) {
+  const generator = json?.asset?.generator;
+  return typeof generator === 'string' && generator.startsWith('irbake') && !mozLightmapIsIrradiance(ext);
+}
+
 // Material `materialIndex`'s MOZ_lightmap `ext` of glTF document `json`: { index, texCoord, intensity, irradiance }
-// when irview would show it (irradiance: the factor that makes the decoded texel the irradiance E, intensity when
-// marked, intensity × π for an older bake); else throws an Error naming the material and the field.
+// when irview would show it (irradiance: the factor that makes the decoded texel the irradiance E, the intensity
+// per the specification, intensity × π for an older irbake's); else throws an Error naming the material and the field.
 export function checkMozLightmap(json, materialIndex, ext) {
   const name = json.materials?.[materialIndex]?.name;
   const what = `material ${materialIndex}${name ? ` ('${name}')` : ''}: MOZ_lightmap`;
@@ -29,6 +37,6 @@ export function checkMozLightmap(json, materialIndex, ext) {
   // Finite as a 32-bit float, as irview stores it: 1e39 would be Infinity in the shader.
   if (typeof intensity !== 'number' || !(intensity >= 0) || !Number.isFinite(Math.fround(intensity)))
     throw new Error(`${what} intensity ${JSON.stringify(intensity)} must be a finite number ≥ 0`);
-  const irradiance = mozLightmapIsIrradiance(ext) ? intensity : intensity * Math.PI;
+  const irradiance = mozLightmapIsOlderIrbake(json, ext) ? intensity * Math.PI : intensity;
   return { index: ext.index, texCoord, intensity, irradiance };
 }
