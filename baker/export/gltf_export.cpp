@@ -31,6 +31,7 @@
 #include "export/gltf_writer.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
+#include "scene/moz_lightmap_units.h"
 
 namespace irbake {
 
@@ -179,13 +180,20 @@ void setLightmapRecord(json& prim, const LightmapRef& ref) {
   prim["extras"]["lightmap"] = {{"page", ref.page}, {"width", ref.width}, {"height", ref.height}};
 }
 
-// MOZ_lightmap of one page: the texture, TEXCOORD_1, the intensity, and our documented extra saying the
-// PNG is sRGB-encoded (docs/export.md).
+// MOZ_lightmap of one page as its specification defines it: the texture, TEXCOORD_1 written explicitly, and
+// the intensity that makes intensity × sRGBToLinear(texel) the irradiance E. The PNG holds map value (E/π) /
+// range, so the intensity is π × the range; the extras say the PNG is sRGB-encoded and carry the units
+// marker that tells these files from an older irbake's (scene/moz_lightmap_units.h, docs/export.md).
 json mozLightmap(int texture, const EncodedMap& image) {
-  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", image.metadata.intensity}};
-  if (image.metadata.srgb) moz["extras"] = {{"colorSpace", "srgb"}};
+  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", kPi * double(image.metadata.intensity)}};
+  if (image.metadata.srgb) moz["extras"]["colorSpace"] = "srgb";
+  moz["extras"][kMozLightmapMarkerKey] = mozLightmapMarker();
   return moz;
 }
+
+// A material that carries MOZ_lightmap drops its occlusionTexture: the bake's own occlusion is in the map,
+// and the specification applies occlusionTexture to the light map, which would darken it twice.
+void dropOcclusionUnderLightmap(json& material) { material.erase("occlusionTexture"); }
 
 // True when a material's texture (core or extension) reads TEXCOORD_1.
 bool readsTexcoord1(const json& j) {
@@ -377,6 +385,7 @@ class SourceExport {
     if (page >= 0) {
       if (!mat.contains("extensions") || !mat["extensions"].is_object()) mat["extensions"] = json::object();
       mat["extensions"]["MOZ_lightmap"] = mozLightmap(lightmapTexture(page), images_[imageOfPage_.at(page)]);
+      dropOcclusionUnderLightmap(mat);
     }
     int index;
     if (source >= 0 && sourceMaterialsTaken_.insert(source).second) {

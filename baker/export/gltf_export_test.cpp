@@ -1,6 +1,7 @@
 // Export with light maps: reload through our loader (TEXCOORD_1, extras.lightmap, MOZ_lightmap, PNG
 // values × intensity, EXR pages), the source-scene path (images, cameras, lights kept), the unwrap
 // case without maps, and atomicity when a write fails half way.
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
 #include "export/gltf_writer.h"
@@ -89,6 +91,9 @@ TEST(GltfExport, GeneratedSceneReloadsWithTexcoord1MozLightmapAndPng) {
   json j = readJson(o.output);
   EXPECT_NE(std::find(j["extensionsUsed"].begin(), j["extensionsUsed"].end(), "MOZ_lightmap"), j["extensionsUsed"].end());
   EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["extras"]["colorSpace"], "srgb");
+  // MOZ_lightmap's own units: intensity × texel is the irradiance, π × the map value's range (page 0: 2.5), marked.
+  EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["extras"]["irbake"]["mozLightmap"], "irradiance");
+  EXPECT_NEAR(j["materials"][0]["extensions"]["MOZ_lightmap"]["intensity"].get<double>(), 2.5 * kPi, 1e-5);
 
   Scene r = loadScene(o.output);
   ASSERT_EQ(r.primitives.size(), 2u);
@@ -369,7 +374,7 @@ TEST(GltfExport, KeepsTheSourceDocumentAndGivesEachInstanceItsOwnRegion) {
   EXPECT_EQ(j["materials"][0]["name"], "paint");
   EXPECT_EQ(j["materials"][0]["extensions"]["EXT_vendor_paint"], source["materials"][0]["extensions"]["EXT_vendor_paint"]);
   EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["texCoord"], 1);
-  EXPECT_NEAR(j["materials"][0]["extensions"]["MOZ_lightmap"]["intensity"].get<double>(), 2.5, 1e-6);
+  EXPECT_NEAR(j["materials"][0]["extensions"]["MOZ_lightmap"]["intensity"].get<double>(), 2.5 * kPi, 1e-5);
 
   // Instancing: body keeps mesh 0, twin gets a copy with the same name; nothing else is left.
   ASSERT_EQ(j["meshes"].size(), 2u);  // "orphan" (unused in the source) is gone
@@ -436,6 +441,41 @@ TEST(GltfExport, KeepsTheSourceDocumentAndGivesEachInstanceItsOwnRegion) {
   ASSERT_EQ(r.cameras.size(), 1u);
   ASSERT_EQ(r.lights.size(), 1u);
   EXPECT_NEAR(r.lights[0].position.y, 5.0f, 1e-6f);
+}
+
+// The specification applies occlusionTexture to the light map, and the bake's own occlusion is in the map: a
+// source material that gets MOZ_lightmap loses its occlusionTexture (and the texture and image nothing else uses).
+TEST(GltfExport, LightMappedMaterialsDropTheirOcclusionTexture) {
+  auto dir = irbake::testing::testFolder("export_occlusion");
+  std::filesystem::create_directories(dir / "in");
+  GltfDocument doc = instancedSource();
+  Texture ao;
+  ao.width = ao.height = 1;
+  ao.texels = {glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)};
+  const int aoTexture = doc.addTexture(doc.addImage(encodePng(ao, false), "ao"), -1);
+  doc.root["materials"][0]["occlusionTexture"] = {{"index", aoTexture}, {"strength", 1.0}};
+  // Without an unknown root extension (which might name a texture) unused textures are collected.
+  doc.root["extensions"].erase("EXT_vendor_root");
+  auto& used = doc.root["extensionsUsed"];
+  used.erase(std::remove(used.begin(), used.end(), "EXT_vendor_root"), used.end());
+  irbake::testing::writeDocument(doc, dir / "in" / "source.gltf");
+  Scene loaded = loadScene(dir / "in" / "source.gltf");
+  for (auto& p : loaded.primitives) {
+    p.uv1.assign(p.positions.size(), glm::vec2(0.5f));
+    p.lightmap = {0, 8, 4};
+  }
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  exportGltf(loaded, maps, o);
+  const json j = readJson(o.output);
+  ASSERT_EQ(j["materials"].size(), 1u);
+  EXPECT_TRUE(j["materials"][0]["extensions"].contains("MOZ_lightmap"));
+  EXPECT_FALSE(j["materials"][0].contains("occlusionTexture")) << j["materials"][0].dump();
+  // Only the light-map texture is left.
+  ASSERT_EQ(j["textures"].size(), 1u);
+  EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["index"], 0);
 }
 
 // A .glb embeds every image: one file beside the EXR pages, the images in buffer views.
@@ -561,7 +601,7 @@ TEST(GltfExport, TenThousandSeparateMeshesEachGetTexcoord1AndTheirPageMaterial) 
                     j["accessors"][attributes["TEXCOORD_1"].get<int>()]["count"] == 4 &&
                     j["accessors"][attributes["TEXCOORD_1"].get<int>()]["type"] == "VEC2" &&
                     j["accessors"][attributes["POSITION"].get<int>()]["count"] == 4 && prim["extras"]["lightmap"]["page"] == i % 2 &&
-                    moz["texCoord"] == 1 && std::abs(moz["intensity"].get<double>() - 2.5 * (i % 2 + 1)) < 1e-5;
+                    moz["texCoord"] == 1 && std::abs(moz["intensity"].get<double>() - kPi * 2.5 * (i % 2 + 1)) < 1e-5;
     if (!ok && ++wrong <= 3) ADD_FAILURE() << "mesh " << i << ": " << mesh.dump();
   }
   EXPECT_EQ(wrong, 0);

@@ -23,6 +23,7 @@
 #include "common/log.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
+#include "scene/moz_lightmap_units.h"
 #include "scene/runtime_lights.h"
 #include "scene/scene_limits.h"
 
@@ -933,7 +934,8 @@ class Loader {
   }
 
   // MOZ_lightmap (docs/export.md). A light map is never dropped silently: a missing texture and an intensity
-  // that is not a number ≥ 0 are refused here; the texCoord is recorded (irview refuses any but 1).
+  // that is not a number ≥ 0 are refused here; the texCoord is recorded (irview refuses any but 1); the
+  // intensity is read in the specification's units, or an older irbake's (scene/moz_lightmap_units.h).
   void readMozLightmap(int index, const std::string& gltfName, const json& moz, Material& m) {
     const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')") +
                              ": MOZ_lightmap";
@@ -959,6 +961,9 @@ class Loader {
         invalid(what + " intensity " + in->dump() + " must be a finite number ≥ 0");
       m.lightmapIntensity = static_cast<float>(v);
     }
+    // Material::lightmapIntensity scales the texel to irbake's map value (irradiance/π): the specification's
+    // intensity carries π, an older irbake's (generator irbake, no marker) does not.
+    m.lightmapIntensity = static_cast<float>(m.lightmapIntensity * mozLightmapToMapValue(moz, model_.asset.generator));
   }
 
   // The viewer's maps (LoadOptions::shadingMaps): the normal texture and IRBAKE_lightmap_directional

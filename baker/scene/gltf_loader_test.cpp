@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
+#include "common/maths.h"
 #include "export/exr_io.h"
 #include "lights/light_kind.h"
 #include "scene/environment.h"
@@ -366,6 +367,46 @@ TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   EXPECT_NEAR(s.textures[m.lightmapTexture].texels[0].r, 128.0f / 255.0f, 1e-5f);
   ASSERT_EQ(s.lightmapExrPaths.size(), 1u);
   EXPECT_EQ(std::filesystem::path(s.lightmapExrPaths[0]), dir / "pages/lightmap_0.exr");
+}
+
+// MOZ_lightmap's units: a file marked extras.irbake.mozLightmap = "irradiance" has intensity × texel = E, read
+// as the map value E/π (intensity / π); an older irbake's (generator "irbake…", no marker) is E/π already;
+// another marker value is not the marker. Another tool's file, or one naming no generator, is read per the
+// specification whether or not it has the marker.
+TEST(GltfLoader, MozLightmapIsReadPerSpecUnlessAnOlderIrbakeWroteIt) {
+  auto intensityOf = [](const json& extras, const char* name, const json& generator = "irbake") {
+    GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+    if (generator.is_null())
+      doc.root["asset"].erase("generator");
+    else
+      doc.root["asset"]["generator"] = generator;
+    auto& prim = doc.root["meshes"][0]["primitives"][0];
+    prim["attributes"]["TEXCOORD_1"] = doc.addVec2({{0.1f, 0.1f}, {0.9f, 0.1f}, {0.1f, 0.9f}});
+    prim["material"] = 0;
+    Texture t;
+    t.width = t.height = 1;
+    t.texels = {glm::vec4(0.5f, 0.25f, 1.0f, 1.0f)};
+    const int tex = doc.addTexture(doc.addImage(encodePng(t, true), "lm"), -1);
+    json moz = {{"index", tex}, {"texCoord", 1}, {"intensity", 3.5}};
+    if (!extras.is_null()) moz["extras"] = extras;
+    doc.append("materials", {{"extensions", {{"MOZ_lightmap", moz}}}});
+    auto dir = testFolder(name);
+    writeDocument(doc, dir / "m.gltf");
+    return loadScene(dir / "m.gltf").materials[0].lightmapIntensity;
+  };
+  const json marker = {{"colorSpace", "srgb"}, {"irbake", {{"mozLightmap", "irradiance"}}}};
+  const float spec = static_cast<float>(3.5 / kPi);
+  EXPECT_FLOAT_EQ(intensityOf(marker, "loader_moz_marked"), spec);
+  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}}, "loader_moz_unmarked"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_no_extras"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"irbake", {{"mozLightmap", "radiance"}}}}, "loader_moz_other"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"irbake", "irradiance"}}, "loader_moz_not_object"), 3.5f);
+  EXPECT_FLOAT_EQ(intensityOf({{"colorSpace", "srgb"}}, "loader_moz_irbake_from", "irbake (from Blender)"), 3.5f);
+  // Other tools' files carry no marker and follow the specification.
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_other_tool", "Khronos glTF Blender I/O"), spec);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_other_tool_prefix", "THREE.GLTFExporter irbake"), spec);
+  EXPECT_FLOAT_EQ(intensityOf(json(), "loader_moz_no_generator", json()), spec);
+  EXPECT_FLOAT_EQ(intensityOf(marker, "loader_moz_other_tool_marked", "glTF-Transform"), spec);
 }
 
 // The viewer's maps (LoadOptions::shadingMaps): TANGENT to world space (w flipped by a mirroring node),

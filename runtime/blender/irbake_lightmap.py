@@ -1,6 +1,7 @@
 # irbake light maps in Blender: wires MOZ_lightmap into the materials that Blender's glTF importer creates, so the
-# bake shows unlit (baseColor x lightmap x intensity + emissive) in the viewport and in renders. docs/export.md,
-# "Blender".
+# bake shows unlit (baseColor x irradiance/pi + emissive) in the viewport and in renders: irradiance/pi is
+# the EXR page, or the PNG x intensity / pi (x intensity for an older irbake's: generator irbake, no units marker).
+# docs/export.md, "Blender".
 #
 # As an add-on (Edit > Preferences > Add-ons > Install..., enable "irbake light maps"): every File > Import >
 # glTF 2.0 wires the maps. As a script, with or without the add-on installed:
@@ -17,6 +18,7 @@ bl_info = {
 
 import argparse
 import json
+import math
 import os
 import struct
 import sys
@@ -50,9 +52,26 @@ def float32_finite(value):
     return abs(value) != float("inf")
 
 
+def is_irradiance(ext):
+    """Whether a MOZ_lightmap carries irbake's marker extras.irbake.mozLightmap = "irradiance"."""
+    extras = ext.get("extras") if isinstance(ext, dict) else None
+    marker = extras.get("irbake") if isinstance(extras, dict) else None
+    return isinstance(marker, dict) and marker.get("mozLightmap") == "irradiance"
+
+
+def is_older_irbake(gltf, ext):
+    """Whether a MOZ_lightmap is in the older irbake convention, intensity x texel = irradiance/pi: the file's
+    asset.generator starts with "irbake" and the marker is absent. Every other file follows MOZ_lightmap's own
+    rule, intensity x texel = the irradiance E."""
+    generator = getattr(getattr(gltf.data, "asset", None), "generator", None)
+    return isinstance(generator, str) and generator.startswith("irbake") and not is_irradiance(ext)
+
+
 def lightmap_of(gltf, material_index, ext):
-    """(texture index, texCoord, intensity) of material material_index's MOZ_lightmap ext, as irview reads it:
-    texCoord and intensity default to 1. Raises LightmapRefused naming the material for what irview refuses."""
+    """(texture index, texCoord, scale) of material material_index's MOZ_lightmap ext, as irview reads it: the
+    scale makes the decoded texel irradiance/pi, the value shown as baseColor x value (intensity / pi per the
+    specification, the intensity for an older irbake's); texCoord and intensity default to 1. Raises
+    LightmapRefused naming the material for what irview refuses."""
     name = gltf.data.materials[material_index].name if material_index is not None else None
     what = "material %s%s: MOZ_lightmap" % (material_index, " ('%s')" % name if name else "")
     if not isinstance(ext, dict):
@@ -69,7 +88,7 @@ def lightmap_of(gltf, material_index, ext):
     intensity = ext.get("intensity", 1.0)
     if not float32_finite(intensity) or intensity < 0:
         raise LightmapRefused("%s intensity %s must be a finite number ≥ 0" % (what, json.dumps(intensity)))
-    return texture, tex_coord, float(intensity)
+    return texture, tex_coord, float(intensity) / (1.0 if is_older_irbake(gltf, ext) else math.pi)
 
 
 def numpy_bool_alias():
@@ -143,7 +162,8 @@ def feed(tree, target, source_socket, constant):
 
 
 def wire_lightmap(material, image, tex_coord, intensity, is_float_page):
-    """Replaces the material's surface with Emission(baseColor x lightmap x intensity + emissive), the
+    """Replaces the material's surface with Emission(baseColor x lightmap x intensity + emissive) (intensity: the
+    scale lightmap_of gives, to irradiance/pi), the
     importer's Principled BSDF kept beside it unlinked. Returns False for a material without Principled BSDF."""
     tree = material.node_tree
     pbr = next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
@@ -176,7 +196,7 @@ def wire_lightmap(material, image, tex_coord, intensity, is_float_page):
     scaled.label = "light-map intensity"
     scaled.location = (x + 100, y)
     tree.links.new(scaled.inputs[0], lit.outputs[0])
-    # The float page holds the value itself; the PNG holds value / intensity.
+    # The float page holds the value itself; the PNG holds value / scale.
     scaled.inputs["Scale"].default_value = 1.0 if is_float_page else intensity
 
     emissive = tree.nodes.new("ShaderNodeVectorMath")

@@ -3,7 +3,8 @@
 # intensity of -1, "NaN", null or 1e39, a texture the file lacks, texCoord 0) each make
 # `irbake_lightmap.py SCENE` exit 5 with irview's message naming the material, and irview exits 5 with the same
 # message; the map is not wired. A MOZ_lightmap without texCoord (default 1) is wired to TEXCOORD_1 (UV map
-# UVMap.001) and one without intensity at intensity 1 (wiring_check.py). Skips (77) without Blender or its numpy.
+# UVMap.001), one without intensity at intensity 1, an older bake's (generator irbake, no units marker) at its
+# intensity as written and another tool's (no marker) at intensity / pi (wiring_check.py). Skips (77) without Blender or its numpy.
 # Usage (from ctest): refusals_test.sh IRBAKE IRVIEW WORK_DIR
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -38,6 +39,17 @@ for case, key, value, message in [
     print("%s\t%s %s" % (case, what, message))
 variant("no_texcoord", "texCoord", KeyError)
 variant("no_intensity", "intensity", KeyError)
+# An older bake: no units marker, its intensity the range of irradiance/pi (the written intensity / pi).
+old = json.loads(json.dumps(doc))
+ext = old["materials"][m]["extensions"]["MOZ_lightmap"]
+del ext["extras"]["irbake"]
+ext["intensity"] = ext["intensity"] / 3.141592653589793
+json.dump(old, open(path.replace(".gltf", "_unmarked.gltf"), "w"))
+# Another tool's file: no marker, generator not irbake, read per MOZ_lightmap's specification.
+other = json.loads(json.dumps(doc))
+del other["materials"][m]["extensions"]["MOZ_lightmap"]["extras"]["irbake"]
+other["asset"]["generator"] = "another exporter"
+json.dump(other, open(path.replace(".gltf", "_other_tool.gltf"), "w"))
 PY
 failures=0
 while IFS=$'\t' read -r case message; do
@@ -58,7 +70,8 @@ while IFS=$'\t' read -r case message; do
   done
 done < "$work/cases.tsv"
 blender --background --factory-startup --python "$here/wiring_check.py" -- "$work/bake/scene.gltf" \
-  "$work/bake/scene_no_texcoord.gltf" "$work/bake/scene_no_intensity.gltf" "$work/bake/scene_intensity_negative.gltf" \
+  "$work/bake/scene_no_texcoord.gltf" "$work/bake/scene_no_intensity.gltf" "$work/bake/scene_intensity_negative.gltf" "$work/bake/scene_unmarked.gltf" \
+  "$work/bake/scene_other_tool.gltf" \
   > "$work/wiring.log" 2>&1 || { echo "wiring_check failed:"; tail -20 "$work/wiring.log"; failures=$((failures + 1)); }
 grep "wiring_check" "$work/wiring.log" || true
 [[ $failures -eq 0 ]]

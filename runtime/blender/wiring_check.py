@@ -1,10 +1,13 @@
 # How irbake_lightmap.py wires one material's MOZ_lightmap (the first material that has one), read from the node
-# tree after an import of the PNG pages: the UV map its image node reads and the intensity it scales by. The
-# scenes given: the bake as written (TEXCOORD_1, its intensity), a copy without texCoord (MOZ_lightmap's default
-# set 1: UVMap.001), one without intensity (1.0), and one with intensity -1 (refused: the material left as
-# imported, one refusal recorded). Exits 1 naming what differs.
-#   blender --background --factory-startup --python wiring_check.py -- BAKE.gltf NO_TEXCOORD.gltf NO_INTENSITY.gltf NEGATIVE.gltf
+# tree after an import of the PNG pages: the UV map its image node reads and the scale to irradiance/pi it
+# multiplies by. The scenes given: the bake as written (TEXCOORD_1, intensity / pi: the units marker says
+# intensity x texel is the irradiance), a copy without texCoord (MOZ_lightmap's default set 1: UVMap.001), one
+# without intensity (1 / pi), one with intensity -1 (refused: the material left as imported, one refusal
+# recorded), an older bake's without the marker (generator irbake: its intensity as written), and another tool's
+# without the marker (MOZ_lightmap's own rule: intensity / pi). Exits 1 naming what differs.
+#   blender --background --factory-startup --python wiring_check.py -- BAKE.gltf NO_TEXCOORD.gltf NO_INTENSITY.gltf NEGATIVE.gltf UNMARKED.gltf OTHER_TOOL.gltf
 import json
+import math
 import os
 import sys
 
@@ -36,14 +39,22 @@ def wiring(scene):
 
 
 arguments = sys.argv[sys.argv.index("--") + 1:]
-baked, no_texcoord, no_intensity, negative = arguments
-written = json.load(open(baked))
-intensity = next(m["extensions"]["MOZ_lightmap"]["intensity"] for m in written["materials"]
-                 if "MOZ_lightmap" in m.get("extensions", {}))
-expected = [(baked, {"uv_map": "UVMap.001", "intensity": intensity}),
-            (no_texcoord, {"uv_map": "UVMap.001", "intensity": intensity}),
-            (no_intensity, {"uv_map": "UVMap.001", "intensity": 1.0}),
-            (negative, None)]
+baked, no_texcoord, no_intensity, negative, unmarked, other_tool = arguments
+
+
+def first_intensity(scene):
+    doc = json.load(open(scene))
+    return next(m["extensions"]["MOZ_lightmap"]["intensity"] for m in doc["materials"]
+                if "MOZ_lightmap" in m.get("extensions", {}))
+
+
+intensity = first_intensity(baked)
+expected = [(baked, {"uv_map": "UVMap.001", "intensity": intensity / math.pi}),
+            (no_texcoord, {"uv_map": "UVMap.001", "intensity": intensity / math.pi}),
+            (no_intensity, {"uv_map": "UVMap.001", "intensity": 1.0 / math.pi}),
+            (negative, None),
+            (unmarked, {"uv_map": "UVMap.001", "intensity": first_intensity(unmarked)}),
+            (other_tool, {"uv_map": "UVMap.001", "intensity": first_intensity(other_tool) / math.pi})]
 errors = []
 for scene, want in expected:
     name, got, refused = wiring(scene)

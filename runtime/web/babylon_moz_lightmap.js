@@ -1,13 +1,15 @@
 // A Babylon.js glTF loader extension for MOZ_lightmap as irbake writes it (docs/export.md):
-//   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity, extras: { colorSpace: "srgb" } }
-// A map texel is irradiance/π (linear); value = decode(PNG) × intensity, decode the sRGB curve when
-// extras.colorSpace says so. irview shows baseColour × map + emissive.
+//   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity,
+//                                         extras: { colorSpace: "srgb", irbake: { mozLightmap: "irradiance" } } }
+// decode(PNG) × intensity is the irradiance E (MOZ_lightmap's own rule), irradiance/π for an older irbake's
+// (generator irbake, no irradiance marker; moz_lightmap_rules.js); decode the sRGB curve when
+// extras.colorSpace says so. irview shows baseColour × E/π + emissive.
 //
 // Babylon's PBR shader (pbrBlockFinalColorComposition) adds a light map to the lit colour unless
 // useLightmapAsShadowmap is set, in which case it multiplies the colour by the map before adding the emission.
 // An unlit PBR material's colour is its base colour, so unlit + useLightmapAsShadowmap gives exactly
 // baseColour × map + emissive, with no scene light (the map holds all the light). The map reads TEXCOORD_1
-// (coordinatesIndex 1) and its level is the intensity. Render with an engine made with
+// (coordinatesIndex 1) and its level is the factor that makes the decoded texel E/π. Render with an engine made with
 // useExactSrgbConversions: true, so the sRGB decode and encode are the exact curves irview uses.
 //
 // A MOZ_lightmap irview refuses (moz_lightmap_rules.js) fails the load with an Error naming the material.
@@ -35,12 +37,12 @@ export class MozLightmapBabylon {
       if (!('lightmapTexture' in babylonMaterial) || !('unlit' in babylonMaterial))
         throw new Error(`${extensionContext}: needs a PBR material (got ${babylonMaterial.getClassName()})`);
       // Refused as irview refuses it (a negative or NaN intensity, a texture the file lacks, another UV set).
-      const { index, texCoord, intensity } = checkMozLightmap(this._loader.gltf, material.index, extension);
+      const { index, texCoord, irradiance } = checkMozLightmap(this._loader.gltf, material.index, extension);
       await this._loader.loadTextureInfoAsync(extensionContext, { index, texCoord },
         texture => {
           texture.name = `${babylonMaterial.name} (MOZ_lightmap)`;
           texture.gammaSpace = extension.extras?.colorSpace === 'srgb';
-          texture.level = intensity;
+          texture.level = irradiance / Math.PI;
           babylonMaterial.lightmapTexture = texture;
         });
       babylonMaterial.useLightmapAsShadowmap = true;

@@ -1,10 +1,12 @@
 // A GLTFLoader plugin for MOZ_lightmap as irbake writes it (docs/export.md):
-//   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity, extras: { colorSpace: "srgb" } }
-// A map texel is irradiance/π (linear). The 8-bit PNG is sRGB-encoded when extras.colorSpace says so
-// (current irbake exports), linear otherwise; value = decode(PNG) × intensity.
-// three.js treats lightMap as irradiance and shades it with BRDF_Lambert = albedo/π, so the
-// lightMapIntensity it needs is intensity × π. Materials with a light map become MeshLambertMaterial
-// (a physical material would add a specular term the bake does not have).
+//   material.extensions.MOZ_lightmap = { index, texCoord: 1, intensity,
+//                                         extras: { colorSpace: "srgb", irbake: { mozLightmap: "irradiance" } } }
+// The 8-bit PNG is sRGB-encoded when extras.colorSpace says so (current irbake exports), linear otherwise.
+// three.js treats lightMap as irradiance and shades it with BRDF_Lambert = albedo/π, so lightMapIntensity is
+// the factor that makes decode(PNG) the irradiance E: the intensity itself (MOZ_lightmap's own rule), intensity × π
+// for an older irbake's (generator irbake, no irradiance marker), whose value was irradiance/π
+// (moz_lightmap_rules.js). Materials with a light map become MeshLambertMaterial (a physical material would
+// add a specular term the bake does not have).
 //
 // Directional maps (IRBAKE_lightmap_directional, docs/export.md): a material with it and a normalTexture is
 // shaded, per channel, with lightmap(n) = max(0, L0 · (n_g·n) + t·n) (baker/transport/directional.h, as irview's
@@ -56,9 +58,9 @@ export class MozLightmapExtension {
     // GLTFLoader filled metallic-roughness parameters a Lambert material does not have.
     for (const key of ['metalness', 'roughness']) delete params[key];
     // Refused as irview refuses it (a negative or NaN intensity, a texture the file lacks, another UV set).
-    const { index, texCoord, intensity } = checkMozLightmap(this.parser.json, materialIndex, moz);
+    const { index, texCoord, irradiance } = checkMozLightmap(this.parser.json, materialIndex, moz);
     const srgb = moz.extras?.colorSpace === 'srgb';
-    params.lightMapIntensity = intensity * Math.PI;
+    params.lightMapIntensity = irradiance;
     return this.parser.assignTexture(params, 'lightMap', { index, texCoord }, srgb ? SRGBColorSpace : NoColorSpace);
   }
 

@@ -9,7 +9,8 @@
 //           moz-only: MOZ_lightmap without irbake_shadowmask.js's mixed lights]
 //          [--min-runtime-lights N, --min-masked N: fail unless three.js shaded N lights in real time, N materials
 //           with a shadow mask]
-//          [--client three|babylon (default three)]
+//          [--client three|babylon|spec (default three; spec: three.js reading MOZ_lightmap from its specification
+//           alone, spec_reader.html; --standard 0 shades it with Lambert instead of MeshStandardMaterial)]
 import fs from 'node:fs';
 import path from 'node:path';
 import { createRequire } from 'node:module';
@@ -22,9 +23,11 @@ for (const k of ['modules', 'scene', 'reference', 'out']) if (!args[k]) fail(`--
 const width = Number(args.width ?? 256), height = Number(args.height ?? 256), camera = Number(args.camera ?? 0);
 const maxMeanAbs = Number(args['max-mean-abs'] ?? 2);
 const client = args.client ?? 'three';
-if (client !== 'three' && client !== 'babylon') fail(`--client ${client}: three or babylon`);
-const page = client === 'babylon' ? { html: 'babylon.html', module: '/web/babylon_viewer.js' }
-                                  : { html: 'index.html', module: '/web/viewer.js' };
+const pages = { three: { html: 'index.html', module: '/web/viewer.js' },
+                babylon: { html: 'babylon.html', module: '/web/babylon_viewer.js' },
+                spec: { html: 'spec_reader.html', module: '/web/spec_moz_lightmap.js' } };
+if (!pages[client]) fail(`--client ${client}: three, babylon or spec`);
+const page = pages[client];
 if (!fs.existsSync(args.scene)) fail(`${args.scene}: no such file`);
 if (!fs.existsSync(args.reference)) fail(`${args.reference}: no such file`);
 
@@ -45,7 +48,7 @@ const { browser, tab, log } = await openTab(puppeteer, { chromium: args.chromium
 let code = 0;
 try {
   const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height,
-                                  lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz' });
+                                  lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz', standard: args.standard ?? '1' });
   await tab.goto(`http://127.0.0.1:${port}/web/${page.html}?${q}`);
   await tab.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
   const error = await tab.evaluate('window.viewerError');

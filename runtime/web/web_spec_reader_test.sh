@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# MOZ_lightmap read from its specification alone: bake the Cornell box, render it from its glTF camera with irview
+# and with three.js in headless Chromium through spec_reader.html (plain GLTFLoader, material.lightMap from the
+# extension's texture, lightMap.channel = 1, lightMapIntensity = intensity, none of irbake's plugins), with the
+# loader's MeshStandardMaterial and with Lambert, and require a mean absolute difference ≤ 2 (8-bit) for each.
+# Then the same on Sponza (../shared/scenes) baked with --sun and --sky, seen from bench/cycles/scenes.py's
+# overview camera (320 × 200); that part is skipped with a message when the scene is absent.
+# Usage (from ctest): web_spec_reader_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
+set -euo pipefail
+irbake="$1" irview="$2" modules="$3" work="$4"
+here="$(cd "$(dirname "$0")" && pwd)"
+source "$here/web_tests_common.sh"
+need_browser_client "$modules" "$work"
+bake_cornell_and_irview "$irbake" "$irview" "$work"
+for standard in 1 0; do
+  node "$here/render_compare.mjs" --modules "$modules" --client spec --standard $standard --scene "$work/bake/scene.gltf" \
+    --camera 0 --width $w --height $h --reference "$work/irview.png" --out "$work/spec_$standard.png" --max-mean-abs 2
+done
+src="$(cd "$here/../.." && pwd)"
+sponza="$src/../shared/scenes/dabrovic_sponza/sponza.glb"
+if [[ ! -f "$sponza" ]]; then echo "Sponza part skipped: $sponza absent"; exit 0; fi
+"$irbake" bake "$sponza" -o "$work/sponza" --sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7 --quiet > "$work/sponza.log" 2>&1
+w=320 h=200
+python3 - "$src/bench/cycles" "$work/sponza/scene.gltf" "$w" "$h" <<'PY'
+import json, math, sys
+sys.path.insert(0, sys.argv[1])
+from scenes import SPONZA_CAMERAS, look_at_quat
+path, w, h = sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+doc = json.load(open(path))
+name, eye, target, yfov = SPONZA_CAMERAS[0]
+doc["cameras"] = [{"type": "perspective", "name": name,
+                   "perspective": {"yfov": math.radians(yfov), "aspectRatio": w / h, "znear": 0.05}}]
+doc["nodes"].append({"name": name, "camera": 0, "translation": list(eye), "rotation": list(look_at_quat(eye, target))})
+doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
+json.dump(doc, open(path, "w"))
+PY
+"$irview" "$work/sponza/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/sponza_irview.png" \
+  > "$work/sponza_irview.log" 2>&1
+for standard in 1 0; do
+  node "$here/render_compare.mjs" --modules "$modules" --client spec --standard $standard --scene "$work/sponza/scene.gltf" \
+    --camera 0 --width $w --height $h --reference "$work/sponza_irview.png" --out "$work/sponza_spec_$standard.png" \
+    --max-mean-abs 2
+done
