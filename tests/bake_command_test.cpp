@@ -142,6 +142,16 @@ TEST(BakeCommand, WritesExrGltfAndReportThatMatchTheClosedForm) {
   EXPECT_GT(checked, 1000u);
   std::printf("point over plane via irbake bake: %zu texels, worst relative error %.2e\n", checked, worst);
   EXPECT_LT(worst, 5e-3);
+
+  // `irbake info` prints the MOZ_lightmap intensity the file holds (the specification's lux scale).
+  std::string infoLog;
+  ASSERT_EQ(runIrbake("info " + q(out / "scene.gltf"), &infoLog), 0) << infoLog;
+  nlohmann::json gltf = nlohmann::json::parse(std::ifstream(out / "scene.gltf"));
+  const double written = gltf["materials"][0]["extensions"]["MOZ_lightmap"]["intensity"].get<double>();
+  const size_t at = infoLog.find("irradiance = decoded × ");
+  ASSERT_NE(at, std::string::npos) << infoLog;
+  const double printed = std::stod(infoLog.substr(at + std::string("irradiance = decoded × ").size()));
+  EXPECT_NEAR(printed, written, 1e-3 * written) << infoLog;
 }
 
 // -o OUT.glb: one GLB with the light-map PNG embedded (no .gltf/.bin/.png beside it), the EXR page

@@ -50,7 +50,10 @@ int runInfo(const Args& args) {
     std::printf("  %s: baseColor (%.4g, %.4g, %.4g, %.4g)%s", m.name.c_str(), m.baseColorFactor.r, m.baseColorFactor.g,
                 m.baseColorFactor.b, m.baseColorFactor.a, m.baseColorTexture >= 0 ? " × texture" : "");
     if (m.isEmissive()) printVec(", emission ", m.emission());
-    if (m.lightmapTexture >= 0) std::printf(", MOZ_lightmap texture %d × %.4g", m.lightmapTexture, m.lightmapIntensity);
+    // Material::lightmapIntensity is irbake's internal scale (irradiance/π); the user reads the specification's.
+    if (m.lightmapTexture >= 0)
+      std::printf(", MOZ_lightmap texture %d, irradiance = decoded × %.4g lux", m.lightmapTexture,
+                  M_PI * m.lightmapIntensity);
     if (m.doubleSided) std::printf(", double-sided");
     std::printf("\n");
   }
