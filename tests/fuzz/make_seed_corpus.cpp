@@ -124,7 +124,7 @@ bool addTextureTransforms(json& doc) {
 bool addWebpSources(json& doc) {
   if (!doc.contains("textures") || doc["textures"].empty()) return false;
   for (json& t : doc["textures"]) {
-    doc["images"].push_back({{"mimeType", "image/webp"}, {"uri", "data:image/webp;base64," + base64(kWebp)}});
+    doc["images"].push_back({{"mimeType", "image/webp"}, {"uri", "data:application/octet-stream;base64," + base64(kWebp)}});
     t["extensions"]["EXT_texture_webp"]["source"] = doc["images"].size() - 1;
   }
   useExtension(doc, "EXT_texture_webp");
