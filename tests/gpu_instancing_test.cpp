@@ -52,7 +52,7 @@ const std::vector<Placement> kPlacements = {
 // The square mesh instanced by EXT_mesh_gpu_instancing on node 0 (gpu) or on one plain node per placement.
 GltfDocument squares(bool gpu) {
   const float h = 0.4f;
-  GltfDocument doc = testing::meshDocument({{-h, 0, -h}, {h, 0, -h}, {h, 0, h}, {-h, 0, h}}, {0, 2, 1, 0, 3, 2},
+  GltfDocument doc = irbake::testing::meshDocument({{-h, 0, -h}, {h, 0, -h}, {h, 0, h}, {-h, 0, h}}, {0, 2, 1, 0, 3, 2},
                                            std::vector<glm::vec3>(4, glm::vec3(0, 1, 0)));
   doc.root["meshes"][0]["name"] = "square";
   std::vector<glm::vec3> t, s;
@@ -111,9 +111,9 @@ TEST(GpuInstancing, EachInstanceHasItsOwnRegionAndTheMapsOfPlainNodes) {
   const fs::path dir = fs::current_path() / "test_scratch" / "gpu_instancing";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  testing::writeDocument(squares(true), dir / "instanced.gltf");
-  testing::writeDocument(squares(false), dir / "plain.gltf");
-  const std::vector<std::string> options = {"--backend", "embree", "--texels-per-unit", "16", "--vpls", "64", "--seed", "3", "--probes", "0"};
+  irbake::testing::writeDocument(squares(true), dir / "instanced.gltf");
+  irbake::testing::writeDocument(squares(false), dir / "plain.gltf");
+  const std::vector<std::string> options = {"--backend", "embree", "--texels-per-unit", "16", "--vpls", "64", "--seed", "3", "--probes", "off"};
   std::string log;
   for (const char* name : {"instanced", "plain"}) {
     std::vector<std::string> args = {"bake", (dir / (std::string(name) + ".gltf")).string(), "-o", (dir / name).string()};
