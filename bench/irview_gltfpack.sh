@@ -40,7 +40,7 @@ echo "irview, gltfpack'd portable GLB against the portable GLB: mean absolute di
      "(portable $portable_bytes B, packed $packed_bytes B, bake ${bake_s} s)"
 if [[ "$csv" != "-" ]]; then
   [[ -f "$csv" ]] || echo "date,scene,bake_options,view,portable_bytes,packed_bytes,mean_abs_diff_255,bake_seconds" > "$csv"
-  echo "$(date -u +%Y-%m-%d),$(basename "$scene"),$*,${view[*]},$portable_bytes,$packed_bytes,$mad,$bake_s" >> "$csv"
+  echo "$(date -u +%Y-%m-%d),$(basename "$scene"),\"$*\",\"${view[*]}\",$portable_bytes,$packed_bytes,$mad,$bake_s" >> "$csv"
 fi
 if [[ "$limit" != "-" ]] && awk -v d="$mad" -v l="$limit" 'BEGIN { exit !(d > l) }'; then
   echo "FAIL: $mad > $limit"; exit 1
