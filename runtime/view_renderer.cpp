@@ -551,6 +551,10 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
       glBindTexture(GL_TEXTURE_2D, I.colorTexture(m.baseColorTexture));
       const glm::vec3 emission = m.emission();
       glUniform3fv(I.u("uEmissive"), 1, &emission[0]);
+      // KHR_texture_transform (the identity without it): set on every draw, the default of a mat3 is zero.
+      const glm::mat3 baseUv = m.baseColorUvTransform.matrix(), emissiveUv = m.emissiveUvTransform.matrix();
+      glUniformMatrix3fv(I.u("uBaseColorUvTransform"), 1, GL_FALSE, &baseUv[0][0]);
+      glUniformMatrix3fv(I.u("uEmissiveUvTransform"), 1, GL_FALSE, &emissiveUv[0][0]);
       glActiveTexture(GL_TEXTURE1);
       glBindTexture(GL_TEXTURE_2D, I.colorTexture(m.emissiveTexture));
       glUniform1f(I.u("uLightmapScale"), g.lightmapScale);

@@ -301,6 +301,57 @@ TEST(ViewRenderer, MaterialFeaturesMatchTheirClosedForm) {
   EXPECT_GT(holes, 150);
 }
 
+// KHR_texture_transform in the shader, the loader's closed form (gltf_loader_test.cpp) on the GPU: a 2-texel
+// image (black, white; centres at u = 1/4, 3/4), clamped. UV (1/8, 1/2) with scale (2, 1) and offset (1/4, 0)
+// reads u = 1/2, halfway: 0.5; UV (0.3, 0.75) turned by π/2 reads u = 0.75, white (the opposite turn, black);
+// the emissive texture takes its own transform. Map = 1, so the pixel is the base colour (+ emission).
+TEST(ViewRenderer, TextureTransformMatchesItsClosedForm) {
+  GlContext gl;
+  struct Case {
+    glm::vec2 uv;
+    UvTransform base, emissive;
+    float expected;
+  };
+  UvTransform half;
+  half.present = true;
+  half.scale = {2, 1};
+  half.offset = {0.25f, 0};
+  UvTransform turn;
+  turn.present = true;
+  turn.rotation = kPi / 2;
+  UvTransform none;
+  const Case cases[] = {{{0.125f, 0.5f}, none, none, 0.0f},
+                        {{0.125f, 0.5f}, half, none, 0.5f},
+                        {{0.3f, 0.75f}, turn, none, 1.0f},
+                        {{0.125f, 0.5f}, none, half, 0.5f}};
+  for (const Case& c : cases) {
+    Scene s;
+    Texture t;
+    t.width = 2;
+    t.height = 1;
+    t.texels = {glm::vec4(0, 0, 0, 1), glm::vec4(1.0f)};
+    t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+    s.textures.push_back(t);
+    Material m;
+    if (c.emissive.present) {
+      m.baseColorFactor = glm::vec4(0, 0, 0, 1);
+      m.emissiveFactor = glm::vec3(1.0f);
+      m.emissiveTexture = 0;
+      m.emissiveUvTransform = c.emissive;
+    } else {
+      m.baseColorTexture = 0;
+      m.baseColorUvTransform = c.base;
+    }
+    s.materials.push_back(m);
+    addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0, 0, 4);
+    s.primitives[0].uv0.assign(4, c.uv);
+    ViewerScene v = makeViewerScene(std::move(s), {constantPage(0, 4, glm::vec3(1.0f))});
+    ViewRenderer r(v);
+    const RgbaImage img = r.render(lookAt({0, 2, 0.01f}, {0, 0, 0}, 40.0f, v.scene.bounds()), 32, 32, {});
+    EXPECT_NEAR(img.at(16, 16).r, c.expected, 0.01f) << "uv " << c.uv.x << ", " << c.uv.y;
+  }
+}
+
 TEST(ViewRenderer, MaterialLightmapTextureIsScaledByIntensity) {
   // No float pages: MOZ_lightmap texture (0.25) × intensity (4) = 1, on albedo 0.6.
   GlContext gl;

@@ -67,6 +67,8 @@ uniform vec4 uBaseColorFactor;
 uniform sampler2D uBaseColorTex;   // linear (decoded from sRGB by the sampler or at load)
 uniform vec3 uEmissive;            // factor × KHR_materials_emissive_strength
 uniform sampler2D uEmissiveTex;
+uniform mat3 uBaseColorUvTransform;  // KHR_texture_transform on (u, v, 1); the identity without it
+uniform mat3 uEmissiveUvTransform;
 uniform sampler2D uLightmap;       // irradiance/π, linear
 uniform float uLightmapScale;      // MOZ_lightmap intensity (1 for float pages)
 uniform vec2 uLightmapSize;        // page size in texels (density checker)
@@ -107,7 +109,7 @@ vec3 chartColor(float id) {
 vec4 baseColor() {
   vec4 base = uBaseColorFactor;
 #if BASE_TEX
-  base *= texture(uBaseColorTex, BASE_UV);
+  base *= texture(uBaseColorTex, (uBaseColorUvTransform * vec3(BASE_UV, 1.0)).xy);
 #endif
 #if ALPHA_MASK
   if (base.a < uAlphaCutoff) discard;
@@ -150,7 +152,7 @@ void main() {
 #if VIEW_MODE == 0
   vec3 emissive = uEmissive;
 #if EMISSIVE_TEX
-  emissive *= texture(uEmissiveTex, EMISSIVE_UV).rgb;
+  emissive *= texture(uEmissiveTex, (uEmissiveUvTransform * vec3(EMISSIVE_UV, 1.0)).xy).rgb;
 #endif
   vec3 base = baseColor().rgb;
   color = base * lightmap() + emissive;

@@ -328,6 +328,8 @@ Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& char
   dst.name = nameThePage ? src.name + "#page" + std::to_string(page) : src.name;
   dst.material = src.material;
   dst.node = src.node;
+  dst.instance = src.instance;
+  dst.instanceToNode = src.instanceToNode;
   dst.gltfMesh = src.gltfMesh;
   dst.gltfPrimitive = src.gltfPrimitive;
   dst.nodeToWorld = src.nodeToWorld;

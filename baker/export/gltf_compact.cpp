@@ -367,7 +367,7 @@ std::vector<std::pair<std::string, std::vector<uint8_t>>> externalizeImages(Gltf
     const uint8_t* bytes = viewBytes(doc, image["bufferView"].get<int>(), length, stride, "image " + std::to_string(i));
     std::vector<uint8_t> data(bytes, bytes + length);
     const ImageFormat format = sniffImageFormat(data.data(), data.size());
-    const std::string ext = format == ImageFormat::Png ? ".png" : format == ImageFormat::Jpeg ? ".jpg" : ".bin";
+    const std::string ext = format == ImageFormat::Png ? ".png" : format == ImageFormat::Jpeg ? ".jpg" : format == ImageFormat::Webp ? ".webp" : ".bin";
     std::string stem;
     if (image.contains(kSourceUriKey) && image[kSourceUriKey].is_string()) {
       const std::string uri = image[kSourceUriKey].get<std::string>();

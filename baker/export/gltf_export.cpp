@@ -5,7 +5,8 @@
 //    the atlas made (every source attribute and morph target gathered through Primitive::sourceVertex,
 //    TEXCOORD_1 added, one glTF primitive per light-map page). A mesh used by several nodes keeps its
 //    index for the first node; every further node gets a copy of the mesh with its own light-map
-//    region. Materials get MOZ_lightmap in place (a copy per further page). Whatever nothing references
+//    region; each EXT_mesh_gpu_instancing instance becomes a child node of its own the same way (the
+//    extension cannot carry a light map per instance). Materials get MOZ_lightmap in place (a copy per further page). Whatever nothing references
 //    any more (the replaced accessors, their views) is dropped and buffer 0 rebuilt (gltf_compact.h).
 //  - a generated scene: written by our writer from a copy whose materials carry the light maps.
 // A .glb embeds every image; a .gltf gets its .bin and the images as files beside it. Every file is
@@ -19,6 +20,8 @@
 #include <map>
 #include <memory>
 #include <set>
+
+#include <glm/gtc/type_ptr.hpp>
 
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -87,6 +90,7 @@ std::string mimeFor(const std::vector<uint8_t>& bytes, const std::string& fallba
   switch (sniffImageFormat(bytes.data(), bytes.size())) {
     case ImageFormat::Png: return "image/png";
     case ImageFormat::Jpeg: return "image/jpeg";
+    case ImageFormat::Webp: return "image/webp";
     default: return fallback.empty() ? "application/octet-stream" : fallback;
   }
 }
@@ -229,30 +233,33 @@ class SourceExport {
   }
 
   GltfDocument run() {
-    // Scene primitives grouped per (node, mesh, source primitive), in scene order; the atlas may have
-    // split one source primitive into one part per page.
-    std::map<int, std::map<int, std::vector<const Primitive*>>> partsOfNode;  // node → source primitive → parts
-    std::vector<int> nodeOrder;
+    // Scene primitives grouped per (node, GPU instance) and source primitive, in scene order; the atlas
+    // may have split one source primitive into one part per page.
+    using Instance = std::pair<int, int>;  // (node, EXT_mesh_gpu_instancing instance or -1)
+    std::map<Instance, std::map<int, std::vector<const Primitive*>>> partsOf;
+    std::vector<Instance> order;
     for (const auto& p : scene_.primitives) {
       if (p.node < 0 || p.gltfMesh < 0 || p.gltfPrimitive < 0) continue;
-      if (!partsOfNode.count(p.node)) nodeOrder.push_back(p.node);
-      partsOfNode[p.node][p.gltfPrimitive].push_back(&p);
+      const Instance key(p.node, p.instance);
+      if (!partsOf.count(key)) order.push_back(key);
+      partsOf[key][p.gltfPrimitive].push_back(&p);
     }
     std::set<int> meshesTaken;  // source meshes already rewritten for their first instance
-    json& nodes = doc_.root["nodes"];
-    for (int node : nodeOrder) {
-      if (node >= static_cast<int>(nodes.size())) continue;
-      const int mesh = nodes[node].value("mesh", -1);
-      if (mesh < 0 || mesh >= static_cast<int>(sourceMeshes_.size())) continue;
-      json rewritten = rewriteMesh(mesh, partsOfNode[node]);
+    for (const Instance& key : order) {
+      const auto& parts = partsOf[key];
+      const Primitive& any = *parts.begin()->second.front();
+      const int node = key.first, mesh = any.gltfMesh;
+      if (node >= static_cast<int>(doc_.root["nodes"].size()) || mesh >= static_cast<int>(sourceMeshes_.size())) continue;
+      json rewritten = rewriteMesh(mesh, parts);
       // Instancing rule: the first node keeps the mesh index; every further instance gets its own
       // copy of the mesh (its own light-map region, TEXCOORD_1 and split vertices).
-      if (meshesTaken.insert(mesh).second) {
-        doc_.root["meshes"][mesh] = std::move(rewritten);
-      } else {
-        nodes[node]["mesh"] = doc_.append("meshes", std::move(rewritten));
-      }
+      int index = mesh;
+      if (meshesTaken.insert(mesh).second) doc_.root["meshes"][mesh] = std::move(rewritten);
+      else index = doc_.append("meshes", std::move(rewritten));
+      if (key.second >= 0) expandGpuInstance(node, key.second, index, any.instanceToNode);
+      else if (index != mesh) doc_.root["nodes"][node]["mesh"] = index;
     }
+    finishGpuInstancing();
     if (!images_.empty()) doc_.useExtension("MOZ_lightmap");
     repairEmissiveFactors();
     compactDocument(doc_);
@@ -338,6 +345,47 @@ class SourceExport {
     return prim;
   }
 
+  // EXT_mesh_gpu_instancing: each instance is written as a child node of the instanced node, with the
+  // instance's transform and a mesh of its own (the light map is per instance, which the extension cannot
+  // carry); the node keeps everything else and loses its mesh and the extension.
+  void expandGpuInstance(int node, int instance, int mesh, const glm::mat4& instanceToNode) {
+    json child = json::object();
+    const std::string name = doc_.root["nodes"][node].value("name", std::string("node") + std::to_string(node));
+    child["name"] = name + "_instance" + std::to_string(instance);
+    child["mesh"] = mesh;
+    if (instanceToNode != glm::mat4(1.0f)) {
+      json matrix = json::array();
+      for (int i = 0; i < 16; ++i) matrix.push_back(glm::value_ptr(instanceToNode)[i]);  // both column-major
+      child["matrix"] = std::move(matrix);
+    }
+    const int index = doc_.append("nodes", std::move(child));
+    json& parent = doc_.root["nodes"][node];
+    if (!parent.contains("children") || !parent["children"].is_array()) parent["children"] = json::array();
+    parent["children"].push_back(index);
+    parent.erase("mesh");
+    if (parent.contains("extensions") && parent["extensions"].is_object()) {
+      parent["extensions"].erase("EXT_mesh_gpu_instancing");
+      if (parent["extensions"].empty()) parent.erase("extensions");
+    }
+    expandedNodes_.insert(node);
+    ++expandedInstances_;
+  }
+
+  // Once no node carries EXT_mesh_gpu_instancing any more, the document no longer uses or requires it.
+  void finishGpuInstancing() {
+    if (expandedNodes_.empty()) return;
+    for (const json& n : doc_.root["nodes"])
+      if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("EXT_mesh_gpu_instancing")) return;
+    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+      if (!doc_.root.contains(list) || !doc_.root[list].is_array()) continue;
+      json& names = doc_.root[list];
+      names.erase(std::remove(names.begin(), names.end(), json("EXT_mesh_gpu_instancing")), names.end());
+      if (names.empty()) doc_.root.erase(list);
+    }
+    log::warn(file_ + ": EXT_mesh_gpu_instancing: " + std::to_string(expandedNodes_.size()) + " instanced node(s) written as " +
+              std::to_string(expandedInstances_) + " nodes, one per instance, each with its own light-map region; the extension is dropped");
+  }
+
   // glTF keeps emissiveFactor in [0, 1]; a source above that (the loader took it as factor × strength)
   // is written as factor / peak with KHR_materials_emissive_strength × peak: the same emission, valid.
   void repairEmissiveFactors() {
@@ -419,6 +467,8 @@ class SourceExport {
   std::map<int, int> pageTexture_;
   bool warnedTexcoord1_ = false;
   bool warnedEmissive_ = false;
+  std::set<int> expandedNodes_;   // nodes whose EXT_mesh_gpu_instancing became child nodes
+  size_t expandedInstances_ = 0;
 };
 
 // Generated scene (no source document): our writer from a copy whose materials carry the light maps.

@@ -43,6 +43,14 @@ glm::quat rotationFromMinusZ(const glm::vec3& dir) {
 
 json rotationJson(const glm::quat& q) { return json::array({q.x, q.y, q.z, q.w}); }
 
+// KHR_texture_transform on a texture reference, when the material has one.
+void writeUvTransform(GltfDocument& doc, json& textureInfo, const UvTransform& t) {
+  if (!t.present) return;
+  textureInfo["extensions"]["KHR_texture_transform"] = {
+      {"offset", {t.offset.x, t.offset.y}}, {"rotation", t.rotation}, {"scale", {t.scale.x, t.scale.y}}};
+  doc.useExtension("KHR_texture_transform");
+}
+
 void writeBytes(const std::filesystem::path& path, const void* data, size_t size, const std::string& finalName) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(ErrorCode::Io, finalName, "cannot open for writing");
@@ -213,6 +221,7 @@ json materialJson(const Scene& scene, const Material& m, GltfDocument& doc, std:
   if (m.baseColorTexture >= 0 && !scene.textures.at(m.baseColorTexture).texels.empty()) {
     pbr["baseColorTexture"] = {{"index", texture(m.baseColorTexture, true)}};
     if (m.baseColorTexCoord) pbr["baseColorTexture"]["texCoord"] = m.baseColorTexCoord;
+    writeUvTransform(doc, pbr["baseColorTexture"], m.baseColorUvTransform);
   }
   mat["pbrMetallicRoughness"] = pbr;
   // glTF keeps emissiveFactor in [0,1]: the scale above 1 moves into KHR_materials_emissive_strength.
@@ -231,6 +240,7 @@ json materialJson(const Scene& scene, const Material& m, GltfDocument& doc, std:
   if (m.emissiveTexture >= 0 && !scene.textures.at(m.emissiveTexture).texels.empty()) {
     mat["emissiveTexture"] = {{"index", texture(m.emissiveTexture, true)}};
     if (m.emissiveTexCoord) mat["emissiveTexture"]["texCoord"] = m.emissiveTexCoord;
+    writeUvTransform(doc, mat["emissiveTexture"], m.emissiveUvTransform);
   }
   if (m.normalTexture >= 0 && !scene.textures.at(m.normalTexture).texels.empty()) {
     mat["normalTexture"] = {{"index", texture(m.normalTexture, false)}};

@@ -42,7 +42,8 @@ int portableScale(const Scene& scene, int page, int pageWidth, int pageHeight, c
     for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
       const uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
       const double mapTexels = 0.5 * std::abs(cross2(p.uv1[b] - p.uv1[a], p.uv1[c] - p.uv1[a])) * pageWidth * pageHeight;
-      const double albedoTexels = 0.5 * std::abs(cross2(uv[b] - uv[a], uv[c] - uv[a])) * albedo->width * albedo->height;
+      const double albedoTexels = 0.5 * std::abs(cross2(uv[b] - uv[a], uv[c] - uv[a])) * m.baseColorUvTransform.areaScale() *
+                                  albedo->width * albedo->height;
       if (!(mapTexels > 0.0) || !std::isfinite(albedoTexels)) continue;
       weighted += mapTexels * std::sqrt(albedoTexels / mapTexels);
       weight += mapTexels;
@@ -186,7 +187,11 @@ PortableBake buildPortable(const Scene& scene, const std::vector<Lightmap>& maps
     p.material = materialFor[key];
     // The page texture reads the atlas UVs as set 0; a primitive without a page keeps its base colour's set.
     if (onPage) p.uv0 = source.uv1;
-    else p.uv0 = m.baseColorTexCoord == 1 ? source.uv1 : source.uv0;
+    else {
+      // KHR_texture_transform is affine, so it goes into the vertex UVs exactly (the portable file has no extension).
+      p.uv0 = m.baseColorTexCoord == 1 ? source.uv1 : source.uv0;
+      for (glm::vec2& uv : p.uv0) uv = m.baseColorUvTransform.apply(uv);
+    }
     copy.primitives.push_back(std::move(p));
   }
   out.document = gltfFromScene(copy);

@@ -28,6 +28,10 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
                      {"primitives", f.scene.primitives.size()},
                      {"lights", f.scene.lights.size()},
                      {"emitterPower", nlohmann::json::array({emitted.x, emitted.y, emitted.z})}};
+  if (f.scene.stats.gpuInstances > 0)
+    report["scene"]["gpuInstancing"] = {{"nodes", f.scene.stats.gpuInstancedNodes},
+                                        {"instances", f.scene.stats.gpuInstances},
+                                        {"export", "EXT_mesh_gpu_instancing dropped: each instance written as a node of its own, with its own light-map region"}};
   report["atlas"] = f.atlas.toJson();
   report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
                       {"supersample", std::max(1, f.options.texels.supersample)},

@@ -74,7 +74,7 @@ FootprintAlbedo::FootprintAlbedo(const Scene& scene) : scene_(scene) {
     for (size_t t = 0; t < prim.triangleCount(); ++t) {
       const uint32_t* idx = &prim.indices[3 * t];
       const double map = uvArea(prim.uv1, idx) * mapTexels;
-      const double texture = uvArea(uvTex, idx) * texTexels;
+      const double texture = uvArea(uvTex, idx) * m.baseColorUvTransform.areaScale() * texTexels;
       if (!(map > 0.0) || !(texture > 0.0)) continue;
       // Texture texels per map texel, along a side: level ⌊log2⌋ is the coarsest whose texel is at most a map texel.
       const double perMapTexel = std::sqrt(texture / map);
@@ -91,7 +91,8 @@ glm::vec3 FootprintAlbedo::at(uint32_t primitive, uint32_t triangle, glm::vec2 b
   if (m.baseColorTexture >= 0) {
     const int lv = level_[primitive][triangle];
     const Texture& tex = lv == 0 ? scene_.textures[m.baseColorTexture] : coarser_[m.baseColorTexture][lv - 1];
-    c *= sampleBilinear(tex, interpolateUv(m.baseColorTexCoord == 1 ? prim.uv1 : prim.uv0, prim, triangle, barycentric));
+    const glm::vec2 uv = interpolateUv(m.baseColorTexCoord == 1 ? prim.uv1 : prim.uv0, prim, triangle, barycentric);
+    c *= sampleBilinear(tex, m.baseColorUvTransform.apply(uv));
   }
   return glm::vec3(c);
 }

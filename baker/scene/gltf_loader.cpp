@@ -56,7 +56,8 @@ constexpr double kBoundSlack = kSceneLimitSlack;
 // any other): the only ones a file may list in extensionsRequired.
 const char* const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_mesh_quantization", "MOZ_lightmap",
-                                            "IRBAKE_lightmap_directional"};
+                                            "IRBAKE_lightmap_directional", "KHR_texture_transform",
+                                            "EXT_mesh_gpu_instancing", "EXT_texture_webp"};
 
 // tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
 // material uses). EXR and unknown formats load too; they are simply recorded.
@@ -414,11 +415,87 @@ class Loader {
     if (node.mesh >= 0) {
       if (node.mesh >= static_cast<int>(model_.meshes.size()))
         invalid("node " + std::to_string(n) + nodeName(n) + " references mesh " + std::to_string(node.mesh) + ", out of range");
-      addMeshInstance(n, node.mesh, world);
+      if (const json* gpu = path(nodeJson(n), {"extensions", "EXT_mesh_gpu_instancing"})) {
+        const std::vector<glm::mat4> instances = gpuInstances(n, *gpu);
+        for (size_t i = 0; i < instances.size(); ++i)
+          addMeshInstance(n, node.mesh, world * instances[i], static_cast<int>(i), instances[i]);
+      } else {
+        addMeshInstance(n, node.mesh, world);
+      }
     }
     if (node.camera >= 0) addCamera(n, world);
     if (const json* l = path(nodeJson(n), {"extensions", "KHR_lights_punctual", "light"})) addLight(n, l, world);
     for (int c : node.children) visitNode(c, world, depth + 1);
+  }
+
+  // EXT_mesh_gpu_instancing: one transform per instance, T · R · S from the TRANSLATION, ROTATION (unit
+  // quaternion) and SCALE accessors, applied before the node's world matrix. Each instance becomes a mesh
+  // instance of the scene of its own (and so its own light-map region). Broken data is refused, naming
+  // the extension, the node and the accessor.
+  std::vector<glm::mat4> gpuInstances(int n, const json& ext) {
+    const std::string what = "node " + std::to_string(n) + nodeName(n) + ": EXT_mesh_gpu_instancing";
+    const json* attributes = child(ext, "attributes");
+    if (!attributes || !attributes->is_object()) invalid(what + " has no \"attributes\" object");
+    std::vector<glm::vec3> translation, scale;
+    std::vector<glm::vec4> rotation;
+    size_t count = 0;
+    bool first = true;
+    for (const auto& [name, index] : attributes->items()) {
+      const int want = name == "ROTATION" ? 4 : (name == "TRANSLATION" || name == "SCALE") ? 3 : 0;
+      if (want == 0) continue;  // custom attributes (_ID, ...) do not move the instance
+      if (!index.is_number_integer()) invalid(what + " attribute " + name + " is not an accessor index");
+      int components;
+      size_t elements;
+      const std::vector<float> v = readAccessor(index.get<int>(), what + " " + name, components, elements);
+      const std::string accessor = "accessor " + index.dump() + " (" + what + " " + name + ")";
+      if (components != want) invalid(accessor + " has " + std::to_string(components) + " components, the extension needs " + std::to_string(want));
+      checkInstanceComponentType(model_.accessors[index.get<int>()], name, accessor);
+      if (!first && elements != count)
+        invalid(accessor + " has " + std::to_string(elements) + " elements, another attribute " + std::to_string(count) + ": every attribute needs one per instance");
+      count = elements;
+      first = false;
+      for (float x : v)
+        if (!std::isfinite(x)) invalid(accessor + " holds a NaN/Inf");
+      for (size_t i = 0; i < elements; ++i) {
+        if (want == 4) rotation.emplace_back(v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]);
+        else (name == "SCALE" ? scale : translation).emplace_back(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+      }
+    }
+    if (first) invalid(what + " has none of TRANSLATION, ROTATION and SCALE");
+    if (count == 0) invalid(what + " has no instances (its accessors hold 0 elements)");
+    gpuInstanceTotal_ += count;
+    if (gpuInstanceTotal_ > kMaxNodeInstances)
+      invalid(what + ": absurd size, more than " + std::to_string(kMaxNodeInstances) + " instances in the file");
+    ++scene_.stats.gpuInstancedNodes;
+    scene_.stats.gpuInstances += count;
+    std::vector<glm::mat4> out(count, glm::mat4(1.0f));
+    for (size_t i = 0; i < count; ++i) {
+      glm::mat4 r(1.0f);
+      if (!rotation.empty()) {
+        const glm::quat q(rotation[i].w, rotation[i].x, rotation[i].y, rotation[i].z);
+        const float len = glm::length(q);
+        if (!(len > 0.0f)) invalid(what + " ROTATION of instance " + std::to_string(i) + " is a zero quaternion");
+        r = glm::mat4_cast(q / len);
+      }
+      const glm::mat4 t = translation.empty() ? glm::mat4(1.0f) : glm::translate(glm::mat4(1.0f), translation[i]);
+      const glm::mat4 sc = scale.empty() ? glm::mat4(1.0f) : glm::scale(glm::mat4(1.0f), scale[i]);
+      out[i] = t * r * sc;
+    }
+    return out;
+  }
+
+  // The extension's component types: float; a normalized signed byte or short for ROTATION; and with
+  // KHR_mesh_quantization any byte or short for TRANSLATION and SCALE.
+  void checkInstanceComponentType(const tinygltf::Accessor& a, const std::string& name, const std::string& accessor) const {
+    const int type = a.componentType;
+    if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) return;
+    const bool signedSmall = type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT;
+    if (name == "ROTATION" && signedSmall && a.normalized) return;
+    const bool small = signedSmall || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    const auto& used = model_.extensionsUsed;
+    if (name != "ROTATION" && small && std::find(used.begin(), used.end(), "KHR_mesh_quantization") != used.end()) return;
+    invalid(accessor + " has component type " + std::to_string(type) + (a.normalized ? " (normalized)" : "") +
+            ", which the extension does not allow for " + name);
   }
 
   const json& nodeJson(int n) const {
@@ -720,7 +797,8 @@ class Loader {
     return (rec && rec->is_object()) ? rec : nullptr;
   }
 
-  void addMeshInstance(int nodeIndex, int meshIndex, const glm::mat4& world) {
+  void addMeshInstance(int nodeIndex, int meshIndex, const glm::mat4& world, int instance = -1,
+                       const glm::mat4& instanceToNode = glm::mat4(1.0f)) {
     const auto& mesh = model_.meshes[meshIndex];
     const glm::mat3 linear(world);
     const float det = glm::determinant(linear);
@@ -735,6 +813,8 @@ class Loader {
       out.gltfMesh = meshIndex;
       out.gltfPrimitive = pi;
       out.nodeToWorld = world;
+      out.instance = instance;
+      out.instanceToNode = instanceToNode;
       out.material = materialIndex(lp.material, "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi));
       out.lightmap = lp.lightmap;
       out.uv0 = lp.uv0;
@@ -911,6 +991,7 @@ class Loader {
     }
     const json* mj = element(src_.json, "materials", index);
     if (mj) {
+      readTextureTransforms(index, g.name, *mj, m);
       m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
       m.transmission = static_cast<float>(
           std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
@@ -931,6 +1012,57 @@ class Loader {
       invalid(what + ": KHR_materials_emissive_strength emissiveStrength must be ≥ 0 and finite (it is " +
               number(m.emissiveStrength) + ")");
     return m;
+  }
+
+  // KHR_texture_transform on the base colour and emissive textures, which every reader applies (a given
+  // texCoord replaces the textureInfo's). On a texture that no reader transforms (the viewer's normal map
+  // and light map) it is named in a warning, once per file, rather than shown untransformed in silence.
+  void readTextureTransforms(int index, const std::string& gltfName, const json& mj, Material& m) {
+    const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')");
+    if (const json* t = path(mj, {"pbrMetallicRoughness", "baseColorTexture", "extensions", "KHR_texture_transform"}))
+      m.baseColorUvTransform = readTextureTransform(*t, what + " baseColorTexture", m.baseColorTexCoord);
+    if (const json* t = path(mj, {"emissiveTexture", "extensions", "KHR_texture_transform"}))
+      m.emissiveUvTransform = readTextureTransform(*t, what + " emissiveTexture", m.emissiveTexCoord);
+    if (!options_.shadingMaps || warnedTextureTransform_) return;
+    for (const char* texture : {"normalTexture", "occlusionTexture"})
+      if (path(mj, {texture, "extensions", "KHR_texture_transform"})) {
+        warnedTextureTransform_ = true;
+        warn(what + " " + texture + ": KHR_texture_transform is applied to base colour and emissive textures only; "
+             "this texture is shown untransformed");
+        return;
+      }
+    if (path(mj, {"extensions", "MOZ_lightmap", "extensions", "KHR_texture_transform"})) {
+      warnedTextureTransform_ = true;
+      warn(what + " MOZ_lightmap: KHR_texture_transform on the light map is not applied");
+    }
+  }
+
+  UvTransform readTextureTransform(const json& ext, const std::string& what, int& texCoord) {
+    const std::string name = what + ": KHR_texture_transform";
+    if (!ext.is_object()) invalid(name + " is not an object");
+    auto pair = [&](const char* key, glm::vec2 fallback) {
+      const json* a = child(ext, key);
+      if (!a) return fallback;
+      if (!a->is_array() || a->size() != 2 || !(*a)[0].is_number() || !(*a)[1].is_number())
+        invalid(name + " " + key + " must be an array of two numbers (got " + a->dump().substr(0, 80) + ")");
+      const glm::vec2 v((*a)[0].get<float>(), (*a)[1].get<float>());
+      if (!std::isfinite(v.x) || !std::isfinite(v.y)) invalid(name + " " + key + " is not finite");
+      return v;
+    };
+    UvTransform t;
+    t.present = true;
+    t.offset = pair("offset", glm::vec2(0.0f));
+    t.scale = pair("scale", glm::vec2(1.0f));
+    if (const json* r = child(ext, "rotation")) {
+      if (!r->is_number() || !std::isfinite(r->get<float>())) invalid(name + " rotation must be a finite number of radians");
+      t.rotation = r->get<float>();
+    }
+    if (const json* tc = child(ext, "texCoord")) {
+      if (!tc->is_number_integer() || tc->get<int64_t>() < 0 || tc->get<int64_t>() > 255)
+        invalid(name + " texCoord " + tc->dump() + " is not a UV set index");
+      texCoord = tc->get<int>();
+    }
+    return t;
   }
 
   // MOZ_lightmap (docs/export.md). A light map is never dropped silently: a missing texture and an intensity
@@ -1033,12 +1165,15 @@ class Loader {
     auto it = textureMap_.find(key);
     if (it != textureMap_.end()) return it->second;
     const auto& t = model_.textures[gltfTexture];
-    if (t.source < 0 || t.source >= static_cast<int>(model_.images.size()))
+    const int webp = webpSource(gltfTexture);
+    if (webp < 0 && (t.source < 0 || t.source >= static_cast<int>(model_.images.size())))
       invalid("texture " + std::to_string(gltfTexture) + " references image " + std::to_string(t.source) + ", out of range");
+    const int fallback = webp >= 0 && t.source >= 0 && t.source < static_cast<int>(model_.images.size()) ? t.source : -1;
+    const int source = webp >= 0 ? webp : t.source;
     Texture tex;
-    const auto& img = model_.images[t.source];
-    tex.name = !img.name.empty() ? img.name : !img.uri.empty() ? img.uri : "image" + std::to_string(t.source);
-    tex.gltfImage = t.source;
+    const auto& img = model_.images[source];
+    tex.name = !img.name.empty() ? img.name : !img.uri.empty() ? img.uri : "image" + std::to_string(source);
+    tex.gltfImage = source;
     if (t.sampler >= 0) {
       if (t.sampler >= static_cast<int>(model_.samplers.size())) invalid("texture " + std::to_string(gltfTexture) + " references a missing sampler");
       tex.wrapS = wrapFromGl(model_.samplers[t.sampler].wrapS);
@@ -1047,8 +1182,24 @@ class Loader {
     int index = static_cast<int>(scene_.textures.size());
     scene_.textures.push_back(std::move(tex));
     textureSrgb_.push_back(srgb);
+    fallbackImage_.push_back(fallback);
+    textureWebp_.push_back(webp >= 0);
     textureMap_[key] = index;
     return index;
+  }
+
+  // EXT_texture_webp: the texture's WebP image (-1: the extension is absent). A source that is no image of
+  // the file is refused, naming the extension.
+  int webpSource(int gltfTexture) const {
+    const json* tj = element(src_.json, "textures", static_cast<size_t>(gltfTexture));
+    const json* ext = tj ? path(*tj, {"extensions", "EXT_texture_webp"}) : nullptr;
+    if (!ext) return -1;
+    const json* source = child(*ext, "source");
+    const int64_t images = static_cast<int64_t>(model_.images.size());
+    if (!source || !source->is_number_integer() || source->get<int64_t>() < 0 || source->get<int64_t>() >= images)
+      invalid("texture " + std::to_string(gltfTexture) + ": EXT_texture_webp source " + (source ? source->dump() : "(missing)") +
+              " is not an image of the file (" + std::to_string(images) + " images)");
+    return source->get<int>();
   }
 
   // Decodes every used texture, in parallel (JPEG/PNG decoding dominates load time on textured scenes).
@@ -1061,17 +1212,30 @@ class Loader {
       for (size_t i = next++; i < n; i = next++) {
         Texture& tex = scene_.textures[i];
         const auto& img = model_.images[tex.gltfImage];
-        if (img.image.empty()) {
+        if (img.image.empty() && !textureWebp_[i]) {
           failures[i] = "image " + std::to_string(tex.gltfImage) + " '" + tex.name + "' has no data (file missing?): treated as white";
           continue;
         }
         try {
-          Texture decoded = decodeImageToTexture(img.image.data(), img.image.size(), textureSrgb_[i], tex.name);
-          tex.width = decoded.width;
-          tex.height = decoded.height;
-          tex.texels = std::move(decoded.texels);
+          decodeInto(tex, img.image, textureSrgb_[i]);
         } catch (const Error& e) {
-          failures[i] = "image " + std::to_string(tex.gltfImage) + " '" + tex.name + "' cannot be decoded (treated as white): " + e.what();
+          if (!textureWebp_[i]) {
+            failures[i] = "image " + std::to_string(tex.gltfImage) + " '" + tex.name + "' cannot be decoded (treated as white): " + e.what();
+            continue;
+          }
+          const int fallback = fallbackImage_[i];
+          if (fallback < 0 || model_.images[fallback].image.empty()) {
+            failures[i] = "EXT_texture_webp: image " + std::to_string(tex.gltfImage) + " '" + tex.name +
+                          "' cannot be read (" + e.what() + ") and the texture has no fallback source";
+            continue;
+          }
+          failures[i] = "EXT_texture_webp: image " + std::to_string(tex.gltfImage) + " '" + tex.name +
+                        "' cannot be read; its fallback image " + std::to_string(fallback) + " is used";
+          try {
+            decodeInto(tex, model_.images[fallback].image, textureSrgb_[i]);
+          } catch (const Error& e2) {
+            failures[i] += ", which cannot be decoded either (treated as white): " + std::string(e2.what());
+          }
         }
       }
     };
@@ -1080,8 +1244,17 @@ class Loader {
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
     work();
     for (auto& t : pool) t.join();
+    for (size_t i = 0; i < n; ++i)
+      if (textureWebp_[i] && scene_.textures[i].texels.empty()) invalid(failures[i]);
     for (const auto& f : failures)
       if (!f.empty()) warn(f);
+  }
+
+  static void decodeInto(Texture& tex, const std::vector<unsigned char>& bytes, bool srgb) {
+    Texture decoded = decodeImageToTexture(bytes.data(), bytes.size(), srgb, tex.name);
+    tex.width = decoded.width;
+    tex.height = decoded.height;
+    tex.texels = std::move(decoded.texels);
   }
 
   // An irbake export's sky (root extras "irbakeSky", export/gltf_export.h): a uniform sky is restored; for a
@@ -1138,6 +1311,10 @@ class Loader {
   int defaultMaterial_ = -1;
   std::map<std::pair<int, bool>, int> textureMap_;
   std::vector<bool> textureSrgb_;
+  std::vector<int> fallbackImage_;   // per scene texture: EXT_texture_webp's fallback image (-1 none)
+  std::vector<bool> textureWebp_;    // per scene texture: read through EXT_texture_webp
+  bool warnedTextureTransform_ = false;
+  size_t gpuInstanceTotal_ = 0;
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "lights/light_kind.h"
 #include "scene/environment.h"
 #include "scene/gltf_loader.h"
+#include "imageio/image_io.h"
 #include "scene/image_codec.h"
 #include "testing/gltf_builder.h"
 
@@ -625,7 +626,7 @@ TEST(GltfLoader, UnsupportedRequiredExtensionIsRefused) {
   doc.root["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
   doc.root["extensionsRequired"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
   EXPECT_EQ(loadDocument(doc, "loader_required_ok").lights.size(), 1u);
-  for (const char* name : {"KHR_draco_mesh_compression", "KHR_texture_transform", "EXT_meshopt_compression"}) {
+  for (const char* name : {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}) {
     doc.root["extensionsRequired"] = {"KHR_lights_punctual", name};
     expectRefused(doc, std::string("loader_required_") + name, {std::string("requires extension ") + name, "extensionsRequired"});
   }
@@ -721,4 +722,170 @@ TEST(GltfLoader, ScenesInsideTheSupportedScaleLoad) {
   const Scene s = loadDocument(far, "loader_far_from_origin");
   ASSERT_EQ(s.stats.warnings.size(), 1u);
   EXPECT_NE(s.stats.warnings[0].find("move it nearer the origin"), std::string::npos) << s.stats.warnings[0];
+}
+
+namespace {
+
+// The triangle with every TEXCOORD_0 at `uv`, and material 0 whose base colour and emissive textures are a
+// 2×1 image, black then white (sRGB 0 and 255: linear 0 and 1), clamped; `transform` on both references.
+GltfDocument twoTexelDocument(glm::vec2 uv, const json& transform) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = doc.addVec2({uv, uv, uv});
+  doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+  Texture t;
+  t.width = 2;
+  t.height = 1;
+  t.texels = {glm::vec4(0, 0, 0, 1), glm::vec4(1.0f)};
+  const int tex = doc.addTexture(doc.addImage(encodePng(t, true), "two"), doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, false));
+  json info = {{"index", tex}};
+  if (!transform.is_null()) info["extensions"]["KHR_texture_transform"] = transform;
+  doc.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", info}}}, {"emissiveTexture", info}, {"emissiveFactor", {1, 1, 1}}});
+  doc.root["extensionsUsed"] = {"KHR_texture_transform"};
+  doc.root["extensionsRequired"] = {"KHR_texture_transform"};
+  return doc;
+}
+
+// The triangle on node 0 (translated by (10, 0, 0)) instanced three times by EXT_mesh_gpu_instancing:
+// translations (0,0,0), (1,0,0), (0,2,0); rotations identity, 90° about z, identity; scales 1, 1, 2.
+GltfDocument instancedDocument() {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["nodes"][0]["translation"] = {10, 0, 0};
+  const int t = doc.addVec3({{0, 0, 0}, {1, 0, 0}, {0, 2, 0}});
+  const float h = std::sqrt(0.5f);
+  const std::vector<float> q = {0, 0, 0, 1, 0, 0, h, h, 0, 0, 0, 1};
+  const int view = doc.addBufferView(q.data(), q.size() * sizeof(float));
+  const int r = doc.append("accessors", {{"bufferView", view}, {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+  const int sc = doc.addVec3({{1, 1, 1}, {1, 1, 1}, {2, 2, 2}});
+  doc.root["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = {{"TRANSLATION", t}, {"ROTATION", r}, {"SCALE", sc}};
+  doc.root["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  doc.root["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+  return doc;
+}
+
+}  // namespace
+
+// KHR_texture_transform, closed form on a 2-texel image (texel centres at u = 1/4 and 3/4): UV (1/8, 1/2)
+// clamps to the black texel; scale 2 takes it to 1/4, the black centre; an offset of half a texel (1/4) on
+// top lands on 1/2, halfway: bilinear 0.5. A rotation of π/2 maps (u, v) to (v, −u): UV (0.3, 0.75) reads
+// the white texel (the opposite turn would read u = −0.75, clamped black). texCoord overrides the set.
+TEST(GltfLoader, TextureTransformOnBaseColourAndEmissiveHasItsClosedForm) {
+  auto at = [](const Scene& s) {
+    return std::make_pair(s.baseColorAt(s.primitives[0], 0, glm::vec2(0.3f)).r, s.emissionAt(s.primitives[0], 0, glm::vec2(0.3f)).r);
+  };
+  const Scene plain = loadDocument(twoTexelDocument({0.125f, 0.5f}, nullptr), "loader_uvt_plain");
+  EXPECT_NEAR(at(plain).first, 0.0f, 1e-6f);
+  const Scene scaled = loadDocument(twoTexelDocument({0.125f, 0.5f}, {{"scale", {2, 1}}}), "loader_uvt_scale");
+  EXPECT_NEAR(at(scaled).first, 0.0f, 1e-6f);
+  const Scene both = loadDocument(twoTexelDocument({0.125f, 0.5f}, {{"offset", {0.25, 0}}, {"scale", {2, 1}}}), "loader_uvt_both");
+  EXPECT_NEAR(at(both).first, 0.5f, 1e-5f);
+  EXPECT_NEAR(at(both).second, 0.5f, 1e-5f);
+  const Material& m = both.materials[0];
+  EXPECT_TRUE(m.baseColorUvTransform.present);
+  const glm::vec3 viaMatrix = m.baseColorUvTransform.matrix() * glm::vec3(0.125f, 0.5f, 1.0f);
+  EXPECT_NEAR(viaMatrix.x, 0.5f, 1e-6f);
+  const Scene turned = loadDocument(twoTexelDocument({0.3f, 0.75f}, {{"rotation", kPi / 2}}), "loader_uvt_rotation");
+  EXPECT_NEAR(at(turned).first, 1.0f, 1e-5f);
+  EXPECT_NEAR(at(turned).second, 1.0f, 1e-5f);
+  const Scene set1 = loadDocument(twoTexelDocument({0.125f, 0.5f}, {{"texCoord", 1}}), "loader_uvt_texcoord");
+  EXPECT_EQ(set1.materials[0].baseColorTexCoord, 1);
+  EXPECT_EQ(set1.materials[0].emissiveTexCoord, 1);
+}
+
+TEST(GltfLoader, BrokenTextureTransformIsRefusedNamingTheExtension) {
+  expectRefused(twoTexelDocument({0, 0}, {{"offset", {1}}}), "loader_uvt_bad_offset", {"KHR_texture_transform offset", "baseColorTexture", "material 0"});
+  expectRefused(twoTexelDocument({0, 0}, {{"rotation", "left"}}), "loader_uvt_bad_rotation", {"KHR_texture_transform rotation"});
+  expectRefused(twoTexelDocument({0, 0}, {{"texCoord", -1}}), "loader_uvt_bad_texcoord", {"KHR_texture_transform texCoord"});
+}
+
+// irview's normal map does not apply the transform: a load for the viewer warns, naming the extension.
+TEST(GltfLoader, TextureTransformOnANormalMapWarnsTheViewer) {
+  GltfDocument doc = twoTexelDocument({0, 0}, nullptr);
+  doc.root["materials"][0]["normalTexture"] = {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"scale", {2, 2}}}}}}};
+  const auto file = testFolder("loader_uvt_normal") / "n.gltf";
+  writeDocument(doc, file);
+  LoadOptions viewer;
+  viewer.shadingMaps = true;
+  const Scene s = loadScene(file, viewer);
+  const auto& w = s.stats.warnings;
+  EXPECT_EQ(std::count_if(w.begin(), w.end(), [](const std::string& x) { return x.find("KHR_texture_transform") != std::string::npos; }), 1);
+}
+
+// EXT_mesh_gpu_instancing: world = node · T · R · S per instance. Vertex (1, 0, 0) of the triangle lands at
+// (11, 0, 0), at (10 + 1 + 0, 1, 0) under the 90° turn, and at (10 + 2, 2, 0) scaled by 2 and moved up 2.
+TEST(GltfLoader, GpuInstancesAreMeshInstancesOfTheirOwn) {
+  const Scene s = loadDocument(instancedDocument(), "loader_gpu_instancing");
+  ASSERT_EQ(s.primitives.size(), 3u);
+  EXPECT_EQ(s.stats.gpuInstancedNodes, 1u);
+  EXPECT_EQ(s.stats.gpuInstances, 3u);
+  const glm::vec3 expected[3] = {{11, 0, 0}, {11, 1, 0}, {12, 2, 0}};
+  for (int i = 0; i < 3; ++i) {
+    const Primitive& p = s.primitives[i];
+    EXPECT_EQ(p.node, 0);
+    EXPECT_EQ(p.instance, i);
+    expectNear(p.positions[1], expected[i]);
+    expectNear(glm::vec3(p.nodeToWorld * glm::vec4(1, 0, 0, 1)), expected[i]);
+    expectNear(glm::vec3(p.instanceToNode * glm::vec4(1, 0, 0, 1)), expected[i] - glm::vec3(10, 0, 0));
+    expectNear(faceNormal(p, 0), {0, 0, 1});
+  }
+}
+
+TEST(GltfLoader, BrokenGpuInstancingIsRefusedNamingExtensionNodeAndAccessor) {
+  GltfDocument doc = instancedDocument();
+  doc.root["nodes"][0]["name"] = "props";
+  auto withAttribute = [&](const char* name, auto add, int& accessor) {
+    GltfDocument d = doc;
+    accessor = add(d);
+    d.root["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"][name] = accessor;
+    return d;
+  };
+  int a = -1;
+  GltfDocument shortScale = withAttribute("SCALE", [](GltfDocument& d) { return d.addVec3({{1, 1, 1}, {1, 1, 1}}); }, a);
+  expectRefused(shortScale, "loader_gpu_count", {"EXT_mesh_gpu_instancing", "node 0 ('props')", "accessor " + std::to_string(a), "SCALE"});
+  GltfDocument flat = withAttribute("TRANSLATION", [](GltfDocument& d) { return d.addVec2({{0, 0}, {1, 0}, {2, 0}}); }, a);
+  expectRefused(flat, "loader_gpu_type", {"EXT_mesh_gpu_instancing", "TRANSLATION", "accessor " + std::to_string(a), "components"});
+  GltfDocument nan = withAttribute("TRANSLATION", [](GltfDocument& d) { return d.addVec3({{0, 0, 0}, {std::nanf(""), 0, 0}, {0, 0, 0}}); }, a);
+  expectRefused(nan, "loader_gpu_nan", {"EXT_mesh_gpu_instancing", "TRANSLATION", "accessor " + std::to_string(a), "NaN"});
+  GltfDocument missing = doc;
+  missing.root["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["ROTATION"] = 99;
+  expectRefused(missing, "loader_gpu_missing", {"EXT_mesh_gpu_instancing", "ROTATION", "accessor 99"});
+}
+
+// EXT_texture_webp: the WebP source is decoded (OpenImageIO reads WebP); an unreadable WebP falls back to
+// the texture's core source, and without one it is refused naming the extension and the image.
+TEST(GltfLoader, WebpTexturesAreDecodedWithTheirFallback) {
+  const auto dir = testFolder("loader_webp");
+  imageio::Pixels px;
+  px.width = 2;
+  px.height = 2;
+  px.channels = 3;
+  px.u8 = {255, 0, 0, 255, 0, 0, 255, 0, 0, 255, 0, 0};
+  imageio::api().writeFile((dir / "red.webp").string(), "webp", px, -1, "red.webp");
+  std::ifstream in(dir / "red.webp", std::ios::binary);
+  const std::vector<uint8_t> webp((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(webp.size(), 12u);
+  Texture grey;
+  grey.width = grey.height = 1;
+  grey.texels = {glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)};
+  auto document = [&](const std::vector<uint8_t>& webpBytes, bool fallback) {
+    GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+    doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+    const int w = doc.addImage(webpBytes, "red", "image/webp");
+    const int png = doc.addImage(encodePng(grey, false), "grey");
+    json texture = {{"extensions", {{"EXT_texture_webp", {{"source", w}}}}}};
+    if (fallback) texture["source"] = png;
+    doc.append("textures", texture);
+    doc.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    doc.root["extensionsUsed"] = {"EXT_texture_webp"};
+    if (!fallback) doc.root["extensionsRequired"] = {"EXT_texture_webp"};
+    return doc;
+  };
+  const Scene s = loadDocument(document(webp, false), "loader_webp_read");
+  const glm::vec4 c = s.baseColorAt(s.primitives[0], 0, glm::vec2(0.3f));
+  EXPECT_NEAR(c.r, 1.0f, 0.01f);
+  EXPECT_NEAR(c.g, 0.0f, 0.01f);
+  std::vector<uint8_t> broken(webp.begin(), webp.begin() + 16);
+  const Scene f = loadDocument(document(broken, true), "loader_webp_fallback");
+  // The fallback PNG holds byte 128, read as sRGB colour.
+  EXPECT_NEAR(f.baseColorAt(f.primitives[0], 0, glm::vec2(0.3f)).g, srgbToLinear(128 / 255.0f), 1e-4f);
+  expectRefused(document(broken, false), "loader_webp_refused", {"EXT_texture_webp", "image 0", "red"});
 }

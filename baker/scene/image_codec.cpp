@@ -25,6 +25,7 @@ ImageFormat sniffImageFormat(const uint8_t* b, size_t n) {
   if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return ImageFormat::Jpeg;
   if (n >= 4 && b[0] == 0x76 && b[1] == 0x2F && b[2] == 0x31 && b[3] == 0x01) return ImageFormat::Exr;
   if (n >= 2 && b[0] == '#' && b[1] == '?') return ImageFormat::Hdr;
+  if (n >= 12 && std::memcmp(b, "RIFF", 4) == 0 && std::memcmp(b + 8, "WEBP", 4) == 0) return ImageFormat::Webp;
   return ImageFormat::Unknown;
 }
 
@@ -37,6 +38,7 @@ const char* nameForFormat(ImageFormat f) {
     case ImageFormat::Jpeg: return "jpeg";
     case ImageFormat::Exr: return "openexr";
     case ImageFormat::Hdr: return "hdr";
+    case ImageFormat::Webp: return "webp";
     case ImageFormat::Unknown: break;
   }
   return "";
@@ -56,7 +58,7 @@ const std::array<float, 256>& srgbTable() {
 Texture decodeImageToTexture(const uint8_t* bytes, size_t size, bool srgb, const std::string& name) {
   ImageFormat format = sniffImageFormat(bytes, size);
   if (format == ImageFormat::Unknown)
-    throw Error(ErrorCode::InvalidData, name, "image is not PNG, JPEG, EXR or HDR");
+    throw Error(ErrorCode::InvalidData, name, "image is not PNG, JPEG, WebP, EXR or HDR");
   const imageio::Pixels px = imageio::api().decodeMemory(bytes, size, nameForFormat(format), name);
   const int w = px.width, h = px.height, nc = px.channels;
   Texture tex;

@@ -9,12 +9,12 @@
 
 namespace irbake {
 
-enum class ImageFormat { Png, Jpeg, Exr, Hdr, Unknown };
+enum class ImageFormat { Png, Jpeg, Exr, Hdr, Webp, Unknown };
 
 // Sniffs the container from its first bytes (glTF mimeTypes are optional and sometimes wrong).
 ImageFormat sniffImageFormat(const uint8_t* bytes, size_t size);
 
-// Decodes an encoded image (PNG, JPEG, EXR, HDR) into linear RGBA float texels, row 0 at the top.
+// Decodes an encoded image (PNG, JPEG, EXR, HDR, WebP) into linear RGBA float texels, row 0 at the top.
 // srgb: decode 8/16-bit values with the sRGB transfer curve (colour textures); float formats are
 // taken as linear regardless. Grey and grey+alpha are expanded; missing alpha is 1.
 // Throws Error(InvalidData, name) when the bytes cannot be decoded.

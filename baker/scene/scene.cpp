@@ -109,12 +109,26 @@ bool Scene::hasEmissiveSurface() const {
 
 bool Scene::hasLightOrEmitter() const { return !lights.empty() || environment.present() || hasEmissiveSurface(); }
 
+glm::vec2 UvTransform::apply(glm::vec2 uv) const {
+  if (!present) return uv;
+  const float c = std::cos(rotation), s = std::sin(rotation);
+  const glm::vec2 p = scale * uv;
+  return offset + glm::vec2(c * p.x + s * p.y, -s * p.x + c * p.y);
+}
+
+glm::mat3 UvTransform::matrix() const {
+  const float c = std::cos(rotation), s = std::sin(rotation);
+  // Columns: the images of u, of v, and the offset.
+  return glm::mat3(glm::vec3(c * scale.x, -s * scale.x, 0.0f), glm::vec3(s * scale.y, c * scale.y, 0.0f),
+                   glm::vec3(offset, 1.0f));
+}
+
 glm::vec4 Scene::baseColorAt(const Primitive& prim, uint32_t triangle, glm::vec2 b) const {
   const Material& m = materials[prim.material];
   glm::vec4 c = m.baseColorFactor;
   if (m.baseColorTexture >= 0) {
     const auto& uv = m.baseColorTexCoord == 1 ? prim.uv1 : prim.uv0;
-    c *= sampleBilinear(textures[m.baseColorTexture], interpolate(uv, prim, triangle, b));
+    c *= sampleBilinear(textures[m.baseColorTexture], m.baseColorUvTransform.apply(interpolate(uv, prim, triangle, b)));
   }
   return c;
 }
@@ -124,7 +138,7 @@ glm::vec3 Scene::emissionAt(const Primitive& prim, uint32_t triangle, glm::vec2 
   glm::vec3 e = m.emission();
   if (m.emissiveTexture >= 0 && m.isEmissive()) {
     const auto& uv = m.emissiveTexCoord == 1 ? prim.uv1 : prim.uv0;
-    e *= glm::vec3(sampleBilinear(textures[m.emissiveTexture], interpolate(uv, prim, triangle, b)));
+    e *= glm::vec3(sampleBilinear(textures[m.emissiveTexture], m.emissiveUvTransform.apply(interpolate(uv, prim, triangle, b))));
   }
   return e;
 }

@@ -2,6 +2,7 @@
 // Units: metres; radiometric quantities in watts (see docs/units.md).
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -34,15 +35,33 @@ struct Texture {
   int gltfImage = -1;         // source image index in the glTF
 };
 
+// KHR_texture_transform on a texture reference: uv' = offset + R · (scale ⊙ uv), the specification's
+// translation × rotation × scale, where R turns the UVs by `rotation` radians counter-clockwise:
+// u' = cos·u + sin·v, v' = −sin·u + cos·v (its example: offset (0, 1), rotation π/2, scale ½ reads the
+// image's lower-left quadrant). The identity when the extension is absent.
+struct UvTransform {
+  glm::vec2 offset{0.0f};
+  float rotation = 0.0f;  // radians
+  glm::vec2 scale{1.0f};
+  bool present = false;   // the extension was given (an identity one included)
+  glm::vec2 apply(glm::vec2 uv) const;
+  // The same as a 3×3 matrix on (u, v, 1), column-major as GLSL's mat3 (the viewer's uniform).
+  glm::mat3 matrix() const;
+  // |det|: how the transform scales UV areas (texel footprints).
+  float areaScale() const { return std::abs(scale.x * scale.y); }
+};
+
 struct Material {
   std::string name;
   glm::vec4 baseColorFactor{1.0f};  // linear
   int baseColorTexture = -1;        // index into Scene::textures, -1 none
-  int baseColorTexCoord = 0;        // which TEXCOORD set the texture reads
+  int baseColorTexCoord = 0;        // which TEXCOORD set the texture reads (KHR_texture_transform's texCoord wins)
+  UvTransform baseColorUvTransform;  // KHR_texture_transform on baseColorTexture
   glm::vec3 emissiveFactor{0.0f};
   float emissiveStrength = 1.0f;    // KHR_materials_emissive_strength
   int emissiveTexture = -1;
   int emissiveTexCoord = 0;
+  UvTransform emissiveUvTransform;   // KHR_texture_transform on emissiveTexture
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
   float transmission = 0.0f;        // KHR_materials_transmission transmissionFactor (texture not read)
@@ -94,6 +113,10 @@ struct Primitive {
   std::vector<uint32_t> indices;     // triangle list, counter-clockwise front faces in world space
   int material = 0;                  // index into Scene::materials (always valid: a default is added)
   int node = -1, gltfMesh = -1, gltfPrimitive = -1;  // provenance for export
+  // EXT_mesh_gpu_instancing: the instance of the node this primitive is (-1: the node itself, no
+  // instancing), and that instance's transform, applied before the node's world matrix.
+  int instance = -1;
+  glm::mat4 instanceToNode{1.0f};
   glm::mat4 nodeToWorld{1.0f};       // the node's world matrix (positions here are already transformed)
   // Vertex i came from source accessor vertex sourceVertex[i] (empty: identity); set by the loader's
   // flat normals and by the atlas.
@@ -147,6 +170,8 @@ struct LoadStats {
   size_t trianglesDropped = 0;     // degenerate: zero area or repeated indices
   size_t primitivesSkipped = 0;    // points/lines
   size_t normalsComputed = 0;      // primitives whose normals were computed
+  size_t gpuInstancedNodes = 0;    // nodes with EXT_mesh_gpu_instancing
+  size_t gpuInstances = 0;         // their instances, each a mesh instance of its own
   std::vector<std::string> warnings;
 };
 

@@ -1,13 +1,18 @@
 // make_seed_corpus IN_FOLDER OUT_FOLDER: packs every IN_FOLDER/*.gltf (irbake samples output: JSON +
 // .bin + images beside it) into two self-contained seeds the fuzzer can mutate as one input each:
 // NAME.glb (buffer 0 in the BIN chunk, other files as data URIs) and NAME.gltf (every file as a
-// base64 data URI). Our own scenes only: no third-party file enters the corpus.
+// base64 data URI). Our own scenes only: no third-party file enters the corpus. Each scene also gives
+// .gltf variants with the inputs the samples do not use: EXT_mesh_gpu_instancing on every node with a
+// mesh, KHR_texture_transform on every texture reference and EXT_texture_webp (a 2×2 WebP made with
+// OpenImageIO's writer, the core source kept as its fallback) on every texture.
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -52,6 +57,78 @@ void embed(json& doc, const char* key, const fs::path& folder, int skip) {
     if (uri.rfind("data:", 0) == 0) continue;
     e["uri"] = "data:application/octet-stream;base64," + base64(readFile(folder / uri));
   }
+}
+
+// A 2×2 lossy WebP of one colour, written by `oiiotool --pattern constant:color=0.8,0.4,0.2 2x2 3 -d uint8`.
+const std::vector<uint8_t> kWebp = {
+    0x52, 0x49, 0x46, 0x46, 0x42, 0x00, 0x00, 0x00, 0x57, 0x45, 0x42, 0x50, 0x56, 0x50, 0x38, 0x20, 0x36, 0x00, 0x00,
+    0x00, 0x50, 0x02, 0x00, 0x9d, 0x01, 0x2a, 0x02, 0x00, 0x02, 0x00, 0x00, 0x00, 0x00, 0x25, 0xa0, 0x02, 0x74, 0xba,
+    0x01, 0xf8, 0x01, 0xfa, 0x01, 0xfc, 0x00, 0x09, 0xd0, 0x00, 0xfe, 0xdf, 0x80, 0x3f, 0xfc, 0xb0, 0xfc, 0x7f, 0x52,
+    0x79, 0xff, 0xcb, 0x10, 0xff, 0xfb, 0x52, 0x7e, 0xbc, 0xc1, 0xca, 0xff, 0xed, 0x32, 0x00, 0x00, 0x00};
+
+void useExtension(json& doc, const char* name) {
+  if (!doc.contains("extensionsUsed")) doc["extensionsUsed"] = json::array();
+  doc["extensionsUsed"].push_back(name);
+}
+
+// Three instances (translations, rotations, scales of their own) of every node with a mesh, in a buffer of
+// their own (a data URI). False when no node has a mesh.
+bool addGpuInstancing(json& doc) {
+  const float h = 0.70710678f;
+  const std::vector<float> values = {0, 0, 0, 1, 0, 0, 0, 0, 1,               // TRANSLATION
+                                     0, 0, 0, 1, 0, h, 0, h, h, 0, 0, h,       // ROTATION
+                                     1, 1, 1, 0.5f, 0.5f, 0.5f, 2, 1, 1};      // SCALE
+  std::vector<uint8_t> bytes(values.size() * 4);
+  std::memcpy(bytes.data(), values.data(), bytes.size());
+  const size_t buffer = doc["buffers"].size();
+  doc["buffers"].push_back({{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}});
+  json attributes = json::object();
+  const std::pair<const char*, int> parts[] = {{"TRANSLATION", 0}, {"ROTATION", 36}, {"SCALE", 84}};
+  for (const auto& [name, offset] : parts) {
+    const bool rotation = std::string(name) == "ROTATION";
+    doc["bufferViews"].push_back({{"buffer", buffer}, {"byteOffset", offset}, {"byteLength", rotation ? 48 : 36}});
+    doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", 5126}, {"count", 3},
+                                {"type", rotation ? "VEC4" : "VEC3"}});
+    attributes[name] = doc["accessors"].size() - 1;
+  }
+  bool any = false;
+  for (json& node : doc["nodes"])
+    if (node.contains("mesh")) {
+      node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = attributes;
+      any = true;
+    }
+  useExtension(doc, "EXT_mesh_gpu_instancing");
+  return any;
+}
+
+// KHR_texture_transform on every texture reference of every material. False when there is none.
+bool addTextureTransforms(json& doc) {
+  bool any = false;
+  auto transform = [&](json* info) {
+    if (!info || !info->is_object() || !info->contains("index")) return;
+    (*info)["extensions"]["KHR_texture_transform"] = {{"offset", {0.25, 0}}, {"rotation", 0.5}, {"scale", {2, 1}}, {"texCoord", 0}};
+    any = true;
+  };
+  if (!doc.contains("materials")) return false;
+  for (json& m : doc["materials"]) {
+    if (m.contains("pbrMetallicRoughness") && m["pbrMetallicRoughness"].contains("baseColorTexture"))
+      transform(&m["pbrMetallicRoughness"]["baseColorTexture"]);
+    for (const char* key : {"emissiveTexture", "normalTexture"})
+      if (m.contains(key)) transform(&m[key]);
+  }
+  if (any) useExtension(doc, "KHR_texture_transform");
+  return any;
+}
+
+// EXT_texture_webp on every texture: a WebP image of its own, the core source kept as the fallback.
+bool addWebpSources(json& doc) {
+  if (!doc.contains("textures") || doc["textures"].empty()) return false;
+  for (json& t : doc["textures"]) {
+    doc["images"].push_back({{"mimeType", "image/webp"}, {"uri", "data:application/octet-stream;base64," + base64(kWebp)}});
+    t["extensions"]["EXT_texture_webp"]["source"] = doc["images"].size() - 1;
+  }
+  useExtension(doc, "EXT_texture_webp");
+  return true;
 }
 
 void appendU32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
@@ -102,6 +179,14 @@ int main(int argc, char** argv) {
       embed(doc, "images", in, -1);
       writeFile(out / (name + ".gltf"), doc.dump());
       seeds += 2;
+      const std::pair<const char*, bool (*)(json&)> variants[] = {
+          {"_gpu_instancing", addGpuInstancing}, {"_texture_transform", addTextureTransforms}, {"_webp", addWebpSources}};
+      for (const auto& [suffix, add] : variants) {
+        json variant = doc;
+        if (!add(variant)) continue;
+        writeFile(out / (name + suffix + ".gltf"), variant.dump());
+        ++seeds;
+      }
     }
     std::cout << "make_seed_corpus: " << seeds << " seeds in " << out.string() << "\n";
     return seeds > 0 ? 0 : 1;
