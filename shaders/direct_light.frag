@@ -123,13 +123,13 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
 // An IES profile's candela towards a unit direction leaving the light, bilinear in (φ, θ) on the table's grid
 // (IesProfile::table).
 float iesCandela(vec3 dir) {
-  float cosTheta = clamp(dot(dir, lightDirection), -1.0, 1.0);
+  float theta = atan(length(cross(dir, lightDirection)), dot(dir, lightDirection));  // exact near the nadir
   vec3 y = cross(-lightDirection, lightAxisX);
   float px = dot(dir, lightAxisX), py = dot(dir, y);
   float phi = (abs(px) + abs(py) > 0.0) ? atan(py, px) : 0.0;
   if (phi < 0.0) phi += 2.0 * kPi;
   ivec2 size = textureSize(iesProfile, 0);
-  vec2 f = vec2(phi / (2.0 * kPi) * float(size.x - 1), acos(cosTheta) / kPi * float(size.y - 1));
+  vec2 f = vec2(phi / (2.0 * kPi) * float(size.x - 1), theta / kPi * float(size.y - 1));
   ivec2 i0 = clamp(ivec2(floor(f)), ivec2(0), size - 2);
   vec2 t = clamp(f - vec2(i0), 0.0, 1.0);
   float c00 = texelFetch(iesProfile, i0, 0).r, c10 = texelFetch(iesProfile, i0 + ivec2(1, 0), 0).r;

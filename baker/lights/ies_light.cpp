@@ -17,7 +17,8 @@ constexpr double kDegrees = 180.0 / kPi;
 // The profile's angles (degrees) of a unit direction leaving the light.
 void profileAngles(const Light& light, const glm::vec3& dir, double& theta, double& phi) {
   const glm::vec3 nadir = light.direction, x = light.profileAxisX, y = glm::cross(-nadir, x);
-  theta = std::acos(std::clamp(static_cast<double>(glm::dot(dir, nadir)), -1.0, 1.0)) * kDegrees;
+  const glm::dvec3 w(dir), n(nadir);
+  theta = std::atan2(glm::length(glm::cross(w, n)), glm::dot(w, n)) * kDegrees;  // exact near the nadir, unlike acos
   phi = std::atan2(static_cast<double>(glm::dot(dir, y)), static_cast<double>(glm::dot(dir, x))) * kDegrees;
 }
 
