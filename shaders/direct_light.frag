@@ -1,5 +1,5 @@
 // Direct light from one punctual light (KHR_lights_punctual) with its shadow map, exact apart from
-// the shadow-map resolution: value = I(ω) cosθx / r² / π (point, spot) or E cosθx / π (directional).
+// the shadow-map resolution: value = I(ω) cosθx / r² / π (point, spot, IES) or E cosθx / π (directional).
 layout(binding = BAKE_UNIT_POSITION_WEIGHT) uniform sampler2DArray gPositionWeight;
 layout(binding = BAKE_UNIT_NORMAL) uniform sampler2DArray gNormal;
 layout(binding = BAKE_UNIT_LIGHT_CUBE) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
@@ -7,13 +7,15 @@ layout(binding = BAKE_UNIT_LIGHT_MAP) uniform sampler2D mapDepth;          // sp
 layout(binding = BAKE_UNIT_GEOMETRIC_NORMAL) uniform sampler2DArray gGeomNormal;  // the sample's triangle's normal (bias, self-shadow)
 layout(binding = BAKE_UNIT_GLASS_CUBE) uniform sampler2DArray glassCube;    // see-through primitives alone: cube faces
 layout(binding = BAKE_UNIT_GLASS_MAP) uniform sampler2D glassMap;          // see-through primitives alone: spot / directional map
+layout(binding = BAKE_UNIT_IES_PROFILE) uniform sampler2D iesProfile;    // IES: candela, x: φ over [0, 360°], y: θ over [0, 180°]
 uniform int seeThroughMaps;    // 1: the glass maps hold the scene's MASK / BLEND / transmissive primitives
 
 uniform int layers;
-uniform int lightType;         // BAKE_LIGHT_POINT, _SPOT or _DIRECTIONAL (bake_interface.glsl)
+uniform int lightType;         // BAKE_LIGHT_POINT, _SPOT, _DIRECTIONAL or _IES (bake_interface.glsl)
 uniform int shadowKind;        // BAKE_SHADOW_CUBE, _PERSPECTIVE (2D) or _ORTHOGRAPHIC (2D)
 uniform vec3 lightPosition;
-uniform vec3 lightDirection;   // direction light travels (spot, directional)
+uniform vec3 lightDirection;   // direction light travels (spot, directional); IES: the profile's nadir
+uniform vec3 lightAxisX;       // IES: the profile's horizontal angle 0 (unit, orthogonal to lightDirection)
 uniform vec3 lightIntensity;   // colour × intensity (W/sr or W/m²)
 uniform float lightRange;      // 0: infinite
 uniform float cosOuter, spotScale;  // spot falloff: t = clamp((cos − cosOuter)·spotScale, 0, 1), I·t²
@@ -118,6 +120,23 @@ float lit(vec3 p, vec3 n, vec3 ng, float cosTheta, float r, out bool ambiguous) 
   return isLit ? 1.0 : 0.0;
 }
 
+// An IES profile's candela towards a unit direction leaving the light, bilinear in (φ, θ) on the table's grid
+// (IesProfile::table).
+float iesCandela(vec3 dir) {
+  float theta = atan(length(cross(dir, lightDirection)), dot(dir, lightDirection));  // exact near the nadir
+  vec3 y = cross(-lightDirection, lightAxisX);
+  float px = dot(dir, lightAxisX), py = dot(dir, y);
+  float phi = (abs(px) + abs(py) > 0.0) ? atan(py, px) : 0.0;
+  if (phi < 0.0) phi += 2.0 * kPi;
+  ivec2 size = textureSize(iesProfile, 0);
+  vec2 f = vec2(phi / (2.0 * kPi) * float(size.x - 1), theta / kPi * float(size.y - 1));
+  ivec2 i0 = clamp(ivec2(floor(f)), ivec2(0), size - 2);
+  vec2 t = clamp(f - vec2(i0), 0.0, 1.0);
+  float c00 = texelFetch(iesProfile, i0, 0).r, c10 = texelFetch(iesProfile, i0 + ivec2(1, 0), 0).r;
+  float c01 = texelFetch(iesProfile, i0 + ivec2(0, 1), 0).r, c11 = texelFetch(iesProfile, i0 + ivec2(1, 1), 0).r;
+  return mix(mix(c00, c10, t.x), mix(c01, c11, t.x), t.y);
+}
+
 void main() {
   ivec2 px = ivec2(gl_FragCoord.xy);
   vec3 sum = vec3(0.0);
@@ -144,6 +163,8 @@ void main() {
       if (lightType == BAKE_LIGHT_SPOT) {
         float t = clamp((dot(lightDirection, -toLight) - cosOuter) * spotScale, 0.0, 1.0);
         I *= t * t;
+      } else if (lightType == BAKE_LIGHT_IES) {
+        I *= iesCandela(-toLight);
       }
       e = I / (r * r);
     }

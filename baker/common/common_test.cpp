@@ -10,6 +10,7 @@
 
 #include "common/command_line.h"
 #include "common/atomic_file.h"
+#include "common/base64.h"
 #include "common/error.h"
 #include "common/excerpt.h"
 #include "common/output_lock.h"
@@ -217,4 +218,18 @@ TEST(Excerpt, EscapesWhatDoesNotPrintAndCutsLongText) {
   EXPECT_EQ(quotedExcerpt(std::string(100, 'x'), 10), "'xxxxxxxxxx…' (100 bytes)");
   EXPECT_EQ(printableExcerpt("C:\\dir \x1B[2J", 100), "C:\\dir \\x1B[2J");
   EXPECT_EQ(printableExcerpt(std::string(100, 'y'), 4), "yyyy… (100 bytes)");
+}
+
+// RFC 4648's test vectors, and every byte value through a round trip.
+TEST(Base64, EncodesTheStandardVectorsAndRoundTripsEveryByte) {
+  const char* const plain[] = {"", "f", "fo", "foo", "foob", "fooba", "foobar"};
+  const char* const coded[] = {"", "Zg==", "Zm8=", "Zm9v", "Zm9vYg==", "Zm9vYmE=", "Zm9vYmFy"};
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(irbake::base64Encode(plain[i]), coded[i]);
+    EXPECT_EQ(irbake::base64Decode(coded[i]), plain[i]);
+  }
+  std::string bytes;
+  for (int b = 0; b < 256; ++b) bytes.push_back(static_cast<char>(b));
+  EXPECT_EQ(irbake::base64Decode(irbake::base64Encode(bytes)), bytes);
+  EXPECT_EQ(irbake::base64Decode("Zm9v\nYmFy"), "foobar");  // line breaks skipped
 }

@@ -145,12 +145,13 @@ void forEachTextureRef(json& root, F&& f) {
   if (root.contains("materials")) forEachTextureInfo(root["materials"], f);
 }
 
-// Textures may be collected only when materials are the only place that can name them: no root
-// extension other than lights (an unknown one, e.g. image-based lighting, might use a texture).
+// Textures may be collected only when materials are the only place that can name them: no root extension
+// other than lights (KHR_lights_punctual, EXT_lights_ies; an unknown one, e.g. image-based lighting, might
+// use a texture).
 bool texturesOnlyInMaterials(const json& root) {
   if (!root.contains("extensions") || !root["extensions"].is_object()) return true;
   for (const auto& [name, ext] : root["extensions"].items())
-    if (name != "KHR_lights_punctual") return false;
+    if (name != "KHR_lights_punctual" && name != "EXT_lights_ies") return false;
   return true;
 }
 

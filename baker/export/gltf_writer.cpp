@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -279,6 +280,28 @@ int addPrimitiveMesh(GltfDocument& doc, const Primitive& prim, int material) {
   return doc.append("meshes", std::move(mesh));
 }
 
+// EXT_lights_ies: the profile (the file as read, as a data URI) once in the root's lights, and a node placing it
+// with its multiplier and colour, its rotation taking −Z to the profile's nadir and +X to its horizontal angle 0.
+static int addIesLight(GltfDocument& doc, const Light& l, std::map<const IesProfile*, size_t>& profiles) {
+  json& lights = doc.root["extensions"]["EXT_lights_ies"]["lights"];
+  if (!lights.is_array()) lights = json::array();
+  auto [it, added] = profiles.emplace(l.profile.get(), lights.size());
+  if (added) {
+    json profile = json::object();
+    lightKind(l).describeGltf(l, profile);
+    if (!l.name.empty()) profile["name"] = l.name;
+    lights.push_back(std::move(profile));
+  }
+  json node = {{"extensions",
+                {{"EXT_lights_ies", {{"light", it->second}, {"multiplier", l.intensity}, {"color", vec(l.color)}}}}}};
+  if (!l.name.empty()) node["name"] = l.name;
+  node["translation"] = vec(l.position);
+  const glm::vec3 z = -glm::normalize(l.direction), x = glm::normalize(l.profileAxisX);
+  node["rotation"] = rotationJson(glm::normalize(glm::quat_cast(glm::mat3(x, glm::cross(z, x), z))));
+  doc.useExtension("EXT_lights_ies");
+  return doc.append("nodes", std::move(node));
+}
+
 GltfDocument gltfFromScene(const Scene& scene, const GltfWriteOptions& options) {
   GltfDocument doc;
   std::map<std::pair<int, bool>, int> textureCache;
@@ -292,7 +315,12 @@ GltfDocument gltfFromScene(const Scene& scene, const GltfWriteOptions& options) 
     if (!prim.name.empty()) node["name"] = prim.name;
     roots.push_back(doc.append("nodes", std::move(node)));
   }
+  std::map<const IesProfile*, size_t> iesProfiles;
   for (const auto& l : scene.lights) {
+    if (l.type == LightType::Ies) {
+      roots.push_back(addIesLight(doc, l, iesProfiles));
+      continue;
+    }
     json light = {{"color", vec(l.color)}, {"intensity", l.intensity}};
     if (!l.name.empty()) light["name"] = l.name;
     const LightKind& kind = lightKind(l.type);

@@ -24,13 +24,14 @@ class DirectionalLight final : public LightKind {
   glm::dvec3 walkPower(const Light& light, float sceneRadius) const override {
     return glm::dvec3(light.color * light.intensity) * (kPi * sceneRadius * sceneRadius);
   }
-  void emit(const Light& light, const glm::vec3& sceneCentre, float sceneRadius, double u0, double u1, double,
-            double, glm::vec3& origin, glm::vec3& dir) const override {
+  double emit(const Light& light, const glm::vec3& sceneCentre, float sceneRadius, double u0, double u1, double,
+              double, glm::vec3& origin, glm::vec3& dir) const override {
     dir = glm::normalize(light.direction);
     glm::vec3 t, b;
     orthonormalBasis(dir, t, b);
     const double r = sceneRadius * std::sqrt(u0), phi = 2.0 * kPi * u1;
     origin = sceneCentre - dir * (1.01f * sceneRadius) + t * float(r * std::cos(phi)) + b * float(r * std::sin(phi));
+    return 1.0;
   }
 
   glm::vec3 toward(const Light& light, const glm::vec3&) const override { return -light.direction; }

@@ -1,4 +1,4 @@
-// A kind of light (point, spot, directional) in one place: what every stage asks of it, after pbrt's Light and
+// A kind of light (point, spot, directional, IES profile) in one place: what every stage asks of it, after pbrt's Light and
 // Filament's driver table. A light's data stays a plain `Light` (scene/scene.h); its kind answers
 //   - the walk:       its radiant intensity, its power and the rays that leave it (emission);
 //   - the transport:  its direct term at a point, before the shadow test (visibility is the caller's);
@@ -40,7 +40,7 @@ class LightKind {
  public:
   virtual ~LightKind() = default;
 
-  // KHR_lights_punctual's type name ("point", "spot", "directional").
+  // KHR_lights_punctual's type name ("point", "spot", "directional"), or "ies" (EXT_lights_ies).
   virtual const char* name() const = 0;
   // True for a light at infinity (a direction, no position): rays towards it never end.
   virtual bool atInfinity() const = 0;
@@ -55,9 +55,10 @@ class LightKind {
   // the scene's bounding sphere (radius sceneRadius).
   virtual glm::dvec3 walkPower(const Light& light, float sceneRadius) const = 0;
   // A ray leaving the light for the walk's random numbers (u0, u1: a point, u2, u3: a direction), distributed
-  // like its intensity so every path carries the same power. Rays of a light at infinity start on a disc
-  // covering the scene's bounding sphere (sceneCentre, sceneRadius), upstream of it.
-  virtual void emit(const Light& light, const glm::vec3& sceneCentre, float sceneRadius, double u0, double u1,
+  // like its intensity so every path carries the same power; returns the path's weight against that power
+  // (I(ω) / (p(ω) · power), 1 where the rays follow the intensity exactly). Rays of a light at infinity start
+  // on a disc covering the scene's bounding sphere (sceneCentre, sceneRadius), upstream of it.
+  virtual double emit(const Light& light, const glm::vec3& sceneCentre, float sceneRadius, double u0, double u1,
                     double u2, double u3, glm::vec3& origin, glm::vec3& dir) const = 0;
 
   // From x towards the light: light position − x, or −direction for a light at infinity (not normalised).
@@ -68,7 +69,8 @@ class LightKind {
   // range, its reach at that threshold or its cone. Lights at infinity reach everywhere.
   virtual bool influences(const Light& light, const glm::vec3& x, float threshold) const = 0;
 
-  // Its glTF light object's "type" and the fields of that type (KHR_lights_punctual).
+  // Its glTF light object's "type" and the fields of that type (KHR_lights_punctual; EXT_lights_ies: its profile
+  // object, whose uri the writer sets).
   virtual void describeGltf(const Light& light, nlohmann::json& gltfLight) const = 0;
   // The shadow map the GL backend renders: spots wider than maxPerspectiveAngle take a cube.
   virtual ShadowProjection shadowProjection(const Light& light, float maxPerspectiveAngle) const = 0;

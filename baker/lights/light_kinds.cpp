@@ -10,12 +10,14 @@ namespace irbake {
 const LightKind& pointLightKind();
 const LightKind& spotLightKind();
 const LightKind& directionalLightKind();
+const LightKind& iesLightKind();
 
 const LightKind& lightKind(LightType type) {
   static const LightKind* const kinds[] = {
       &pointLightKind(),        // LightType::Point
       &spotLightKind(),         // LightType::Spot
       &directionalLightKind(),  // LightType::Directional
+      &iesLightKind(),          // LightType::Ies
   };
   return *kinds[static_cast<size_t>(type)];
 }

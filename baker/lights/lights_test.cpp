@@ -10,6 +10,8 @@
 #include "common/maths.h"
 #include "lights/positional_light.h"
 #include "sampling/sampling.h"
+#include "scene/ies_profile.h"
+#include "testing/ies_profiles.h"
 
 namespace irbake {
 namespace {
@@ -66,6 +68,8 @@ TEST(LightKinds, RegistryFindsEachKindByItsType) {
   EXPECT_STREQ(lightKind(LightType::Point).name(), "point");
   EXPECT_STREQ(lightKind(LightType::Spot).name(), "spot");
   EXPECT_STREQ(lightKind(LightType::Directional).name(), "directional");
+  EXPECT_STREQ(lightKind(LightType::Ies).name(), "ies");
+  EXPECT_EQ(lightKind(LightType::Ies).shaderCode(), 3);
   EXPECT_TRUE(lightKind(LightType::Directional).atInfinity());
   EXPECT_FALSE(lightKind(LightType::Point).atInfinity());
   EXPECT_NE(lightKind(LightType::Point).shaderCode(), lightKind(LightType::Spot).shaderCode());
@@ -161,6 +165,87 @@ TEST(DirectionalLight, RaysStartOnTheDiscUpstreamOfTheSceneSphere) {
     }
 }
 
+// An IES light tilted off the axes: the profile's nadir along `nadir`, its horizontal angle 0 along `axisX`.
+Light iesLight(std::shared_ptr<const IesProfile> profile) {
+  Light l = makeLight(LightType::Ies, glm::vec3(0.5f, -1.0f, 2.0f), glm::vec3(0.3f, -0.2f, -1.0f), 2.0f);
+  l.color = glm::vec3(1.0f, 0.5f, 0.25f);
+  l.profile = std::move(profile);
+  const glm::vec3 across(1.0f, 0.4f, 0.1f);
+  l.profileAxisX = glm::normalize(across - l.direction * glm::dot(across, l.direction));
+  return l;
+}
+
+// The profile's angles of a direction leaving light l, in degrees.
+void anglesOf(const Light& l, const glm::vec3& w, double& theta, double& phi) {
+  const glm::vec3 y = glm::cross(-l.direction, l.profileAxisX);
+  theta = std::acos(std::clamp(double(glm::dot(w, l.direction)), -1.0, 1.0)) * 180.0 / kPi;
+  phi = std::atan2(double(glm::dot(w, y)), double(glm::dot(w, l.profileAxisX))) * 180.0 / kPi;
+}
+
+TEST(IesLight, IntensityIsCandelaTimesMultiplierAndColourInTheNodesFrame) {
+  const auto profile = std::make_shared<const IesProfile>(parseIesProfile(testing::cosineIesProfile(40.0), "t.ies"));
+  const Light l = iesLight(profile);
+  const LightKind& kind = lightKind(l);
+  const glm::vec3 y = glm::cross(-l.direction, l.profileAxisX);
+  // Straight down the nadir: I0 · f(0) = 40 · 1.5; along +X at 60° from the nadir: 40 cos 60° · 1.5; along +Y
+  // at 60°: 40 · 0.5 · 1.2; along −X: · 0.5; upwards: nothing.
+  auto at = [&](float theta, glm::vec3 side) {
+    return glm::normalize(l.direction * std::cos(theta) + side * std::sin(theta));
+  };
+  const float sixty = float(kPi / 3.0);
+  EXPECT_NEAR(kind.intensityToward(l, l.direction).x, 2.0 * 60.0, 1e-5 * 120.0);
+  EXPECT_NEAR(kind.intensityToward(l, at(sixty, l.profileAxisX)).y, 2.0 * 0.5 * 20.0 * 1.5, 1e-3);
+  EXPECT_NEAR(kind.intensityToward(l, at(sixty, y)).x, 2.0 * 20.0 * 1.2, 1e-3);
+  EXPECT_NEAR(kind.intensityToward(l, at(sixty, -l.profileAxisX)).z, 2.0 * 0.25 * 20.0 * 0.5, 1e-3);
+  EXPECT_EQ(kind.intensityToward(l, -l.direction).x, 0.0f);
+  // The direct term at a receiver below and beside the light: I(ω) cosθ / (π d²).
+  const glm::vec3 x(1.2f, -0.4f, 0.0f), n(0.0f, 0.0f, 1.0f);
+  const glm::vec3 d = x - l.position;
+  const glm::vec3 w = glm::normalize(d);
+  double theta, phi;
+  anglesOf(l, w, theta, phi);
+  const double expected = 2.0 * testing::cosineIesCandela(40.0, theta, phi) * double(glm::dot(-w, n)) /
+                          (kPi * double(glm::dot(d, d)));
+  EXPECT_NEAR(kind.direct(l, x, n).mapValue.x, expected, 1e-5 * expected);
+  EXPECT_NEAR(kind.atNormalIncidence(l, x).mapValue.x, expected / double(glm::dot(-w, n)), 1e-5 * expected);
+}
+
+// Power = ∮ I dω, and the walk's rays weighted by what emit returns carry I: the weighted mean of any g over
+// them is ∮ g I dω / Φ (the cosine to the nadir, and to the horizontal axis, which an unweighted or mirrored
+// sampling would get wrong), with a mean weight of 1.
+TEST(IesLight, PowerIsTheIntegralAndWeightedRaysFollowTheProfile) {
+  const auto profile = std::make_shared<const IesProfile>(parseIesProfile(testing::cosineIesProfile(40.0), "t.ies"));
+  const Light l = iesLight(profile);
+  const LightKind& kind = lightKind(l);
+  const auto intensity = [&](const glm::vec3& w) { return double(kind.intensityToward(l, w).x); };
+  const double power = kind.power(l).x;
+  EXPECT_NEAR(power, 2.0 * 40.0 * kPi, 2.0 * 40.0 * kPi * 4e-5);  // IesProfile.IntegralIsTheClosedForm
+  EXPECT_NEAR(sphereIntegral(intensity, 800), power, 2e-3 * power);
+  const Halton halton(3, 7);
+  const int n = 200000;
+  double weights = 0.0, nadir = 0.0, axis = 0.0;
+  for (int i = 0; i < n; ++i) {
+    glm::vec3 origin, dir;
+    const double w = kind.emit(l, glm::vec3(0.0f), 1.0f, halton.sample(0, i), 0.5, halton.sample(1, i),
+                               halton.sample(2, i), origin, dir);
+    EXPECT_EQ(origin, l.position);
+    weights += w;
+    nadir += w * glm::dot(dir, l.direction);
+    axis += w * glm::dot(dir, l.profileAxisX);
+  }
+  const auto expected = [&](const glm::vec3& v) {
+    return sphereIntegral([&](const glm::vec3& w) { return double(glm::dot(w, v)) * intensity(w); }, 800) / power;
+  };
+  EXPECT_NEAR(weights / n, 1.0, 2e-3);
+  EXPECT_NEAR(nadir / n, expected(l.direction), 2e-3);
+  EXPECT_NEAR(axis / n, expected(l.profileAxisX), 2e-3);
+  EXPECT_GT(axis / n, 0.05);  // f(0°) > f(180°): more light towards +X
+  EXPECT_EQ(kind.shadowProjection(l, 1.0f), ShadowProjection::Cube);
+  // Its reach follows the profile's peak: 2 · 60 cd at threshold 1 reaches √(120 / π) m.
+  EXPECT_TRUE(kind.influences(l, l.position + glm::vec3(0, 0, 6.1f), 1.0f));
+  EXPECT_FALSE(kind.influences(l, l.position + glm::vec3(0, 0, 6.3f), 1.0f));
+}
+
 // A kind the registry does not hold, to show the seam: a point light with a cosine lobe around its direction,
 // I(ω) = I₀ max(0, d·ω). Everything a stage asks of a light is here; a real one adds its LightType value, its row in
 // light_kinds.cpp and its name in the glTF loader.
@@ -174,10 +259,11 @@ class CosineLobeLight final : public LightKind {
   }
   glm::vec3 power(const Light& l) const override { return kPiF * (l.color * l.intensity); }
   glm::dvec3 walkPower(const Light& l, float) const override { return glm::dvec3(power(l)); }
-  void emit(const Light& l, const glm::vec3&, float, double, double, double u2, double u3, glm::vec3& origin,
-            glm::vec3& dir) const override {
+  double emit(const Light& l, const glm::vec3&, float, double, double, double u2, double u3, glm::vec3& origin,
+              glm::vec3& dir) const override {
     origin = l.position;
     dir = cosineHemisphere(l.direction, u2, u3);
+    return 1.0;
   }
   glm::vec3 toward(const Light& l, const glm::vec3& x) const override { return l.position - x; }
   PunctualContribution direct(const Light& l, const glm::vec3& x, const glm::vec3& nx) const override {

@@ -18,10 +18,11 @@ class PointLight final : public LightKind {
   }
   glm::vec3 power(const Light& light) const override { return 4.0f * kPiF * (light.color * light.intensity); }
   glm::dvec3 walkPower(const Light& light, float) const override { return glm::dvec3(power(light)); }
-  void emit(const Light& light, const glm::vec3&, float, double, double, double u2, double u3, glm::vec3& origin,
-            glm::vec3& dir) const override {
+  double emit(const Light& light, const glm::vec3&, float, double, double, double u2, double u3, glm::vec3& origin,
+              glm::vec3& dir) const override {
     origin = light.position;
     dir = uniformSphere(u2, u3);
+    return 1.0;
   }
 
   glm::vec3 toward(const Light& light, const glm::vec3& x) const override { return light.position - x; }

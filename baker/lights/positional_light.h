@@ -1,4 +1,4 @@
-// What the lights with a position (point, spot) share: the inverse-square direct term and the reach.
+// What the lights with a position (point, spot, IES) share: the inverse-square direct term and the reach.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -28,8 +28,10 @@ PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, co
 
 // Whether a point at squared distance r2 from the light lies within the distance where the peak intensity falls to
 // `threshold` (W/m² facing the light; 0: no such limit) and within the range.
-inline bool withinReach(const Light& light, float r2, float threshold) {
-  const float peak = std::max(light.color.x, std::max(light.color.y, light.color.z)) * light.intensity;  // W/sr
+// `peakScale` scales the intensity to the light's peak (an IES profile's largest candela).
+inline bool withinReach(const Light& light, float r2, float threshold, float peakScale = 1.0f) {
+  const float peak = std::max(light.color.x, std::max(light.color.y, light.color.z)) * light.intensity *
+                     peakScale;  // W/sr
   if (!(peak > 0.0f)) return false;
   float reach2 = threshold > 0.0f ? peak / (3.14159265f * threshold) : INFINITY;
   if (light.range > 0.0f) reach2 = std::min(reach2, light.range * light.range);

@@ -138,6 +138,10 @@ std::vector<RequestedLightMode> resolveLightModes(const Scene& scene, const std:
       if (lights.empty()) refuseName(scene, r);
       for (const size_t i : lights) modes[i] = {r.mode, requestText(r), true};
     }
+  // No client shades an IES profile in real time: its direct light stays in the map.
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (scene.lights[i].type == LightType::Ies && modes[i].mode != LightMode::Baked)
+      modes[i] = {LightMode::Baked, "an EXT_lights_ies light stays baked (" + modes[i].reason + " ignored)", true};
   return modes;
 }
 

@@ -22,6 +22,7 @@
 #include "common/error.h"
 #include "common/log.h"
 #include "scene/gltf_source.h"
+#include "scene/ies_lights_gltf.h"
 #include "scene/image_codec.h"
 #include "scene/moz_lightmap_units.h"
 #include "scene/runtime_lights.h"
@@ -57,7 +58,7 @@ constexpr double kBoundSlack = kSceneLimitSlack;
 const char* const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_mesh_quantization", "MOZ_lightmap",
                                             "IRBAKE_lightmap_directional", "KHR_texture_transform",
-                                            "EXT_mesh_gpu_instancing", "EXT_texture_webp"};
+                                            "EXT_mesh_gpu_instancing", "EXT_texture_webp", "EXT_lights_ies"};
 
 // tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
 // material uses). EXR and unknown formats load too; they are simply recorded.
@@ -425,6 +426,10 @@ class Loader {
     }
     if (node.camera >= 0) addCamera(n, world);
     if (const json* l = path(nodeJson(n), {"extensions", "KHR_lights_punctual", "light"})) addLight(n, l, world);
+    if (const json* ies = path(nodeJson(n), {"extensions", "EXT_lights_ies"})) {
+      if (!iesLights_) iesLights_ = std::make_unique<IesLightReader>(src_, model_, file_);
+      scene_.lights.push_back(iesLights_->light(n, *ies, world));
+    }
     for (int c : node.children) visitNode(c, world, depth + 1);
   }
 
@@ -1304,6 +1309,7 @@ class Loader {
   GltfSource src_;
   const LoadOptions& options_;
   std::string file_;
+  std::unique_ptr<IesLightReader> iesLights_;  // EXT_lights_ies, made by the first node that has one
   tinygltf::Model model_;
   Scene scene_;
   std::map<std::pair<int, int>, LocalPrimitive> localCache_;

@@ -4,12 +4,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "scene/environment.h"
+#include "scene/ies_profile.h"
 
 namespace irbake {
 
@@ -125,7 +127,8 @@ struct Primitive {
   size_t triangleCount() const { return indices.size() / 3; }
 };
 
-enum class LightType { Point, Spot, Directional };
+// Ies: an EXT_lights_ies light, a point light whose intensity follows an IES LM-63 profile.
+enum class LightType { Point, Spot, Directional, Ies };
 
 // How a punctual light reaches the light map (mixed lighting): baked: its direct light and its bounces;
 // indirect: its bounces only (the runtime shades its direct light); shadowmask: as indirect, plus its baked
@@ -150,6 +153,10 @@ struct Light {
   glm::vec3 direction{0.0f, 0.0f, -1.0f};  // world, unit, direction light travels (spot/directional)
   int node = -1;                       // -1 for lights from the command line
   int gltfLight = -1;                  // index in KHR_lights_punctual's lights (-1: from the command line)
+  // Ies: the profile (candela), scaled by intensity (EXT_lights_ies' multiplier) × color; direction is its
+  // nadir (θ = 0, the node's −Z) and profileAxisX its horizontal angle 0 (the node's +X), both world and unit.
+  std::shared_ptr<const IesProfile> profile;
+  glm::vec3 profileAxisX{1.0f, 0.0f, 0.0f};
   bool hasExtrasMode = false;          // the glTF light's extras.irbake.mode was given (then extrasMode holds it)
   LightMode extrasMode = LightMode::Baked;
   // glTF: intensity is zero beyond range (inverse-square inside it). 1 inside, 0 beyond; range 0 = infinite.

@@ -75,10 +75,11 @@ struct PathStart {
 };
 
 // Where a ray leaves punctual light l for the random numbers (u0..u3): its origin and direction, as its kind
-// emits (a light at infinity: on a disc covering the scene's bounding sphere, upstream of it).
-void lightRay(const Light& l, const LightSources& sources, double u0, double u1, double u2, double u3, glm::vec3& origin,
-              glm::vec3& dir) {
-  lightKind(l.type).emit(l, sources.sceneCentre, sources.sceneRadius, u0, u1, u2, u3, origin, dir);
+// emits (a light at infinity: on a disc covering the scene's bounding sphere, upstream of it); returns the path's
+// weight (LightKind::emit).
+double lightRay(const Light& l, const LightSources& sources, double u0, double u1, double u2, double u3,
+                glm::vec3& origin, glm::vec3& dir) {
+  return lightKind(l.type).emit(l, sources.sceneCentre, sources.sceneRadius, u0, u1, u2, u3, origin, dir);
 }
 
 // The sky's ray: a direction towards the sky by radiance (u2, u3; its density in `pdf`) and a point on a
@@ -131,8 +132,8 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
                           : glm::dvec3(0.0);
   } else {
     const Light& l = scene.lights[s - numTriangles];
-    pathPower = sources.lightPower[s - numTriangles] / (p * static_cast<double>(N));
-    lightRay(l, sources, residual, u1, halton.sample(2, i), halton.sample(3, i), origin, dir);
+    const double weight = lightRay(l, sources, residual, u1, halton.sample(2, i), halton.sample(3, i), origin, dir);
+    pathPower = sources.lightPower[s - numTriangles] * weight / (p * static_cast<double>(N));
   }
   return path;
 }
@@ -155,21 +156,21 @@ std::vector<double> weighByReach(const Scene& scene, const RayTracer& rt, LightS
   reach.assign(lights, 0.0);
   tbb::parallel_for(size_t(0), lights, [&](size_t k) {
     Rng rng(hashSeed(seed, 0x72656163680000ull, k));  // "reach"
-    int received = 0;
+    double received = 0.0;  // pilots' weights (LightKind::emit), 1 each for the sky
     for (int n = 0; n < kReachPilots; ++n) {
       const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
       glm::vec3 origin, dir;
-      double pdf = 0.0;
-      if (k < scene.lights.size()) lightRay(scene.lights[k], sources, u0, u1, u2, u3, origin, dir);
+      double pdf = 0.0, weight = 1.0;
+      if (k < scene.lights.size()) weight = lightRay(scene.lights[k], sources, u0, u1, u2, u3, origin, dir);
       else skyRay(scene, sources, u0, u1, u2, u3, origin, dir, pdf);
       const RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
       if (!hit.hit) continue;
       const Primitive& prim = scene.primitives[hit.primitive];
       const bool doubleSided = prim.material >= 0 && prim.material < static_cast<int>(scene.materials.size()) &&
                                scene.materials[prim.material].doubleSided;
-      if (!hit.backFace || doubleSided) ++received;
+      if (!hit.backFace || doubleSided) received += weight;
     }
-    reach[k] = static_cast<double>(received) / kReachPilots;
+    reach[k] = received / kReachPilots;
   });
   // The lights' and the sky's start weights times their reach; the triangles' (emitters light what faces them)
   // stay as they are.

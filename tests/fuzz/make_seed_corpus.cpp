@@ -158,6 +158,27 @@ std::string glb(json doc, const fs::path& folder) {
   return out;
 }
 
+// A small LM-63 profile (type C, quadrant symmetry, TILT=INCLUDE) for the EXT_lights_ies seeds.
+const char kIesProfile[] =
+    "IESNA:LM-63-2002\n[TEST] seed\nTILT=INCLUDE\n1\n2\n0 90\n1 1\n"
+    "1 -1 1.5 4 2 1 2 0.1 0.1 0\n1 1 20\n0 30 60 90\n0 90\n100 90 50 0\n80 70 40 0\n";
+
+// The scene with an EXT_lights_ies light above its centre: its profile as a data URI, its node tilted, with a
+// multiplier and a colour.
+json withIesLight(json doc) {
+  const std::string text = kIesProfile;
+  doc["extensions"]["EXT_lights_ies"]["lights"] = json::array(
+      {{{"name", "seed lamp"}, {"uri", "data:application/x-ies-lm-63;base64," + base64({text.begin(), text.end()})}}});
+  json node = {{"name", "ies lamp"},
+               {"translation", {0.1, 1.5, 0.2}},
+               {"rotation", {0.2588190, 0.0, 0.0, 0.9659258}},
+               {"extensions", {{"EXT_lights_ies", {{"light", 0}, {"multiplier", 2.0}, {"color", {1.0, 0.9, 0.8}}}}}}};
+  doc["nodes"].push_back(node);
+  doc["scenes"][doc.value("scene", 0)]["nodes"].push_back(doc["nodes"].size() - 1);
+  doc["extensionsUsed"].push_back("EXT_lights_ies");
+  return doc;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -179,6 +200,11 @@ int main(int argc, char** argv) {
       embed(doc, "images", in, -1);
       writeFile(out / (name + ".gltf"), doc.dump());
       seeds += 2;
+      if (seeds == 2) {  // one scene also with an IES light
+        writeFile(out / (name + "_ies.gltf"), withIesLight(doc).dump());
+        writeFile(out / (name + "_ies.glb"), glb(withIesLight(json::parse(std::ifstream(entry.path()))), in));
+        seeds += 2;
+      }
       const std::pair<const char*, bool (*)(json&)> variants[] = {
           {"_gpu_instancing", addGpuInstancing}, {"_texture_transform", addTextureTransforms}, {"_webp", addWebpSources}};
       for (const auto& [suffix, add] : variants) {

@@ -298,6 +298,22 @@ const GlProgram& GlBaker::vplProgram(int layers) {
                       defines);
 }
 
+namespace {
+
+// An IES profile's table (IesProfile::table) for direct_light.frag, θ every quarter degree, φ every degree: a
+// profile measured at such angles reads back exactly.
+constexpr int kIesTableRows = 721, kIesTableColumns = 361;
+
+void uploadIesProfile(const IesProfile& profile, GlTexture& texture) {
+  const std::vector<float> table = profile.table(kIesTableRows, kIesTableColumns);
+  glCreateTextures(GL_TEXTURE_2D, 1, texture.out());
+  glTextureStorage2D(texture.get(), 1, GL_R32F, kIesTableColumns, kIesTableRows);
+  glTextureSubImage2D(texture.get(), 0, 0, 0, kIesTableColumns, kIesTableRows, GL_RED, GL_FLOAT, table.data());
+  glBindTextureUnit(BAKE_UNIT_IES_PROFILE, texture.get());
+}
+
+}  // namespace
+
 void GlBaker::bakeDirect(const Light& light) {
   const Bounds3 bounds = in_.scene.bounds();
   StageClock sw;
@@ -364,6 +380,9 @@ void GlBaker::bakeDirect(const Light& light) {
   glUniform1i(p.uniform("shadowKind"), static_cast<int>(shadowKind));
   glUniform3fv(p.uniform("lightPosition"), 1, &light.position[0]);
   glUniform3fv(p.uniform("lightDirection"), 1, &light.direction[0]);
+  glUniform3fv(p.uniform("lightAxisX"), 1, &light.profileAxisX[0]);
+  GlTexture profileTexture;
+  if (shaderLight.code == BAKE_LIGHT_IES && light.profile) uploadIesProfile(*light.profile, profileTexture);
   glUniform3fv(p.uniform("lightIntensity"), 1, &shaderLight.intensity[0]);
   glUniform1f(p.uniform("lightRange"), light.range);
   glUniform1f(p.uniform("cosOuter"), shaderLight.cosOuter);

@@ -14,6 +14,7 @@
 #include "glcontext/gl_program.h"
 #include "lights/light_kind.h"
 #include "raytrace/ray_tracer.h"
+#include "testing/ies_profiles.h"
 #include "testing/scenes.h"
 
 namespace irbake {
@@ -504,6 +505,46 @@ TEST(GlBackend, PointAndSpotLightsAreExactWithShadowMaps) {
     // A texel far from the shadow edge: exact. Texel (2, 2) at (-0.84, -0.84).
     EXPECT_NEAR(maps[0].texels[2 * 32 + 2].x, ref[2 * 32 + 2].x, 1e-4 * ref[2 * 32 + 2].x + 1e-9);
   }
+}
+
+// An EXT_lights_ies light 1 m above a 2×2 m floor, its nadir straight down and its horizontal angle 0 along +X:
+// each texel holds candela(θ, φ) × multiplier × cosθ / d² as the map's E/π (docs/export.md), on the GL backend
+// (its profile table, direct_light.frag) and on Embree (the light kind's direct term), θ from 0 to 55°.
+TEST(GlBackend, IesLightOnAFloorIsCandelaTimesCosineOverDistanceSquared) {
+  Fixture f = floorScene(false);
+  Light L;
+  L.type = LightType::Ies;
+  L.position = {0.1f, -0.05f, 1.0f};
+  L.direction = {0.0f, 0.0f, -1.0f};
+  L.profileAxisX = {1.0f, 0.0f, 0.0f};
+  L.intensity = 1.5f;
+  L.profile = std::make_shared<const IesProfile>(parseIesProfile(testing::cosineIesProfile(3.0), "floor.ies"));
+  f.scene.lights.push_back(L);
+  f.rt = std::make_unique<RayTracer>(f.scene);
+  GlBackendOptions opt;
+  opt.pointFaceSize = 256;
+  const std::vector<Lightmap> gl = f.bake({}, opt);
+  const BakeInputs in{f.scene, *f.rt, f.pages, f.vpls, {}, {}};
+  const std::vector<Lightmap> embree = EmbreeEvaluator().evaluate(in);
+  double glWorst = 0.0, embreeWorst = 0.0, widest = 0.0;
+  for (size_t i = 0; i < f.pages[0].layerSize(); ++i) {
+    const glm::vec4 pw = f.pages[0].positionWeight[i];
+    if (pw.w <= 0.0f) continue;
+    const glm::dvec3 d = glm::dvec3(glm::vec3(pw)) - glm::dvec3(L.position);  // from the light
+    const double r2 = glm::dot(d, d), r = std::sqrt(r2);
+    const double theta = std::acos(-d.z / r) * 180.0 / kPi, phi = std::atan2(d.y, d.x) * 180.0 / kPi;
+    const double expected = pw.w * 1.5 * testing::cosineIesCandela(3.0, theta, phi) * (-d.z / r) / (kPi * r2);
+    glWorst = std::max(glWorst, std::abs(gl[0].texels[i].x - expected) / expected);
+    embreeWorst = std::max(embreeWorst, std::abs(embree[0].texels[i].x - expected) / expected);
+    widest = std::max(widest, theta);
+  }
+  EXPECT_GT(widest, 50.0);
+  EXPECT_LT(glWorst, 1e-3);
+  EXPECT_LT(embreeWorst, 1e-4);
+  // Beside the light along +X and −X, about 40° off the nadir: the profile's f(0°) = 1.5 against f(180°) = 0.5.
+  const size_t plusX = 16 * 32 + 30, minusX = 16 * 32 + 3;
+  EXPECT_GT(embree[0].texels[plusX].x, 2.0f * embree[0].texels[minusX].x);
+  EXPECT_GT(gl[0].texels[plusX].x, 2.0f * gl[0].texels[minusX].x);
 }
 
 TEST(GlBackend, DirectionalLightIsExactWithOrthoShadowMap) {
