@@ -200,6 +200,29 @@ TEST(OutputSafety, PortableNamingAnOutputOrAnInputIsRefused) {
   EXPECT_EQ(fileText(dir / "p.glb"), portableBefore);
 }
 
+// --portable goes beside the other outputs: alone, as OUTDIR/portable.glb; a bare name, in OUTDIR (also with
+// -o OUT.glb: its folder); a name with a folder, there. The report names the file and counts its time.
+TEST(OutputSafety, PortableGoesBesideTheOutputsUnlessAPathIsGiven) {
+  const fs::path dir = scratch("portable_where");
+  const fs::path scene = copyOfCornell(dir / "in", "box");
+  IrbakeRun alone = bake(scene, dir / "a", {"--portable"}, dir / "alone.txt");
+  ASSERT_EQ(alone.code, 0) << alone.output;
+  EXPECT_TRUE(fs::exists(dir / "a" / "portable.glb"));
+  const nlohmann::json report = nlohmann::json::parse(fileText(dir / "a" / "report.json"));
+  EXPECT_EQ(fs::path(report["portable"]["file"].get<std::string>()), dir / "a" / "portable.glb");
+  EXPECT_TRUE(report["timings"]["seconds"].contains("portable"));
+  EXPECT_GE(report["timings"]["memoryPeakMiB"].get<double>(), 1.0);
+  ASSERT_EQ(bake(scene, dir / "b" / "level.glb", {"--portable", "shipped.glb"}, dir / "bare.txt").code, 0);
+  EXPECT_TRUE(fs::exists(dir / "b" / "shipped.glb"));
+  ASSERT_EQ(bake(scene, dir / "c", {"--portable", (dir / "elsewhere" / "p.glb").string()}, dir / "path.txt").code, 0);
+  EXPECT_TRUE(fs::exists(dir / "elsewhere" / "p.glb"));
+  EXPECT_FALSE(fs::exists(dir / "c" / "p.glb"));
+  // A bare name is checked where it goes: there it is the glTF output itself.
+  IrbakeRun clash = bake(scene, dir / "d" / "level.glb", {"--portable", "level.glb"}, dir / "clash.txt");
+  EXPECT_EQ(clash.code, 2) << clash.output;
+  EXPECT_FALSE(fs::exists(dir / "d" / "level.glb"));
+}
+
 // A bake killed by SIGTERM, SIGINT or SIGABRT takes its lock file with it.
 TEST(OutputSafety, KilledBakeLeavesNoLock) {
   const fs::path dir = scratch("killed");

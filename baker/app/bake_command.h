@@ -29,8 +29,10 @@ struct BakeCommand {
   bool quiet = false;              // --quiet
   bool verbose = false;            // --verbose
   bool noGltf = false;             // --no-gltf
-  std::string portable;            // --portable FILE.glb: also the unlit core-glTF bake (empty: none)
-  double portableExposure = 1.0;   // --portable-exposure: scale on the portable file's shown values
+  std::string portable;            // --portable [FILE.glb]: also the unlit core-glTF bake (empty: none; a bare
+                                   // name: in OUTDIR; resolved by bakeOutputGuard)
+  double portableExposure = PortableOptions{}.exposure;   // --portable-exposure: scale on the shown values
+  int portableMaxSize = PortableOptions{}.maxTextureSize;  // --portable-max-size: texels a side per texture
   int shardIndex = 0;              // --shard K/N: K (1-based), 0 without --shard
   int shardCount = 0;              // N
   bool resume = false;             // --resume: continue from OUTDIR's checkpoint when it matches
@@ -42,6 +44,10 @@ struct BakeCommand {
   nlohmann::json resultOptions;    // every option that changes the result, given at other than its default
   std::string optionsHash;         // hash of resultOptions (not -o, --threads, ...)
 };
+
+// Where --portable writes: `given` as it is when it names a folder, else in -o's folder (OUTDIR, or the
+// folder of OUT.glb / OUT.gltf); "" without --portable.
+std::filesystem::path portableOutputPath(const std::string& out, const std::string& given);
 
 // Parses the arguments after "bake"; nullopt when --help was printed. Throws Error(Usage).
 std::optional<BakeCommand> parseBakeCommand(const Args& args);

@@ -336,14 +336,19 @@ void addProbeAndOutputRows(std::vector<OptionDescriptor>& t) {
   t.push_back(flag("--directional", kCommon, "also bake directional (L1) maps (docs/export.md)",
                    opt([](BakeOptions& o) { return &o.directional; })));
   t.push_back(flag("--no-gltf", kOutputs, "write only the EXR pages and the report", cmd(&BakeCommand::noGltf), kNotResult));
-  t.push_back(text("--portable", kCommon, "FILE.glb",
-                   "also write FILE.glb for viewers without MOZ_lightmap: base colour × light\n"
-                   "map + emission baked into unlit textures (KHR_materials_unlit; docs/export.md)",
+  t.push_back(text("--portable", kCommon, "[GLB]",
+                   "also write GLB (in OUTDIR unless it names a folder) for viewers without MOZ_lightmap:\n"
+                   "base colour × light map + emission baked into unlit textures (docs/export.md)",
                    cmd(&BakeCommand::portable), kPath | kNotResult));
+  t.back().valueWhenBare = kPortableName;
   t.push_back(number("--portable-exposure", 1e-6, 1e6, kOutputs, "X",
-                     "--portable: scale on the shown values before the 8-bit sRGB encode\n"
-                     "(default " + shown(dc.portableExposure) + ": the map as it is; values above 1 clip)",
+                     "--portable: scale on the shown values before the range and the 8-bit sRGB encode\n"
+                     "(default " + shown(dc.portableExposure) + ": the map as it is)",
                      cmd(&BakeCommand::portableExposure), kNotResult));
+  t.push_back(integer("--portable-max-size", 64, 16384, kOutputs, "N",
+                      "--portable: at most N texels a side per texture; a larger page is tiled\n"
+                      "into several textures (default " + std::to_string(dc.portableMaxSize) + ")",
+                      cmd(&BakeCommand::portableMaxSize), kNotResult));
 }
 
 // Diagnostics, threads and logging, distributed and resumable bakes, presets and config files.
@@ -459,6 +464,7 @@ CLI::Option* addOption(CLI::App& app, const OptionDescriptor& d, OptionField fie
   }
   if (!d.typeName.empty()) option->type_name(d.typeName);
   if (d.kind == OptionKind::Repeated) option->allow_extra_args(false);  // one value each time: never the SCENE after it
+  if (!d.valueWhenBare.empty()) option->expected(0, 1)->default_str(d.valueWhenBare);
   option->group(d.group);
   return option;
 }

@@ -37,6 +37,9 @@ struct BakeArguments {
   std::string clampText() const { return clampOption && !clampOption->results().empty() ? clampOption->results()[0] : ""; }
 };
 
+// --portable given without a file name: this name in OUTDIR.
+constexpr const char* kPortableName = "portable.glb";
+
 // Light from the command line: at most this much (W/m², W/(m² sr)), so sums over the bake stay finite in float.
 constexpr double kLargestLight = 1e20;
 
@@ -81,6 +84,7 @@ struct OptionDescriptor {
   std::function<OptionField(BakeCommand&, BakeArguments&)> field;  // where the value goes; its initial value
                                                                     // is the default
   std::function<long long(const QualityPreset&)> preset;  // the --quality knob it overrides (empty: none)
+  std::string valueWhenBare;  // Text: may be given without a value, which then is this ("": a value is needed)
 
   bool has(OptionTraits t) const { return (traits & t) != 0; }
   bool isFlag() const { return kind == OptionKind::Flag; }

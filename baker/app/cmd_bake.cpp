@@ -315,6 +315,7 @@ std::vector<ConfigEntry> effectiveOptions(const CLI::App& app, BakeCommand& comm
         continue;
       }
       std::string value = d.isFlag() ? "true" : joinedResults(*option);
+      if (d.name == "portable") value = portableOutputPath(command.out, value).string();  // where it is written
       if (d.has(kPath)) value = std::filesystem::absolute(value).lexically_normal().string();
       entries.push_back({d.configKey(), value, 0, false, {}});
       continue;
@@ -485,11 +486,18 @@ bool isBakeStateName(const std::string& name) {
 
 }  // namespace
 
+fs::path portableOutputPath(const std::string& out, const std::string& given) {
+  if (given.empty()) return {};
+  const fs::path path(given);
+  return path.has_parent_path() ? path : outputFolderOf(out) / path;
+}
+
 std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<fs::path>& moreInputs) {
   auto guard = std::make_shared<OutputGuard>();
   const fs::path outDir = outputFolderOf(c.out);
   const bool gltfNamed = namesGltfFile(c.out);
   const fs::path gltf = gltfNamed ? fs::path(c.out) : outDir / "scene.gltf";
+  c.portable = portableOutputPath(c.out, c.portable).string();
   if (!c.portable.empty() && !hasExtension(c.portable, ".glb"))
     throw Error(ErrorCode::Usage, c.portable, "--portable writes one GLB: give a .glb file name");
   // Inputs first: the scene and its files, --env's map, and what the command reads besides (merge's partials).
@@ -661,6 +669,7 @@ void writeFinishedBake(const BakeCommand& c, const BakeResult& result, TerminalP
   outputOptions.writeGltf = !c.noGltf;
   outputOptions.portablePath = c.portable;
   outputOptions.portable.exposure = c.portableExposure;
+  outputOptions.portable.maxTextureSize = c.portableMaxSize;
   outputOptions.inputs = c.inputs;
   Stopwatch writeTime;
   c.options.progress("write", 0.0);  // coarse: EXR pages, glTF and report are written one after another

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include "app/bake_command.h"
+#include "app/bake_option_table.h"
 #include "app/commands.h"
 #include "common/command_line.h"
 #include "common/atomic_file.h"
@@ -90,7 +91,8 @@ int runMerge(const Args& args) {
   int threads = 0;
   bool quiet = false, noGltf = false;
   std::string portable;
-  double portableExposure = 1.0;
+  double portableExposure = PortableOptions{}.exposure;
+  int portableMaxSize = PortableOptions{}.maxTextureSize;
   auto app = cli::makeApp("irbake merge",
                           "Adds the partial VPL sums of 'irbake bake --shard K/N' (every share once) and\n"
                           "finishes the bake: the same outputs, byte for byte, as the bake on one machine.");
@@ -98,10 +100,14 @@ int runMerge(const Args& args) {
   app->add_option("-o,--output", out, "output folder (OUTDIR), or OUT.glb / OUT.gltf")->type_name("OUTDIR");
   app->add_option("--report", report, "report path (default OUTDIR/report.json)")->type_name("R.json");
   app->add_flag("--no-gltf", noGltf, "write only the EXR pages and the report");
-  app->add_option("--portable", portable, "also write FILE.glb, the unlit core-glTF bake (as irbake bake --portable)")
-      ->type_name("FILE.glb");
+  app->add_option("--portable", portable, "also write FILE.glb, the unlit core-glTF bake (as irbake bake --portable:\n"
+                  "in OUTDIR unless it names a folder; alone: OUTDIR/" + std::string(kPortableName) + ")")
+      ->type_name("[FILE.glb]")->expected(0, 1)->default_str(kPortableName);
   app->add_option("--portable-exposure", portableExposure, "--portable: scale on the shown values (default 1)")
       ->transform(cli::numberIn(1e-6, 1e6))->type_name("X");
+  app->add_option("--portable-max-size", portableMaxSize,
+                  "--portable: at most N texels a side per texture (default " + std::to_string(portableMaxSize) + ")")
+      ->transform(cli::integerIn(64, 16384))->type_name("N");
   app->add_option("--threads", threads, "worker threads (default 0: every core)")
       ->transform(cli::integerIn(0, 1024))->type_name("N");
   app->add_flag("--quiet", quiet, "warnings and errors only, no progress bars");
@@ -137,6 +143,7 @@ int runMerge(const Args& args) {
   c.noGltf = noGltf;
   c.portable = portable;  // where and how to write, never the shards' own arguments
   c.portableExposure = portableExposure;
+  c.portableMaxSize = portableMaxSize;
   c.options.backend = parseBackend(first.backend);
   if (c.optionsHash != first.optionsHash)
     throw Error(ErrorCode::InvalidData, files[0].string(), "the stored arguments do not give the options hashed");

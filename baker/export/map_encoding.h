@@ -92,6 +92,11 @@ struct Png8Error {
   double clippedFraction = 0.0;  // fraction of covered texels with a channel above the range (clipped)
 };
 
+// The range of MapRange::Percentile from the texels' largest channels (`peaks`, those > 0; reordered): their
+// nearest-rank `percentile`, 1 when there is none. The one rule for every 8-bit range: the MOZ_lightmap PNG's
+// intensity and the portable GLB's range (export/portable_export.h).
+float rangeAtPercentile(std::vector<float>& peaks, double percentile);
+
 // Quantises `map` as png8 would with MapRange::Percentile (decoding the 8-bit codes) and measures the error.
 Png8Error measurePng8(const Lightmap& map, const MapEncodeOptions& options = {});
 

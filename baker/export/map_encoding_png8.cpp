@@ -26,12 +26,7 @@ float percentileRange(const Lightmap& map, double percentile) {
       const float m = std::max(t.x, std::max(t.y, t.z));
       if (m > 0.0f) peaks.push_back(m);
     }
-  if (peaks.empty()) return 1.0f;
-  const double q = std::clamp(percentile, 0.0, 100.0) / 100.0;
-  const double rank = std::ceil(q * double(peaks.size())) - 1.0;  // nearest-rank percentile
-  const size_t k = std::min(peaks.size() - 1, static_cast<size_t>(std::max(0.0, rank)));
-  std::nth_element(peaks.begin(), peaks.begin() + static_cast<long>(k), peaks.end());
-  return peaks[k] > 0.0f ? peaks[k] : 1.0f;
+  return rangeAtPercentile(peaks, percentile);
 }
 
 // The largest |value| over the valid texels (1 when all are 0 or it is not finite).
@@ -113,6 +108,15 @@ class Png8Encoding final : public MapEncoding {
 };
 
 }  // namespace
+
+float rangeAtPercentile(std::vector<float>& peaks, double percentile) {
+  if (peaks.empty()) return 1.0f;
+  const double q = std::clamp(percentile, 0.0, 100.0) / 100.0;
+  const double rank = std::ceil(q * double(peaks.size())) - 1.0;  // nearest-rank percentile
+  const size_t k = std::min(peaks.size() - 1, static_cast<size_t>(std::max(0.0, rank)));
+  std::nth_element(peaks.begin(), peaks.begin() + static_cast<long>(k), peaks.end());
+  return peaks[k] > 0.0f ? peaks[k] : 1.0f;
+}
 
 const MapEncoding& png8MapEncoding() {
   static const Png8Encoding encoding;

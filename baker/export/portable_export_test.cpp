@@ -218,3 +218,134 @@ TEST(PortableExport, PrimitiveWithoutPageKeepsItsBaseColourAndNamesAGlbOnly) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "portable.gltf"));
 }
+
+namespace {
+
+// The image of texture `texture` in the written document, decoded with the sRGB curve (linear values).
+Texture imageOfTexture(const ReadBack& r, int texture) {
+  const int image = r.root["textures"][texture]["source"].get<int>();
+  const json& view = r.root["bufferViews"][r.root["images"][image]["bufferView"].get<int>()];
+  const size_t offset = view.value("byteOffset", size_t(0)), length = view["byteLength"].get<size_t>();
+  return decodeImageToTexture(r.doc.bin.data() + offset, length, true, "tile");
+}
+
+}  // namespace
+
+// A white quad over a whole 64×64 page whose map ramps from 0 to 10: the shown values go far above 1. The
+// range is the 99.9th percentile of the texels (nearest rank 4092 of 4096: (4092 − 0.5) / 4096 × 10), so the
+// written texture, decoded and times the range, gives back every texel but the 4 above it (0.098%) within
+// one 8-bit sRGB code, and the file says the range.
+TEST(PortableExport, RangeKeepsTheClippedTexelsUnderOnePerMille) {
+  auto dir = irbake::testing::testFolder("portable_range");
+  Scene s = quadScene();
+  s.materials[0].baseColorFactor = glm::vec4(1.0f);
+  s.primitives[0].uv1 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  s.primitives[0].lightmap = {0, 64, 64};
+  Lightmap map = constantMap(0.0f, 64);
+  for (size_t i = 0; i < map.size(); ++i) {
+    const size_t rank = (i * 2654435761u) % map.size();  // a permutation of the ramp over the page
+    map.texels[i] = glm::vec3(10.0f * (static_cast<float>(rank) + 0.5f) / static_cast<float>(map.size()));
+  }
+  json summary;
+  writeAllAtomically({portableGlbFile(s, {map}, dir / "range.glb", {}, &summary)});
+  const double range = summary["range"].get<double>();
+  EXPECT_NEAR(range, 10.0 * (4091 + 0.5) / 4096, 1e-5);
+  ReadBack r = readPortable(dir / "range.glb");
+  EXPECT_NEAR(r.root["asset"]["extras"]["irbakePortable"]["range"].get<double>(), range, 1e-12);
+  const Texture t = imageOfTexture(r, 0);
+  ASSERT_EQ(t.width, 64);
+  size_t clipped = 0;
+  for (size_t i = 0; i < map.size(); ++i) {
+    const double value = map.texels[i].x, back = t.texels[i].x * range;
+    // One code at the top of the range is its widest step in linear terms: 1 − srgbToLinear(254.5/255).
+    const double code = range * (1.0 - srgbToLinear(254.5f / 255.0f));
+    if (value > range + 1e-6) {
+      ++clipped;
+      EXPECT_NEAR(back, range, code);
+    } else {
+      ASSERT_NEAR(back, value, code) << i;
+    }
+  }
+  EXPECT_EQ(clipped, 4u);
+  EXPECT_LE(static_cast<double>(clipped) / map.size(), 0.001);
+  EXPECT_NEAR(summary["pages"][0]["clippedFraction"].get<double>(), 4.0 / 4096, 1e-12);
+  EXPECT_NEAR(summary["pages"][0]["litClippedFraction"].get<double>(), 4.0 / 4096, 1e-12);
+
+  // A dim bake is not brightened: the range is at least 1.
+  for (glm::vec3& v : map.texels) v *= 0.05f;
+  writeAllAtomically({portableGlbFile(s, {map}, dir / "dim.glb", {}, &summary)});
+  EXPECT_EQ(summary["range"].get<double>(), 1.0);
+  EXPECT_EQ(summary["pages"][0]["clippedFraction"].get<double>(), 0.0);
+}
+
+// An emitter's face is a lamp: it may clip (white, as irview shows it) and does not set the range.
+TEST(PortableExport, EmittersDoNotSetTheRange) {
+  Scene s = quadScene();
+  Primitive lamp = s.primitives[0];
+  lamp.uv1 = {{0.0f, 0.0f}, {0.2f, 0.0f}, {0.2f, 0.2f}, {0.0f, 0.2f}};
+  lamp.material = 1;
+  Material bright;
+  bright.emissiveFactor = glm::vec3(1.0f);
+  bright.emissiveStrength = 50.0f;
+  s.materials.push_back(bright);
+  s.primitives.push_back(lamp);
+  const PortableBake bake = buildPortable(s, {constantMap(0.4f)});
+  EXPECT_EQ(bake.range, 1.0);
+  EXPECT_GT(bake.pages[0].clippedFraction, 0.0);
+  EXPECT_EQ(bake.pages[0].litClippedFraction, 0.0);
+}
+
+// Nine quads on a 64×64 page, 16×16 texels each, with a texture limit of 32: nine tiles (the 2×2 grid's
+// middle quads straddle its cells, so a 3×3 grid), each at most 32 texels a side, each quad's material reading
+// its own tile; every texel the quads cover reads, through the tile, what the whole-page texture has there.
+TEST(PortableExport, LargePageIsTiledIntoTexturesUnderTheLimit) {
+  auto dir = irbake::testing::testFolder("portable_tiles");
+  Scene s = quadScene();
+  const Primitive quad = s.primitives[0];
+  s.primitives.clear();
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      Primitive p = quad;
+      p.name = "quad" + std::to_string(j * 3 + i);
+      const glm::vec2 lo(4 + 20 * i, 4 + 20 * j);
+      p.uv1 = {lo / 64.0f, (lo + glm::vec2(16, 0)) / 64.0f, (lo + glm::vec2(16, 16)) / 64.0f, (lo + glm::vec2(0, 16)) / 64.0f};
+      for (glm::vec3& v : p.positions) v += glm::vec3(1.5f * i, 0.0f, -1.5f * j);
+      p.lightmap = {0, 64, 64};
+      s.primitives.push_back(p);
+    }
+  Lightmap map = constantMap(0.0f, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) map.texels[static_cast<size_t>(y) * 64 + x] = glm::vec3(x / 64.0f, y / 64.0f, 0.5f);
+  const Texture whole = bakePortableTexture(s, map, 1, {});
+  PortableOptions o;
+  o.maxTextureSize = 32;
+  json summary;
+  writeAllAtomically({portableGlbFile(s, {map}, dir / "tiles.glb", o, &summary)});
+  ReadBack r = readPortable(dir / "tiles.glb");
+  ASSERT_EQ(summary["pages"][0]["tiles"].size(), 9u);
+  ASSERT_EQ(r.root["images"].size(), 9u);
+  ASSERT_EQ(r.root["meshes"].size(), 9u);
+  for (size_t m = 0; m < 9; ++m) {
+    const json& prim = r.root["meshes"][m]["primitives"][0];
+    const json& mat = r.root["materials"][prim["material"].get<int>()];
+    const Texture tile = imageOfTexture(r, mat["pbrMetallicRoughness"]["baseColorTexture"]["index"].get<int>());
+    EXPECT_LE(tile.width, 32);
+    EXPECT_LE(tile.height, 32);
+    AccessorBytes uvBytes = readAccessor(r.doc, prim["attributes"]["TEXCOORD_0"].get<int>(), "tiles");
+    std::vector<glm::vec2> uv(uvBytes.count);
+    std::memcpy(uv.data(), uvBytes.bytes.data(), sizeof(glm::vec2) * uv.size());
+    // The quad's texels: its UVs map the tile's texel (u·w − ½, v·h − ½) onto the page's texel of the same centre.
+    const glm::vec2 page0 = s.primitives[m].uv1[0] * 64.0f, tile0 = uv[0] * glm::vec2(tile.width, tile.height);
+    const glm::vec2 page2 = s.primitives[m].uv1[2] * 64.0f, tile2 = uv[2] * glm::vec2(tile.width, tile.height);
+    EXPECT_NEAR(glm::length((page2 - page0) - (tile2 - tile0)), 0.0f, 1e-3f);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        const int px = static_cast<int>(page0.x) + x, py = static_cast<int>(page0.y) + y;
+        const int tx = static_cast<int>(std::lround(tile0.x)) + x, ty = static_cast<int>(std::lround(tile0.y)) + y;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(srgbCode(tile.texels[static_cast<size_t>(ty) * tile.width + tx][c]),
+                    srgbCode(whole.texels[static_cast<size_t>(py) * 64 + px][c]))
+              << "quad " << m << " texel " << x << "," << y;
+      }
+  }
+}

@@ -1,4 +1,5 @@
 // Writing a finished bake: EXR pages, glTF with the maps attached, the portable GLB when asked, the JSON report.
+#include <algorithm>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -7,6 +8,7 @@
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/log.h"
+#include "common/progress.h"
 #include "common/version.h"
 #include "export/directional_export.h"
 #include "export/exr_io.h"
@@ -95,8 +97,15 @@ std::vector<PendingFile> portableFiles(const BakeResult& result, const OutputOpt
 // The report, naming what is written: glTF (+ .bin, PNG), EXR pages and report are one all-or-nothing set,
 // so a failed bake leaves the previous outputs, report included, untouched.
 PendingFile reportFile(const BakeResult& result, const std::vector<std::filesystem::path>& written,
-                       const nlohmann::json* portableSummary, const std::filesystem::path& reportPath) {
+                       const nlohmann::json* portableSummary, double portableSeconds,
+                       const std::filesystem::path& reportPath) {
   nlohmann::json report = result.report;
+  if (portableSummary) {
+    // The portable GLB is made (its textures encoded) before the report: its time and memory count in it.
+    nlohmann::json& timings = report["timings"];
+    timings["seconds"]["portable"] = portableSeconds;
+    timings["memoryPeakMiB"] = std::max(timings.value("memoryPeakMiB", 0.0), peakMemoryMiB());
+  }
   report["reportSchema"] = 2;  // bumped when a field changes meaning or goes away (2: timings in one object)
   report["irbakeVersion"] = versionLine("irbake");
   report["outputs"] = nlohmann::json::array();
@@ -183,12 +192,14 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   for (const auto& [path, map] : l1Exrs) written.push_back(path);
   const std::vector<PendingFile> errorPages = errorPageFiles(result, outDir, written);
   nlohmann::json portableSummary;
+  const Stopwatch portableTime;
   const std::vector<PendingFile> portable = portableFiles(result, options, portableSummary);
+  const double portableSeconds = portableTime.seconds();
   if (!portable.empty()) written.push_back(options.portablePath);
   for (const PendingFile& f : options.alsoWrite) written.push_back(f.finalPath);
 
   // The report first, then the portable GLB, the error pages and the caller's files, with the pages.
-  std::vector<PendingFile> more = {reportFile(result, written, portable.empty() ? nullptr : &portableSummary, reportPath)};
+  std::vector<PendingFile> more = {reportFile(result, written, portable.empty() ? nullptr : &portableSummary, portableSeconds, reportPath)};
   more.insert(more.end(), portable.begin(), portable.end());
   more.insert(more.end(), errorPages.begin(), errorPages.end());
   more.insert(more.end(), options.alsoWrite.begin(), options.alsoWrite.end());

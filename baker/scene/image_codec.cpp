@@ -114,4 +114,10 @@ std::vector<uint8_t> encodePng(const Texture& texture, bool srgb, float scale) {
   return imageio::api().encodePngMemory(px.data(), w, h, texture.name);
 }
 
+std::vector<uint8_t> encodePngRgba8(const std::vector<uint8_t>& rgba, int width, int height, const std::string& name) {
+  if (width <= 0 || height <= 0 || rgba.size() != static_cast<size_t>(width) * height * 4)
+    throw Error(ErrorCode::InvalidData, name, "cannot encode an empty image as PNG");
+  return imageio::api().encodePngMemory(rgba.data(), width, height, name);
+}
+
 }  // namespace irbake

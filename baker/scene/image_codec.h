@@ -25,6 +25,9 @@ Texture decodeImageToTexture(const uint8_t* bytes, size_t size, bool srgb, const
 // scale multiplies every RGB value first (alpha is kept). Values are clamped to [0,1].
 std::vector<uint8_t> encodePng(const Texture& texture, bool srgb, float scale = 1.0f);
 
+// Encodes 8-bit RGBA pixels (width × height × 4 bytes, row 0 at the top) as a PNG.
+std::vector<uint8_t> encodePngRgba8(const std::vector<uint8_t>& rgba, int width, int height, const std::string& name);
+
 // The sRGB transfer curve and its inverse on [0,1].
 float srgbToLinear(float c);
 float linearToSrgb(float c);
