@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "scene/gltf_decompress.h"
+
 namespace irbake {
 
 void describeBake(const BakeFacts& f, nlohmann::json& report) {
@@ -28,6 +30,8 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
                      {"primitives", f.scene.primitives.size()},
                      {"lights", f.scene.lights.size()},
                      {"emitterPower", nlohmann::json::array({emitted.x, emitted.y, emitted.z})}};
+  const std::vector<std::string> decoded = decodedExtensionsOf(f.scene);
+  if (!decoded.empty()) report["scene"]["decodedExtensions"] = decoded;
   report["atlas"] = f.atlas.toJson();
   report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
                       {"supersample", std::max(1, f.options.texels.supersample)},
