@@ -6,7 +6,7 @@
 # ones within MAX_MAD of 255; each variant's export passes the Khronos validator (runtime/web/validate.mjs).
 # Prints one CSV row per variant; with CSV set, appends them there too (bench/results/compressed_inputs.csv).
 # MESHOPT: the glTF-Transform command of the meshopt variant (default "meshopt"; "optimize --simplify false"
-# is the README's whole optimiser).
+# is the README's whole optimiser). ATLAS_MAY_DIFFER=1: see below.
 # Usage: compressed_inputs_test.sh IRBAKE IRVIEW GLTF_TRANSFORM WORKDIR [SCENE [NAME [BAKE_ARGS...]]]
 set -euo pipefail
 irbake=$1 irview=$2 gt=$3 work=$4
@@ -41,6 +41,14 @@ shot() {  # shot SCENE OUT.png [irview args]: headless screenshot from camera 0,
   "$irview" "$in" --width 256 --height 256 --screenshot "$out" "$@" >"$out.log" 2>&1 || { cat "$out.log"; return 1; }
 }
 
+# validate VARIANT INPUT: the Khronos validator on the variant's export; prints its error count.
+validate_export() {
+  node "$validate" --modules "$modules" --output "$work/bake_$1/scene.gltf" --input "$2" >"$work/validate_$1.log" 2>&1 || true
+  python3 -c 'import json,sys; print(json.loads(sys.stdin.readline())["errors"])' <"$work/validate_$1.log" 2>/dev/null || echo 999999
+}
+can_validate=0
+command -v node >/dev/null && [[ -d "$modules" ]] && can_validate=1
+
 fail=0
 echo "date,scene,variant,options,relative_rmse,mean_bias,input_mad,bake_mad"
 for variant in plain meshopt draco quantize; do
@@ -49,24 +57,35 @@ for variant in plain meshopt draco quantize; do
   "$irbake" bake "$in" -o "$work/bake_$variant" --quiet "$@" >"$work/bake_$variant.log" 2>&1 || { cat "$work/bake_$variant.log"; fail=1; continue; }
   shot "$in" "$work/input_$variant.png" --view albedo || { fail=1; continue; }
   shot "$work/bake_$variant/scene.gltf" "$work/bake_$variant.png" || { fail=1; continue; }
+  # What the export wrote back (the decoded document) validates as the plain input's export does (a
+  # third-party input may bring errors of its own, e.g. a mimeType 'image/JPG').
+  if [[ $can_validate == 1 ]]; then
+    errors=$(validate_export "$variant" "$in")
+    [[ $variant == plain ]] && plain_errors=$errors
+    if [[ $variant != plain ]] && ((errors > plain_errors)); then
+      echo "FAIL: $variant: the export has $errors validator errors, the plain one $plain_errors"; cat "$work/validate_$variant.log"; fail=1
+    fi
+  fi
   [[ $variant == plain ]] && continue
   if [[ $variant != quantize ]] && ! grep -q '"decodedExtensions"' "$work/bake_$variant/report.json"; then
     echo "FAIL: $variant: report.json does not list the decoded extension"; fail=1
   fi
-  # What the export wrote back (the decoded document) must validate like any export.
-  if command -v node >/dev/null && [[ -d "$modules" ]]; then
-    node "$validate" --modules "$modules" --output "$work/bake_$variant/scene.gltf" --input "$in" >"$work/validate_$variant.log" 2>&1 ||
-      { echo "FAIL: $variant: the export does not validate"; cat "$work/validate_$variant.log"; fail=1; }
-  fi
-  figures=$("$irbake" diff "$work/bake_$variant" "$work/bake_plain" --json 2>&1) || { echo "FAIL: $variant: $figures"; fail=1; continue; }
-  rmse=$(python3 -c 'import json,sys; print("%.5f" % json.loads(sys.stdin.read())["relativeRmse"])' <<<"$figures")
-  bias=$(python3 -c 'import json,sys; print("%.5f" % json.loads(sys.stdin.read())["relativeBias"])' <<<"$figures")
   input_mad=$(mad "$work/input_$variant.png" "$work/input_plain.png")
   bake_mad=$(mad "$work/bake_$variant.png" "$work/bake_plain.png")
+  # irbake diff compares texel by texel on one atlas. Quantised positions can change a large scene's
+  # chart sizes and so its atlas: with ATLAS_MAY_DIFFER=1 that is recorded (no figure) and the
+  # screenshots of the bakes compare the maps in scene space instead.
+  rmse="" bias=""
+  if figures=$("$irbake" diff "$work/bake_$variant" "$work/bake_plain" --json 2>&1); then
+    rmse=$(python3 -c 'import json,sys; print("%.5f" % json.loads(sys.stdin.read())["relativeRmse"])' <<<"$figures")
+    bias=$(python3 -c 'import json,sys; print("%.5f" % json.loads(sys.stdin.read())["relativeBias"])' <<<"$figures")
+  elif [[ "${ATLAS_MAY_DIFFER:-0}" != 1 || $figures != *"not the same atlas"* ]]; then
+    echo "FAIL: $variant: $figures"; fail=1; continue
+  fi
   row="$(date -u +%Y-%m-%d),$name,$variant,\"$*\",$rmse,$bias,$input_mad,$bake_mad"
   echo "$row"
   [[ -n "${CSV:-}" ]] && echo "$row" >>"$CSV"
-  if ! python3 -c "import sys; sys.exit(0 if $rmse <= $max_rmse and $input_mad <= $max_mad and $bake_mad <= $max_mad else 1)"; then
+  if ! python3 -c "import sys; sys.exit(0 if ('$rmse' == '' or $rmse <= $max_rmse) and $input_mad <= $max_mad and $bake_mad <= $max_mad else 1)"; then
     echo "FAIL: $variant: relative RMSE $rmse (at most $max_rmse), MAD $input_mad / $bake_mad of 255 (at most $max_mad)"; fail=1
   fi
 done
