@@ -438,7 +438,7 @@ def t_compressed_inputs():
     rows = latest(read("compressed_inputs.csv"), lambda r: (r["scene"], r["variant"]))
     out = []
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        cells = {r["variant"]: f"{pct(r['relative_rmse'])} · {num(r['input_mad'], 1)} / {num(r['bake_mad'], 1)}"
+        cells = {r["variant"]: f"{pct(r['relative_rmse']) or 'new atlas'}; {num(r['input_mad'], 1)}/{num(r['bake_mad'], 1)}"
                  for r in rows if r["scene"] == scene}
         out.append([scene] + [cells.get(v, "") for v in ("meshopt", "draco", "quantize")])
     return table(["scene", "meshopt", "draco", "quantize"], out)

@@ -6,7 +6,8 @@
 # ones within MAX_MAD of 255; each variant's export passes the Khronos validator (runtime/web/validate.mjs).
 # Prints one CSV row per variant; with CSV set, appends them there too (bench/results/compressed_inputs.csv).
 # MESHOPT: the glTF-Transform command of the meshopt variant (default "meshopt"; "optimize --simplify false"
-# is the README's whole optimiser). ATLAS_MAY_DIFFER=1: see below.
+# is the README's whole optimiser). VIEW: irview's view (default camera 0, else its overview).
+# ATLAS_MAY_DIFFER=1: see below.
 # Usage: compressed_inputs_test.sh IRBAKE IRVIEW GLTF_TRANSFORM WORKDIR [SCENE [NAME [BAKE_ARGS...]]]
 set -euo pipefail
 irbake=$1 irview=$2 gt=$3 work=$4
@@ -38,7 +39,8 @@ mad() { { idiff -abs "$1" "$2" 2>/dev/null || true; } | awk '/Mean error/ {m = $
 
 shot() {  # shot SCENE OUT.png [irview args]: headless screenshot from camera 0, or the overview
   local in=$1 out=$2; shift 2
-  "$irview" "$in" --width 256 --height 256 --screenshot "$out" "$@" >"$out.log" 2>&1 || { cat "$out.log"; return 1; }
+  # shellcheck disable=SC2086  # VIEW: irview's view options, e.g. "--eye X,Y,Z --target X,Y,Z"
+  "$irview" "$in" --width 256 --height 256 --screenshot "$out" ${VIEW:-} "$@" >"$out.log" 2>&1 || { cat "$out.log"; return 1; }
 }
 
 # validate VARIANT INPUT: the Khronos validator on the variant's export; prints its error count.
