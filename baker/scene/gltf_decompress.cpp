@@ -70,6 +70,23 @@ bool anyPrimitiveCompressed(const json& root) {
   return false;
 }
 
+// Members read before tinygltf has checked their types: a wrong type gives the fallback (and then a
+// refusal naming it), never a JSON exception.
+size_t sizeOr(const json& object, const char* key, size_t fallback) {
+  auto it = object.is_object() ? object.find(key) : object.end();
+  if (!object.is_object() || it == object.end() || !it->is_number() || !(it->get<double>() >= 0.0)) return fallback;
+  return it->is_number_unsigned() ? it->get<size_t>() : static_cast<size_t>(it->get<double>());
+}
+
+std::string stringOr(const json& object, const char* key) {
+  auto it = object.is_object() ? object.find(key) : object.end();
+  return object.is_object() && it != object.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+json memberOrNull(const json& object, const char* key) {
+  return object.is_object() && object.contains(key) ? object[key] : json();
+}
+
 size_t componentSize(int componentType) {
   switch (componentType) {
     case 5120: case 5121: return 1;
@@ -137,7 +154,7 @@ class Decompressor {
     for (size_t i = 0; i < buffers->size(); ++i) {
       const json& b = (*buffers)[i];
       std::vector<uint8_t> bytes;
-      const size_t length = b.value("byteLength", size_t(0));
+      const size_t length = sizeOr(b, "byteLength", 0);
       if (b.contains("uri")) {
         const std::string uri = b["uri"].get<std::string>();
         if (uri.rfind("data:", 0) == 0) {
@@ -169,7 +186,7 @@ class Decompressor {
     if (views == root_.end()) return;
     for (size_t i = 0; i < views->size(); ++i) {
       json& v = (*views)[i];
-      const size_t offset = v.value("byteOffset", size_t(0)), length = v.value("byteLength", size_t(0));
+      const size_t offset = sizeOr(v, "byteOffset", 0), length = sizeOr(v, "byteLength", 0);
       const size_t buffer = v["buffer"].get<size_t>();
       std::vector<uint8_t> decoded;
       const uint8_t* data = nullptr;
@@ -289,7 +306,7 @@ class Decompressor {
     const size_t viewIndex = ext["bufferView"].get<size_t>();
     const json& view = root_["bufferViews"][viewIndex];
     draco::DecoderBuffer stream;
-    stream.Init(reinterpret_cast<const char*>(bin_.data() + view["byteOffset"].get<size_t>()), view.value("byteLength", size_t(0)));
+    stream.Init(reinterpret_cast<const char*>(bin_.data() + sizeOr(view, "byteOffset", 0)), sizeOr(view, "byteLength", 0));
     draco::Decoder decoder;
     auto decoded = decoder.DecodeMeshFromBuffer(&stream);
     if (!decoded.ok())
@@ -319,11 +336,12 @@ class Decompressor {
 
   void writeDracoAttribute(const std::string& where, size_t index, const draco::PointAttribute& source, uint32_t points) {
     const json& a = accessor(where, json(index));
-    const int type = a.value("componentType", 0), n = componentCount(a.value("type", std::string()));
+    const int type = static_cast<int>(sizeOr(a, "componentType", 0)), n = componentCount(stringOr(a, "type"));
     const size_t element = componentSize(type) * n, stride = (element + 3) / 4 * 4;
-    if (element == 0) fail(where + "componentType " + a.value("componentType", json()).dump() + " / type " + a.value("type", json()).dump() + " is not readable");
-    if (a.value("count", json()) != points)
-      fail(where + "count " + a.value("count", json()).dump() + ", but the Draco stream decodes " + std::to_string(points) + " points");
+    if (element == 0)
+      fail(where + "componentType " + memberOrNull(a, "componentType").dump() + " / type " + memberOrNull(a, "type").dump() + " is not readable");
+    if (memberOrNull(a, "count") != points)
+      fail(where + "count " + memberOrNull(a, "count").dump() + ", but the Draco stream decodes " + std::to_string(points) + " points");
     std::vector<uint8_t> bytes(stride * points, 0);
     for (uint32_t i = 0; i < points; ++i)
       if (!convertDracoValue(source, source.mapped_index(draco::PointIndex(i)), type, n, bytes.data() + stride * i))
@@ -340,12 +358,12 @@ class Decompressor {
     const size_t index = prim["indices"].is_number_unsigned() ? prim["indices"].get<size_t>() : size_t(-1);
     const std::string where = what + "accessor " + prim["indices"].dump() + " (indices): ";
     const json& a = accessor(where, prim["indices"]);
-    const int type = a.value("componentType", 0);
+    const int type = static_cast<int>(sizeOr(a, "componentType", 0));
     const size_t size = componentSize(type);
-    if (a.value("type", std::string()) != "SCALAR" || (type != 5121 && type != 5123 && type != 5125))
+    if (stringOr(a, "type") != "SCALAR" || (type != 5121 && type != 5123 && type != 5125))
       fail(where + "indices must be unsigned SCALAR");
-    if (a.value("count", json()) != count)
-      fail(where + "count " + a.value("count", json()).dump() + ", but the Draco stream decodes " + std::to_string(count) + " indices");
+    if (memberOrNull(a, "count") != count)
+      fail(where + "count " + memberOrNull(a, "count").dump() + ", but the Draco stream decodes " + std::to_string(count) + " indices");
     const uint64_t limit = size == 4 ? 0xFFFFFFFFull : (uint64_t(1) << (8 * size)) - 1;
     std::vector<uint8_t> bytes(count * size);
     for (uint32_t f = 0; f < mesh.num_faces(); ++f)
