@@ -1,6 +1,7 @@
 // glTF → Scene. Two passes: readGltfSource() checks the container, JSON, URIs and buffers before
-// tinygltf reads anything, and decompressGltf() decodes meshopt and Draco data into a plain document; tinygltf then parses the document (images kept as encoded bytes), and
-// this file flattens nodes to world space while validating accessors, indices and values.
+// tinygltf reads anything, and decompressGltf() decodes meshopt and Draco data into a plain document;
+// tinygltf then parses the document (images kept as encoded bytes), and this file flattens nodes to
+// world space while validating accessors, indices and values.
 #include "scene/gltf_loader.h"
 #include "common/maths.h"
 
