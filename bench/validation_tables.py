@@ -432,6 +432,18 @@ def t_gallery_walk():
     return table(["walk", "seeds", "mean ratio, ours/converged", "rel. RMSE 4×4, median", "worst seed"], out)
 
 
+def t_compressed_inputs():
+    """Per scene, each glTF-Transform variant's bake against the plain input's (tests/compressed): irbake diff's
+    relative RMSE, then irview's MAD (of 255) on the input's albedo view / on the bake."""
+    rows = latest(read("compressed_inputs.csv"), lambda r: (r["scene"], r["variant"]))
+    out = []
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        cells = {r["variant"]: f"{pct(r['relative_rmse']) or 'new atlas'}; {num(r['input_mad'], 1)}/{num(r['bake_mad'], 1)}"
+                 for r in rows if r["scene"] == scene}
+        out.append([scene] + [cells.get(v, "") for v in ("meshopt", "draco", "quantize")])
+    return table(["scene", "meshopt", "draco", "quantize"], out)
+
+
 # The Cycles comparison behind each timed preset case: (scene, options) of quality_presets.csv -> the compare.py
 # CSV, its mode (map: page 0; view: every view, summarised by their mean) and the options compare.py gave
 # besides --quality (the same scene as the timed one, its light in the file or on the command line).

@@ -17,6 +17,10 @@ pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # checksums of par
 # OpenMesh's CMake package has no version file: find it without a version and use OpenMeshCore.
 find_package(OpenMesh REQUIRED)
 
+# Decoders of compressed glTF geometry (KHR_draco_mesh_compression, EXT_meshopt_compression).
+find_package(draco CONFIG REQUIRED)
+find_package(meshoptimizer CONFIG REQUIRED)
+
 # OpenImageIO's imported target may list an OpenCV include dir that does not exist on this machine:
 # drop include dirs that are missing so CMake does not refuse the target.
 find_package(OpenImageIO REQUIRED)

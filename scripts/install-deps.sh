@@ -11,6 +11,7 @@ packages=(
   libopenimageio-dev openimageio-tools   # OIIO: image decode and EXR output (its CMake config needs the tools)
   libglm-dev               # GLM: vector maths
   libtinygltf-dev          # tinygltf: glTF 2.0 parsing and writing
+  libdraco-dev libmeshoptimizer-dev   # decoders of Draco- and meshopt-compressed glTF geometry
   libeigen3-dev            # Eigen: sparse solves for LSCM
   libtbb-dev               # TBB: parallel loops
   libepoxy-dev libegl-dev libgl1-mesa-dri libegl-mesa0   # GL entry points + headless EGL (Mesa llvmpipe)

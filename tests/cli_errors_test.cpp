@@ -216,8 +216,14 @@ TEST(CliErrors, NegativeLightColourAndUnsupportedRequiredExtension) {
     doc.root["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {-1, -1, -1};
   });
   expectError(colour, ErrorCode::InvalidData, "light 0 has a negative or non-finite colour (-1, -1, -1)");
-  auto required = validScene("required_draco", [](GltfDocument& doc) { doc.root["extensionsRequired"] = {"KHR_draco_mesh_compression"}; });
-  expectError(required, ErrorCode::InvalidData, "requires extension KHR_draco_mesh_compression");
+  auto required = validScene("required_unknown", [](GltfDocument& doc) { doc.root["extensionsRequired"] = {"EXT_unknown_vendor_geometry"}; });
+  expectError(required, ErrorCode::InvalidData, "requires extension EXT_unknown_vendor_geometry");
+  // A supported extension whose data is broken: refused naming the extension and the primitive.
+  auto draco = validScene("broken_draco", [](GltfDocument& doc) {
+    doc.root["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    doc.root["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"] = {{"bufferView", 99}, {"attributes", {{"POSITION", 0}}}};
+  });
+  expectError(draco, ErrorCode::InvalidData, "KHR_draco_mesh_compression: mesh 0 primitive 0: bufferView 99 is missing or out of range");
 }
 
 // 200,000 nested arrays in extras overflowed tinygltf's recursive parser (SIGSEGV). The depth scan

@@ -32,6 +32,7 @@
 #include "export/light_probes_export.h"
 #include "export/map_encoding.h"
 #include "export/gltf_writer.h"
+#include "scene/gltf_decompress.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
 #include "scene/moz_lightmap_units.h"
@@ -56,28 +57,6 @@ std::vector<uint8_t> readWholeFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};
   return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::vector<uint8_t> decodeDataUri(const std::string& uri) {
-  size_t comma = uri.find(',');
-  if (comma == std::string::npos || uri.find(";base64") == std::string::npos) return {};
-  // Plain RFC 4648 base64 (the only data URI encoding glTF allows).
-  std::vector<uint8_t> out;
-  uint32_t acc = 0;
-  int bits = 0;
-  for (size_t i = comma + 1; i < uri.size(); ++i) {
-    char c = uri[i];
-    int v = c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52
-          : c == '+' ? 62 : c == '/' ? 63 : -1;
-    if (v < 0) continue;  // padding and whitespace
-    acc = (acc << 6) | static_cast<uint32_t>(v);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xFF));
-    }
-  }
-  return out;
 }
 
 // Bytes behind a buffer or image URI of the source (data URI or file beside it; URIs were checked).
@@ -109,7 +88,7 @@ bool readFileInto(const std::filesystem::path& path, std::vector<uint8_t>& bin, 
 
 // (gltf_export.h) Reserved pages it does not use are never touched, so cost no memory.
 GltfDocument documentFromSource(const std::filesystem::path& sourcePath, size_t extraBytes) {
-  GltfSource src = readGltfSource(sourcePath);
+  GltfSource src = decompressGltf(readGltfSource(sourcePath));
   json root = std::move(src.json);
   std::vector<uint8_t> bin;
   std::vector<size_t> offsets;

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "scene/gltf_decompress.h"
+
 namespace irbake {
 
 void describeBake(const BakeFacts& f, nlohmann::json& report) {
@@ -32,6 +34,8 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
     report["scene"]["gpuInstancing"] = {{"nodes", f.scene.stats.gpuInstancedNodes},
                                         {"instances", f.scene.stats.gpuInstances},
                                         {"export", "EXT_mesh_gpu_instancing dropped: each instance written as a node of its own, with its own light-map region"}};
+  const std::vector<std::string> decoded = decodedExtensionsOf(f.scene);
+  if (!decoded.empty()) report["scene"]["decodedExtensions"] = decoded;
   report["atlas"] = f.atlas.toJson();
   report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
                       {"supersample", std::max(1, f.options.texels.supersample)},

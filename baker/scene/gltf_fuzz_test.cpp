@@ -8,6 +8,7 @@
 #include "common/error.h"
 #include "scene/gltf_loader.h"
 #include "scene/image_codec.h"
+#include "testing/compressed_gltf.h"
 #include "testing/gltf_builder.h"
 
 using namespace irbake;
@@ -71,6 +72,33 @@ TEST(GltfFuzz, RandomByteCorruptionOfGlbNeverCrashes) {
   }
   // Most single-byte hits land in vertex data and still load; a fair share must be caught.
   EXPECT_GT(errors, cases / 20);
+}
+
+// The meshopt and Draco files: corrupted streams and JSON reach the decoders, which refuse or decode them.
+TEST(GltfFuzz, RandomByteCorruptionOfCompressedGlbNeverCrashes) {
+  const std::vector<glm::vec3> grid = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+  const std::vector<uint32_t> indices = {0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4};
+  auto dir = irbake::testing::testFolder("fuzz_compressed");
+  std::mt19937 rng(4321);
+  for (const auto& [name, parts] : {std::pair{"meshopt", irbake::testing::meshoptParts(grid, indices)},
+                                    std::pair{"draco", irbake::testing::dracoParts(grid, indices)}}) {
+    const std::vector<uint8_t> good = irbake::testing::glbBytes(parts);
+    std::ofstream(dir / "good.glb", std::ios::binary).write(reinterpret_cast<const char*>(good.data()), static_cast<std::streamsize>(good.size()));
+    ASSERT_EQ(loadOrError(dir / "good.glb", name), 0);
+    int errors = 0;
+    const int cases = 200;
+    for (int c = 0; c < cases; ++c) {
+      std::vector<uint8_t> bad = good;
+      // Half the hits in the BIN chunk (the compressed streams), half anywhere.
+      const size_t bin = good.size() - parts.bin.size();
+      for (int k = 0, flips = 1 + static_cast<int>(rng() % 4); k < flips; ++k)
+        bad[k % 2 ? rng() % bad.size() : bin + rng() % parts.bin.size()] = static_cast<uint8_t>(rng() & 0xFF);
+      const std::filesystem::path file = dir / (std::string(name) + std::to_string(c) + ".glb");
+      std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(bad.data()), static_cast<std::streamsize>(bad.size()));
+      errors += loadOrError(file, std::string(name) + " case " + std::to_string(c)) == 1;
+    }
+    EXPECT_GT(errors, cases / 20) << name;
+  }
 }
 
 TEST(GltfFuzz, JsonValueReplacementNeverCrashes) {

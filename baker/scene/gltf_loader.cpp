@@ -1,6 +1,7 @@
 // glTF → Scene. Two passes: readGltfSource() checks the container, JSON, URIs and buffers before
-// tinygltf reads anything; tinygltf then parses the document (images kept as encoded bytes), and
-// this file flattens nodes to world space while validating accessors, indices and values.
+// tinygltf reads anything, and decompressGltf() decodes meshopt and Draco data into a plain document;
+// tinygltf then parses the document (images kept as encoded bytes), and this file flattens nodes to
+// world space while validating accessors, indices and values.
 #include "scene/gltf_loader.h"
 #include "common/maths.h"
 
@@ -21,6 +22,7 @@
 
 #include "common/error.h"
 #include "common/log.h"
+#include "scene/gltf_decompress.h"
 #include "scene/gltf_source.h"
 #include "scene/ies_lights_gltf.h"
 #include "scene/image_codec.h"
@@ -218,11 +220,12 @@ struct LocalPrimitive {
 class Loader {
  public:
   Loader(GltfSource source, const LoadOptions& options)
-      : src_(std::move(source)), options_(options), file_(src_.path.string()) {}
+      : src_(decompressGltf(std::move(source))), options_(options), file_(src_.path.string()) {}
 
   Scene load() {
     parseWithTinygltf();
     scene_.sourcePath = file_;
+    for (const std::string& e : src_.decodedExtensions) warn(decodedExtensionWarning(e));
     checkRequiredExtensions();
     materialMap_.assign(model_.materials.size(), -1);
     // Scene material i is glTF material i (the default material, when needed, comes after them).

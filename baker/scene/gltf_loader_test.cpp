@@ -1,5 +1,6 @@
 // Loader tests on hand-made glTF files: transforms, winding, primitive modes, normals, materials,
-// textures, lights, cameras, extensions, and the DamagedHelmet counts (skipped without ../shared).
+// textures, lights, cameras, extensions (compressed geometry too), and the DamagedHelmet counts (skipped without ../shared).
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -11,9 +12,11 @@
 #include "export/exr_io.h"
 #include "lights/light_kind.h"
 #include "scene/environment.h"
+#include "scene/gltf_decompress.h"
 #include "scene/gltf_loader.h"
 #include "imageio/image_io.h"
 #include "scene/image_codec.h"
+#include "testing/compressed_gltf.h"
 #include "testing/gltf_builder.h"
 
 using namespace irbake;
@@ -626,7 +629,7 @@ TEST(GltfLoader, UnsupportedRequiredExtensionIsRefused) {
   doc.root["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
   doc.root["extensionsRequired"] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
   EXPECT_EQ(loadDocument(doc, "loader_required_ok").lights.size(), 1u);
-  for (const char* name : {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}) {
+  for (const char* name : {"EXT_unknown_vendor_geometry", "KHR_texture_basisu"}) {
     doc.root["extensionsRequired"] = {"KHR_lights_punctual", name};
     expectRefused(doc, std::string("loader_required_") + name, {std::string("requires extension ") + name, "extensionsRequired"});
   }
@@ -762,6 +765,51 @@ GltfDocument instancedDocument() {
   return doc;
 }
 
+// Two triangles of a unit square in z = 0, CCW seen from +Z.
+const std::vector<glm::vec3> kSquare = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+const std::vector<uint32_t> kSquareIndices = {0, 1, 2, 0, 2, 3};
+
+std::filesystem::path writeGlb(const irbake::testing::GlbParts& parts, const std::string& folder) {
+  const auto file = testFolder(folder) / (folder + ".glb");
+  const std::vector<uint8_t> bytes = irbake::testing::glbBytes(parts);
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return file;
+}
+
+void expectGlbRefused(const irbake::testing::GlbParts& parts, const std::string& folder, const std::vector<std::string>& parts_) {
+  const auto file = writeGlb(parts, folder);
+  try {
+    loadScene(file);
+    ADD_FAILURE() << folder << ": loaded, expected a refusal";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidData) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+    for (const auto& p : parts_) EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+  }
+}
+
+// The square's two triangles: area 1 in total, every normal +Z, every corner one of the square's.
+void expectSquare(const Scene& scene) {
+  ASSERT_EQ(scene.primitives.size(), 1u);
+  const Primitive& p = scene.primitives[0];
+  ASSERT_EQ(p.indices.size(), 6u);
+  double area = 0.0;
+  for (size_t t = 0; t < 2; ++t) {
+    const glm::vec3 &a = p.positions[p.indices[3 * t]], &b = p.positions[p.indices[3 * t + 1]], &c = p.positions[p.indices[3 * t + 2]];
+    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    expectNear(faceNormal(p, t), {0, 0, 1});
+  }
+  EXPECT_NEAR(area, 1.0, 1e-6);
+  for (const glm::vec3& v : p.positions)
+    EXPECT_TRUE(std::any_of(kSquare.begin(), kSquare.end(), [&](const glm::vec3& s) { return glm::length(s - v) < 1e-6f; }));
+}
+
+bool warned(const Scene& scene, const std::string& part) {
+  return std::any_of(scene.stats.warnings.begin(), scene.stats.warnings.end(),
+                     [&](const std::string& w) { return w.find(part) != std::string::npos; });
+}
+
 }  // namespace
 
 // KHR_texture_transform, closed form on a 2-texel image (texel centres at u = 1/4 and 3/4): UV (1/8, 1/2)
@@ -888,4 +936,56 @@ TEST(GltfLoader, WebpTexturesAreDecodedWithTheirFallback) {
   // The fallback PNG holds byte 128, read as sRGB colour.
   EXPECT_NEAR(f.baseColorAt(f.primitives[0], 0, glm::vec2(0.3f)).g, srgbToLinear(128 / 255.0f), 1e-4f);
   expectRefused(document(broken, false), "loader_webp_refused", {"EXT_texture_webp", "image 0", "red"});
+}
+
+TEST(GltfLoader, MeshoptCompressedViewsAreDecodedAndTheFallbackBufferNeedsNoData) {
+  const Scene scene = loadScene(writeGlb(irbake::testing::meshoptParts(kSquare, kSquareIndices), "meshopt_square"));
+  expectSquare(scene);
+  EXPECT_TRUE(warned(scene, "input used EXT_meshopt_compression"));
+  EXPECT_EQ(decodedExtensionsOf(scene), std::vector<std::string>{"EXT_meshopt_compression"});
+}
+
+TEST(GltfLoader, DracoPrimitivesAreDecodedIntoTheirAccessors) {
+  const Scene scene = loadScene(writeGlb(irbake::testing::dracoParts(kSquare, kSquareIndices), "draco_square"));
+  expectSquare(scene);
+  EXPECT_EQ(decodedExtensionsOf(scene), std::vector<std::string>{"KHR_draco_mesh_compression"});
+}
+
+TEST(GltfLoader, BrokenMeshoptViewsAreRefusedNamingTheExtensionAndView) {
+  using irbake::testing::meshoptParts;
+  auto parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["bufferViews"][1]["extensions"]["EXT_meshopt_compression"]["mode"] = "QUADS";
+  expectGlbRefused(parts, "meshopt_bad_mode", {"EXT_meshopt_compression", "buffer view 1", "mode QUADS"});
+  parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["bufferViews"][1]["extensions"]["EXT_meshopt_compression"]["byteStride"] = 6;
+  expectGlbRefused(parts, "meshopt_bad_stride", {"EXT_meshopt_compression", "buffer view 1", "byteStride 6"});
+  parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["count"] = 5;
+  expectGlbRefused(parts, "meshopt_bad_count", {"EXT_meshopt_compression", "buffer view 0", "count 5"});
+  parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["bufferViews"][1]["extensions"]["EXT_meshopt_compression"]["filter"] = "OCTAHEDRAL";
+  expectGlbRefused(parts, "meshopt_bad_filter", {"EXT_meshopt_compression", "buffer view 1", "filter OCTAHEDRAL"});
+  parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["bufferViews"][1]["extensions"]["EXT_meshopt_compression"]["byteLength"] = 8;  // cut short
+  expectGlbRefused(parts, "meshopt_truncated", {"EXT_meshopt_compression", "buffer view 1", "does not decode"});
+  parts = meshoptParts(kSquare, kSquareIndices);
+  parts.json["accessors"][0]["bufferView"] = 2;
+  parts.json["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 4}});  // plain view into the fallback
+  expectGlbRefused(parts, "meshopt_plain_view_of_fallback", {"EXT_meshopt_compression", "buffer view 2", "fallback buffer"});
+}
+
+TEST(GltfLoader, BrokenDracoPrimitivesAreRefusedNamingTheExtensionAndAccessor) {
+  using irbake::testing::dracoParts;
+  auto parts = dracoParts(kSquare, kSquareIndices);
+  std::fill(parts.bin.begin(), parts.bin.end(), uint8_t(0x5A));
+  expectGlbRefused(parts, "draco_bad_stream", {"KHR_draco_mesh_compression", "mesh 0 primitive 0", "does not decode"});
+  parts = dracoParts(kSquare, kSquareIndices);
+  parts.json["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["POSITION"] = 7;
+  expectGlbRefused(parts, "draco_missing_id", {"KHR_draco_mesh_compression", "accessor 1 (POSITION)", "id 7 is not in the stream"});
+  parts = dracoParts(kSquare, kSquareIndices);
+  parts.json["accessors"][1]["count"] = 99;
+  expectGlbRefused(parts, "draco_bad_count", {"KHR_draco_mesh_compression", "accessor 1 (POSITION)", "count 99"});
+  parts = dracoParts(kSquare, kSquareIndices);
+  parts.json["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["NORMAL"] = 1;
+  expectGlbRefused(parts, "draco_unmapped_attribute", {"KHR_draco_mesh_compression", "attribute NORMAL"});
 }

@@ -95,6 +95,8 @@ void checkBuffers(const GltfSource& s) {
     } else if (s.binary && i == 0) {
       actual = s.binSize;
       where = "GLB BIN chunk";
+    } else if (isMeshoptPlaceholder(j, i)) {
+      continue;  // no data: what reads it is decoded from elsewhere (scene/gltf_decompress.h)
     } else {
       fail(ErrorCode::InvalidData, s, "missing buffer: " + what + " has no uri and no GLB BIN chunk");
     }
@@ -175,6 +177,50 @@ void splitGlb(GltfSource& s) {
 }
 
 }  // namespace
+
+std::vector<uint8_t> decodeDataUri(const std::string& uri) {
+  size_t comma = uri.find(',');
+  if (comma == std::string::npos || uri.find(";base64") == std::string::npos) return {};
+  // Plain RFC 4648 base64 (the only data URI encoding glTF allows).
+  std::vector<uint8_t> out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (size_t i = comma + 1; i < uri.size(); ++i) {
+    char c = uri[i];
+    int v = c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52
+          : c == '+' ? 62 : c == '/' ? 63 : -1;
+    if (v < 0) continue;  // padding and whitespace
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xFF));
+    }
+  }
+  return out;
+}
+
+bool isMeshoptPlaceholder(const nlohmann::json& j, size_t index) {
+  const auto meshopt = [](const nlohmann::json& object) -> const nlohmann::json* {
+    if (!object.is_object() || !object.contains("extensions") || !object["extensions"].is_object()) return nullptr;
+    const auto& e = object["extensions"];
+    return e.contains("EXT_meshopt_compression") ? &e["EXT_meshopt_compression"] : nullptr;
+  };
+  if (!j.contains("buffers") || !j["buffers"].is_array() || index >= j["buffers"].size()) return false;
+  const auto& buffer = j["buffers"][index];
+  if (!buffer.is_object() || buffer.contains("uri")) return false;
+  const nlohmann::json* tag = meshopt(buffer);
+  if (tag && tag->is_object() && tag->contains("fallback") && (*tag)["fallback"] == true) return true;
+  // Untagged: a placeholder only when every view that reads it carries its own compressed data.
+  if (!j.contains("bufferViews") || !j["bufferViews"].is_array()) return false;
+  bool read = false;
+  for (const auto& v : j["bufferViews"]) {
+    if (!v.is_object() || !v.contains("buffer") || v["buffer"] != index) continue;
+    if (!meshopt(v)) return false;
+    read = true;
+  }
+  return read;
+}
 
 std::string decodeUriEscapes(const std::string& uri) {
   std::string out;

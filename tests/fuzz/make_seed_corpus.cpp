@@ -1,10 +1,11 @@
 // make_seed_corpus IN_FOLDER OUT_FOLDER: packs every IN_FOLDER/*.gltf (irbake samples output: JSON +
 // .bin + images beside it) into two self-contained seeds the fuzzer can mutate as one input each:
 // NAME.glb (buffer 0 in the BIN chunk, other files as data URIs) and NAME.gltf (every file as a
-// base64 data URI). Our own scenes only: no third-party file enters the corpus. Each scene also gives
-// .gltf variants with the inputs the samples do not use: EXT_mesh_gpu_instancing on every node with a
-// mesh, KHR_texture_transform on every texture reference and EXT_texture_webp (a 2×2 WebP made with
-// OpenImageIO's writer, the core source kept as its fallback) on every texture.
+// base64 data URI). Also a small EXT_meshopt_compression and a small KHR_draco_mesh_compression GLB, made
+// by our own code (testing/compressed_gltf.h). Our own scenes only: no third-party file enters the corpus.
+// Each scene also gives .gltf variants with the inputs the samples do not use: EXT_mesh_gpu_instancing on
+// every node with a mesh, KHR_texture_transform on every texture reference and EXT_texture_webp (a 2×2 WebP
+// made with OpenImageIO's writer, the core source kept as its fallback) on every texture.
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -16,6 +17,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "testing/compressed_gltf.h"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -213,6 +216,14 @@ int main(int argc, char** argv) {
         writeFile(out / (name + suffix + ".gltf"), variant.dump());
         ++seeds;
       }
+    }
+    const std::vector<glm::vec3> square = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
+    for (const auto& [name, parts] : {std::pair{"meshopt_square.glb", irbake::testing::meshoptParts(square, indices)},
+                                      std::pair{"draco_square.glb", irbake::testing::dracoParts(square, indices)}}) {
+      const std::vector<uint8_t> bytes = irbake::testing::glbBytes(parts);
+      writeFile(out / name, std::string(bytes.begin(), bytes.end()));
+      ++seeds;
     }
     std::cout << "make_seed_corpus: " << seeds << " seeds in " << out.string() << "\n";
     return seeds > 0 ? 0 : 1;
