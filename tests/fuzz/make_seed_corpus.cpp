@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -81,6 +82,22 @@ std::string glb(json doc, const fs::path& folder) {
   return out;
 }
 
+// The document with every material written as KHR_materials_pbrSpecularGlossiness (its base colour as the
+// diffuse factor, no metal-rough fallback), as older exporters write them.
+json specularGlossiness(json doc) {
+  if (!doc.contains("materials")) return doc;
+  for (json& m : doc["materials"]) {
+    json pbr = m.value("pbrMetallicRoughness", json::object());
+    json sg = {{"diffuseFactor", pbr.value("baseColorFactor", json::array({1.0, 1.0, 1.0, 1.0}))},
+               {"specularFactor", {0.04, 0.04, 0.04}}, {"glossinessFactor", 0.2}};
+    if (pbr.contains("baseColorTexture")) sg["diffuseTexture"] = pbr["baseColorTexture"];
+    m.erase("pbrMetallicRoughness");
+    m["extensions"]["KHR_materials_pbrSpecularGlossiness"] = std::move(sg);
+  }
+  doc["extensionsUsed"].push_back("KHR_materials_pbrSpecularGlossiness");
+  return doc;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,11 +114,15 @@ int main(int argc, char** argv) {
       std::ifstream f(entry.path());
       json doc = json::parse(f);
       std::string name = entry.path().stem().string();
-      writeFile(out / (name + ".glb"), glb(doc, in));
-      embed(doc, "buffers", in, -1);
-      embed(doc, "images", in, -1);
-      writeFile(out / (name + ".gltf"), doc.dump());
-      seeds += 2;
+      std::vector<std::pair<std::string, json>> variants = {{name, doc}};
+      if (name == "cornell_box") variants.emplace_back(name + "_spec_gloss", specularGlossiness(doc));
+      for (auto& [variant, d] : variants) {
+        writeFile(out / (variant + ".glb"), glb(d, in));
+        embed(d, "buffers", in, -1);
+        embed(d, "images", in, -1);
+        writeFile(out / (variant + ".gltf"), d.dump());
+        seeds += 2;
+      }
     }
     std::cout << "make_seed_corpus: " << seeds << " seeds in " << out.string() << "\n";
     return seeds > 0 ? 0 : 1;
