@@ -561,8 +561,9 @@ TEST(GltfExport, SpecularGlossinessMaterialsBecomeMetalRough) {
   EXPECT_EQ(matte["extensions"]["KHR_materials_specular"]["specularColorFactor"], json::array({1.0, 1.0, 1.0}));
   EXPECT_NO_THROW(loadScene(o.output));
 
-  // A malformed factor is refused naming the material and the field, before anything is written.
-  doc.root["materials"][1]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["diffuseFactor"] = {0.5, 0.5, 0.5};
+  // A malformed factor (one the loader does not read) is refused naming the material and the field, before anything
+  // is written.
+  doc.root["materials"][1]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["specularFactor"] = {0.5, 0.5};
   irbake::testing::writeDocument(doc, dir / "in" / "bad.gltf");
   Scene bad = loadScene(dir / "in" / "bad.gltf");
   for (auto& p : bad.primitives) {
@@ -572,9 +573,9 @@ TEST(GltfExport, SpecularGlossinessMaterialsBecomeMetalRough) {
   o.output = dir / "bad_out" / "baked.gltf";
   try {
     exportGltf(bad, maps, o);
-    ADD_FAILURE() << "a 3-number diffuseFactor was exported";
+    ADD_FAILURE() << "a 2-number specularFactor was exported";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("material 1 ('matte'): KHR_materials_pbrSpecularGlossiness.diffuseFactor must be 4 numbers"),
+    EXPECT_NE(std::string(e.what()).find("material 1 ('matte'): KHR_materials_pbrSpecularGlossiness.specularFactor must be 3 numbers"),
               std::string::npos) << e.what();
   }
   EXPECT_FALSE(std::filesystem::exists(o.output));
