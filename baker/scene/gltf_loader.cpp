@@ -914,7 +914,8 @@ class Loader {
       m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
       m.transmission = static_cast<float>(
           std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
-      if (const json* sg = path(*mj, {"extensions", "KHR_materials_pbrSpecularGlossiness"})) readDiffuse(index, g.name, *sg, m);
+      const json* sg = path(*mj, {"extensions", "KHR_materials_pbrSpecularGlossiness"});
+      if (sg && !child(*mj, "pbrMetallicRoughness")) readDiffuse(index, g.name, *sg, m);
       if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) readMozLightmap(index, g.name, *moz, m);
       if (options_.shadingMaps) readShadingMaps(g, *mj, m);
     }
@@ -937,9 +938,10 @@ class Loader {
   // MOZ_lightmap (docs/export.md). A light map is never dropped silently: a missing texture and an intensity
   // that is not a number ≥ 0 are refused here; the texCoord is recorded (irview refuses any but 1); the
   // intensity is read in the specification's units, or an older irbake's (scene/moz_lightmap_units.h).
-  // KHR_materials_pbrSpecularGlossiness: its diffuse colour is the surface's albedo (in place of the
-  // metal-rough fallback's base colour, as the extension asks of a client that reads it); the export converts
-  // the material to metal-rough with that colour as its base colour (export/spec_gloss_conversion.h).
+  // KHR_materials_pbrSpecularGlossiness without a metal-rough fallback: its diffuse colour is the surface's
+  // albedo; the export converts the material to metal-rough with that colour as its base colour
+  // (export/spec_gloss_conversion.h). A material with a fallback is read from the fallback, as before: exporters
+  // write the two alike, but some put the opacity in the fallback only (Sibenik's glass).
   void readDiffuse(int index, const std::string& gltfName, const json& sg, Material& m) {
     const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')") +
                              ": KHR_materials_pbrSpecularGlossiness";
