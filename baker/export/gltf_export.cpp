@@ -6,7 +6,8 @@
 //    TEXCOORD_1 added, one glTF primitive per light-map page). A mesh used by several nodes keeps its
 //    index for the first node; every further node gets a copy of the mesh with its own light-map
 //    region; each EXT_mesh_gpu_instancing instance becomes a child node of its own the same way (the
-//    extension cannot carry a light map per instance). Materials get MOZ_lightmap in place (a copy per further page). Whatever nothing references
+//    extension cannot carry a light map per instance). Materials get MOZ_lightmap in place (a copy per further
+//    page); specular-glossiness materials become metal-rough (spec_gloss_conversion.h). Whatever nothing references
 //    any more (the replaced accessors, their views) is dropped and buffer 0 rebuilt (gltf_compact.h).
 //  - a generated scene: written by our writer from a copy whose materials carry the light maps.
 // A .glb embeds every image; a .gltf gets its .bin and the images as files beside it. Every file is
@@ -31,6 +32,7 @@
 #include "export/directional_export.h"
 #include "export/light_probes_export.h"
 #include "export/map_encoding.h"
+#include "export/spec_gloss_conversion.h"
 #include "export/gltf_writer.h"
 #include "scene/gltf_decompress.h"
 #include "scene/gltf_source.h"
@@ -241,6 +243,7 @@ class SourceExport {
     finishGpuInstancing();
     if (!images_.empty()) doc_.useExtension("MOZ_lightmap");
     repairEmissiveFactors();
+    convertSpecularGlossiness(doc_, file_);  // before compaction: a replaced fallback texture may go unused
     compactDocument(doc_);
     const std::string generator = doc_.root["asset"].value("generator", std::string("unknown"));
     if (generator.rfind("irbake", 0) != 0) doc_.root["asset"]["generator"] = "irbake (from " + generator + ")";

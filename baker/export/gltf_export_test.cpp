@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -75,6 +76,10 @@ std::vector<std::string> filesIn(const std::filesystem::path& dir) {
 }
 
 json readJson(const std::filesystem::path& p) { return json::parse(std::ifstream(p)); }
+std::vector<uint8_t> readWholeFileForTest(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
 
 }  // namespace
 
@@ -476,6 +481,104 @@ TEST(GltfExport, LightMappedMaterialsDropTheirOcclusionTexture) {
   // Only the light-map texture is left.
   ASSERT_EQ(j["textures"].size(), 1u);
   EXPECT_EQ(j["materials"][0]["extensions"]["MOZ_lightmap"]["index"], 0);
+}
+
+// KHR_materials_pbrSpecularGlossiness becomes metal-rough as glTF-Transform's metalRough converts it
+// (spec_gloss_conversion.h): diffuse → base colour, glossiness → roughness (a new texture: G = 1 − alpha ×
+// glossiness), specular → KHR_materials_specular with KHR_materials_ior 1000; the extension leaves the lists.
+TEST(GltfExport, SpecularGlossinessMaterialsBecomeMetalRough) {
+  auto dir = irbake::testing::testFolder("export_spec_gloss");
+  std::filesystem::create_directories(dir / "in");
+  GltfDocument doc = instancedSource();
+  doc.root["extensions"].erase("EXT_vendor_root");
+  auto& used = doc.root["extensionsUsed"];
+  used.erase(std::remove(used.begin(), used.end(), "EXT_vendor_root"), used.end());
+  std::map<std::string, std::vector<uint8_t>> png;
+  auto image = [&](std::vector<glm::vec4> texels, const std::string& name) {
+    Texture t;
+    t.width = static_cast<int>(texels.size());
+    t.height = 1;
+    t.texels = std::move(texels);
+    png[name] = encodePng(t, false);
+    return doc.addTexture(doc.addImage(png[name], name), -1);
+  };
+  const int diffuse = image({glm::vec4(0.8f, 0.6f, 0.4f, 1.0f)}, "diffuse");
+  // Alpha codes 255 and 102: roughness codes 255 − round(255 × 0.5) = 127 and 255 − round(102 × 0.5) = 204.
+  const int specGloss = image({glm::vec4(0.2f, 0.3f, 0.4f, 1.0f), glm::vec4(0.5f, 0.5f, 0.5f, 0.4f)}, "specgloss");
+  const int fallbackMr = image({glm::vec4(0.0f, 0.9f, 1.0f, 1.0f)}, "fallback_mr");
+  doc.root["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}},
+                                                      {"metallicRoughnessTexture", {{"index", fallbackMr}}}};
+  doc.root["materials"][0]["extensions"]["KHR_materials_pbrSpecularGlossiness"] = {
+      {"diffuseFactor", {0.25, 0.5, 1.0, 1.0}}, {"diffuseTexture", {{"index", diffuse}, {"texCoord", 0}}},
+      {"specularFactor", {0.1, 0.2, 0.3}}, {"glossinessFactor", 0.5}, {"specularGlossinessTexture", {{"index", specGloss}}}};
+  doc.append("materials", {{"name", "matte"}, {"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.25}}}}}});
+  doc.useExtension("KHR_materials_pbrSpecularGlossiness");
+  doc.root["extensionsRequired"] = json::array({"KHR_materials_pbrSpecularGlossiness"});
+  irbake::testing::writeDocument(doc, dir / "in" / "source.gltf");
+  Scene loaded = loadScene(dir / "in" / "source.gltf");
+  for (auto& p : loaded.primitives) {
+    p.uv1.assign(p.positions.size(), glm::vec2(0.5f));
+    p.lightmap = {0, 8, 4};
+  }
+  std::vector<Lightmap> maps = ramps();
+  maps.resize(1);
+  ExportOptions o;
+  o.output = dir / "out" / "baked.gltf";
+  exportGltf(loaded, maps, o);
+  const json j = readJson(o.output);
+  EXPECT_EQ(j.dump().find("KHR_materials_pbrSpecularGlossiness"), std::string::npos) << j.dump();
+  for (const char* e : {"KHR_materials_specular", "KHR_materials_ior", "MOZ_lightmap"})
+    EXPECT_NE(std::find(j["extensionsUsed"].begin(), j["extensionsUsed"].end(), e), j["extensionsUsed"].end()) << e;
+  auto imageBytes = [&](const json& textureInfo) {
+    const json& img = j["images"][j["textures"][textureInfo["index"].get<int>()]["source"].get<int>()];
+    return readWholeFileForTest(dir / "out" / img["uri"].get<std::string>());
+  };
+  const json& m = j["materials"][0];
+  ASSERT_TRUE(m["extensions"].contains("MOZ_lightmap")) << m.dump();
+  const json& pbr = m["pbrMetallicRoughness"];
+  EXPECT_EQ(pbr["baseColorFactor"], json::array({0.25, 0.5, 1.0, 1.0}));
+  EXPECT_EQ(pbr["metallicFactor"], 0.0);
+  EXPECT_EQ(pbr["roughnessFactor"], 1.0);
+  EXPECT_EQ(pbr["baseColorTexture"]["texCoord"], 0);
+  EXPECT_EQ(imageBytes(pbr["baseColorTexture"]), png["diffuse"]);
+  const std::vector<uint8_t> mr = imageBytes(pbr["metallicRoughnessTexture"]);
+  const Texture roughness = decodeImageToTexture(mr.data(), mr.size(), false, "roughness");
+  ASSERT_EQ(roughness.width, 2);
+  EXPECT_EQ(std::lround(roughness.texels[0].g * 255.0f), 127);
+  EXPECT_EQ(std::lround(roughness.texels[1].g * 255.0f), 204);
+  EXPECT_EQ(roughness.texels[1].r, 0.0f);
+  EXPECT_EQ(roughness.texels[1].b, 0.0f);
+  const json& specular = m["extensions"]["KHR_materials_specular"];
+  EXPECT_EQ(specular["specularColorFactor"], json::array({0.1, 0.2, 0.3}));
+  EXPECT_EQ(imageBytes(specular["specularColorTexture"]), png["specgloss"]);
+  EXPECT_EQ(m["extensions"]["KHR_materials_ior"]["ior"], 1000.0);
+  // The fallback's own metallic-roughness texture is gone with its image; diffuse, spec-gloss, roughness and the
+  // light map are left.
+  EXPECT_EQ(j["images"].size(), 4u) << j["images"].dump();
+  const json& matte = j["materials"][1];
+  EXPECT_EQ(matte["pbrMetallicRoughness"]["roughnessFactor"], 0.75);
+  EXPECT_FALSE(matte["pbrMetallicRoughness"].contains("baseColorFactor"));
+  EXPECT_EQ(matte["extensions"]["KHR_materials_specular"]["specularColorFactor"], json::array({1.0, 1.0, 1.0}));
+  EXPECT_NO_THROW(loadScene(o.output));
+
+  // A malformed factor (one the loader does not read) is refused naming the material and the field, before anything
+  // is written.
+  doc.root["materials"][1]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["specularFactor"] = {0.5, 0.5};
+  irbake::testing::writeDocument(doc, dir / "in" / "bad.gltf");
+  Scene bad = loadScene(dir / "in" / "bad.gltf");
+  for (auto& p : bad.primitives) {
+    p.uv1.assign(p.positions.size(), glm::vec2(0.5f));
+    p.lightmap = {0, 8, 4};
+  }
+  o.output = dir / "bad_out" / "baked.gltf";
+  try {
+    exportGltf(bad, maps, o);
+    ADD_FAILURE() << "a 2-number specularFactor was exported";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("material 1 ('matte'): KHR_materials_pbrSpecularGlossiness.specularFactor must be 3 numbers"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(o.output));
 }
 
 // A .glb embeds every image: one file beside the EXR pages, the images in buffer views.

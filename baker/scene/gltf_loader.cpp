@@ -60,7 +60,8 @@ constexpr double kBoundSlack = kSceneLimitSlack;
 const char* const kSupportedExtensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_mesh_quantization", "MOZ_lightmap",
                                             "IRBAKE_lightmap_directional", "KHR_texture_transform",
-                                            "EXT_mesh_gpu_instancing", "EXT_texture_webp", "EXT_lights_ies"};
+                                            "EXT_mesh_gpu_instancing", "EXT_texture_webp", "EXT_lights_ies",
+                                            "KHR_materials_pbrSpecularGlossiness"};
 
 // tinygltf image callback: keep the encoded bytes (decoded later, in parallel, only for the images a
 // material uses). EXR and unknown formats load too; they are simply recorded.
@@ -1003,6 +1004,8 @@ class Loader {
       m.emissiveStrength = static_cast<float>(numberOr(path(*mj, {"extensions", "KHR_materials_emissive_strength", "emissiveStrength"}), 1.0));
       m.transmission = static_cast<float>(
           std::clamp(numberOr(path(*mj, {"extensions", "KHR_materials_transmission", "transmissionFactor"}), 0.0), 0.0, 1.0));
+      const json* sg = path(*mj, {"extensions", "KHR_materials_pbrSpecularGlossiness"});
+      if (sg && !child(*mj, "pbrMetallicRoughness")) readDiffuse(index, g.name, *sg, m);
       if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) readMozLightmap(index, g.name, *moz, m);
       if (options_.shadingMaps) readShadingMaps(g, *mj, m);
     }
@@ -1076,6 +1079,34 @@ class Loader {
   // MOZ_lightmap (docs/export.md). A light map is never dropped silently: a missing texture and an intensity
   // that is not a number ≥ 0 are refused here; the texCoord is recorded (irview refuses any but 1); the
   // intensity is read in the specification's units, or an older irbake's (scene/moz_lightmap_units.h).
+  // KHR_materials_pbrSpecularGlossiness without a metal-rough fallback: its diffuse colour is the surface's
+  // albedo; the export converts the material to metal-rough with that colour as its base colour
+  // (export/spec_gloss_conversion.h). A material with a fallback is read from the fallback, as before: exporters
+  // write the two alike, but some put the opacity in the fallback only (Sibenik's glass).
+  void readDiffuse(int index, const std::string& gltfName, const json& sg, Material& m) {
+    const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')") +
+                             ": KHR_materials_pbrSpecularGlossiness";
+    if (!sg.is_object()) invalid(what + " is not an object");
+    m.baseColorFactor = glm::vec4(1.0f);
+    m.baseColorTexture = -1;
+    m.baseColorTexCoord = 0;
+    if (const json* f = child(sg, "diffuseFactor")) {
+      bool ok = f->is_array() && f->size() == 4;
+      for (size_t i = 0; ok && i < 4; ++i) ok = (*f)[i].is_number() && std::isfinite((*f)[i].get<double>());
+      if (!ok) invalid(what + " diffuseFactor " + f->dump() + " must be 4 finite numbers");
+      m.baseColorFactor = glm::vec4((*f)[0].get<float>(), (*f)[1].get<float>(), (*f)[2].get<float>(), (*f)[3].get<float>());
+    }
+    if (const json* t = child(sg, "diffuseTexture")) {
+      const json* ti = t->is_object() ? child(*t, "index") : nullptr;
+      if (!ti || !ti->is_number_integer()) invalid(what + " diffuseTexture has no texture index");
+      const json* tc = child(*t, "texCoord");
+      if (tc && (!tc->is_number_integer() || tc->get<int64_t>() < 0 || tc->get<int64_t>() > 255))
+        invalid(what + " diffuseTexture has texCoord " + tc->dump() + ", not a UV set index");
+      m.baseColorTexture = textureIndex(static_cast<int>(std::clamp<int64_t>(ti->get<int64_t>(), -1, 1 << 30)), true, m.name);
+      m.baseColorTexCoord = tc ? tc->get<int>() : 0;
+    }
+  }
+
   void readMozLightmap(int index, const std::string& gltfName, const json& moz, Material& m) {
     const std::string what = "material " + std::to_string(index) + (gltfName.empty() ? "" : " ('" + gltfName + "')") +
                              ": MOZ_lightmap";

@@ -222,6 +222,48 @@ TEST(GltfLoader, DegenerateTrianglesAreDroppedAndCounted) {
   EXPECT_EQ(s.stats.warnings[0], "2 degenerate triangles (zero area or a repeated corner) dropped");
 }
 
+// KHR_materials_pbrSpecularGlossiness without a metal-rough fallback: the diffuse factor and texture are the albedo;
+// a malformed diffuse factor is refused naming the material and the extension. With a fallback, the fallback.
+TEST(GltfLoader, SpecularGlossinessDiffuseIsTheAlbedo) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = doc.addVec2({{0, 0}, {1, 0}, {0, 1}});
+  doc.root["meshes"][0]["primitives"][0]["material"] = 0;
+  Texture t;
+  t.width = t.height = 1;
+  t.texels = {glm::vec4(1.0f)};
+  const int fallback = doc.addTexture(doc.addImage(encodePng(t, false), "fallback"), -1);
+  const int diffuse = doc.addTexture(doc.addImage(encodePng(t, false), "diffuse"), -1);
+  doc.append("materials", {{"name", "old"},
+                           {"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                                            {{"diffuseFactor", {0.25, 0.5, 0.75, 1}}, {"diffuseTexture", {{"index", diffuse}, {"texCoord", 0}}},
+                                             {"specularFactor", {0.04, 0.04, 0.04}}, {"glossinessFactor", 0.3}}}}}});
+  doc.useExtension("KHR_materials_pbrSpecularGlossiness");
+  doc.root["extensionsRequired"] = json::array({"KHR_materials_pbrSpecularGlossiness"});
+  auto dir = testFolder("loader_spec_gloss");
+  writeDocument(doc, dir / "t.gltf");
+  Scene s = loadScene(dir / "t.gltf");
+  ASSERT_EQ(s.materials.size(), 1u);
+  expectNear(glm::vec3(s.materials[0].baseColorFactor), {0.25f, 0.5f, 0.75f});
+  ASSERT_GE(s.materials[0].baseColorTexture, 0);
+  EXPECT_EQ(s.textures[s.materials[0].baseColorTexture].gltfImage, doc.root["textures"][diffuse]["source"].get<int>());
+  doc.root["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}, {"baseColorTexture", {{"index", fallback}}}};
+  writeDocument(doc, dir / "fallback.gltf");
+  Scene withFallback = loadScene(dir / "fallback.gltf");
+  expectNear(glm::vec3(withFallback.materials[0].baseColorFactor), {0.5f, 0.5f, 0.5f});
+  EXPECT_EQ(withFallback.textures[withFallback.materials[0].baseColorTexture].gltfImage,
+            doc.root["textures"][fallback]["source"].get<int>());
+  doc.root["materials"][0].erase("pbrMetallicRoughness");
+  doc.root["materials"][0]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["diffuseFactor"] = {0.25, 0.5};
+  writeDocument(doc, dir / "bad.gltf");
+  try {
+    loadScene(dir / "bad.gltf");
+    ADD_FAILURE() << "a 2-number diffuseFactor loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("material 0 ('old'): KHR_materials_pbrSpecularGlossiness diffuseFactor [0.25,0.5] must be 4"),
+              std::string::npos) << e.what();
+  }
+}
+
 TEST(GltfLoader, MaterialsTexturesAndEmissiveStrength) {
   GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
   doc.root["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = doc.addVec2({{0, 0}, {1, 0}, {0, 1}});

@@ -2,7 +2,7 @@
 // --client babylon) from one of its cameras and compares it with a reference PNG (irview --camera N
 // --screenshot): prints the mean absolute difference over RGB in 8-bit units and exits 1 when it exceeds
 // --max-mean-abs.
-// Usage: node render_compare.mjs --modules DIR --scene FILE.gltf --camera N --width W --height H
+// Usage: node render_compare.mjs --modules DIR --scene FILE.gltf [--camera N] --width W --height H
 //          --reference REF.png --out WEB.png [--max-mean-abs 2] [--chromium /usr/bin/chromium]
 //          [--lightmap sh|l0] [--min-directional N: fail unless N materials were shaded with directional maps]
 //          [--plugin none: the client's glTF loader without our MOZ_lightmap plugin, as any viewer (the portable GLB);
@@ -20,7 +20,7 @@ import { openTab, serve } from './serve.mjs';
 const args = Object.fromEntries(process.argv.slice(2).reduce((a, v, i, all) => (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1]]] : a), []));
 const fail = msg => { console.error(`render_compare: ${msg}`); process.exit(2); };
 for (const k of ['modules', 'scene', 'reference', 'out']) if (!args[k]) fail(`--${k} is required`);
-const width = Number(args.width ?? 256), height = Number(args.height ?? 256), camera = Number(args.camera ?? 0);
+const width = Number(args.width ?? 256), height = Number(args.height ?? 256), camera = args.camera;
 const maxMeanAbs = Number(args['max-mean-abs'] ?? 2);
 const client = args.client ?? 'three';
 const pages = { three: { html: 'index.html', module: '/web/viewer.js' },
@@ -47,8 +47,9 @@ const port = server.address().port;
 const { browser, tab, log } = await openTab(puppeteer, { chromium: args.chromium, width, height });
 let code = 0;
 try {
-  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, camera, width, height,
+  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, width, height,
                                   lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz', standard: args.standard ?? '1' });
+  if (camera !== undefined) q.set('camera', camera);  // none: the viewer's default (camera 0, or the overview)
   await tab.goto(`http://127.0.0.1:${port}/web/${page.html}?${q}`);
   await tab.waitForFunction('window.viewerReady || window.viewerError', { timeout: 120000 });
   const error = await tab.evaluate('window.viewerError');

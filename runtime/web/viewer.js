@@ -1,4 +1,5 @@
-// Loads a baked glTF and renders it once from one of its cameras, the way irview does.
+// Loads a baked glTF and renders it once from one of its cameras, the way irview does (without a camera to
+// ask for and none in the file, irview's overview: overview_camera.js).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
@@ -6,13 +7,15 @@ import { MozLightmapExtension } from './moz_lightmap.js';
 import { IrbakeShadowmaskExtension } from './irbake_shadowmask.js';
 import { IrbakeLightProbesExtension } from './irbake_light_probes.js';
 import { addProbeObjects, lookAtCamera } from './probe_objects.js';
+import { overviewCamera } from './overview_camera.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
 // plugin false: plain GLTFLoader without our plugins (MOZ_lightmap, IRBAKE_light_probes), as a viewer that does not know them.
 // mixedLights false: MOZ_lightmap only, every light removed (the map alone, as a client without irbake_shadowmask.js).
 // probeObjects: [[x, y, z, r], ...] white spheres lit by IRBAKE_light_probes (probe_objects.js); view: { eye,
 // target, fov } a look-at camera instead of glTF camera `camera`, as irview --eye/--target/--fov.
-export async function showBakedScene({ scene, camera = 0, width, height, lightmapMode = 'sh', plugin = true,
+// camera null: the file's camera 0, or irview's overview of the scene when it has none (as irview without --camera).
+export async function showBakedScene({ scene, camera = null, width, height, lightmapMode = 'sh', plugin = true,
                                        mixedLights = true, probeObjects = [], view = null }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
@@ -39,9 +42,11 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   shadowmask?.syncLights(gltf.scene);
   gltf.scene.updateMatrixWorld(true);
 
+  const overview = !view && camera === null && gltf.cameras.length === 0;
+  const bounds = overview ? new THREE.Box3().setFromObject(gltf.scene, true) : null;  // before the probe spheres
   const probes = addProbeObjects(gltf, probeObjects, scene);
-  const cam = view ? lookAtCamera(view) : gltf.cameras[camera];
-  if (!cam) throw new Error(`${scene}: no camera ${camera}`);
+  const cam = view ? lookAtCamera(view) : overview ? overviewCamera(bounds) : gltf.cameras[camera ?? 0];
+  if (!cam) throw new Error(`${scene}: no camera ${camera}: the file has ${gltf.cameras.length} (leave the camera out for the overview)`);
   cam.aspect = width / height;  // irview uses the viewport's aspect
   cam.updateProjectionMatrix();
   // Behind the scene the bake's uniform sky (root extras irbakeSky), as irview draws it; else black.
@@ -51,7 +56,7 @@ export async function showBakedScene({ scene, camera = 0, width, height, lightma
   else
     renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);
-  return { width, height, lights: lights.length, lightmapMode, plugin,
+  return { width, height, overview, lights: lights.length, lightmapMode, plugin,
            runtimeLights: shadowmask?.runtimeLights.length ?? 0, maskedMaterials: shadowmask?.maskedMaterials ?? 0,
            directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
            generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes };

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # glTF-Transform keeps the bake (docs/export.md, "Optimisers"): `gltf-transform optimize` with
-# gltf-transform.config.mjs and WebP texture compression on
+# gltf-transform.config.mjs, --simplify false and WebP texture compression (docs/export.md's command) on
 #   - the Cornell box (as web_client_test.sh bakes it) and the same with --directional;
 #   - the normal-mapped plane of make_directional_scene.mjs with --directional: optimize with its default
-#     simplify must refuse (the plane's grid simplifies), with --simplify false it must pass;
+#     simplify must refuse (the plane's grid simplifies), with --simplify false it must pass; then README.md's
+#     command, read from README.md and run as written from the source folder (only in.gltf and out.glb replaced);
 #   - the DamagedHelmet from ../shared with --directional (skipped with a message when absent).
 # Each output: every MOZ_lightmap / IRBAKE_lightmap_directional, every TEXCOORD_1 and (Cornell) the
 # IRBAKE_light_probes grid with its accessors' values survives with the bake's
@@ -27,7 +28,7 @@ size() { stat -c %s "$1"; }
 bake_size() { local d="$1" n=0 f; for f in "$d"/*; do [[ $f == *.exr || $f == */report.json ]] || n=$((n + $(size "$f"))); done; echo $n; }
 optimize() {  # input glTF, output GLB, optimize options...
   local in="$1" out="$2"; shift 2
-  "$gltf_transform" optimize "$in" "$out" --texture-compress webp "$@" --config "$config" >> "$work/gltf-transform.log" 2>&1
+  "$gltf_transform" optimize "$in" "$out" --texture-compress webp --simplify false "$@" --config "$config" >> "$work/gltf-transform.log" 2>&1
   echo "== $(basename "$out"): $(bake_size "$(dirname "$in")") bytes (glTF, bin, images) -> $(size "$out") bytes"
 }
 survives() { node "$here/gltf_transform_check.mjs" survives --modules "$modules" --input "$1" --output "$2" "${@:3}"; }
@@ -61,10 +62,24 @@ grep -q "the geometry was simplified" "$work/simplify.log" || { echo "FAIL: no s
 [[ ! -e "$work/plane_simplified.glb" ]] || { echo "FAIL: the refused optimize left $work/plane_simplified.glb"; exit 1; }
 echo "== plane: optimize with simplify refused: $(grep -o 'light-mapped triangles [0-9]* → [0-9]*' "$work/simplify.log")"
 "$irview" "$work/plane/scene.gltf" --camera 0 --width 256 --height 256 --screenshot "$work/plane_irview.png" >> "$work/irview.log" 2>&1
-optimize "$work/plane/scene.gltf" "$work/plane.glb" --simplify false
+optimize "$work/plane/scene.gltf" "$work/plane.glb"
 survives "$work/plane/scene.gltf" "$work/plane.glb" --directional
 compare "$work/plane.glb" "$work/plane_irview.png" "$work/plane_web.png" 256 --min-directional 1
 validate "$work/plane.glb" "$work/plane/scene.gltf"
+# README.md's command as written ("Ship it"), from the source folder, on the plane its simplify would break.
+readme=$(grep -o 'gltf-transform optimize in\.gltf out\.glb[^`]*' "$source/README.md" | head -1)
+[[ -n $readme ]] || { echo "FAIL: no 'gltf-transform optimize in.gltf out.glb …' command in README.md"; exit 1; }
+read -ra words <<< "${readme#gltf-transform }"
+for i in "${!words[@]}"; do
+  [[ ${words[$i]} == in.gltf ]] && words[$i]="$work/plane/scene.gltf"
+  [[ ${words[$i]} == out.glb ]] && words[$i]="$work/plane_readme.glb"
+done
+echo "== README.md: gltf-transform ${words[*]}"
+(cd "$source" && "$gltf_transform" "${words[@]}") > "$work/readme.log" 2>&1 \
+  || { echo "FAIL: README.md's command failed:"; cat "$work/readme.log"; exit 1; }
+survives "$work/plane/scene.gltf" "$work/plane_readme.glb" --directional
+compare "$work/plane_readme.glb" "$work/plane_irview.png" "$work/plane_readme_web.png" 256 --min-directional 1
+validate "$work/plane_readme.glb" "$work/plane/scene.gltf"
 
 node "$here/gltf_transform_check.mjs" refusals --modules "$modules" --input "$work/cornell_directional/scene.gltf"
 
@@ -78,7 +93,7 @@ if [[ -f "$helmet" ]]; then
     d.scenes[d.scene ?? 0].nodes.push(d.nodes.length - 1);
     fs.writeFileSync(f, JSON.stringify(d));' "$work/helmet/scene.gltf"
   "$irview" "$work/helmet/scene.gltf" --camera 0 --width 320 --height 320 --screenshot "$work/helmet_irview.png" >> "$work/irview.log" 2>&1
-  optimize "$work/helmet/scene.gltf" "$work/helmet.glb" --simplify false
+  optimize "$work/helmet/scene.gltf" "$work/helmet.glb"
   survives "$work/helmet/scene.gltf" "$work/helmet.glb" --directional
   compare "$work/helmet.glb" "$work/helmet_irview.png" "$work/helmet_web.png" 320 --min-directional 1
   validate "$work/helmet.glb" "$work/helmet/scene.gltf"

@@ -47,19 +47,7 @@ sponza="$src/../shared/scenes/dabrovic_sponza/sponza.glb"
 if [[ ! -f "$sponza" ]]; then echo "Sponza part skipped: $sponza absent"; exit 0; fi
 "$irbake" bake "$sponza" -o "$work/sponza" --sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7 --quiet > "$work/sponza.log" 2>&1
 w=320 h=200
-python3 - "$src/bench/cycles" "$work/sponza/scene.gltf" "$w" "$h" <<'PY'
-import json, math, sys
-sys.path.insert(0, sys.argv[1])
-from scenes import SPONZA_CAMERAS, look_at_quat
-path, w, h = sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
-doc = json.load(open(path))
-name, eye, target, yfov = SPONZA_CAMERAS[0]
-doc["cameras"] = [{"type": "perspective", "name": name,
-                   "perspective": {"yfov": math.radians(yfov), "aspectRatio": w / h, "znear": 0.05}}]
-doc["nodes"].append({"name": name, "camera": 0, "translation": list(eye), "rotation": list(look_at_quat(eye, target))})
-doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 1)
-json.dump(doc, open(path, "w"))
-PY
+python3 "$src/bench/cycles/add_sponza_camera.py" "$work/sponza/scene.gltf" "$w" "$h"
 "$irview" "$work/sponza/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/sponza_irview.png" \
   > "$work/sponza_irview.log" 2>&1
 for standard in 1 0; do

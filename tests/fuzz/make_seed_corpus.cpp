@@ -182,6 +182,22 @@ json withIesLight(json doc) {
   return doc;
 }
 
+// The document with every material written as KHR_materials_pbrSpecularGlossiness (its base colour as the
+// diffuse factor, no metal-rough fallback), as older exporters write them.
+json specularGlossiness(json doc) {
+  if (!doc.contains("materials")) return doc;
+  for (json& m : doc["materials"]) {
+    json pbr = m.value("pbrMetallicRoughness", json::object());
+    json sg = {{"diffuseFactor", pbr.value("baseColorFactor", json::array({1.0, 1.0, 1.0, 1.0}))},
+               {"specularFactor", {0.04, 0.04, 0.04}}, {"glossinessFactor", 0.2}};
+    if (pbr.contains("baseColorTexture")) sg["diffuseTexture"] = pbr["baseColorTexture"];
+    m.erase("pbrMetallicRoughness");
+    m["extensions"]["KHR_materials_pbrSpecularGlossiness"] = std::move(sg);
+  }
+  doc["extensionsUsed"].push_back("KHR_materials_pbrSpecularGlossiness");
+  return doc;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -206,6 +222,14 @@ int main(int argc, char** argv) {
       if (seeds == 2) {  // one scene also with an IES light
         writeFile(out / (name + "_ies.gltf"), withIesLight(doc).dump());
         writeFile(out / (name + "_ies.glb"), glb(withIesLight(json::parse(std::ifstream(entry.path()))), in));
+        seeds += 2;
+      }
+      if (name == "cornell_box") {  // also as an older exporter's specular-glossiness materials
+        json sg = specularGlossiness(json::parse(std::ifstream(entry.path())));
+        writeFile(out / (name + "_spec_gloss.glb"), glb(sg, in));
+        embed(sg, "buffers", in, -1);
+        embed(sg, "images", in, -1);
+        writeFile(out / (name + "_spec_gloss.gltf"), sg.dump());
         seeds += 2;
       }
       const std::pair<const char*, bool (*)(json&)> variants[] = {
