@@ -506,12 +506,17 @@ TEST(GltfExport, SpecularGlossinessMaterialsBecomeMetalRough) {
   // Alpha codes 255 and 102: roughness codes 255 − round(255 × 0.5) = 127 and 255 − round(102 × 0.5) = 204.
   const int specGloss = image({glm::vec4(0.2f, 0.3f, 0.4f, 1.0f), glm::vec4(0.5f, 0.5f, 0.5f, 0.4f)}, "specgloss");
   const int fallbackMr = image({glm::vec4(0.0f, 0.9f, 1.0f, 1.0f)}, "fallback_mr");
-  doc.root["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}},
-                                                      {"metallicRoughnessTexture", {{"index", fallbackMr}}}};
+  // Material 0 without a metal-rough fallback (its diffuse is the base colour); "glass" with one whose opacity
+  // the diffuse factor lacks (the fallback's base colour is kept, as the bake read it).
+  doc.root["materials"][0].erase("pbrMetallicRoughness");
   doc.root["materials"][0]["extensions"]["KHR_materials_pbrSpecularGlossiness"] = {
       {"diffuseFactor", {0.25, 0.5, 1.0, 1.0}}, {"diffuseTexture", {{"index", diffuse}, {"texCoord", 0}}},
       {"specularFactor", {0.1, 0.2, 0.3}}, {"glossinessFactor", 0.5}, {"specularGlossinessTexture", {{"index", specGloss}}}};
   doc.append("materials", {{"name", "matte"}, {"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.25}}}}}});
+  doc.append("materials", {{"name", "glass"},
+                           {"pbrMetallicRoughness", {{"baseColorFactor", {0.9, 0.9, 1.0, 0.1}},
+                                                     {"metallicRoughnessTexture", {{"index", fallbackMr}}}}},
+                           {"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"diffuseFactor", {1, 1, 1, 1}}}}}}});
   doc.useExtension("KHR_materials_pbrSpecularGlossiness");
   doc.root["extensionsRequired"] = json::array({"KHR_materials_pbrSpecularGlossiness"});
   irbake::testing::writeDocument(doc, dir / "in" / "source.gltf");
@@ -552,13 +557,16 @@ TEST(GltfExport, SpecularGlossinessMaterialsBecomeMetalRough) {
   EXPECT_EQ(specular["specularColorFactor"], json::array({0.1, 0.2, 0.3}));
   EXPECT_EQ(imageBytes(specular["specularColorTexture"]), png["specgloss"]);
   EXPECT_EQ(m["extensions"]["KHR_materials_ior"]["ior"], 1000.0);
-  // The fallback's own metallic-roughness texture is gone with its image; diffuse, spec-gloss, roughness and the
-  // light map are left.
+  // The glass fallback's own metallic-roughness texture is gone with its image; diffuse, spec-gloss, roughness and
+  // the light map are left.
   EXPECT_EQ(j["images"].size(), 4u) << j["images"].dump();
   const json& matte = j["materials"][1];
   EXPECT_EQ(matte["pbrMetallicRoughness"]["roughnessFactor"], 0.75);
   EXPECT_FALSE(matte["pbrMetallicRoughness"].contains("baseColorFactor"));
   EXPECT_EQ(matte["extensions"]["KHR_materials_specular"]["specularColorFactor"], json::array({1.0, 1.0, 1.0}));
+  const json& glass = j["materials"][2];
+  EXPECT_EQ(glass["pbrMetallicRoughness"]["baseColorFactor"], json::array({0.9, 0.9, 1.0, 0.1})) << glass.dump();
+  EXPECT_FALSE(glass["pbrMetallicRoughness"].contains("metallicRoughnessTexture"));
   EXPECT_NO_THROW(loadScene(o.output));
 
   // A malformed factor (one the loader does not read) is refused naming the material and the field, before anything

@@ -114,8 +114,18 @@ int convertSpecularGlossiness(GltfDocument& doc, const std::string& file) {
       if (!sg.is_object()) r.invalid("", "must be an object");
       const double glossiness = r.glossiness();
       json pbr = json::object();
-      if (sg.contains("diffuseFactor")) pbr["baseColorFactor"] = r.factor("diffuseFactor", 4, json());
-      if (const json* diffuse = r.texture("diffuseTexture", doc.root)) pbr["baseColorTexture"] = *diffuse;
+      // A metal-rough fallback's base colour is what the bake used (scene/gltf_loader.cpp) and may hold an
+      // opacity the diffuse factor lacks: it is kept; the diffuse colour fills in only where it is absent.
+      const json fallback = mat.contains("pbrMetallicRoughness") && mat["pbrMetallicRoughness"].is_object()
+                                ? mat["pbrMetallicRoughness"]
+                                : json();
+      if (!fallback.is_null()) {
+        for (const char* kept : {"baseColorFactor", "baseColorTexture"})
+          if (fallback.contains(kept)) pbr[kept] = fallback[kept];
+      } else {
+        if (sg.contains("diffuseFactor")) pbr["baseColorFactor"] = r.factor("diffuseFactor", 4, json());
+        if (const json* diffuse = r.texture("diffuseTexture", doc.root)) pbr["baseColorTexture"] = *diffuse;
+      }
       pbr["metallicFactor"] = 0.0;
       json specular = {{"specularColorFactor", r.factor("specularFactor", 3, json::array({1.0, 1.0, 1.0}))}};
       if (const json* sgTexture = r.texture("specularGlossinessTexture", doc.root)) {
