@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/error.h"
+#include "scene/gltf_component_types.h"
 #include "scene/gltf_source.h"
 #include "scene/image_codec.h"
 
@@ -16,25 +17,6 @@ using json = nlohmann::json;
 namespace {
 
 constexpr int kArrayBuffer = 34962;
-
-size_t componentSize(int componentType) {
-  switch (componentType) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    case 5125: case 5126: return 4;
-    default: return 0;
-  }
-}
-
-size_t componentCount(const std::string& type) {
-  if (type == "SCALAR") return 1;
-  if (type == "VEC2") return 2;
-  if (type == "VEC3") return 3;
-  if (type == "VEC4" || type == "MAT2") return 4;
-  if (type == "MAT3") return 9;
-  if (type == "MAT4") return 16;
-  return 0;
-}
 
 double componentValue(const uint8_t* p, int componentType) {
   switch (componentType) {
@@ -223,7 +205,7 @@ AccessorBytes readAccessor(const GltfDocument& doc, int index, const std::string
   out.type = a.value("type", std::string());
   out.normalized = a.value("normalized", false);
   out.count = a.value("count", size_t(0));
-  out.elementSize = componentSize(out.componentType) * componentCount(out.type);
+  out.elementSize = gltfComponentSize(out.componentType) * gltfComponentCount(out.type);
   if (out.elementSize == 0) throw Error(ErrorCode::InvalidData, file, what + " has an unknown component type or type");
   out.bytes.assign(out.count * out.elementSize, 0);  // no view: zeros (glTF), sparse may fill in
   if (a.contains("bufferView")) {
@@ -244,7 +226,7 @@ AccessorBytes readAccessor(const GltfDocument& doc, int index, const std::string
     const uint8_t* ib = viewBytes(doc, si.value("bufferView", -1), li, stride, file) + si.value("byteOffset", size_t(0));
     const uint8_t* vb = viewBytes(doc, sv.value("bufferView", -1), lv, stride, file) + sv.value("byteOffset", size_t(0));
     const int indexType = si.value("componentType", 5125);
-    const size_t isz = componentSize(indexType);
+    const size_t isz = gltfComponentSize(indexType);
     if (isz == 0 || n * isz + si.value("byteOffset", size_t(0)) > li || n * out.elementSize + sv.value("byteOffset", size_t(0)) > lv)
       throw Error(ErrorCode::InvalidData, file, what + " has sparse data past its buffer view");
     for (size_t k = 0; k < n; ++k) {
@@ -265,7 +247,7 @@ int addGatheredAccessor(GltfDocument& doc, const AccessorBytes& src, const std::
   json a = {{"bufferView", view}, {"componentType", src.componentType}, {"count", at.size()}, {"type", src.type}};
   if (src.normalized) a["normalized"] = true;
   if (withMinMax && !at.empty()) {
-    const size_t n = componentCount(src.type), cs = componentSize(src.componentType);
+    const size_t n = gltfComponentCount(src.type), cs = gltfComponentSize(src.componentType);
     std::vector<double> lo(n, 1e300), hi(n, -1e300);
     for (size_t i = 0; i < at.size(); ++i)
       for (size_t c = 0; c < n; ++c) {

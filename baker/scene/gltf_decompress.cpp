@@ -14,6 +14,7 @@
 #include <meshoptimizer.h>
 
 #include "common/error.h"
+#include "scene/gltf_component_types.h"
 
 namespace irbake {
 
@@ -85,22 +86,6 @@ std::string stringOr(const json& object, const char* key) {
 
 json memberOrNull(const json& object, const char* key) {
   return object.is_object() && object.contains(key) ? object[key] : json();
-}
-
-size_t componentSize(int componentType) {
-  switch (componentType) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    case 5125: case 5126: return 4;
-    default: return 0;
-  }
-}
-
-int componentCount(const std::string& type) {
-  static const std::map<std::string, int> counts = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4},
-                                                    {"MAT2", 4},   {"MAT3", 9}, {"MAT4", 16}};
-  auto it = counts.find(type);
-  return it == counts.end() ? 0 : it->second;
 }
 
 // One value of a Draco attribute as the accessor's component type, into `out`.
@@ -336,8 +321,8 @@ class Decompressor {
 
   void writeDracoAttribute(const std::string& where, size_t index, const draco::PointAttribute& source, uint32_t points) {
     const json& a = accessor(where, json(index));
-    const int type = static_cast<int>(sizeOr(a, "componentType", 0)), n = componentCount(stringOr(a, "type"));
-    const size_t element = componentSize(type) * n, stride = (element + 3) / 4 * 4;
+    const int type = static_cast<int>(sizeOr(a, "componentType", 0)), n = static_cast<int>(gltfComponentCount(stringOr(a, "type")));
+    const size_t element = gltfComponentSize(type) * n, stride = (element + 3) / 4 * 4;
     if (element == 0)
       fail(where + "componentType " + memberOrNull(a, "componentType").dump() + " / type " + memberOrNull(a, "type").dump() + " is not readable");
     if (memberOrNull(a, "count") != points)
@@ -359,7 +344,7 @@ class Decompressor {
     const std::string where = what + "accessor " + prim["indices"].dump() + " (indices): ";
     const json& a = accessor(where, prim["indices"]);
     const int type = static_cast<int>(sizeOr(a, "componentType", 0));
-    const size_t size = componentSize(type);
+    const size_t size = gltfComponentSize(type);
     if (stringOr(a, "type") != "SCALAR" || (type != 5121 && type != 5123 && type != 5125))
       fail(where + "indices must be unsigned SCALAR");
     if (memberOrNull(a, "count") != count)
