@@ -3,7 +3,6 @@
 
 #include <algorithm>
 
-#include "scene/gltf_decompress.h"
 
 namespace irbake {
 
@@ -34,8 +33,7 @@ void describeBake(const BakeFacts& f, nlohmann::json& report) {
     report["scene"]["gpuInstancing"] = {{"nodes", f.scene.stats.gpuInstancedNodes},
                                         {"instances", f.scene.stats.gpuInstances},
                                         {"export", "EXT_mesh_gpu_instancing dropped: each instance written as a node of its own, with its own light-map region"}};
-  const std::vector<std::string> decoded = decodedExtensionsOf(f.scene);
-  if (!decoded.empty()) report["scene"]["decodedExtensions"] = decoded;
+  if (!f.scene.stats.decodedExtensions.empty()) report["scene"]["decodedExtensions"] = f.scene.stats.decodedExtensions;
   report["atlas"] = f.atlas.toJson();
   report["texels"] = {{"total", texelCount}, {"covered", covered}, {"valid", valid},
                       {"supersample", std::max(1, f.options.texels.supersample)},

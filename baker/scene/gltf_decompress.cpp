@@ -415,14 +415,4 @@ std::string decodedExtensionWarning(const std::string& extension) {
   return "input used " + extension + "; the output is uncompressed — recompress with " + how;
 }
 
-std::vector<std::string> decodedExtensionsOf(const Scene& scene) {
-  std::vector<std::string> decoded;
-  for (const char* name : {kMeshoptCompression, kDracoCompression}) {
-    const std::string warning = decodedExtensionWarning(name);
-    if (std::find(scene.stats.warnings.begin(), scene.stats.warnings.end(), warning) != scene.stats.warnings.end())
-      decoded.push_back(name);
-  }
-  return decoded;
-}
-
 }  // namespace irbake

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "scene/gltf_source.h"
-#include "scene/scene.h"
 
 namespace irbake {
 
@@ -21,9 +20,6 @@ inline constexpr const char* kDracoCompression = "KHR_draco_mesh_compression";
 GltfSource decompressGltf(GltfSource source);
 
 // The warning for an extension the input used and the output no longer does, and how to get it back.
-// The loader puts it among the scene's warnings, which is where the bake's report finds it again.
 std::string decodedExtensionWarning(const std::string& extension);
-// The extensions a loaded scene's source used and its document no longer does (empty for most files).
-std::vector<std::string> decodedExtensionsOf(const Scene& scene);
 
 }  // namespace irbake

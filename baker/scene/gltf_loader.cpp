@@ -226,6 +226,7 @@ class Loader {
   Scene load() {
     parseWithTinygltf();
     scene_.sourcePath = file_;
+    scene_.stats.decodedExtensions = src_.decodedExtensions;
     for (const std::string& e : src_.decodedExtensions) warn(decodedExtensionWarning(e));
     checkRequiredExtensions();
     materialMap_.assign(model_.materials.size(), -1);

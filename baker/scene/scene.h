@@ -179,6 +179,8 @@ struct LoadStats {
   size_t normalsComputed = 0;      // primitives whose normals were computed
   size_t gpuInstancedNodes = 0;    // nodes with EXT_mesh_gpu_instancing
   size_t gpuInstances = 0;         // their instances, each a mesh instance of its own
+  // Compression extensions the file used and the loaded document no longer does (scene/gltf_decompress.h).
+  std::vector<std::string> decodedExtensions;
   std::vector<std::string> warnings;
 };
 
