@@ -3,6 +3,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "atlas/atlas_estimate.h"
 #include "common/command_line.h"
 #include "export/light_probes_export.h"
 #include "pipeline/backend_choice.h"
@@ -166,14 +167,20 @@ void addWalkRows(std::vector<OptionDescriptor>& t) {
                          shown(d.vplImportance.keepShare) + ")",
                      opt([](BakeOptions& o) { return &o.vplImportance.keepShare; })));
   t.push_back(number("--texels-per-unit", 0.0, 1e6, kCommon, "T",
-                     "texels per metre (default: about one " + shown(q.autoPageSize) + "² page, ≥ " +
-                         shown(d.atlas.texelsPerTriangle) + " per triangle)",
+                     "texels per metre (default: the density rule, " + shown(q.autoTexelsPerMetre) +
+                         " per metre; a small scene ≥ one " + shown(q.autoPageSize) + "² page)",
                      arg(&BakeArguments::tpu), kReplayable));
   t.push_back(integer("--max-texels", 0, double(1LL << 40), kTexels, "N",
                       "texel budget of all pages together (default " + shown(d.atlas.maxTexels) + " = " +
                           shown(d.atlas.maxTexels >> 20) + "M);\n"
-                          "a denser atlas fails at once, naming the density that fits;\n0 = no limit",
+                          "the density rule is lowered to fit it, with a warning; a given\n"
+                          "--texels-per-unit over it fails at once, naming the density that fits;\n0 = no limit",
                       opt([](BakeOptions& o) { return &o.atlas.maxTexels; })));
+  t.push_back(integer("--page-size", 0, 16384, kTexels, "S",
+                      "largest page edge in texels; more pages when one is full (default 0: the\n"
+                          "smallest power of two from " + shown(kMinAutoPageSize) + " to " + shown(kMaxAutoPageSize) +
+                          " that holds the atlas twice over, else " + shown(kMaxAutoPageSize) + ")",
+                      opt([](BakeOptions& o) { return &o.atlas.maxPageSize; })));
   t.push_back(integer("--supersample", 1, 8, kTexels, "S", "S×S samples per texel (default " + shown(d.texels.supersample) + ")",
                       opt([](BakeOptions& o) { return &o.texels.supersample; })));
 }
@@ -508,6 +515,7 @@ void applyQuality(const CLI::App& app, const QualityPreset& preset, BakeCommand&
         d.field(command, arguments));
   }
   command.options.atlas.targetPageSize = preset.autoPageSize;  // read only where --texels-per-unit is auto
+  command.options.atlas.autoTexelsPerUnit = preset.autoTexelsPerMetre;
 }
 
 }  // namespace irbake::app

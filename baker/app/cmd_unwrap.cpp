@@ -11,6 +11,7 @@
 
 #include "app/bake_option_table.h"
 #include "app/commands.h"
+#include "app/quality.h"
 #include "atlas/atlas.h"
 #include "common/command_line.h"
 #include "common/atomic_file.h"
@@ -35,6 +36,7 @@ nlohmann::json reportJson(const std::string& input, const AtlasResult& r) {
       {"charts", {{"total", s.charts}, {"planar", s.planarCharts}, {"lscm", s.lscmCharts}, {"split_by_checks", s.chartsSplit}}},
       {"pages", pages},
       {"texels_per_unit", s.texelsPerUnit},
+      {"page_size", s.pageSize},
       {"centre_utilisation", s.centreUtilisation},
       {"area_stretch", {{"p5", s.areaStretchP5}, {"p50", s.areaStretchP50}, {"p95", s.areaStretchP95}}},
       {"l2_stretch", s.l2Stretch},
@@ -58,6 +60,7 @@ int runUnwrap(const Args& args) {
   double tpu = 0.0;
   int threads = 0;
   AtlasOptions options;
+  options.autoTexelsPerUnit = defaultQualityPreset().autoTexelsPerMetre;  // the bake's density rule
   auto app = cli::makeApp("irbake unwrap",
                               "Adds a lightmap UV set (TEXCOORD_1) and extras.lightmap {page, width, height} per "
                               "primitive.");
@@ -68,9 +71,8 @@ int runUnwrap(const Args& args) {
   addOption(*app, *findBakeOption("max-texels"), &options.maxTexels)->group("Options");
   app->add_option("--padding", options.padding, "empty texels between charts (default 2)")
       ->transform(cli::integerIn(0, 256))->type_name("P");
-  app->add_option("--max-page", options.maxPageSize, "largest page edge in texels (default 2048); more pages when full")
-      ->transform(cli::integerIn(16, 16384))->type_name("S");
-  app->add_option("--target-page", options.targetPageSize, "page edge the automatic density aims at (default 1024)")
+  addOption(*app, *findBakeOption("page-size"), &options.maxPageSize)->group("Options");
+  app->add_option("--target-page", options.targetPageSize, "the density rule: a small scene fills at least one page of this edge (default 1024)")
       ->transform(cli::integerIn(16, 16384))->type_name("S");
   app->add_flag("--keep-uv1", options.keepUv1, "keep an input TEXCOORD_1 and only repack its islands");
   app->add_option("--report", report, "write the atlas statistics")->type_name("R.json");

@@ -10,6 +10,10 @@ namespace {
 // smaller default its own callers are tuned to; the command always sets the walk's paths from here.
 constexpr int kDefaultPaths = 4096;
 
+// The density rule's texels per metre at --quality default (AtlasOptions::autoTexelsPerUnit): a level's maps
+// are at least this fine; a small scene or a detailed model gets more (docs/guide.md, "Texel density").
+constexpr double kDefaultTexelsPerMetre = 16.0;
+
 // value × num / den: a preset as a multiple of the default bake.
 struct Scale {
   long long num = 1, den = 1;
@@ -23,7 +27,7 @@ constexpr Scale kPathsUnderGather{3, 4};
 
 // The default bake scaled: paths, every stage's rays and ray budgets, the shadow-edge sub-samples per axis and
 // the automatic page edge. The rays, budgets, sub-samples and page edge start from each stage's option struct.
-QualityPreset scaledDefault(const char* name, Scale paths, Scale rays, Scale edgeSamples, Scale page) {
+QualityPreset scaledDefault(const char* name, Scale paths, Scale rays, Scale edgeSamples, Scale page, double texelsPerMetre) {
   const BakeOptions base;
   const int p = paths.of(kDefaultPaths);
   return {name,
@@ -37,7 +41,8 @@ QualityPreset scaledDefault(const char* name, Scale paths, Scale rays, Scale edg
           rays.of(base.sky.raysPerSample),
           rays.of(base.sky.maxRays),
           edgeSamples.of(base.shadowEdges.subSamples),
-          page.of(base.atlas.targetPageSize)};
+          page.of(base.atlas.targetPageSize),
+          texelsPerMetre};
 }
 
 }  // namespace
@@ -46,11 +51,13 @@ const std::vector<QualityPreset>& qualityPresets() {
   // preview: an eighth of the paths, a quarter of the rays, half the shadow-edge sub-samples per axis and a quarter
   // of the texels where the density is automatic (every per-texel stage costs that much less); high and
   // production: twice and four times the paths and rays (production also 1.5× the sub-samples per axis).
+  // Texels per metre of the density rule (docs/guide.md "Texel density"): preview half the default's (a quarter
+  // of the texels); high and production the default's (they spend their time on paths and rays).
   static const std::vector<QualityPreset> presets = {
-      scaledDefault("preview", {1, 8}, {1, 4}, {1, 2}, {1, 2}),
-      scaledDefault("default", {}, {}, {}, {}),
-      scaledDefault("high", {2, 1}, {2, 1}, {}, {}),
-      scaledDefault("production", {4, 1}, {4, 1}, {3, 2}, {}),
+      scaledDefault("preview", {1, 8}, {1, 4}, {1, 2}, {1, 2}, kDefaultTexelsPerMetre / 2),
+      scaledDefault("default", {}, {}, {}, {}, kDefaultTexelsPerMetre),
+      scaledDefault("high", {2, 1}, {2, 1}, {}, {}, kDefaultTexelsPerMetre),
+      scaledDefault("production", {4, 1}, {4, 1}, {3, 2}, {}, kDefaultTexelsPerMetre),
   };
   return presets;
 }

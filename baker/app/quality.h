@@ -22,7 +22,8 @@ struct QualityPreset {
   int skyRays;                // --sky-rays
   int skyRayBudget;           // --sky-ray-budget
   int shadowEdgeSamples;      // --shadow-edge-samples
-  int autoPageSize;           // --texels-per-unit auto: the density fills about one page of this edge
+  int autoPageSize;           // --texels-per-unit auto: small scenes get at least one page of this edge
+  double autoTexelsPerMetre;  // --texels-per-unit auto: the density rule's texels per metre
 };
 
 // preview, default, high, production (in that order).

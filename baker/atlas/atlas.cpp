@@ -1,4 +1,5 @@
 #include "atlas/atlas.h"
+#include "atlas/atlas_estimate.h"
 #include "scene/triangle_area.h"
 
 #include <algorithm>
@@ -81,9 +82,9 @@ std::vector<ChartUv> chartsFromUv1(const Primitive& prim, const AtlasMesh& mesh)
   return charts;
 }
 
-// The texel budget (options.maxTexels). Charts fill about kTypicalFill of the pages they are packed
-// into (the auto-fit below aims at the same figure), so N texels hold area × density² / kTypicalFill.
-constexpr double kTypicalFill = 0.6;
+// The texel budget (options.maxTexels). Charts fill at least kWorstPageFill of the pages they are packed
+// into (the density rule assumes the same figure), so N texels hold area × density² / kWorstPageFill.
+constexpr double kTypicalFill = kWorstPageFill;
 
 // A density a little under the one that fits, shown with 3 significant digits.
 std::string densityThatFits(double density) {
@@ -108,8 +109,11 @@ std::string densityThatFits(double density) {
 void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
   if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
   double area = 0.0;
-  for (const Primitive& p : scene.primitives)
-    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
+  for (const Primitive& p : scene.primitives) {
+    double primitiveArea = 0.0;
+    for (size_t t = 0; t < p.triangleCount(); ++t) primitiveArea += triangleArea(p, t);
+    area += primitiveArea * double(p.lightmapScale) * double(p.lightmapScale);
+  }
   const double density = options.texelsPerUnit;
   const double estimate = area * density * density / kTypicalFill;
   if (estimate > double(options.maxTexels))
@@ -124,19 +128,21 @@ size_t pageTexels(const std::vector<AtlasPage>& pages) {
 }
 
 // After packing: the pages as they are. Padding does not shrink with the density, so the density
-// named is one whose packing was tried and fits.
-void checkTexelBudget(const Scene& scene, const AtlasOptions& options, const std::vector<ChartUv>& charts,
-                      atlas::PackOptions packOptions, const std::vector<AtlasPage>& pages) {
+// named is one whose packing was tried and fits. `charts` are packed at `density` (in page texels), so a trial
+// scales them by fits / density. Returns 0 within the budget; over it, the density rule's density gets the
+// density that fits (buildAtlas packs again at it), and a given one is refused.
+double fitTexelBudget(const Scene& scene, const AtlasOptions& options, const std::vector<ChartUv>& charts,
+                      atlas::PackOptions packOptions, double density, const std::vector<AtlasPage>& pages) {
   const size_t texels = pageTexels(pages);
-  if (options.maxTexels == 0 || texels <= options.maxTexels) return;
-  const double density = packOptions.texelsPerUnit;
+  if (options.maxTexels == 0 || texels <= options.maxTexels) return 0.0;
   double fits = density, used = double(texels);
   for (int attempt = 0; attempt < 12 && used > double(options.maxTexels); ++attempt) {
     fits *= std::sqrt(double(options.maxTexels) / used) * 0.97;
-    packOptions.texelsPerUnit = fits;
+    packOptions.texelsPerUnit = fits / density;
     std::vector<ChartUv> trial = charts;  // packing places (and may scale) the charts it is given
     used = double(pageTexels(atlas::packCharts(trial, packOptions).pages));
   }
+  if (!(options.texelsPerUnit > 0.0) && used <= double(options.maxTexels)) return fits;
   // overBudget names 0.97 × its argument: hand it the density that fitted, over 0.97.
   overBudget(scene, options, density, double(texels), fits / 0.97, "needs");
 }
@@ -266,25 +272,69 @@ void chartAllPrimitives(const Scene& scene, const AtlasOptions& options, std::ve
   }
 }
 
-// Texels per unit length: given, or chosen so the charts' area fills about 60% of a texel count that follows
-// the scene: one target page, or texelsPerTriangle per triangle where that is more (capped at
-// maxAutoTexels). Shading varies on the scale of the geometry (columns, mouldings, the sun's shadows of
-// them), so a level with many triangles needs more texels than a box (at one page's density a level's error
-// sits mostly along shadow edges).
-double chooseDensity(const std::vector<ChartUv>& charts, const AtlasOptions& options, const Scene& scene) {
-  double totalArea = 0.0;
-  for (const ChartUv& c : charts) totalArea += c.area3d;
-  double density = options.texelsPerUnit;
-  if (!(density > 0.0)) {
-    const double page = double(options.targetPageSize) * options.targetPageSize;
-    double byTriangles = std::min(double(options.texelsPerTriangle) * double(scene.triangleCount()),
-                                  double(options.maxAutoTexels));
-    // Never past the texel budget by itself: the pages hold about the texels aimed at (charts fill ~60%), so
-    // half the budget leaves room for the packing's slack.
-    if (options.maxTexels > 0) byTriangles = std::min(byTriangles, 0.5 * double(options.maxTexels));
-    density = totalArea > 0.0 ? std::sqrt(0.6 * std::max(page, byTriangles) / totalArea) : 1.0;
+// Each primitive's charts weighed by its lightmapScale²: the area the density rule maps (m²).
+double scaledChartArea(const Scene& scene, const std::vector<PrimitiveCharts>& prims, const std::vector<ChartUv>& charts) {
+  double area = 0.0;
+  for (size_t p = 0; p < prims.size(); ++p) {
+    const double s = scene.primitives[p].lightmapScale;
+    for (size_t c = prims[p].firstChart; c < prims[p].firstChart + prims[p].chartCount; ++c) area += charts[c].area3d * s * s;
   }
+  return area;
+}
+
+// Charts of a primitive with a lightmapScale other than 1 grow by it (their uv are in metres until packing).
+void applyLightmapScales(const Scene& scene, const std::vector<PrimitiveCharts>& prims, std::vector<ChartUv>& charts) {
+  for (size_t p = 0; p < prims.size(); ++p) {
+    const double s = scene.primitives[p].lightmapScale;
+    if (s == 1.0) continue;
+    for (size_t c = prims[p].firstChart; c < prims[p].firstChart + prims[p].chartCount; ++c)
+      for (glm::dvec2& uv : charts[c].uv) uv *= s;
+  }
+}
+
+// The objects (primitives of one node instance) with the fewest packed texels per square metre, fewest first.
+std::vector<ObjectDensity> sparsestObjects(const Scene& scene, const std::vector<PrimitiveCharts>& prims,
+                                           const std::vector<ChartUv>& charts, size_t count) {
+  std::vector<ObjectDensity> objects;
+  std::vector<double> area;
+  std::unordered_map<uint64_t, size_t> objectOf;  // (node, instance) -> index in objects
+  for (size_t p = 0; p < prims.size(); ++p) {
+    const Primitive& prim = scene.primitives[p];
+    const uint64_t key = (uint64_t(uint32_t(prim.node)) << 32) | uint32_t(prim.instance);
+    auto [it, added] = objectOf.try_emplace(key, objects.size());
+    if (added) {
+      objects.push_back({prim.name, prim.node, prim.instance, 0.0});
+      area.push_back(0.0);
+    }
+    for (size_t c = prims[p].firstChart; c < prims[p].firstChart + prims[p].chartCount; ++c) {
+      for (size_t f = 0; f < charts[c].faces.size(); ++f) objects[it->second].texelsPerSquareMetre += std::abs(atlas::uvArea(charts[c], f));
+      area[it->second] += charts[c].area3d;
+    }
+  }
+  std::vector<ObjectDensity> mapped;
+  for (size_t i = 0; i < objects.size(); ++i)
+    if (area[i] > 0.0) {
+      objects[i].texelsPerSquareMetre /= area[i];
+      mapped.push_back(objects[i]);
+    }
+  std::stable_sort(mapped.begin(), mapped.end(),
+                   [](const ObjectDensity& a, const ObjectDensity& b) { return a.texelsPerSquareMetre < b.texelsPerSquareMetre; });
+  if (mapped.size() > count) mapped.resize(count);
+  return mapped;
+}
+
+// The density rule (atlas_estimate.h) on the charts' area: the density used, with its warning.
+double chooseDensity(const Scene& scene, const std::vector<PrimitiveCharts>& prims, const std::vector<ChartUv>& charts,
+                     const AtlasOptions& options, AtlasStats& stats) {
+  const double area = scaledChartArea(scene, prims, charts);
+  const DensityChoice choice = chooseTexelsPerUnit(area, scene.triangleCount(), options);
+  const double density = choice.texelsPerUnit;
   if (!std::isfinite(density) || density <= 0.0) throw Error(ErrorCode::InvalidData, scene.sourcePath, "atlas: no surface area to unwrap");
+  if (choice.lowered) {
+    log::warn("atlas: " + choice.warning);
+    stats.warnings.push_back(choice.warning);
+  }
+  stats.pageSize = choosePageSize(area, density, options);
   return density;
 }
 
@@ -335,6 +385,7 @@ Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& char
   dst.nodeToWorld = src.nodeToWorld;
   dst.normalsComputed = src.normalsComputed;
   dst.lightmap = {page, pg.width, pg.height};
+  dst.lightmapScale = src.lightmapScale;
   const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);
   std::unordered_map<uint64_t, uint32_t> vertexOf;
   auto emit = [&](uint32_t inputVertex, glm::dvec2 texelUv) {
@@ -384,12 +435,32 @@ void emitOnPages(const Primitive& src, const PrimitiveCharts& range, const std::
     out.push_back(primitiveOnPage(src, charts, fc, packed, page, pages[size_t(page)], pagesUsed.size() > 1));
 }
 
+// The log's line: density, pages and the objects with the fewest texels per square metre.
+std::string atlasSummary(const AtlasResult& result) {
+  const AtlasStats& s = result.stats;
+  char text[160];
+  std::snprintf(text, sizeof(text), "%.4g texels per metre, %zu page%s (edge at most %d)", s.texelsPerUnit, result.pages.size(),
+                result.pages.size() == 1 ? "" : "s", s.pageSize);
+  std::string line = text;
+  if (!s.sparsest.empty()) line += "; fewest texels per m²:";
+  for (size_t i = 0; i < s.sparsest.size(); ++i) {
+    std::snprintf(text, sizeof(text), "%s %s (node %d) %.4g", i ? "," : "", s.sparsest[i].name.c_str(), s.sparsest[i].node,
+                  s.sparsest[i].texelsPerSquareMetre);
+    line += text;
+  }
+  return line;
+}
+
 }  // namespace
 
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (options.padding < 0) throw Error(ErrorCode::Usage, "", "atlas padding must be ≥ 0");
   if (options.maxSplitDepth < 0) throw Error(ErrorCode::Usage, "", "atlas split depth must be ≥ 0");
-  if (options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
+  if (options.maxPageSize != 0 && options.maxPageSize < 16) throw Error(ErrorCode::Usage, "", "atlas page size must be ≥ 16");
+  for (const Primitive& p : scene.primitives)
+    if (!(p.lightmapScale > 0.0f) || !std::isfinite(p.lightmapScale))
+      throw Error(ErrorCode::InvalidData, scene.sourcePath,
+                  "primitive \"" + p.name + "\": lightmapScale " + std::to_string(p.lightmapScale) + " is not a positive number");
   checkTexelEstimate(scene, options);
   const Stopwatch total;
   AtlasResult result;
@@ -402,20 +473,32 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   std::vector<ChartUv> charts;
   chartAllPrimitives(scene, options, prims, charts, stats);
   for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
-  stats.texelsPerUnit = chooseDensity(charts, options, scene);
+  stats.texelsPerUnit = chooseDensity(scene, prims, charts, options, stats);
+  applyLightmapScales(scene, prims, charts);
 
   clock.reset();
   atlas::PackOptions packOptions;
   packOptions.texelsPerUnit = stats.texelsPerUnit;
   packOptions.padding = options.padding;
-  packOptions.maxPageSize = options.maxPageSize;
+  packOptions.maxPageSize = stats.pageSize;
   atlas::PackResult packed = atlas::packCharts(charts, packOptions);
   for (const std::string& w : packed.warnings) {
     log::warn("atlas: " + w);
     stats.warnings.push_back(w);
   }
   result.pages = packed.pages;
-  checkTexelBudget(scene, options, charts, packOptions, result.pages);
+  if (const double fits = fitTexelBudget(scene, options, charts, packOptions, stats.texelsPerUnit, result.pages); fits > 0.0) {
+    char text[200];
+    std::snprintf(text, sizeof(text), "the packed atlas was over the budget of %.4g M texels (--max-texels): lowered from %.4g to %.4g "
+                  "texels per metre for every object", double(options.maxTexels) / 1e6, stats.texelsPerUnit, fits);
+    log::warn(std::string("atlas: ") + text);
+    stats.warnings.push_back(text);
+    packOptions.texelsPerUnit = fits / stats.texelsPerUnit;
+    packed = atlas::packCharts(charts, packOptions);
+    result.pages = packed.pages;
+    stats.texelsPerUnit = fits;
+  }
+  stats.sparsest = sparsestObjects(scene, prims, charts, 5);
   stats.secondsPack = clock.seconds();
   progress(0.85);
 
@@ -439,6 +522,7 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   if (stats.degenerateFaces) stats.warnings.push_back(std::to_string(stats.degenerateFaces) + " degenerate faces mapped to a point");
   if (stats.nonManifoldFaces) stats.warnings.push_back(std::to_string(stats.nonManifoldFaces) + " non-manifold faces split off");
   stats.secondsTotal = total.seconds();
+  log::info("atlas: " + atlasSummary(result));
   progress(1.0);
   return result;
 }

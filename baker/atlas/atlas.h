@@ -11,17 +11,18 @@
 namespace irbake {
 
 struct AtlasOptions {
-  double texelsPerUnit = 0.0;  // texels per metre; 0 = auto-fit so the charts fill about one targetPageSize page
-  int targetPageSize = 1024;   // page edge used by the auto-fit when texelsPerUnit is 0
-  float texelsPerTriangle = 64.0f;       // auto-fit: at least this many chart texels per triangle, so a
-                                         // detailed level gets a finer map than one page
-  size_t maxAutoTexels = size_t(1) << 22;  // auto-fit: chart texels never above this (4M), whatever the
-                                           // triangle count
+  double texelsPerUnit = 0.0;  // texels per metre; 0 = the density rule (atlas_estimate.h, docs/guide.md)
+  double autoTexelsPerUnit = 0.0;  // the rule: at least this many texels per metre (the command's --quality sets it)
+  int targetPageSize = 1024;   // the rule's floor for small scenes: the charts fill about one page of this edge
+  float texelsPerTriangle = 64.0f;       // the rule's floor: at least this many chart texels per triangle, so a
+                                         // detailed model gets a finer map than one page
+  size_t maxAutoTexels = size_t(1) << 22;  // the per-triangle floor never asks for more chart texels than this (4M)
   int padding = 2;             // empty texels kept around every chart (bilinear-safe)
-  int maxPageSize = 2048;      // largest page edge; more pages are opened when one is full
+  int maxPageSize = 0;         // largest page edge (more pages are opened when one is full); 0 = the rule's edge
   bool keepUv1 = false;        // keep an input TEXCOORD_1 and only repack its islands
   size_t maxTexels = size_t(1) << 24;  // budget for all pages together (16M texels, 64 MiB per float RGBA
-                                       // layer); over it buildAtlas fails early naming the density that fits.
+                                       // layer): the rule's density is lowered to fit it (with a warning); a
+                                       // given texelsPerUnit over it fails early naming the density that fits.
                                        // 0 = no limit
   int maxSplitDepth = 24;      // bisections of one segmented chart before its faces become one planar chart each
   ProgressCallback progress;   // optional
@@ -29,6 +30,13 @@ struct AtlasOptions {
 
 struct AtlasPage {
   int width = 0, height = 0;   // multiples of 4
+};
+
+// An object's map density: the primitives of one node (instance) together.
+struct ObjectDensity {
+  std::string name;                   // the mesh's name
+  int node = -1, instance = -1;       // the glTF node (and EXT_mesh_gpu_instancing instance, -1: none)
+  double texelsPerSquareMetre = 0.0;  // packed chart texels over its surface area
 };
 
 struct AtlasStats {
@@ -40,7 +48,9 @@ struct AtlasStats {
   double centreUtilisation = 0.0;  // texels whose centre lies inside a triangle / page area
   double areaStretchP5 = 0.0, areaStretchP50 = 0.0, areaStretchP95 = 0.0;
   double l2Stretch = 0.0;
-  double texelsPerUnit = 0.0;      // the density used
+  double texelsPerUnit = 0.0;      // the density used (texels per metre, before per-object lightmapScale)
+  int pageSize = 0;                // the page edge limit used (the rule's or the one given)
+  std::vector<ObjectDensity> sparsest;  // the five objects with the fewest texels per square metre, fewest first
   // Mesh, charts and parameterisation are summed over primitives (which run in parallel); the others are wall.
   double secondsMesh = 0.0, secondsCharts = 0.0, secondsParam = 0.0, secondsPack = 0.0;
   size_t nonManifoldFaces = 0;     // faces given their own vertex copies so the half-edge mesh accepts them
@@ -56,9 +66,17 @@ struct AtlasResult {
   nlohmann::json toJson() const {  // report "atlas": page sizes and the figures a user checks
     nlohmann::json sizes = nlohmann::json::array();
     for (const auto& pg : pages) sizes.push_back({{"width", pg.width}, {"height", pg.height}});
+    nlohmann::json sparsest = nlohmann::json::array();
+    for (const ObjectDensity& o : stats.sparsest)
+      sparsest.push_back({{"name", o.name}, {"node", o.node}, {"instance", o.instance},
+                          {"texelsPerSquareMetre", o.texelsPerSquareMetre}});
     return {{"pages", sizes},
+            {"pageCount", pages.size()},
+            {"pageSize", stats.pageSize},
             {"charts", stats.charts},
             {"texelsPerUnit", stats.texelsPerUnit},
+            {"texelsPerMetre", stats.texelsPerUnit},
+            {"sparsestObjects", sparsest},
             {"centreUtilisation", stats.centreUtilisation},
             {"warnings", stats.warnings}};
   }

@@ -160,7 +160,9 @@ void prepare(BakeState& s) {
   settleLightModes(s.plan, s.options, s.scene, s.texels);
   const bool autoDensity = !(s.options.atlas.texelsPerUnit > 0.0);
   s.plan.settle("texels-per-unit", s.atlas.stats.texelsPerUnit,
-                autoDensity ? "about one page at the preset's size, more for many triangles" : "asked for",
+                autoDensity ? "the density rule: the preset's texels per metre, more for a small scene, less to fit "
+                              "--max-texels (docs/guide.md, \"Texel density\")"
+                            : "asked for",
                 autoDensity);
   timed(s, "vpls", [&] { walkVpls(s); });
   settleWalk(s);
