@@ -12,6 +12,7 @@ namespace irbake {
 
 struct AtlasOptions {
   double texelsPerUnit = 0.0;  // texels per metre; 0 = auto-fit so the charts fill about one targetPageSize page
+  double autoTexelsPerUnit = 16.0;  // the density rule: at least this many texels per metre (--quality sets it)
   int targetPageSize = 1024;   // page edge used by the auto-fit when texelsPerUnit is 0
   float texelsPerTriangle = 64.0f;       // auto-fit: at least this many chart texels per triangle, so a
                                          // detailed level gets a finer map than one page

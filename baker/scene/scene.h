@@ -124,6 +124,7 @@ struct Primitive {
   // flat normals and by the atlas.
   std::vector<uint32_t> sourceVertex;
   LightmapRef lightmap;
+  float lightmapScale = 1.0f;  // texel density multiplier (extras.irbake.lightmapScale on the node or mesh)
   size_t triangleCount() const { return indices.size() / 3; }
 };
 
