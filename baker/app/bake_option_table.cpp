@@ -364,6 +364,8 @@ void addRunRows(std::vector<OptionDescriptor>& t) {
                    opt([](BakeOptions& o) { return &o.gl.gpuTimers; })));
   t.push_back(integer("--threads", 0, 1024, kCommon, "N", "worker threads (default 0: every core; same bytes for any count)",
                       cmd(&BakeCommand::threads), kNotResult));
+  t.push_back(number("--max-memory", 0.0, 1e6, kCommon, "GB", "refuse a bake predicted to need more memory (irbake plan; 0: none)",
+                     opt([](BakeOptions& o) { return &o.maxMemoryGB; }), kNotResult));
   t.push_back(flag("--quiet", kCommon, "warnings and errors only, no progress bars", cmd(&BakeCommand::quiet), kNotResult));
   t.push_back(flag("--verbose", kOutputs, "also the stages' debug lines (e.g. the compensation's sweeps)",
                    cmd(&BakeCommand::verbose), kNotResult));
