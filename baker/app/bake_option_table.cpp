@@ -337,8 +337,7 @@ void addProbeAndOutputRows(std::vector<OptionDescriptor>& t) {
                    opt([](BakeOptions& o) { return &o.directional; })));
   t.push_back(flag("--no-gltf", kOutputs, "write only the EXR pages and the report", cmd(&BakeCommand::noGltf), kNotResult));
   t.push_back(text("--portable", kCommon, "[GLB]",
-                   "also write GLB (in OUTDIR unless it names a folder) for viewers without MOZ_lightmap:\n"
-                   "base colour × light map + emission baked into unlit textures (docs/export.md)",
+                   "also an unlit GLB for viewers without MOZ_lightmap, in OUTDIR unless a folder is named (docs/export.md)",
                    cmd(&BakeCommand::portable), kPath | kNotResult));
   t.back().valueWhenBare = kPortableName;
   t.push_back(number("--portable-exposure", 1e-6, 1e6, kOutputs, "X",

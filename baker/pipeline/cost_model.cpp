@@ -14,6 +14,32 @@ namespace irbake {
 CostCoefficients calibratedCostCoefficients() {
   CostCoefficients c;
   // fit_cost_model.py: begin
+  c.loadPerTriangle = 5.38311e-07;
+  c.atlasPerTriangle = 9.8778e-06;
+  c.atlasPerPageTexel = 1.08106e-07;
+  c.raytracePerTriangle = 1.78892e-06;
+  c.texelsPerPageTexel = 9.75574e-07;
+  c.texelsPerTriangle = 2.47395e-05;
+  c.vplsPerPath = 1.44381e-05;
+  c.importancePerTexelPath = 1.00629e-10;
+  c.backendFixed = 0.902978;
+  c.backendPerTexelPath = 1.00412e-09;
+  c.backendPerLightTexel = 4.27453e-08;
+  c.shadowEdgesPerLightRay = 9.0827e-10;
+  c.skyPerRay = 1.31808e-07;
+  c.compensationPerRay = 4.77695e-07;
+  c.compensationPerTexel = 1.3541e-06;
+  c.gatherPerRay = 1.28166e-07;
+  c.gatherPerTexel = 1.47328e-06;
+  c.postPerPageTexel = 1.7406e-08;
+  c.probesPerRay = 3.80577e-06;
+  c.probesPerProbeLight = 7.96286e-07;
+  c.writePerPageTexel = 4.83853e-07;
+  c.parallelShare = 0.85;
+  c.memoryBaseMiB = 121.087;
+  c.memoryPerTriangle = 0.00268905;
+  c.memoryPerPageTexel = 0.000110486;
+  c.memoryPerTexelPath = 0;
   // fit_cost_model.py: end
   return c;
 }

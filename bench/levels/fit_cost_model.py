@@ -99,24 +99,59 @@ def nnls(rows, targets):
     return best
 
 
-def plan_inputs(irbake, measured):
-    out = subprocess.run([irbake, "plan", measured["scene"], "--json"] + measured["options"], check=True,
-                         capture_output=True, text=True).stdout
-    return json.loads(out)["inputs"]
+def run_plan(irbake, scene, options):
+    t0 = time.time()
+    out = subprocess.run([irbake, "plan", scene, "--json"] + options, check=True, capture_output=True, text=True).stdout
+    return json.loads(out), time.time() - t0
+
+
+def make_run(irbake, measured, seconds, memory):
+    """measured: name, scene, options, wall_s, cpu_s, cores, load_before; seconds: the stages' wall seconds."""
+    plan, plan_s = run_plan(irbake, measured["scene"], measured["options"])
+    cpu_per_wall = measured["cpu_s"] / measured["wall_s"]  # the process's busy cores, whatever the load
+    cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
+    return {"name": measured["name"], "measured": measured, "features": features(plan["inputs"]), "cpu": cpu,
+            "memory": memory, "plan": plan, "plan_s": plan_s}
 
 
 def load(irbake, folder):
     measured = json.load(open(os.path.join(folder, "measured.json")))
     report = json.load(open(os.path.join(folder, "report.json")))
     seconds = dict(report["timings"]["seconds"])
-    wall = seconds.get("bake", 0.0) + seconds.get("load", 0.0)
-    cpu_per_wall = measured["cpu_s"] / measured["wall_s"]  # the process's busy cores, whatever the load
-    seconds["write"] = max(0.0, measured["wall_s"] - wall)  # the outputs, after the report's stages
-    cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
-    if "vplImportance" not in seconds:
-        cpu["vplImportance"] = 0.0
-    return {"name": measured["name"], "measured": measured, "features": features(plan_inputs(irbake, measured)),
-            "cpu": cpu, "memory": report["timings"]["memoryPeakMiB"], "wall": wall}
+    seconds["write"] = max(0.0, measured["wall_s"] - seconds.get("bake", 0.0) - seconds.get("load", 0.0))
+    run = make_run(irbake, measured, seconds, report["timings"]["memoryPeakMiB"])
+    run["density"] = report["atlas"]["texelsPerUnit"]
+    return run
+
+
+# levels_scale.sh's towns: blocks, lamps, cell (None: town.py's default).
+TOWNS = {"town4": (4, 32, None), "town8": (8, 128, None), "town16": (16, 512, None), "town32": (32, 2000, 2.2)}
+
+
+def town_scene(name):
+    blocks, lamps, cell = TOWNS[name]
+    path = os.path.join("build", "levels", "ladder_%s.glb" % name)
+    if not os.path.exists(path):
+        extra = ["--cell", str(cell)] if cell else []
+        subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "town.py"), path, "--blocks", str(blocks),
+                        "--lamps", str(lamps)] + extra, check=True, stdout=subprocess.DEVNULL)
+    return path
+
+
+def load_levels(irbake, path):
+    runs = []
+    for row in csv.DictReader(open(path)):
+        if row["scene"] not in TOWNS or "--shard" in row["options"]:
+            continue
+        options = row["options"].split() + ["--texels-per-unit", row["texels_per_m"]]
+        measured = {"name": "%s_run%s" % (row["scene"], row["run"]), "scene": town_scene(row["scene"]), "options": options,
+                    "wall_s": float(row["wall_s"]), "cpu_s": float(row["cpu_s"]), "cores": 2,
+                    "load_before": float(row["load_avg_start"]), "load_after": float(row["load_avg_end"])}
+        seconds = {k[:-2]: float(v) for k, v in row.items() if k.endswith("_s") and v not in ("", None)}
+        seconds["write"] = seconds.get("export", 0.0)
+        runs.append(make_run(irbake, measured, seconds, float(row["peak_mib"])))
+        runs[-1]["density"] = float(row["texels_per_m"])
+    return runs
 
 
 def fit(runs):
