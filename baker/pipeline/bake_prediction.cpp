@@ -102,7 +102,7 @@ void checkMemoryLimit(const BakePrediction& prediction, double maxMemoryGB, cons
               "the bake is predicted to need " + gbText(peak) + " of memory at its peak, over --max-memory " + limit +
                   " (about " + std::to_string(long(prediction.atlas.pageTexels)) + " page texels, " +
                   std::to_string(long(prediction.inputs.triangles)) +
-                  " triangles): lower the density (--tpu, --quality preview) or raise --max-memory");
+                  " triangles): lower the density (--texels-per-unit, --quality preview) or raise --max-memory");
 }
 
 }  // namespace irbake

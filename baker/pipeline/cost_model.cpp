@@ -14,31 +14,31 @@ namespace irbake {
 CostCoefficients calibratedCostCoefficients() {
   CostCoefficients c;
   // fit_cost_model.py: begin
-  c.loadPerTriangle = 5.38311e-07;
-  c.atlasPerTriangle = 9.8778e-06;
-  c.atlasPerPageTexel = 1.08106e-07;
-  c.raytracePerTriangle = 1.78892e-06;
-  c.texelsPerPageTexel = 9.75574e-07;
-  c.texelsPerTriangle = 2.47395e-05;
-  c.vplsPerPath = 1.44381e-05;
-  c.importancePerTexelPath = 1.00629e-10;
-  c.backendFixed = 0.902978;
-  c.backendPerTexelPath = 1.00412e-09;
-  c.backendPerLightTexel = 4.27453e-08;
-  c.shadowEdgesPerLightRay = 9.0827e-10;
-  c.skyPerRay = 1.31808e-07;
-  c.compensationPerRay = 4.77695e-07;
-  c.compensationPerTexel = 1.3541e-06;
-  c.gatherPerRay = 1.28166e-07;
-  c.gatherPerTexel = 1.47328e-06;
-  c.postPerPageTexel = 1.7406e-08;
-  c.probesPerRay = 3.80577e-06;
-  c.probesPerProbeLight = 7.96286e-07;
-  c.writePerPageTexel = 4.83853e-07;
+  c.loadPerTriangle = 2.5304e-07;
+  c.atlasPerTriangle = 3.34184e-06;
+  c.atlasPerPageTexel = 1.26379e-07;
+  c.raytracePerTriangle = 1.4308e-06;
+  c.texelsPerPageTexel = 1.05197e-06;
+  c.texelsPerTriangle = 1.96366e-06;
+  c.vplsPerPath = 1.31289e-05;
+  c.importancePerTexelPath = 1.21357e-10;
+  c.backendFixed = 0.847738;
+  c.backendPerTexelPath = 8.55067e-10;
+  c.backendPerLightTexel = 4.36667e-08;
+  c.shadowEdgesPerLightRay = 9.51939e-10;
+  c.skyPerRay = 1.17619e-07;
+  c.compensationPerRay = 5.04334e-09;
+  c.compensationPerTexel = 2.31682e-06;
+  c.gatherPerRay = 6.56773e-08;
+  c.gatherPerTexel = 2.13485e-06;
+  c.postPerPageTexel = 1.82561e-08;
+  c.probesPerRay = 2.99883e-06;
+  c.probesPerProbeLight = 1.08171e-05;
+  c.writePerPageTexel = 5.32289e-07;
   c.parallelShare = 0.85;
-  c.memoryBaseMiB = 121.087;
-  c.memoryPerTriangle = 0.00268905;
-  c.memoryPerPageTexel = 0.000110486;
+  c.memoryBaseMiB = 120.256;
+  c.memoryPerTriangle = 0.000593771;
+  c.memoryPerPageTexel = 0.000126465;
   c.memoryPerTexelPath = 0;
   // fit_cost_model.py: end
   return c;
@@ -95,16 +95,25 @@ CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
 
 namespace {
 
-// Surface area binned by triangle centroid into cubes of one edge: the area within a sphere is the cubes'
-// whose centre lies in it.
+// Surface area binned by triangle centroid into cubes of one edge, each cube's area at its area-weighted
+// centroid: the area within a sphere is the cubes' whose centroid lies in it.
 struct AreaGrid {
+  struct Cell {
+    double area = 0.0;
+    glm::dvec3 weighted{0.0};  // sum of area × centroid
+  };
   double cell = 1.0;
-  std::unordered_map<uint64_t, double> area;
+  std::unordered_map<uint64_t, Cell> cells;
   static uint64_t key(long x, long y, long z) {
     const uint64_t m = (1u << 21) - 1;
     return (uint64_t(x) & m) | ((uint64_t(y) & m) << 21) | ((uint64_t(z) & m) << 42);
   }
   long index(double v) const { return long(std::floor(v / cell)); }
+  void add(const glm::dvec3& centroid, double area) {
+    Cell& c = cells[key(index(centroid.x), index(centroid.y), index(centroid.z))];
+    c.area += area;
+    c.weighted += area * centroid;
+  }
   double within(const glm::vec3& centre, double radius) const {
     const long r = long(std::ceil(radius / cell)) + 1;
     const long cx = index(centre.x), cy = index(centre.y), cz = index(centre.z);
@@ -112,10 +121,9 @@ struct AreaGrid {
     for (long x = cx - r; x <= cx + r; ++x)
       for (long y = cy - r; y <= cy + r; ++y)
         for (long z = cz - r; z <= cz + r; ++z) {
-          const glm::dvec3 mid((x + 0.5) * cell, (y + 0.5) * cell, (z + 0.5) * cell);
-          if (glm::length(mid - glm::dvec3(centre)) > radius) continue;
-          const auto it = area.find(key(x, y, z));
-          if (it != area.end()) sum += it->second;
+          const auto it = cells.find(key(x, y, z));
+          if (it == cells.end() || !(it->second.area > 0.0)) continue;
+          if (glm::length(it->second.weighted / it->second.area - glm::dvec3(centre)) <= radius) sum += it->second.area;
         }
     return sum;
   }
@@ -141,8 +149,9 @@ double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, bool reac
   grid.cell = gridCell(scene);
   for (const Primitive& p : scene.primitives)
     for (size_t t = 0; t < p.triangleCount(); ++t) {
-      const glm::vec3 c = (p.positions[p.indices[3 * t]] + p.positions[p.indices[3 * t + 1]] + p.positions[p.indices[3 * t + 2]]) / 3.0f;
-      grid.area[AreaGrid::key(grid.index(c.x), grid.index(c.y), grid.index(c.z))] += triangleArea(p, t);
+      const glm::dvec3 c = (glm::dvec3(p.positions[p.indices[3 * t]]) + glm::dvec3(p.positions[p.indices[3 * t + 1]]) +
+                            glm::dvec3(p.positions[p.indices[3 * t + 2]])) / 3.0;
+      grid.add(c, triangleArea(p, t));
     }
   const double perArea = atlas.texelsPerUnit * atlas.texelsPerUnit;
   for (const Light& l : scene.lights)

@@ -69,7 +69,7 @@ TEST(CostModel, WallTimeIsTheCpuTimeOverTheBusyCores) {
 TEST(CostModel, LightReachIsTheSurfaceWithinTheRange) {
   // A 100 m floor in 0.5 m quads; a lamp of range 6 m on it lights a disc of π 6² m², a lamp of range 6 m 4 m
   // above it a disc of π (6² − 4²) m², a lamp without range all of it. The area is binned in cubes of a third of
-  // the smallest range, counted where a cube's centre lies in the sphere: within 20% of the disc.
+  // the smallest range, counted where a cube's area-weighted centroid lies in the sphere: within 20% of the disc.
   Scene s;
   const int m = addMaterial(s, glm::vec3(0.5f));
   addQuad(s, m, glm::vec3(-50, 0, -50), glm::vec3(100, 0, 0), glm::vec3(0, 0, 100), 200);

@@ -124,15 +124,15 @@ def load(irbake, folder):
     return run
 
 
-# levels_scale.sh's towns: blocks, lamps, cell (None: town.py's default).
-TOWNS = {"town4": (4, 32, None), "town8": (8, 128, None), "town16": (16, 512, None), "town32": (32, 2000, 2.2)}
+# levels_scale.sh's towns: blocks, lamps, town.py's further options.
+TOWNS = {"town4": (4, 32, []), "town8": (8, 128, []), "town16": (16, 512, []), "town32": (32, 2000, ["--cell", "2.2"]),
+         "lamps_range": (16, 1000, []), "lamps_norange": (16, 1000, ["--range", "0"])}
 
 
 def town_scene(name):
-    blocks, lamps, cell = TOWNS[name]
+    blocks, lamps, extra = TOWNS[name]
     path = os.path.join("build", "levels", "ladder_%s.glb" % name)
     if not os.path.exists(path):
-        extra = ["--cell", str(cell)] if cell else []
         subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "town.py"), path, "--blocks", str(blocks),
                         "--lamps", str(lamps)] + extra, check=True, stdout=subprocess.DEVNULL)
     return path
@@ -143,7 +143,9 @@ def load_levels(irbake, path):
     for row in csv.DictReader(open(path)):
         if row["scene"] not in TOWNS or "--shard" in row["options"]:
             continue
-        options = row["options"].split() + ["--texels-per-unit", row["texels_per_m"]]
+        options = row["options"].split()
+        if "--texels-per-unit" not in options:  # the density the bake had, so the plan predicts its atlas
+            options += ["--texels-per-unit", row["texels_per_m"]]
         measured = {"name": "%s_run%s" % (row["scene"], row["run"]), "scene": town_scene(row["scene"]), "options": options,
                     "wall_s": float(row["wall_s"]), "cpu_s": float(row["cpu_s"]), "cores": 2,
                     "load_before": float(row["load_avg_start"]), "load_after": float(row["load_avg_end"])}

@@ -6,7 +6,8 @@
 # machine's wall time the CPU time implies, the plan's own time and the load average. The machine is shared, so
 # the CPU time is compared and the wall time recorded. From the repository root after a Release build:
 #   HOLD_OUT=town8_sunsky_tpu3_preview,sponza_sunsky_preview bash bench/levels/plan_accuracy.sh [IRBAKE]
-# HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names).
+# HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV another
+# level ladder's CSV.
 set -euo pipefail
 IRBAKE=${1:-build/baker/irbake}
 W=build/calibration
@@ -32,7 +33,8 @@ bake town8_sunsky_tpu3_preview build/levels/town8.glb $SUN $SKY --texels-per-uni
 bake sponza_sun $SHARED/dabrovic_sponza/sponza.glb $SUN
 bake sponza_sunsky_preview $SHARED/dabrovic_sponza/sponza.glb $SUN $SKY --quality preview
 LEVELS=()
-[[ -f bench/results/levels_scale.csv ]] && LEVELS=(--levels bench/results/levels_scale.csv)
+LEVELS_CSV=${LEVELS_CSV:-bench/results/levels_scale.csv}
+[[ -f $LEVELS_CSV ]] && LEVELS=(--levels "$LEVELS_CSV")
 python3 bench/levels/fit_cost_model.py "$IRBAKE" $W/*/ "${LEVELS[@]}" --hold-out "${HOLD_OUT:-}" \
   --accuracy bench/results/plan_accuracy.csv > /dev/null
 tail -n +2 bench/results/plan_accuracy.csv
