@@ -344,8 +344,7 @@ void addProbeAndOutputRows(std::vector<OptionDescriptor>& t) {
                    opt([](BakeOptions& o) { return &o.directional; })));
   t.push_back(flag("--no-gltf", kOutputs, "write only the EXR pages and the report", cmd(&BakeCommand::noGltf), kNotResult));
   t.push_back(text("--portable", kCommon, "[GLB]",
-                   "also write GLB (in OUTDIR unless it names a folder) for viewers without MOZ_lightmap:\n"
-                   "base colour × light map + emission baked into unlit textures (docs/export.md)",
+                   "also an unlit GLB for viewers without MOZ_lightmap, in OUTDIR unless a folder is named (docs/export.md)",
                    cmd(&BakeCommand::portable), kPath | kNotResult));
   t.back().valueWhenBare = kPortableName;
   t.push_back(number("--portable-exposure", 1e-6, 1e6, kOutputs, "X",
@@ -371,6 +370,8 @@ void addRunRows(std::vector<OptionDescriptor>& t) {
                    opt([](BakeOptions& o) { return &o.gl.gpuTimers; })));
   t.push_back(integer("--threads", 0, 1024, kCommon, "N", "worker threads (default 0: every core; same bytes for any count)",
                       cmd(&BakeCommand::threads), kNotResult));
+  t.push_back(number("--max-memory", 0.0, 1e6, kCommon, "GB", "refuse a bake predicted to need more memory (irbake plan; 0: none)",
+                     opt([](BakeOptions& o) { return &o.maxMemoryGB; }), kNotResult));
   t.push_back(flag("--quiet", kCommon, "warnings and errors only, no progress bars", cmd(&BakeCommand::quiet), kNotResult));
   t.push_back(flag("--verbose", kOutputs, "also the stages' debug lines (e.g. the compensation's sweeps)",
                    cmd(&BakeCommand::verbose), kNotResult));

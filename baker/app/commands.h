@@ -13,4 +13,5 @@ int runMerge(const Args& args);
 int runDiff(const Args& args);
 int runSamples(const Args& args);
 int runProbe(const Args& args);
+int runPlan(const Args& args);
 }  // namespace irbake::app

@@ -15,6 +15,7 @@ const char* kUsage =
     "commands:\n"
     "  info SCENE                       print a summary of a glTF scene\n"
     "  unwrap IN -o OUT [options]       add a lightmap UV set (TEXCOORD_1)\n"
+    "  plan SCENE [options]             predict a bake (atlas, choices, time, memory) without baking\n"
     "  bake SCENE -o OUTDIR [options]   bake light maps (EXR) and export glTF with MOZ_lightmap\n"
     "  merge DIR... -o OUTDIR           finish a bake from its shards (bake --shard K/N)\n"
     "  diff A B                         compare two bakes of the same atlas\n"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "info") return irbake::app::runInfo(args);
     if (cmd == "unwrap") return irbake::app::runUnwrap(args);
+    if (cmd == "plan") return irbake::app::runPlan(args);
     if (cmd == "bake") return irbake::app::runBake(args);
     if (cmd == "merge") return irbake::app::runMerge(args);
     if (cmd == "diff") return irbake::app::runDiff(args);

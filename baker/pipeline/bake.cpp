@@ -234,6 +234,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   report["timings"]["seconds"] = s.seconds;
   report["timings"]["backendParts"] = s.backendParts;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
+  report["prediction"] = s.prediction.cost.toJson();  // the preflight's, beside the measured timings
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);
   s.gather = {};

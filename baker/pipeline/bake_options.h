@@ -100,6 +100,8 @@ struct BakeOptions {
                                             // of each over earlier ones; any over the glTF's extras.irbake.mode)
   ErrorEstimateOptions errorEstimate;     // the bake's own error from independent replicates of the walk, and
                                           // --target-error's rounds (off: one walk, the same bytes as before)
+  double maxMemoryGB = 0.0;               // refuse up front a bake predicted to need more memory at its peak
+                                          // (GB of 10^9 bytes; pipeline/bake_prediction.h); 0: no limit
   ProgressCallback progress;
 };
 

@@ -172,11 +172,11 @@ void settleCompensation(BakePlan& plan, const BakeOptions& options, const std::f
 // The sky: a uniform sky in a scene without see-through surfaces is counted by the final gather's escaping
 // rays (its cosine rays are the sky stage's own estimator), so the sky stage's light is read only at its hits
 // and half its rays do.
-void settleSky(BakePlan& plan, const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options) {
+void settleSky(BakePlan& plan, const Scene& scene, bool transmission, const BakeOptions& options) {
   plan.sky = options.sky;
   plan.sky.seed = options.walk.seed;
   plan.skyByGather = plan.finalGather && scene.environment.present() && scene.environment.isUniform() &&
-                     !rayTracer.hasTransmission();
+                     !transmission;
   if (plan.skyByGather) {
     plan.sky.minRays = std::min(plan.sky.minRays, 4);
     plan.settle("sky-by-gather", "on", "a uniform sky: the final gather's escaping rays count it");
@@ -245,13 +245,24 @@ void settleProbes(BakePlan& plan, const Scene& scene, const BakeOptions& options
 
 BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
                   const std::function<GlProbe()>& probeGl) {
+  return planBake(scene, rayTracer.hasTransmission(), options, probeGl);
+}
+
+bool hasTransmissiveMaterial(const Scene& scene) {
+  for (const Primitive& p : scene.primitives)
+    if (scene.materials[p.material].isTransmissive()) return true;
+  return false;
+}
+
+BakePlan planBake(const Scene& scene, bool transmission, const BakeOptions& options,
+                  const std::function<GlProbe()>& probeGl) {
   BakePlan plan;
   plan.directional = options.directional;
   settleBackend(plan, scene, options, probeGl);
   settleFinalGather(plan, scene, options);
   settleWalk(plan, scene, options);
   settleCompensation(plan, options, probeGl);
-  settleSky(plan, scene, rayTracer, options);
+  settleSky(plan, scene, transmission, options);
   plan.shadowEdges = options.shadowEdges;
   settleProbes(plan, scene, options);
   plan.shadowMask = options.shadowMask;

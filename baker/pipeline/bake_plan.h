@@ -75,6 +75,12 @@ std::string seeThroughMaterials(const Scene& scene);
 // context (the caller keeps it) and is called where the choice depends on it.
 BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOptions& options,
                   const std::function<GlProbe()>& probeGl);
+// The same before any ray tracer is built: transmission says whether a surface is see-through to shadow rays
+// (RayTracer::hasTransmission, as hasTransmissiveMaterial finds it).
+BakePlan planBake(const Scene& scene, bool transmission, const BakeOptions& options,
+                  const std::function<GlProbe()>& probeGl);
+// Whether a primitive's material lets light through (BLEND or KHR_materials_transmission), as the ray tracer finds it.
+bool hasTransmissiveMaterial(const Scene& scene);
 
 // Each punctual light's mode (--light-mode, extras, baked) and the shadow-mask channels; a shadow-mask light
 // that gets no channel falls back to indirect with a warning naming it. Throws Error(Usage) for a bad name or

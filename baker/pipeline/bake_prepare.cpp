@@ -153,6 +153,9 @@ void planBlocks(BakeState& s) {
 }  // namespace
 
 void prepare(BakeState& s) {
+  // The preflight first: a bake predicted over --max-memory is refused before any work.
+  s.prediction = predictBake(s.scene, s.options, bakeCores());
+  checkMemoryLimit(s.prediction, s.options.maxMemoryGB, s.scene.sourcePath);
   buildGeometry(s);
   // The backend first (the GL context is made here: its time counts to the backend, as it did): the
   // reference backend reads no VPLs, so it needs no VPL selection.

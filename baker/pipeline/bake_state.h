@@ -18,6 +18,7 @@
 #include "pipeline/bake.h"
 #include "pipeline/bake_options.h"
 #include "pipeline/bake_plan.h"
+#include "pipeline/bake_prediction.h"
 #include "pipeline/bake_stages.h"
 #include "pipeline/evaluator_factory.h"
 #include "pipeline/vpl_sums.h"
@@ -59,6 +60,7 @@ struct BakeState {
   std::vector<TexelSamples> texels;
   VplSet vpls;
   BakePlan plan;                           // every automatic choice, settled once
+  BakePrediction prediction;               // the preflight's time and memory, made before any work (report "prediction")
   VplImportanceStats importanceStats;
   EvaluatorDevices devices;                // the GL context, while the plan may choose GL
   std::unique_ptr<Evaluator> evaluator;    // the plan's, made once it is chosen (it keeps its own figures)

@@ -1,0 +1,113 @@
+// The cost model and the preflight: more work predicts more time and memory, the lights' reach is the
+// surface within their range, and the prediction of a sample scene is complete.
+#include "pipeline/cost_model.h"
+#include "pipeline/bake_prediction.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/error.h"
+#include "samples/sample_scenes.h"
+#include "testing/scenes.h"
+
+namespace irbake {
+namespace {
+
+using testing::addMaterial;
+using testing::addQuad;
+using testing::pointLight;
+
+CostInputs levelInputs() {
+  CostInputs in;
+  in.triangles = 2e5;
+  in.texels = 2e6;
+  in.pageTexels = 2.5e6;
+  in.pages = 1;
+  in.paths = 3072;
+  in.punctualLights = 100;
+  in.lightTexels = 100 * in.texels;
+  in.skyRays = 16 * in.texels;
+  in.compensationRays = 2e6;
+  in.gatherRays = 16 * in.texels;
+  in.shadowEdgeRays = 64;
+  in.probes = 2048;
+  in.probeRays = 256;
+  in.cores = 2;
+  return in;
+}
+
+TEST(CostModel, MoreTexelsCostMoreTimeAndMemory) {
+  const CostInputs small = levelInputs();
+  CostInputs large = small;
+  for (double* v : {&large.texels, &large.pageTexels, &large.lightTexels, &large.skyRays, &large.gatherRays}) *v *= 4.0;
+  const CostPrediction a = predictCost(small), b = predictCost(large);
+  EXPECT_GT(b.seconds, a.seconds);
+  EXPECT_GT(b.memoryPeakMiB, a.memoryPeakMiB);
+  for (const char* stage : {"texels", "backend", "post", "finalGather", "sky", "shadowEdges", "write"})
+    EXPECT_GE(b.perStage.at(stage), a.perStage.at(stage)) << stage;
+  // Each texel-bound stage that costs anything costs more; none costs less.
+  size_t grew = 0;
+  for (const auto& [stage, s] : a.perStage) grew += b.perStage.at(stage) > s;
+  EXPECT_GE(grew, 3u);
+}
+
+TEST(CostModel, WallTimeIsTheCpuTimeOverTheBusyCores) {
+  CostInputs one = levelInputs();
+  one.cores = 1;
+  CostInputs four = one;
+  four.cores = 4;
+  const CostPrediction a = predictCost(one), b = predictCost(four);
+  EXPECT_NEAR(a.cpuSeconds, b.cpuSeconds, 1e-9 * a.cpuSeconds);
+  EXPECT_NEAR(a.seconds / b.seconds, 4.0, 1e-9);
+  EXPECT_GT(a.seconds, 0.0);
+  double sum = 0.0;
+  for (const auto& [stage, s] : a.perStage) sum += s;
+  EXPECT_NEAR(sum, a.seconds, 1e-9 * a.seconds);
+}
+
+TEST(CostModel, LightReachIsTheSurfaceWithinTheRange) {
+  // A 100 m floor in 0.5 m quads; a lamp of range 6 m on it lights a disc of π 6² m², a lamp of range 6 m 4 m
+  // above it a disc of π (6² − 4²) m², a lamp without range all of it. The area is binned in cubes of a third of
+  // the smallest range, counted where a cube's area-weighted centroid lies in the sphere: within 20% of the disc.
+  Scene s;
+  const int m = addMaterial(s, glm::vec3(0.5f));
+  addQuad(s, m, glm::vec3(-50, 0, -50), glm::vec3(100, 0, 0), glm::vec3(0, 0, 100), 200);
+  Light onFloor = pointLight(glm::vec3(0.3f, 0.0f, 0.2f), 1.0f), above = pointLight(glm::vec3(10, 4, 10), 1.0f);
+  onFloor.range = above.range = 6.0f;
+  s.lights = {onFloor, above};
+  AtlasEstimate atlas;
+  atlas.texelsPerUnit = 4.0;
+  atlas.texels = 1e4 * 16.0;
+  const double perArea = 16.0, pi = std::acos(-1.0);
+  const double both = lightTexelReach(s, atlas, true);
+  s.lights = {onFloor};
+  EXPECT_NEAR(lightTexelReach(s, atlas, true) / (pi * 36.0 * perArea), 1.0, 0.2);
+  EXPECT_NEAR((both - lightTexelReach(s, atlas, true)) / (pi * 20.0 * perArea), 1.0, 0.2);
+  s.lights.push_back(pointLight(glm::vec3(0, 3, 0), 1.0f));  // no range: every texel
+  EXPECT_NEAR(lightTexelReach(s, atlas, true) - lightTexelReach(s, atlas, false) / 2.0, pi * 36.0 * perArea,
+              0.2 * pi * 36.0 * perArea);
+  EXPECT_DOUBLE_EQ(lightTexelReach(s, atlas, false), 2.0 * atlas.texels);  // every light at every texel
+}
+
+TEST(BakePrediction, CornellBoxIsPredictedWithEveryPart) {
+  const Scene box = samples::makeCornellBox();
+  BakeOptions o;
+  o.finalGather = FinalGatherMode::Auto;
+  const BakePrediction p = predictBake(box, o, 2.0);
+  EXPECT_EQ(p.atlas.pages, 1);
+  EXPECT_GT(p.atlas.texels, 0.0);
+  EXPECT_EQ(p.inputs.triangles, double(box.triangleCount()));
+  EXPECT_TRUE(std::isfinite(p.cost.seconds) && p.cost.seconds > 0.0);
+  EXPECT_TRUE(std::isfinite(p.cost.memoryPeakMiB) && p.cost.memoryPeakMiB > 0.0);
+  EXPECT_EQ(p.plan.choices.at("clamp").value, kSettledAtBake);  // derived from the walk's VPLs
+  EXPECT_EQ(p.plan.choices.at("final-gather").value, "off");    // an emissive quad: the bake's own rule
+  EXPECT_TRUE(p.cost.perStage.count("backend"));
+  EXPECT_FALSE(p.cost.perStage.count("finalGather"));
+  EXPECT_THROW(checkMemoryLimit(p, 1e-6, "box.gltf"), Error);
+  EXPECT_NO_THROW(checkMemoryLimit(p, 1e6, "box.gltf"));
+  EXPECT_NO_THROW(checkMemoryLimit(p, 0.0, "box.gltf"));
+}
+
+}  // namespace
+}  // namespace irbake

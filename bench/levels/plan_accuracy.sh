@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The preflight against the bake on the level sizes: bakes the calibration levels (bench/levels/cost_bakes.py,
+# into build/calibration; a folder with a measured.json is kept, REBAKE=1 bakes again), then appends to
+# bench/results/plan_accuracy.csv one row per bake, and per row of the level ladder (levels_scale.csv): the
+# binary's `plan --json` prediction against the measured CPU seconds and peak memory, their ratios, the idle
+# machine's wall time the CPU time implies, the plan's own time and the load average. The machine is shared, so
+# the CPU time is compared and the wall time recorded. From the repository root after a Release build:
+#   HOLD_OUT=town8_sunsky_tpu3_preview,sponza_sunsky_preview bash bench/levels/plan_accuracy.sh [IRBAKE]
+# HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV another
+# level ladder's CSV.
+set -euo pipefail
+IRBAKE=${1:-build/baker/irbake}
+W=build/calibration
+SHARED=../shared/scenes
+SUN="--sun 0.35,-1,0.2,5"
+SKY="--sky 0.4,0.5,0.7"
+mkdir -p $W build/levels
+bake() {  # name scene options...
+  local name=$1 scene=$2; shift 2
+  [[ -f $scene ]] || { echo "plan_accuracy: $scene not found, skipped"; return 0; }
+  [[ -f $W/$name/measured.json && ${REBAKE:-0} != 1 ]] || python3 bench/levels/cost_bakes.py "$IRBAKE" $W "$name" "$scene" "$@"
+}
+[[ -f build/levels/town4.glb ]] || python3 bench/levels/town.py build/levels/town4.glb --blocks 4 --lamps 32 --cell 2.2
+[[ -f build/levels/town6.glb ]] || python3 bench/levels/town.py build/levels/town6.glb --blocks 6 --lamps 64
+[[ -f build/levels/town8.glb ]] || python3 bench/levels/town.py build/levels/town8.glb --blocks 8 --lamps 128
+[[ -f build/scenes/cornell_box.gltf ]] || "$IRBAKE" samples build/scenes --quiet
+bake cornell_default build/scenes/cornell_box.gltf
+bake cornell_preview build/scenes/cornell_box.gltf --quality preview
+bake town4_sunsky_tpu4 build/levels/town4.glb $SUN $SKY --texels-per-unit 4
+bake town4_sun_tpu6 build/levels/town4.glb $SUN --texels-per-unit 6
+bake town6_sun_tpu5_preview build/levels/town6.glb $SUN --texels-per-unit 5 --quality preview
+bake town8_sunsky_tpu3_preview build/levels/town8.glb $SUN $SKY --texels-per-unit 3 --quality preview
+bake sponza_sun $SHARED/dabrovic_sponza/sponza.glb $SUN
+bake sponza_sunsky_preview $SHARED/dabrovic_sponza/sponza.glb $SUN $SKY --quality preview
+LEVELS=()
+LEVELS_CSV=${LEVELS_CSV:-bench/results/levels_scale.csv}
+[[ -f $LEVELS_CSV ]] && LEVELS=(--levels "$LEVELS_CSV")
+python3 bench/levels/fit_cost_model.py "$IRBAKE" $W/*/ "${LEVELS[@]}" --hold-out "${HOLD_OUT:-}" \
+  --accuracy bench/results/plan_accuracy.csv > /dev/null
+tail -n +2 bench/results/plan_accuracy.csv
