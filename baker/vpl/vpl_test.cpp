@@ -251,7 +251,9 @@ TEST(Walk, FirstHitsOfALightWithARangeCarryItsWindow) {
     if (v.bounce != 1) continue;
     const float d = glm::length(v.position - l.position);
     EXPECT_LT(d, R);
-    EXPECT_NEAR(v.power.x, perVpl * l.rangeWindow(d), 1e-4 * perVpl) << "at " << d << " m";
+    // (1e-3: the VPL sits inset from its hit by the ray tracer's epsilon, and the window falls by at most 2.42/R
+    // per metre)
+    EXPECT_NEAR(v.power.x, perVpl * l.rangeWindow(d), 1e-3 * perVpl) << "at " << d << " m";
     firstBounce += v.power.x;
     ++n;
   }

@@ -61,7 +61,7 @@ const port = server.address().port;
 const { browser, tab, log } = await openTab(puppeteer, { chromium: args.chromium, width, height });
 let code = 0;
 try {
-  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene))}`, width, height,
+  const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene ?? ''))}`, width, height,
                                   lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz', standard: args.standard ?? '1' });
   if (camera !== undefined) q.set('camera', camera);  // none: the viewer's default (camera 0, or the overview)
   const imageUrl = image ? `/ref/${encodeURIComponent(path.basename(image))}` : null;
