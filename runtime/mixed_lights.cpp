@@ -17,9 +17,10 @@ glm::vec3 runtimeLightIrradiance(const Light& light, const glm::vec3& p, const g
   const glm::vec3 d = kind.toward(light, p);
   if (kind.atInfinity()) return light.color * light.intensity * std::max(0.0f, glm::dot(n, d));
   const float r2 = std::max(glm::dot(d, d), 1e-20f), r = std::sqrt(r2);
-  if (light.rangeWindow(r) == 0.0f) return glm::vec3(0.0f);
+  const float window = light.rangeWindow(r);
+  if (window == 0.0f) return glm::vec3(0.0f);
   const glm::vec3 l = d / r;
-  return kind.intensityToward(light, -l) * (std::max(0.0f, glm::dot(n, l)) / r2);
+  return kind.intensityToward(light, -l) * (std::max(0.0f, glm::dot(n, l)) / r2 * window);
 }
 
 MixedLights::MixedLights(const ViewerScene& v) : scene_(v), lights_(v.scene.runtimeLights) {

@@ -253,7 +253,7 @@ struct ViewRenderer::Impl {
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
-                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "view_mixed_lights.glsl", "view_mesh.frag"}}},
+                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "light_range.glsl", "view_mixed_lights.glsl", "view_mesh.frag"}}},
                                  defines, "330 core"))
                .first;
     }

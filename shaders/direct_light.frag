@@ -1,5 +1,6 @@
 // Direct light from one punctual light (KHR_lights_punctual) with its shadow map, exact apart from
-// the shadow-map resolution: value = I(ω) cosθx / r² / π (point, spot, IES) or E cosθx / π (directional).
+// the shadow-map resolution: value = I(ω) cosθx / r² · window(r) / π (point, spot, IES; window: glTF's range,
+// light_range.glsl) or E cosθx / π (directional).
 layout(binding = BAKE_UNIT_POSITION_WEIGHT) uniform sampler2DArray gPositionWeight;
 layout(binding = BAKE_UNIT_NORMAL) uniform sampler2DArray gNormal;
 layout(binding = BAKE_UNIT_LIGHT_CUBE) uniform sampler2DArray cubeMaps;     // point (and wide spot): 6 face layers
@@ -17,7 +18,7 @@ uniform vec3 lightPosition;
 uniform vec3 lightDirection;   // direction light travels (spot, directional); IES: the profile's nadir
 uniform vec3 lightAxisX;       // IES: the profile's horizontal angle 0 (unit, orthogonal to lightDirection)
 uniform vec3 lightIntensity;   // colour × intensity (W/sr or W/m²)
-uniform float lightRange;      // 0: infinite
+uniform float lightRange;      // 0: infinite (rangeWindow)
 uniform float cosOuter, spotScale;  // spot falloff: t = clamp((cos − cosOuter)·spotScale, 0, 1), I·t²
 uniform mat4 shadowClip;       // 2D maps: world → clip
 uniform mat4 shadowClipInverse;  // 2D maps: clip → world (contact check)
@@ -157,7 +158,8 @@ void main() {
     } else {
       vec3 d = lightPosition - pw.xyz;
       r = length(d);
-      if (r <= 0.0 || (lightRange > 0.0 && r > lightRange)) continue;
+      float window = rangeWindow(r, lightRange);
+      if (r <= 0.0 || window == 0.0) continue;
       toLight = d / r;
       vec3 I = lightIntensity;
       if (lightType == BAKE_LIGHT_SPOT) {
@@ -166,7 +168,7 @@ void main() {
       } else if (lightType == BAKE_LIGHT_IES) {
         I *= iesCandela(-toLight);
       }
-      e = I / (r * r);
+      e = I / (r * r) * window;
     }
     float cosTheta = dot(n, toLight);
     vec3 ng = texelFetch(gGeomNormal, ivec3(px, l), 0).xyz;

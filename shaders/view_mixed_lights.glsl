@@ -1,6 +1,7 @@
 // irview's mixed lights (runtime/mixed_lights.h): the direct irradiance of the lights an export leaves to the
-// client, in glTF's units (KHR_lights_punctual): E = I cosθ / r² for point and spot (spot falloff as the
-// baker's spot light kind, baker/lights/spot_light.cpp), E = I cosθ for directional; times the light's shadow-mask channel.
+// client, in glTF's units (KHR_lights_punctual): E = I cosθ / r² · window(r) for point and spot (window: glTF's
+// range as the bake applies it, light_range.glsl; spot falloff as the baker's spot light kind,
+// baker/lights/spot_light.cpp), E = I cosθ for directional; times the light's shadow-mask channel.
 // Concatenated before view_mesh.frag; compiled in only where MIXED_LIGHTS is 1.
 #if defined(MIXED_LIGHTS) && MIXED_LIGHTS
 #define MAX_MIXED_LIGHTS 16
@@ -23,7 +24,7 @@ vec3 mixedIrradiance(vec3 p, vec3 n, vec2 uv1) {
       vec3 d = pos.xyz - p;
       float r2 = max(dot(d, d), 1e-20);
       l = d * inversesqrt(r2);
-      scale = (dir.w > 0.0 && r2 > dir.w * dir.w) ? 0.0 : 1.0 / r2;
+      scale = rangeWindow(sqrt(r2), dir.w) / r2;
       if (pos.w > 0.5) {
         float t = clamp((dot(dir.xyz, -l) - uMixedCone[i].x) * uMixedCone[i].y, 0.0, 1.0);
         scale *= t * t;

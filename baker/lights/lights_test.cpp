@@ -2,6 +2,7 @@
 // rays leave it distributed like its intensity), and a test-only kind that shows what a new kind implements.
 #include "lights/light_kind.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -100,6 +101,44 @@ TEST(PointLight, RangeAndReachBoundItsInfluence) {
   EXPECT_FALSE(kind.influences(l, glm::vec3(2.1f, 0, 0), 1e-3f));
   EXPECT_EQ(kind.direct(l, glm::vec3(2.1f, 0, 0), glm::vec3(-1, 0, 0)).mapValue, glm::vec3(0.0f));  // glTF's window
   EXPECT_GT(kind.direct(l, glm::vec3(1.9f, 0, 0), glm::vec3(-1, 0, 0)).mapValue.x, 0.0f);
+}
+
+// glTF's range as three.js and Babylon window the inverse square law: w(d) = clamp(1 − (d/R)⁴, 0, 1)².
+TEST(PointLight, RangeWindowIsSmoothAndZeroFromTheRangeOn) {
+  Light l = makeLight(LightType::Point, glm::vec3(0.0f), glm::vec3(0, 0, -1), 8.0f);
+  EXPECT_EQ(l.rangeWindow(0.0f), 1.0f);  // no range: the inverse square law alone, at every distance
+  EXPECT_EQ(l.rangeWindow(1e6f), 1.0f);
+  const float R = 2.0f;
+  l.range = R;
+  EXPECT_EQ(l.rangeWindow(0.0f), 1.0f);
+  EXPECT_NEAR(l.rangeWindow(0.5f * R), (15.0 / 16.0) * (15.0 / 16.0), 1e-7);  // (1 − 1/16)²
+  EXPECT_NEAR(l.rangeWindow(0.9f * R), std::pow(1.0 - std::pow(0.9, 4.0), 2.0), 1e-6);
+  EXPECT_EQ(l.rangeWindow(R), 0.0f);
+  EXPECT_EQ(l.rangeWindow(1.01f * R), 0.0f);
+  EXPECT_EQ(l.rangeWindow(100.0f * R), 0.0f);
+  // No step anywhere: |w′| = 8 q³ (1 − q⁴) / R is largest at q⁴ = 3/7, where it is (32/7)(3/7)^¾ / R; each
+  // step of h changes w by at most that times h (and a little float rounding).
+  const double maxSlope = 32.0 / 7.0 * std::pow(3.0 / 7.0, 0.75) / R;
+  const int n = 12000;
+  const double h = 1.5 * R / n;
+  double worst = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double step = std::abs(double(l.rangeWindow(float((i + 1) * h))) - l.rangeWindow(float(i * h)));
+    worst = std::max(worst, step);
+    EXPECT_LE(step, maxSlope * h * 1.001 + 1e-6) << "d = " << i * h;
+  }
+  EXPECT_GT(worst, 0.9 * maxSlope * h);  // the bound is tight: the window does fall that fast near q = 0.81
+  // The direct term carries it: E/π = I w(d) / (π d²) facing the light, for point, spot and IES kinds alike.
+  const LightKind& kind = lightKind(l);
+  EXPECT_NEAR(kind.direct(l, glm::vec3(0.5f * R, 0, 0), glm::vec3(-1, 0, 0)).mapValue.x,
+              8.0 * (225.0 / 256.0) / (R * R / 4.0) / kPi, 1e-6);
+  EXPECT_NEAR(kind.atNormalIncidence(l, glm::vec3(0, 0.9f * R, 0)).mapValue.x,
+              8.0 * l.rangeWindow(0.9f * R) / (0.81 * R * R) / kPi, 1e-6);
+  Light s = spot(0.2f, 0.6f);
+  s.range = R;
+  EXPECT_NEAR(lightKind(s).direct(s, glm::vec3(0, 0, -0.5f * R), glm::vec3(0, 0, 1)).mapValue.x,
+              3.0 * (225.0 / 256.0) / (R * R / 4.0) / kPi, 1e-6);
+  EXPECT_EQ(lightKind(s).direct(s, glm::vec3(0, 0, -R), glm::vec3(0, 0, 1)).mapValue.x, 0.0f);
 }
 
 TEST(SpotLight, ConeFalloffIsTheSquareOfALinearRampInCosine) {

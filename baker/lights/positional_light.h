@@ -8,7 +8,8 @@
 
 namespace irbake {
 
-// E = I(−l) · max(0, n_x·l) / r² · window(r), as irradiance / π; intensityToward(light, dirFromLight) is the kind's.
+// E = I(−l) · max(0, n_x·l) / r² · window(r), as irradiance / π, window(r) glTF's range (Light::rangeWindow);
+// intensityToward(light, dirFromLight) is the kind's.
 template <typename IntensityToward>
 PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, const glm::vec3& nx,
                                       IntensityToward intensityToward) {
@@ -19,10 +20,11 @@ PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, co
   float r = std::sqrt(r2);
   glm::vec3 l = d / r;
   float cosX = glm::dot(nx, l);
-  if (cosX <= 0.0f || light.rangeWindow(r) == 0.0f) return c;
+  const float window = light.rangeWindow(r);
+  if (cosX <= 0.0f || window == 0.0f) return c;
   c.toLight = l;
   c.distance = r;
-  c.mapValue = intensityToward(light, -l) * (cosX / (r2 * kPiF));
+  c.mapValue = intensityToward(light, -l) * (cosX / (r2 * kPiF)) * window;
   return c;
 }
 

@@ -160,8 +160,15 @@ struct Light {
   glm::vec3 profileAxisX{1.0f, 0.0f, 0.0f};
   bool hasExtrasMode = false;          // the glTF light's extras.irbake.mode was given (then extrasMode holds it)
   LightMode extrasMode = LightMode::Baked;
-  // glTF: intensity is zero beyond range (inverse-square inside it). 1 inside, 0 beyond; range 0 = infinite.
-  float rangeWindow(float distance) const { return (range > 0.0f && distance > range) ? 0.0f : 1.0f; }
+  // What multiplies the inverse square law at a distance from the light: glTF's range (KHR_lights_punctual) as
+  // the smooth window three.js and Babylon apply, clamp(1 − (d/range)⁴, 0, 1)², so the light fades to zero at
+  // the range with no step, and is zero beyond it. 1 without a range (range 0).
+  float rangeWindow(float distance) const {
+    if (!(range > 0.0f)) return 1.0f;
+    const float q = distance / range, q2 = q * q;
+    const float w = 1.0f - q2 * q2;  // at most 1
+    return w > 0.0f ? w * w : 0.0f;
+  }
 };
 
 struct Camera {

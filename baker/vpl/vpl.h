@@ -52,7 +52,8 @@ struct VplSet {
   double meanReflectivity = 0.0;            // ρ̄ used for the path-count reduction
   int split = 1;                            // children per path past bounce 1
   std::vector<double> lightReach;           // per punctual light, then the sky: share of pilot rays that reach a
-                                            // lit side; the start table weighs their power by it
+                                            // lit side (within a light's range, by its window); the start table
+                                            // weighs their power by it
   double rehitFraction = 1.0;               // auto split: V_2 M_1 / (V_1 M_2), the share of paths leaving
                                             // bounce 1 that hit the scene again
   int bounces = 0;                          // deepest bounce generated

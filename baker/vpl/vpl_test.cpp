@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "lights/light_kind.h"
@@ -220,6 +221,46 @@ TEST(Walk, BounceVplsCarryTheTexturedAlbedoAtTheirHit) {
     EXPECT_NEAR(v.power.z, Phi * albedo.z / M1, 1e-4 * Phi / M1);
     EXPECT_NEAR(v.position.z, 0.0f, 1e-5f);
   }
+}
+
+// glTF's range in the walk: a path leaving a point light I at height h over a wide floor (ρ) carries the light's
+// window w(d) = clamp(1 − (d/R)⁴, 0, 1)² to its first hit, as the direct term does (Light::rangeWindow). So the
+// first bounce holds ρ times the windowed flux onto the floor, 2π I ∫ from a to 1 of (1 − (a/μ)⁴)² dμ with a = h/R
+// (μ = cos of the angle from the downward vertical) = 2π I ((1 − a) + (2/3)(a⁴ − a) − (1/7)(a⁸ − a)), and no
+// VPL lies at or beyond the range.
+TEST(Walk, FirstHitsOfALightWithARangeCarryItsWindow) {
+  Scene s;
+  const float rho = 0.5f, I = 3.0f, h = 1.0f, R = 2.0f;
+  const int floor = addMaterial(s, glm::vec3(rho));
+  addQuad(s, floor, glm::vec3(-5, 0, 5), glm::vec3(10, 0, 0), glm::vec3(0, 0, -10));  // faces +y
+  Light l = pointLight(glm::vec3(0, h, 0), I);
+  l.range = R;
+  s.lights.push_back(l);
+  RayTracer rt(s);
+  WalkOptions o;
+  o.paths = 8192;
+  o.maxBounces = 1;
+  const VplSet set = generateVpls(s, rt, o);
+  const double a = h / R;
+  const double flux = 2.0 * kPi * I * ((1.0 - a) + 2.0 / 3.0 * (std::pow(a, 4) - a) - (std::pow(a, 8) - a) / 7.0);
+  // Before the window, every first-bounce VPL carries ρ Φ / M₁: Φ = 4π I, M₁ = N ρ̄ paths reach bounce 1.
+  const double perVpl = rho * 4.0 * kPi * I / (o.paths * double(rho));
+  double firstBounce = 0.0;
+  size_t n = 0;
+  for (const Vpl& v : set.vpls) {
+    if (v.bounce != 1) continue;
+    const float d = glm::length(v.position - l.position);
+    EXPECT_LT(d, R);
+    // (1e-3: the VPL sits inset from its hit by the ray tracer's epsilon, and the window falls by at most 2.42/R
+    // per metre)
+    EXPECT_NEAR(v.power.x, perVpl * l.rangeWindow(d), 1e-3 * perVpl) << "at " << d << " m";
+    firstBounce += v.power.x;
+    ++n;
+  }
+  std::printf("[ figure ] walk under a light with a range: first bounce %.5f W, closed form %.5f W (%zu VPLs)\n",
+              firstBounce, rho * flux, n);
+  EXPECT_GT(n, 500u);
+  EXPECT_NEAR(firstBounce, rho * flux, 0.01 * rho * flux);
 }
 
 TEST(Walk, SpotPathsFollowTheFalloffAndDirectionalCoversTheScene) {

@@ -72,6 +72,7 @@ struct PathStart {
   glm::vec3 origin{0.0f}, dir{0.0f}, normal{0.0f};
   glm::dvec3 power{0.0};
   bool onSurface = false;  // starts on a surface (origin inset): rays leave along the normal
+  const Light* light = nullptr;  // the punctual light it leaves (its range windows the first hit)
 };
 
 // Where a ray leaves punctual light l for the random numbers (u0..u3): its origin and direction, as its kind
@@ -132,6 +133,7 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
                           : glm::dvec3(0.0);
   } else {
     const Light& l = scene.lights[s - numTriangles];
+    path.light = &l;
     const double weight = lightRay(l, sources, residual, u1, halton.sample(2, i), halton.sample(3, i), origin, dir);
     pathPower = sources.lightPower[s - numTriangles] * weight / (p * static_cast<double>(N));
   }
@@ -144,7 +146,8 @@ PathStart startPath(const Scene& scene, const RayTracer& rt, const LightSources&
 // light lost). So each such source's weight in the start table is its power times its reach: the share of
 // kReachPilots rays whose first hit is a side that receives light (a front face, or either face of a
 // double-sided material). Sources no pilot ray reached keep a small weight, together at most
-// kUnreachedShare of the rest, so every source can still start paths and the walk stays unbiased.
+// kUnreachedShare of the rest, so every source can still start paths and the walk stays unbiased. A ray of a
+// light with a range counts with the light's window at its hit (Light::rangeWindow), as its path's VPL will.
 constexpr int kReachPilots = 1024;
 constexpr double kUnreachedShare = 0.01;
 
@@ -165,6 +168,7 @@ std::vector<double> weighByReach(const Scene& scene, const RayTracer& rt, LightS
       else skyRay(scene, sources, u0, u1, u2, u3, origin, dir, pdf);
       const RayHit hit = rt.intersect(origin, dir, 0.0f, 1e30f);
       if (!hit.hit) continue;
+      if (k < scene.lights.size()) weight *= scene.lights[k].rangeWindow(glm::length(hit.position - origin));
       const Primitive& prim = scene.primitives[hit.primitive];
       const bool doubleSided = prim.material >= 0 && prim.material < static_cast<int>(scene.materials.size()) &&
                                scene.materials[prim.material].doubleSided;
@@ -237,6 +241,13 @@ void followPath(const Scene& scene, const RayTracer& rt, const Halton& halton, c
   const glm::vec3 start = path.onSurface ? path.origin + path.normal * eps : path.origin;
   const RayHit first = nextBounce(scene, rt, seed, i, 1, start, path.dir, throughput1);
   if (!first.hit) return;  // escaped: its energy leaves the scene
+  // A punctual light's range windows what reaches the first hit, as it windows the direct term
+  // (Light::rangeWindow): the light reflected there is the light that arrived. Beyond the range, nothing did.
+  if (path.light) {
+    const float window = path.light->rangeWindow(glm::length(first.position - start));
+    if (window == 0.0f) return;
+    throughput1 *= static_cast<double>(window);
+  }
   glm::vec3 at1, n1;
   leaveVpl(first, 1, throughput1, 1.0, at1, n1);
   if (maxBounce < 2 || i >= survivors[2]) return;

@@ -32,7 +32,8 @@ export async function showBakedSceneBabylon({ scene, camera = 0, width, height, 
   if (plugin) registerMozLightmap();
   else unregisterMozLightmap();
   await AppendSceneAsync(new URL(scene, location.href).href, s);
-  // The light maps hold the punctual lights' light already.
+  // The light maps hold the punctual lights' light already. (An application that keeps a light the bake left to
+  // the client gets the bake's range window: Babylon's glTF loader gives KHR lights FALLOFF_GLTF and their range.)
   const lights = s.lights.length;
   for (const l of [...s.lights]) l.dispose();
   const cam = s.cameras.find(c => c._internalMetadata?.gltf?.pointers?.includes(`/cameras/${camera}`));

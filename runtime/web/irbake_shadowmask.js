@@ -7,7 +7,9 @@
 //   material: extensions.IRBAKE_shadowmask = { index, texCoord: 1 }   (RGBA, linear, value = visibility)
 // An indirect light has no mask: it shades unshadowed. Lights three.js gets from KHR_lights_punctual are in
 // glTF's units (three.js r155+: physically based, candela and lux, decay 2), so E = I cosθ / r² and I cosθ
-// as the bake's; three's spot cone (smoothstep) and range window (smooth) differ from glTF's.
+// as the bake's. A light's range is three's distance: its window, clamp(1 − (d/range)⁴, 0, 1)², is the one the
+// bake applies (docs/units.md, "Light range"), so decay 2 and distance = range are set on every light kept here.
+// three's spot cone (smoothstep) differs from glTF's.
 // Usage: loader.register(p => (plugin = new IrbakeShadowmaskExtension(p))); after loading, keep the lights
 // plugin.isRuntimeLight(light) says, and call plugin.syncLights(root) once the lights are in place (and
 // again whenever lights are added, removed or hidden: it maps three's per-type light order to channels).
@@ -104,6 +106,13 @@ export class IrbakeShadowmaskExtension {
       const mode = light.userData?.irbake?.mode;
       if (this.root.byIndex.has(index)) this.channelOfLight.set(light, this.root.byIndex.get(index));
       else if (mode === 'indirect' || mode === 'shadowmask') this.channelOfLight.set(light, -1);
+      if (this.channelOfLight.has(light) && (light.isPointLight || light.isSpotLight)) {
+        light.decay = 2;  // the inverse square law, and range's window as the bake's
+        const range = this.parser.json.extensions?.[KHR_LIGHTS]?.lights?.[index]?.range;
+        if (range !== undefined && !(Number.isFinite(range) && range > 0))
+          throw new Error(`${KHR_LIGHTS}.lights[${index}]: range must be a number > 0 (got ${JSON.stringify(range)})`);
+        light.distance = range ?? 0;
+      }
     }
     if (this.root.sun) {  // the command line's sun: not a KHR light, so made here
       const sun = new DirectionalLight(0xffffff, 1);

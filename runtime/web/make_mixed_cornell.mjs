@@ -1,17 +1,20 @@
 // Writes a variant of irbake's Cornell box sample for the mixed-lighting web test: the emissive quad under the
 // ceiling is switched off (emission 0) and a KHR_lights_punctual point light takes its place 5 cm below it,
 // with the quad's colour and the on-axis intensity of the quad (Le·A: 17 × 0.01365 ≈ 0.232 W/sr in red, so
-// the room is about as bright), optionally with extras.irbake.mode. The buffers stay where they are (the
-// variant is written beside the sample). Pure node, no dependencies.
-// Usage: node make_mixed_cornell.mjs SAMPLE.gltf OUT.gltf [--mode baked|indirect|shadowmask]
+// the room is about as bright), optionally with extras.irbake.mode and a range (metres). The buffers stay where
+// they are (the variant is written beside the sample). Pure node, no dependencies.
+// Usage: node make_mixed_cornell.mjs SAMPLE.gltf OUT.gltf [--mode baked|indirect|shadowmask] [--range R]
 import fs from 'node:fs';
 import path from 'node:path';
 
 const [input, output] = process.argv.slice(2);
 const modeAt = process.argv.indexOf('--mode');
 const mode = modeAt > 0 ? process.argv[modeAt + 1] : undefined;
-if (!input || !output || (mode !== undefined && !['baked', 'indirect', 'shadowmask'].includes(mode))) {
-  console.error('usage: node make_mixed_cornell.mjs SAMPLE.gltf OUT.gltf [--mode baked|indirect|shadowmask]');
+const rangeAt = process.argv.indexOf('--range');
+const range = rangeAt > 0 ? Number(process.argv[rangeAt + 1]) : undefined;
+if (!input || !output || (mode !== undefined && !['baked', 'indirect', 'shadowmask'].includes(mode)) ||
+    (range !== undefined && !(range > 0))) {
+  console.error('usage: node make_mixed_cornell.mjs SAMPLE.gltf OUT.gltf [--mode baked|indirect|shadowmask] [--range R > 0]');
   process.exit(2);
 }
 if (path.resolve(path.dirname(input)) !== path.resolve(path.dirname(output))) {
@@ -28,6 +31,7 @@ const area = 0.130 * 0.105;
 const peak = Math.max(...le);
 const def = { name: 'lamp', type: 'point', color: le.map(v => v / peak), intensity: peak * area };
 if (mode) def.extras = { irbake: { mode } };
+if (range !== undefined) def.range = range;
 gltf.extensions = { ...(gltf.extensions ?? {}), KHR_lights_punctual: { lights: [def] } };
 gltf.extensionsUsed = [...new Set([...(gltf.extensionsUsed ?? []), 'KHR_lights_punctual'])];
 // The quad is 0.5 mm below the 548.8 mm ceiling, centred at (278, ·, 279.5) mm.

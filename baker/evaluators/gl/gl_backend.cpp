@@ -475,7 +475,7 @@ std::vector<Lightmap> GlBaker::run() {
       std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"shadow_depth.vert"}}, {GL_FRAGMENT_SHADER, {"shadow_depth.frag"}}});
   shadowViewLocation_ = depthProgram_->uniform("shadowView");
   directProgram_ = &programs_.get(std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"lightmap_pass.vert"}},
-                                                           {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "direct_light.frag"}}},
+                                                           {GL_FRAGMENT_SHADER, {"bake_interface.glsl", "ir_transport.glsl", "light_range.glsl", "direct_light.frag"}}},
                                   directional() ? std::vector<std::string>{"#define DIRECTIONAL 1"} : std::vector<std::string>{});
   {
     const GlProgram* p = directProgram_;
