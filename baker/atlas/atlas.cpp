@@ -108,8 +108,11 @@ std::string densityThatFits(double density) {
 void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
   if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
   double area = 0.0;
-  for (const Primitive& p : scene.primitives)
-    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
+  for (const Primitive& p : scene.primitives) {
+    if (!p.getsLightmap()) continue;
+    const double scale2 = double(p.lightmapScale) * p.lightmapScale;
+    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t) * scale2;
+  }
   const double density = options.texelsPerUnit;
   const double estimate = area * density * density / kTypicalFill;
   if (estimate > double(options.maxTexels))
@@ -205,6 +208,7 @@ struct PrimitiveWork {
 void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOptions& options, PrimitiveWork& work) {
   AtlasStats& stats = work.stats;
   std::vector<ChartUv>& charts = work.charts;
+  if (!prim.getsLightmap()) return;  // shadow-only, probe-lit or off: no charts, no texels
   Stopwatch clock;
   if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
     charts = chartsFromUv1(prim, mesh);
@@ -262,7 +266,16 @@ void chartAllPrimitives(const Scene& scene, const AtlasOptions& options, std::ve
     }
     prims[p].firstChart = charts.size();
     prims[p].chartCount = work[p].charts.size();
-    for (ChartUv& c : work[p].charts) charts.push_back(std::move(c));
+    // The primitive's texel density multiplier: its charts (in metres, packed at the density) grow by it, so
+    // its texel area grows by its square, and the auto density counts them at that size.
+    const double scale = scene.primitives[p].lightmapScale;
+    for (ChartUv& c : work[p].charts) {
+      if (scale != 1.0) {
+        for (glm::dvec2& uv : c.uv) uv *= scale;
+        c.area3d *= scale * scale;
+      }
+      charts.push_back(std::move(c));
+    }
   }
 }
 
@@ -376,8 +389,12 @@ void emitOnPages(const Primitive& src, const PrimitiveCharts& range, const std::
   }
   std::sort(pagesUsed.begin(), pagesUsed.end());
   pagesUsed.erase(std::unique(pagesUsed.begin(), pagesUsed.end()), pagesUsed.end());
-  if (pagesUsed.empty()) {  // nothing to map (no faces at all)
+  if (pagesUsed.empty()) {  // nothing to map (no faces at all, or an object that gets no map)
     out.push_back(src);
+    if (!src.getsLightmap()) {  // no map UVs, not even an input TEXCOORD_1's
+      out.back().uv1.clear();
+      out.back().lightmap = LightmapRef{};
+    }
     return;
   }
   for (int page : pagesUsed)
@@ -401,6 +418,10 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   std::vector<PrimitiveCharts> prims(scene.primitives.size());
   std::vector<ChartUv> charts;
   chartAllPrimitives(scene, options, prims, charts, stats);
+  if (charts.empty() && !scene.primitives.empty() && !scene.primitives.front().getsLightmap() &&
+      std::none_of(scene.primitives.begin(), scene.primitives.end(), [](const Primitive& p) { return p.getsLightmap(); }))
+    throw Error(ErrorCode::EmptyScene, scene.sourcePath,
+                "every object's extras.irbake.mode leaves it without a light map: nothing to bake");
   for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
   stats.texelsPerUnit = chooseDensity(charts, options, scene);
 
