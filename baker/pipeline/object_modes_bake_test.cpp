@@ -3,6 +3,7 @@
 // direct term alone, E/π = I cosθ / (π d²) where the plate lets the light through and 0 in its umbra.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -175,8 +176,12 @@ TEST(ObjectModes, OffShadowOnlyAndBakedPlatesOnTheFloorsClosedForm) {
     SCOPED_TRACE(c.name);
     const BakeResult r = bake(loadScene(floorAndPlate(c.name, c.irbake)), smallBake(false));
     const FloorFigures f = floorFigures(r, c.casts);
-    EXPECT_GT(f.lit, 300u);
-    EXPECT_LT(f.litError, 0.02);  // point light, exact direct term: only the texel's own spread of E
+    RecordProperty(std::string(c.name) + "LitRelativeError", std::to_string(f.litError));
+    RecordProperty(std::string(c.name) + "UmbraMax", std::to_string(f.umbraMax));
+    std::printf("%s: %zu lit texels, worst relative error %.2e; %zu umbra texels, max %.2e (closed form up to %.3f)\n",
+                c.name, f.lit, f.litError, f.umbra, f.umbraMax, f.umbraClosedForm);
+    EXPECT_GT(f.lit, c.casts ? 150u : 600u);
+    EXPECT_LT(f.litError, 0.002);  // point light, exact direct term: only the texel's own spread of E
     if (c.casts) {
       EXPECT_GT(f.umbra, 200u);
       EXPECT_LT(f.umbraMax, 0.002 * f.umbraClosedForm);  // black scene: nothing bounces into the umbra
@@ -200,7 +205,7 @@ TEST(ObjectModes, OffShadowOnlyAndBakedPlatesOnTheFloorsClosedForm) {
 TEST(ObjectModes, ProbeLitPlateCastsGetsNoTexelsAndIsMarkedForTheClients) {
   const BakeResult r = bake(loadScene(floorAndPlate("probes", {{"mode", "probes"}})), smallBake(true));
   const FloorFigures f = floorFigures(r, true);
-  EXPECT_LT(f.litError, 0.02);
+  EXPECT_LT(f.litError, 0.002);
   EXPECT_GT(f.umbra, 200u);
   EXPECT_LT(f.umbraMax, 0.002 * f.umbraClosedForm);
   EXPECT_GT(r.probes.size(), 0u);
@@ -258,6 +263,7 @@ TEST(ObjectModes, LightmapScaleTwoGivesFourTimesTheTexels) {
     size_t texels[2] = {0, 0};
     for (const Primitive& p : s.primitives) texels[p.node] += texelCentres(p).size();
     const double expected = density * density;  // a 1 m² square at the density, scale 1
+    std::printf("%.0f texels per metre: %zu texels at scale 1, %zu at scale 2\n", density, texels[0], texels[1]);
     EXPECT_NEAR(double(texels[0]), expected, 0.1 * expected) << density;
     EXPECT_NEAR(double(texels[1]) / double(texels[0]), 4.0, 0.4) << density;
   }
