@@ -73,8 +73,6 @@ std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& o, ProbeSphereSun*
   return spheres;
 }
 
-namespace {
-
 // The exact emitters' triangles (every sphere's are the same grid's), at most kMaxExactEmitterTriangles.
 int emitterTriangles(const std::vector<ProbeSphere>& spheres) {
   size_t n = 0;
@@ -107,6 +105,8 @@ void setEmitterUniforms(const GlProgram& p, const ProbeSphere& s, int triangles)
   glUniform3fv(p.uniform("uEmitterRadiance"), n, &radiance[0][0]);
   glUniform4fv(p.uniform("uEmitterVisibility"), n, &visibility[0][0]);
 }
+
+namespace {
 
 // The spheres' GL side: one program per output encoding, an empty vertex array, one draw per sphere.
 class ProbeOverlay {
@@ -160,7 +160,7 @@ class ProbeOverlay {
     if (!p)
       p = std::make_unique<GlProgram>(
           std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_probe.vert"}},
-                                   {GL_FRAGMENT_SHADER, {"view_encode.glsl", "probe_emitters.glsl", "view_probe.frag"}}},
+                                   {GL_FRAGMENT_SHADER, {"view_encode.glsl", "probe_emitters.glsl", "probe_sh.glsl", "view_probe.frag"}}},
           std::vector<std::string>{"#define OUTPUT " + std::to_string(output),
                                    "#define EMITTER_TRIANGLES " + std::to_string(emitterTriangles_)},
           "330 core");

@@ -18,6 +18,10 @@
 #include "lightmap/probe_field.h"
 #include "lightmap/probe_grid.h"
 
+namespace irbake {
+class GlProgram;
+}
+
 namespace irbake::view {
 
 class ViewRenderer;
@@ -62,6 +66,12 @@ std::vector<ProbeSphere> probeSpheresFor(const ViewerOptions& options, ProbeSphe
 
 // The shader's sun of a grid's sun level.
 ProbeSphereSun probeSphereSun(const LightProbeGrid& grid);
+
+// The exact emitters' triangles the spheres carry (every sphere's are the same grid's), at most
+// kMaxExactEmitterTriangles: the EMITTER_TRIANGLES of a program that shades them (shaders/probe_emitters.glsl).
+int emitterTriangles(const std::vector<ProbeSphere>& spheres);
+// Sphere `s`'s exact emitters as that program's per-triangle uniforms (the bound program `p`).
+void setEmitterUniforms(const GlProgram& p, const ProbeSphere& s, int triangles);
 
 // Draws `spheres` after the scene in every frame of `renderer` (ViewRenderer::addOverlay), their sun level `sun`;
 // GL context current.

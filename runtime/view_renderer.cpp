@@ -11,8 +11,11 @@
 #include <epoxy/gl.h>
 
 #include "common/error.h"
+#include "common/log.h"
+#include "export/light_probes_export.h"
 #include "export/map_encoding.h"
 #include "mixed_lights.h"
+#include "probe_view.h"
 #include "screenshot.h"
 #include "glcontext/gl_program.h"
 
@@ -132,13 +135,15 @@ struct Variant {
   int alphaMask = 0;    // 1: alphaMode MASK
   int directional = 0;  // L1 SH with the normal map: 0 off, 1 normal map on TEXCOORD_0, 2 on TEXCOORD_1
   int mixed = 0;        // 1: shades the export's runtime lights (mixed_lights.h)
+  int probeLit = 0;     // 1: lit by the probes instead of a map (a probe-lit object)
 
   int key() const {
     return mode | output << 3 | baseTex << 4 | emissiveTex << 6 | lightmap << 8 | alphaMask << 9 | directional << 10 |
-           mixed << 12;
+           mixed << 12 | probeLit << 13;
   }
   static Variant fromKey(int k) {
-    return {k & 7, (k >> 3) & 1, (k >> 4) & 3, (k >> 6) & 3, (k >> 8) & 1, (k >> 9) & 1, (k >> 10) & 3, (k >> 12) & 1};
+    return {k & 7,         (k >> 3) & 1,  (k >> 4) & 3,  (k >> 6) & 3, (k >> 8) & 1,
+            (k >> 9) & 1,  (k >> 10) & 3, (k >> 12) & 1, (k >> 13) & 1};
   }
   // `all`: every feature of the primitive; keeps those `mode` reads (and the SH only when `sh`).
   static Variant forMode(int mode, int output, const Variant& all, bool sh = true) {
@@ -153,11 +158,12 @@ struct Variant {
     v.lightmap = mode == 0 || mode == 1 ? all.lightmap : 0;
     v.directional = v.lightmap && sh ? all.directional : 0;
     v.mixed = mode == 0 ? all.mixed : 0;
+    v.probeLit = mode == 0 || mode == 1 ? all.probeLit : 0;
     return v;
   }
   int needUv0() const { return baseTex == 1 || emissiveTex == 1 || directional == 1; }
   int needUv1() const { return baseTex == 2 || emissiveTex == 2 || lightmap || mode == 4 || directional == 2 || mixed; }
-  int needNormal() const { return mode == 3 || directional != 0 || mixed; }
+  int needNormal() const { return mode == 3 || directional != 0 || mixed || probeLit; }
   int needTangent() const { return directional != 0; }
   int needChart() const { return mode == 3 || mode == 4; }
 };
@@ -177,6 +183,7 @@ struct ViewRenderer::Impl {
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // world-space bounds, for the draw order
     bool cullBackFaces = false;          // closed outward solid, opaque: back faces only show from inside
     GLuint shadowMask = 0;               // with Variant::mixed: the material's mask page (or white)
+    ProbeSphere probe;                   // with Variant::probeLit: the probes over the primitive
   };
   const Scene& scene;
   GLuint program = 0;                      // the bound variant
@@ -194,6 +201,52 @@ struct ViewRenderer::Impl {
   std::unique_ptr<GlProgram> skyPrograms[2];  // view_sky per OUTPUT (0 linear, 1 exposure + sRGB)
   GLuint skyVao = 0;                        // empty: the sky triangle comes from gl_VertexID
   std::unique_ptr<MixedLights> mixed;       // the export's runtime lights and mask pages
+  std::optional<LightProbeGrid> probeGrid;  // the file's probes, read for the first probe-lit primitive
+  bool probeGridRead = false;
+  ProbeSphereSun probeSun;                  // the grid's sun level (none: zero)
+  int probeEmitterTriangles = 0;            // the grid's exact emitters (probe_emitters.glsl's EMITTER_TRIANGLES)
+
+  // A probe-lit primitive (an export's extras.lightProbes, Primitive::mode): the probes over its bounding sphere
+  // (world box centre, farthest vertex), as three.js's irbake_light_probes.js lightObject takes them. Without
+  // probes in the file it keeps the plain shading (albedo), with a warning.
+  void lightFromProbes(const Primitive& p, GpuPrimitive& g) {
+    if (!probeGridRead) {
+      probeGridRead = true;
+      try {
+        probeGrid = readLightProbes(scene.sourcePath);
+        probeSun = probeSphereSun(*probeGrid);
+        if (!probeGrid->emitters.empty()) {
+          ProbeSphere any;
+          any.emitters = std::make_shared<const std::vector<ProbeEmitter>>(probeGrid->emitters);
+          probeEmitterTriangles = emitterTriangles({any});
+        }
+      } catch (const Error& e) {
+        log::warn(std::string(e.what()) + ": probe-lit objects are drawn without light");
+      }
+    }
+    if (!probeGrid) return;
+    const glm::vec3 centre = 0.5f * (g.boundsMin + g.boundsMax);
+    float radius = 0.0f;
+    for (const glm::vec3& q : p.positions) radius = std::max(radius, glm::length(q - centre));
+    try {
+      g.probe = probeObject(*probeGrid, centre, radius, scene.sourcePath);
+      g.features.probeLit = 1;
+    } catch (const Error& e) {
+      log::warn(std::string(e.what()) + " (probe-lit object \"" + p.name + "\")");
+    }
+  }
+
+  void setProbeUniforms(const GpuPrimitive& g, int key) {
+    setEmitterUniforms(*programs.at(key), g.probe, probeEmitterTriangles);
+    glUniform3fv(u("uCentre"), 1, &g.probe.centre[0]);
+    glUniform3fv(u("uSh"), kShCoefficients, &g.probe.coefficients[0][0]);
+    glUniform3fv(u("uShGradient"), 3 * kShCoefficients, &g.probe.gradient[0][0][0]);
+    glUniform1f(u("uSunVisibility"), g.probe.sunVisibility);
+    glUniform3fv(u("uSunGradient"), 1, &g.probe.sunGradient[0]);
+    glUniform3fv(u("uSunDirection"), 1, &probeSun.direction[0]);
+    glUniform3fv(u("uSunIrradiance"), 1, &probeSun.irradiance[0]);
+    glUniform3fv(u("uSunSh"), kShCoefficients, &probeSun.sh[0][0]);
+  }
 
   // Draws the environment map over the whole viewport, without depth, before the scene.
   void drawSky(const glm::mat4& viewProjection, int width, int height, bool encode, float exposure) {
@@ -249,11 +302,13 @@ struct ViewRenderer::Impl {
           define("NEED_UV0", f.needUv0()),      define("NEED_UV1", f.needUv1()),
           define("NEED_NORMAL", f.needNormal()), define("NEED_CHART", f.needChart()),
           define("DIRECTIONAL", f.directional), define("NEED_TANGENT", f.needTangent()),
-          define("MIXED_LIGHTS", f.mixed),      define("NEED_POSITION", f.mixed)};
+          define("MIXED_LIGHTS", f.mixed),      define("NEED_POSITION", f.mixed || f.probeLit),
+          define("PROBE_LIT", f.probeLit),
+          define("EMITTER_TRIANGLES", f.probeLit ? probeEmitterTriangles : 0)};
       it = programs
                .emplace(key, std::make_unique<GlProgram>(
                                  std::vector<ShaderStage>{{GL_VERTEX_SHADER, {"view_mesh.vert"}},
-                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "light_range.glsl", "view_mixed_lights.glsl", "view_mesh.frag"}}},
+                                                          {GL_FRAGMENT_SHADER, {"view_encode.glsl", "light_range.glsl", "view_mixed_lights.glsl", "probe_sh.glsl", "probe_emitters.glsl", "view_mesh.frag"}}},
                                  defines, "330 core"))
                .first;
     }
@@ -436,6 +491,7 @@ ViewRenderer::ViewRenderer(const ViewerScene& v) : impl_(std::make_unique<Impl>(
     g.features.alphaMask = m.alphaMode == AlphaMode::Mask ? 1 : 0;
     g.features.mixed = I.mixed->shades(g.lightmap != 0) ? 1 : 0;
     if (g.features.mixed) g.shadowMask = I.mixed->maskTexture(p.material);
+    if (p.mode == ObjectMode::Probes && !g.lightmap) I.lightFromProbes(p, g);
     // Directional maps only change what a normal map bends: at n = n_g the reconstruction is L0 itself
     // (the L1 pages hold t ⟂ n_g), so a primitive without a normal map keeps the plain shading and skips the
     // three fetches.
@@ -571,6 +627,7 @@ void ViewRenderer::draw(const ViewCamera& camera, int width, int height, const D
           glBindTexture(GL_TEXTURE_2D, g.l1[k]);
         }
       }
+      if (variant.probeLit) I.setProbeUniforms(g, variant.key());
       if (variant.mixed) {
         glActiveTexture(GL_TEXTURE7);
         glBindTexture(GL_TEXTURE_2D, g.shadowMask);

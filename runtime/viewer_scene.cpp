@@ -50,7 +50,7 @@ ViewerScene makeViewerScene(Scene scene, std::vector<Lightmap> pages, std::array
   v.directionalPages = std::move(directionalPages);
   size_t unlit = 0;
   for (const auto& p : v.scene.primitives)
-    if (lightmapSourceOf(v, p) == LightmapSource::None) ++unlit;
+    if (lightmapSourceOf(v, p) == LightmapSource::None && p.mode != ObjectMode::Probes) ++unlit;  // probe-lit: lit
   const std::string where = v.scene.sourcePath.empty() ? std::string("scene") : v.scene.sourcePath;
   if (!v.scene.primitives.empty() && unlit == v.scene.primitives.size())
     v.warnings.push_back(where + ": no light map: showing albedo only");

@@ -43,6 +43,12 @@
 #ifndef MIXED_LIGHTS
 #define MIXED_LIGHTS 0  // 1: add the export's runtime lights (view_mixed_lights.glsl), needs vPosition
 #endif
+#ifndef PROBE_LIT
+#define PROBE_LIT 0  // 1: lit by the probes instead of a map (a probe-lit object, docs/export.md), needs vPosition
+#endif
+#ifndef EMITTER_TRIANGLES
+#define EMITTER_TRIANGLES 0  // the probes' exact emitters (probe_emitters.glsl, concatenated before this file)
+#endif
 
 #if NEED_NORMAL
 in vec3 vNormal;
@@ -59,7 +65,7 @@ flat in float vChart;
 #if NEED_TANGENT
 in vec4 vTangent;
 #endif
-#if MIXED_LIGHTS
+#if MIXED_LIGHTS || PROBE_LIT
 in vec3 vPosition;
 #endif
 
@@ -78,6 +84,18 @@ uniform vec3 uLineColor;
 uniform sampler2D uNormalTex;      // glTF normalTexture, linear: tangent-space normal × 0.5 + 0.5
 uniform float uNormalScale;        // normalTexture.scale
 uniform sampler2D uL1x, uL1y, uL1z;  // L1 pages (values: world x, y, z component of t per colour channel)
+#if PROBE_LIT
+// The probes over the object as irview's probe spheres take them (probe_view.h): SH at the centre, its gradient,
+// and the sun level (zero irradiance and SH without one).
+uniform vec3 uCentre;
+uniform vec3 uSh[9];
+uniform vec3 uShGradient[27];  // ∂uSh/∂x (0..8), ∂uSh/∂y (9..17), ∂uSh/∂z (18..26)
+uniform vec3 uSunDirection;
+uniform vec3 uSunIrradiance;
+uniform vec3 uSunSh[9];
+uniform float uSunVisibility;
+uniform vec3 uSunGradient;
+#endif
 
 out vec4 fragColor;
 
@@ -142,6 +160,17 @@ vec3 lightmap() {
   return max(v, vec3(0.0));
 #elif HAS_LIGHTMAP
   return texture(uLightmap, vUv1).rgb * uLightmapScale;
+#elif PROBE_LIT
+  // As view_probe.frag at this point and normal: max(0, SH(p) without the sun) + the sun's exact clamped cosine.
+  vec3 o = vPosition - uCentre, n = normalize(vNormal), sh[9];
+  float v = clamp(uSunVisibility + dot(o, uSunGradient), 0.0, 1.0);
+  for (int k = 0; k < 9; ++k)
+    sh[k] = uSh[k] + o.x * uShGradient[k] + o.y * uShGradient[9 + k] + o.z * uShGradient[18 + k] - v * uSunSh[k];
+  vec3 e = max(shIrradiance(sh, n), vec3(0.0)) + v * uSunIrradiance * max(0.0, -dot(n, uSunDirection));
+#if EMITTER_TRIANGLES > 0
+  e += exactEmitterLight(vPosition, n, o);
+#endif
+  return e;
 #else
   return vec3(1.0);
 #endif

@@ -20,16 +20,6 @@ uniform float uExposureScale;
 in vec3 vWorld;
 out vec4 fragColor;
 
-vec3 shIrradiance(vec3 sh[9], vec3 n) {
-  float x = n.x, y = n.y, z = n.z;
-  vec3 r = sh[0] * 0.886227;
-  r += sh[1] * (2.0 * 0.511664 * y) + sh[2] * (2.0 * 0.511664 * z) + sh[3] * (2.0 * 0.511664 * x);
-  r += sh[4] * (2.0 * 0.429043 * x * y) + sh[5] * (2.0 * 0.429043 * y * z);
-  r += sh[6] * (0.743125 * z * z - 0.247708) + sh[7] * (2.0 * 0.429043 * x * z);
-  r += sh[8] * (0.429043 * (x * x - y * y));
-  return r;
-}
-
 void main() {
   vec3 d = normalize(vWorld - uEye);
   vec3 oc = uEye - uCentre;

@@ -110,9 +110,9 @@ void checkTexelEstimate(const Scene& scene, const AtlasOptions& options) {
   if (options.maxTexels == 0 || !(options.texelsPerUnit > 0.0f)) return;
   double area = 0.0;
   for (const Primitive& p : scene.primitives) {
-    double primitiveArea = 0.0;
-    for (size_t t = 0; t < p.triangleCount(); ++t) primitiveArea += triangleArea(p, t);
-    area += primitiveArea * double(p.lightmapScale) * double(p.lightmapScale);
+    if (!p.getsLightmap()) continue;
+    const double scale2 = double(p.lightmapScale) * p.lightmapScale;
+    for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t) * scale2;
   }
   const double density = options.texelsPerUnit;
   const double estimate = area * density * density / kTypicalFill;
@@ -211,6 +211,7 @@ struct PrimitiveWork {
 void chartPrimitive(const Primitive& prim, const AtlasMesh& mesh, const AtlasOptions& options, PrimitiveWork& work) {
   AtlasStats& stats = work.stats;
   std::vector<ChartUv>& charts = work.charts;
+  if (!prim.getsLightmap()) return;  // shadow-only, probe-lit or off: no charts, no texels
   Stopwatch clock;
   if (options.keepUv1 && prim.uv1.size() == prim.positions.size() && !prim.uv1.empty()) {
     charts = chartsFromUv1(prim, mesh);
@@ -300,6 +301,7 @@ std::vector<ObjectDensity> sparsestObjects(const Scene& scene, const std::vector
   std::unordered_map<uint64_t, size_t> objectOf;  // (node, instance) -> index in objects
   for (size_t p = 0; p < prims.size(); ++p) {
     const Primitive& prim = scene.primitives[p];
+    if (!prim.getsLightmap()) continue;  // no map: no texels to count
     const uint64_t key = (uint64_t(uint32_t(prim.node)) << 32) | uint32_t(prim.instance);
     auto [it, added] = objectOf.try_emplace(key, objects.size());
     if (added) {
@@ -427,8 +429,12 @@ void emitOnPages(const Primitive& src, const PrimitiveCharts& range, const std::
   }
   std::sort(pagesUsed.begin(), pagesUsed.end());
   pagesUsed.erase(std::unique(pagesUsed.begin(), pagesUsed.end()), pagesUsed.end());
-  if (pagesUsed.empty()) {  // nothing to map (no faces at all)
+  if (pagesUsed.empty()) {  // nothing to map (no faces at all, or an object that gets no map)
     out.push_back(src);
+    if (!src.getsLightmap()) {  // no map UVs, not even an input TEXCOORD_1's
+      out.back().uv1.clear();
+      out.back().lightmap = LightmapRef{};
+    }
     return;
   }
   for (int page : pagesUsed)
@@ -472,6 +478,10 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   std::vector<PrimitiveCharts> prims(scene.primitives.size());
   std::vector<ChartUv> charts;
   chartAllPrimitives(scene, options, prims, charts, stats);
+  if (charts.empty() && !scene.primitives.empty() && !scene.primitives.front().getsLightmap() &&
+      std::none_of(scene.primitives.begin(), scene.primitives.end(), [](const Primitive& p) { return p.getsLightmap(); }))
+    throw Error(ErrorCode::EmptyScene, scene.sourcePath,
+                "every object's extras.irbake.mode leaves it without a light map: nothing to bake");
   for (const ChartUv& c : charts) (c.planar ? stats.planarCharts : stats.lscmCharts) += 1;
   stats.texelsPerUnit = chooseDensity(scene, prims, charts, options, stats);
   applyLightmapScales(scene, prims, charts);

@@ -87,8 +87,9 @@ struct AtlasResult {
 // Unwraps every primitive of `scene` in place: vertices are split along chart seams (sourceVertex
 // records where each came from), uv1 is set in [0,1] over the primitive's page, and
 // primitive.lightmap names the page. A primitive whose charts land on several pages is split into
-// one primitive per page. Every primitive is lightmapped, emissive ones included (there is no option
-// to leave one out).
+// one primitive per page. Every primitive is lightmapped, emissive ones included, except those whose
+// extras.irbake.mode says otherwise (Primitive::mode): they keep page −1 and no uv1. A primitive's charts are
+// scaled by its lightmapScale (texel area × scale²).
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options);
 
 }  // namespace irbake

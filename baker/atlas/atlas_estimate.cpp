@@ -66,6 +66,7 @@ AtlasEstimate estimateAtlas(const Scene& scene, const AtlasOptions& options) {
   AtlasEstimate estimate;
   double scaledArea = 0.0;
   for (const Primitive& p : scene.primitives) {
+    if (!p.getsLightmap()) continue;  // shadow-only, probe-lit, off: no charts
     double area = 0.0;
     for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
     scaledArea += area * double(p.lightmapScale) * double(p.lightmapScale);

@@ -165,6 +165,14 @@ void setLightmapRecord(json& prim, const LightmapRef& ref) {
   prim["extras"]["lightmap"] = {{"page", ref.page}, {"width", ref.width}, {"height", ref.height}};
 }
 
+// A probe-lit object (extras.irbake.mode "probes"): its primitives say so, for the clients (docs/export.md,
+// "Probe-lit objects"); a source primitive's extras of another type are left alone.
+void setProbeLitRecord(json& prim, const Primitive& part) {
+  if (part.mode != ObjectMode::Probes) return;
+  if (!prim.contains("extras")) prim["extras"] = json::object();
+  if (prim["extras"].is_object()) prim["extras"]["lightProbes"] = true;
+}
+
 // MOZ_lightmap of one page as its specification defines it: the texture, TEXCOORD_1 written explicitly, and
 // the intensity that makes intensity × sRGBToLinear(texel) the irradiance E. The PNG holds map value (E/π) /
 // range, so the intensity is π × the range; the extras say the PNG is sRGB-encoded and carry the units
@@ -324,6 +332,7 @@ class SourceExport {
     if (material >= 0) prim["material"] = material;
     else prim.erase("material");
     setLightmapRecord(prim, part.lightmap);
+    setProbeLitRecord(prim, part);
     return prim;
   }
 

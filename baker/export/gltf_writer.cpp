@@ -275,6 +275,7 @@ int addPrimitiveMesh(GltfDocument& doc, const Primitive& prim, int material) {
   if (material >= 0) p["material"] = material;
   if (prim.lightmap.page >= 0)
     p["extras"]["lightmap"] = {{"page", prim.lightmap.page}, {"width", prim.lightmap.width}, {"height", prim.lightmap.height}};
+  if (prim.mode == ObjectMode::Probes) p["extras"]["lightProbes"] = true;  // a probe-lit object (docs/export.md)
   json mesh = {{"primitives", json::array({p})}};
   if (!prim.name.empty()) mesh["name"] = prim.name;
   return doc.append("meshes", std::move(mesh));

@@ -39,6 +39,31 @@ void checkOptionRanges(const BakeOptions& o) {
                                           "; ClampMode::Off for no clamp)");
 }
 
+// extras.irbake.mode "off" (Primitive::mode): out of the scene every stage sees (no shadows, bounces, emission or
+// texels), kept aside for the export, which writes them as they were.
+std::vector<Primitive> takeObjectsOff(Scene& scene) {
+  std::vector<Primitive> kept, off;
+  for (Primitive& p : scene.primitives) (p.mode == ObjectMode::Off ? off : kept).push_back(std::move(p));
+  scene.primitives = std::move(kept);
+  for (Primitive& p : off) {
+    p.uv1.clear();
+    p.lightmap = LightmapRef{};
+  }
+  if (!off.empty() && scene.triangleCount() == 0)
+    throw Error(ErrorCode::EmptyScene, scene.sourcePath, "every object's extras.irbake.mode is \"off\": nothing to bake");
+  return off;
+}
+
+// Probe-lit objects need the probes: with --probes off the clients have none to light them with.
+void warnProbeObjectsWithoutProbes(const BakeOptions& options, const Scene& scene) {
+  if (options.probes.enabled) return;
+  const auto probeLit = [](const Primitive& p) { return p.mode == ObjectMode::Probes; };
+  const size_t count = size_t(std::count_if(scene.primitives.begin(), scene.primitives.end(), probeLit));
+  if (count == 0) return;
+  log::warn(scene.sourcePath + ": " + std::to_string(count) + " primitive(s) have extras.irbake.mode \"probes\" " +
+            "but --probes is off: they get no light-map texels and no probes, so the clients draw them unlit");
+}
+
 }  // namespace
 
 double peakMemoryMiB() {
@@ -52,7 +77,9 @@ StagedBake::StagedBake(Scene scene, const BakeOptions& options) : state_(std::ma
   s.options = options;
   s.scene = std::move(scene);
   if (s.scene.triangleCount() == 0) throw Error(ErrorCode::EmptyScene, s.scene.sourcePath, "no triangles to bake");
+  s.objectsOff = takeObjectsOff(s.scene);
   checkOptionRanges(options);
+  warnProbeObjectsWithoutProbes(options, s.scene);
   checkLightModes(options, s.scene);  // a bad light name costs nothing
   prepare(s);
 }
@@ -241,6 +268,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   s.wholeInputs.reset();
   s.rayTracer.reset();  // it refers to the scene, which moves into the result
   r.scene = std::move(s.scene);
+  for (Primitive& p : s.objectsOff) r.scene.primitives.push_back(std::move(p));
   return r;
 }
 

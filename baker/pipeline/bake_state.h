@@ -55,6 +55,7 @@ struct BakeState {
   // The inputs and the preparation (bake_prepare.cpp).
   BakeOptions options;
   Scene scene;
+  std::vector<Primitive> objectsOff;       // extras.irbake.mode "off": out of the bake, back in the result's scene
   AtlasResult atlas;
   std::unique_ptr<RayTracer> rayTracer;
   std::vector<TexelSamples> texels;

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <set>
 #include <tuple>
 #include <thread>
 
@@ -27,6 +28,7 @@
 #include "scene/ies_lights_gltf.h"
 #include "scene/image_codec.h"
 #include "scene/moz_lightmap_units.h"
+#include "scene/object_settings.h"
 #include "scene/runtime_lights.h"
 #include "scene/scene_limits.h"
 
@@ -235,7 +237,7 @@ class Loader {
     std::vector<int> roots = rootNodes();
     checkNodeGraph(roots);
     checkInstanceCount(roots);
-    for (int r : roots) visitNode(r, glm::mat4(1.0f), 0);
+    for (int r : roots) visitNode(r, glm::mat4(1.0f), 0, ObjectSettings{});
     if (scene_.triangleCount() == 0) {
       std::string why = std::to_string(scene_.stats.primitivesSkipped) + " point/line primitives skipped, " +
                         std::to_string(scene_.stats.trianglesDropped) + " degenerate triangles dropped";
@@ -415,18 +417,49 @@ class Loader {
     return m;
   }
 
-  void visitNode(int n, const glm::mat4& parent, int depth) {
+  // extras.irbake of node n over what its ancestors set (scene/object_settings.h).
+  ObjectSettings nodeSettings(int n, const ObjectSettings& inherited) {
+    std::vector<std::string> unknown;
+    const ObjectSettings own = readObjectSettings(nodeJson(n), "node " + std::to_string(n) + nodeName(n), file_, unknown);
+    warnUnknownSettings(unknown, "node " + std::to_string(n) + nodeName(n));
+    return own.over(inherited);
+  }
+
+  const ObjectSettings& meshSettings(int meshIndex) {
+    auto it = meshSettings_.find(meshIndex);
+    if (it != meshSettings_.end()) return it->second;
+    static const json empty = json::object();
+    const json* mesh = element(src_.json, "meshes", static_cast<size_t>(meshIndex));
+    const std::string& name = model_.meshes[meshIndex].name;
+    const std::string what = "mesh " + std::to_string(meshIndex) + (name.empty() ? "" : " ('" + name + "')");
+    std::vector<std::string> unknown;
+    ObjectSettings settings = readObjectSettings(mesh ? *mesh : empty, what, file_, unknown);
+    warnUnknownSettings(unknown, what);
+    return meshSettings_.emplace(meshIndex, settings).first->second;
+  }
+
+  // Each unknown key under extras.irbake is named once per file (the first object that has it).
+  void warnUnknownSettings(const std::vector<std::string>& keys, const std::string& what) {
+    std::string fresh;
+    for (const std::string& k : keys)
+      if (unknownSettingsWarned_.insert(k).second) fresh += (fresh.empty() ? "\"" : ", \"") + k + "\"";
+    if (!fresh.empty())
+      warn(what + ": extras.irbake has unknown key(s) " + fresh + ", ignored (known: mode, lightmapScale)");
+  }
+
+  void visitNode(int n, const glm::mat4& parent, int depth, const ObjectSettings& inherited) {
     const auto& node = model_.nodes[n];
     glm::mat4 world = parent * localMatrix(n);
+    const ObjectSettings settings = nodeSettings(n, inherited);
     if (node.mesh >= 0) {
       if (node.mesh >= static_cast<int>(model_.meshes.size()))
         invalid("node " + std::to_string(n) + nodeName(n) + " references mesh " + std::to_string(node.mesh) + ", out of range");
       if (const json* gpu = path(nodeJson(n), {"extensions", "EXT_mesh_gpu_instancing"})) {
         const std::vector<glm::mat4> instances = gpuInstances(n, *gpu);
         for (size_t i = 0; i < instances.size(); ++i)
-          addMeshInstance(n, node.mesh, world * instances[i], static_cast<int>(i), instances[i]);
+          addMeshInstance(n, node.mesh, world * instances[i], settings, static_cast<int>(i), instances[i]);
       } else {
-        addMeshInstance(n, node.mesh, world);
+        addMeshInstance(n, node.mesh, world, settings);
       }
     }
     if (node.camera >= 0) addCamera(n, world);
@@ -435,7 +468,7 @@ class Loader {
       if (!iesLights_) iesLights_ = std::make_unique<IesLightReader>(src_, model_, file_);
       scene_.lights.push_back(iesLights_->light(n, *ies, world));
     }
-    for (int c : node.children) visitNode(c, world, depth + 1);
+    for (int c : node.children) visitNode(c, world, depth + 1, settings);
   }
 
   // EXT_mesh_gpu_instancing: one transform per instance, T · R · S from the TRANSLATION, ROTATION (unit
@@ -807,9 +840,18 @@ class Loader {
     return (rec && rec->is_object()) ? rec : nullptr;
   }
 
-  void addMeshInstance(int nodeIndex, int meshIndex, const glm::mat4& world, int instance = -1,
-                       const glm::mat4& instanceToNode = glm::mat4(1.0f)) {
+  // An irbake export's probe-lit primitive (extras.lightProbes, docs/export.md): the viewer lights it from the probes.
+  bool exportMarksProbeLit(int meshIndex, int primIndex) const {
+    const json* mesh = element(src_.json, "meshes", meshIndex);
+    const json* prim = mesh ? element(*mesh, "primitives", primIndex) : nullptr;
+    const json* mark = prim ? path(*prim, {"extras", "lightProbes"}) : nullptr;
+    return mark && mark->is_boolean() && mark->get<bool>();
+  }
+
+  void addMeshInstance(int nodeIndex, int meshIndex, const glm::mat4& world, const ObjectSettings& fromNodes,
+                       int instance = -1, const glm::mat4& instanceToNode = glm::mat4(1.0f)) {
     const auto& mesh = model_.meshes[meshIndex];
+    const ObjectSettings settings = fromNodes.over(meshSettings(meshIndex));
     const glm::mat3 linear(world);
     const float det = glm::determinant(linear);
     const glm::mat3 normalMatrix = std::abs(det) > 0.0f ? glm::transpose(glm::inverse(linear)) : linear;
@@ -825,6 +867,9 @@ class Loader {
       out.nodeToWorld = world;
       out.instance = instance;
       out.instanceToNode = instanceToNode;
+      out.mode = settings.mode.value_or(ObjectMode::Baked);
+      if (options_.shadingMaps && exportMarksProbeLit(meshIndex, pi)) out.mode = ObjectMode::Probes;
+      out.lightmapScale = settings.lightmapScale.value_or(1.0f);
       out.material = materialIndex(lp.material, "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi));
       out.lightmap = lp.lightmap;
       out.uv0 = lp.uv0;
@@ -1355,6 +1400,8 @@ class Loader {
   std::vector<int> fallbackImage_;   // per scene texture: EXT_texture_webp's fallback image (-1 none)
   std::vector<bool> textureWebp_;    // per scene texture: read through EXT_texture_webp
   bool warnedTextureTransform_ = false;
+  std::map<int, ObjectSettings> meshSettings_;      // extras.irbake of each mesh, read once
+  std::set<std::string> unknownSettingsWarned_;     // unknown extras.irbake keys already named
   size_t gpuInstanceTotal_ = 0;
 };
 

@@ -385,6 +385,71 @@ TEST(GltfLoader, ReadsEachLightsBakeModeFromExtras) {
   }
 }
 
+// Per-object settings (extras.irbake on nodes and meshes): a node's setting holds for its descendants until a nearer
+// node sets its own, each key on its own; the node chain wins over the mesh's extras; absent everywhere: baked, 1.
+TEST(GltfLoader, ObjectSettingsFromNodeAndMeshExtras) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["meshes"][0]["extras"]["irbake"] = {{"mode", "shadow-only"}, {"lightmapScale", 0.5}};
+  doc.root["meshes"].push_back(doc.root["meshes"][0]);
+  doc.root["meshes"][1].erase("extras");
+  doc.root["nodes"] = json::array(
+      {{{"name", "group"}, {"children", {1, 2}}, {"extras", {{"irbake", {{"mode", "probes"}, {"lightmapScale", 2}}}}}},
+       {{"name", "inherits"}, {"mesh", 0}},
+       {{"name", "overrides"}, {"mesh", 0}, {"extras", {{"irbake", {{"mode", "baked"}, {"note", 1}}}}}},
+       {{"name", "mesh setting"}, {"mesh", 0}},
+       {{"name", "off"}, {"mesh", 1}, {"extras", {{"irbake", {{"mode", "off"}, {"lightmapScale", 4}, {"note", 2}}}}}},
+       {{"name", "plain"}, {"mesh", 1}, {"extras", "not an object"}}});
+  doc.root["scenes"][0]["nodes"] = {0, 3, 4, 5};
+  const Scene s = loadDocument(doc, "loader_object_settings");
+  ASSERT_EQ(s.primitives.size(), 5u);
+  const std::vector<std::pair<ObjectMode, float>> expected = {{ObjectMode::Probes, 2.0f}, {ObjectMode::Baked, 2.0f},
+                                                              {ObjectMode::ShadowOnly, 0.5f}, {ObjectMode::Off, 4.0f},
+                                                              {ObjectMode::Baked, 1.0f}};
+  for (size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(s.primitives[i].mode, expected[i].first) << i;
+    EXPECT_EQ(s.primitives[i].lightmapScale, expected[i].second) << i;
+  }
+  // An unknown key is named once, at the first object that has it.
+  const auto unknown = std::count_if(s.stats.warnings.begin(), s.stats.warnings.end(), [](const std::string& w) {
+    return w.find("extras.irbake has unknown key(s) \"note\"") != std::string::npos;
+  });
+  EXPECT_EQ(unknown, 1);
+  EXPECT_TRUE(std::any_of(s.stats.warnings.begin(), s.stats.warnings.end(),
+                          [](const std::string& w) { return w.find("node 2 ('overrides')") != std::string::npos; }));
+}
+
+// A bad mode or texel scale stops the load naming the file, the node or mesh, the key and the value.
+TEST(GltfLoader, BadObjectSettingsAreRefusedNamingTheObject) {
+  GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
+  doc.root["nodes"][0]["name"] = "crate";
+  doc.root["meshes"][0]["name"] = "box";
+  const std::vector<std::pair<json, std::string>> badScales = {
+      {json(0), "0"}, {json(-1.5), "-1.5"}, {json(65), "65"}, {json(0.01), "0.01"}, {json("2"), "\"2\""},
+      {json(nullptr), "null"}, {json::array({2}), "[2]"}};
+  int i = 0;
+  for (const auto& [value, shown] : badScales) {
+    doc.root["nodes"][0]["extras"]["irbake"] = {{"lightmapScale", value}};
+    expectRefused(doc, "loader_bad_scale_" + std::to_string(i++),
+                  {"node 0 ('crate')", "extras.irbake.lightmapScale must be a number from 1/64 to 64", "(got " + shown + ")"});
+  }
+  for (const json& mode : {json("shadow"), json(3), json("Baked")}) {
+    doc.root["nodes"][0]["extras"]["irbake"] = {{"mode", mode}};
+    expectRefused(doc, "loader_bad_mode_" + std::to_string(i++),
+                  {"node 0 ('crate')", "extras.irbake.mode must be \"baked\", \"shadow-only\", \"probes\" or \"off\"",
+                   "(got " + mode.dump() + ")"});
+  }
+  doc.root["nodes"][0]["extras"]["irbake"] = 5;
+  expectRefused(doc, "loader_bad_irbake", {"node 0 ('crate')", "extras.irbake must be an object (got 5)"});
+  doc.root["nodes"][0].erase("extras");
+  doc.root["meshes"][0]["extras"]["irbake"] = {{"lightmapScale", 100}};
+  expectRefused(doc, "loader_bad_mesh_scale", {"mesh 0 ('box')", "lightmapScale", "(got 100)"});
+  // The range's ends are settings, not errors.
+  for (double edge : {1.0 / 64.0, 64.0}) {
+    doc.root["meshes"][0]["extras"]["irbake"] = {{"lightmapScale", edge}};
+    EXPECT_EQ(loadDocument(doc, "loader_scale_edge").primitives.at(0).lightmapScale, float(edge));
+  }
+}
+
 TEST(GltfLoader, ReadsMozLightmapPrimitiveRecordsAndPageList) {
   GltfDocument doc = meshDocument(kTriangle, {0, 1, 2});
   auto& prim = doc.root["meshes"][0]["primitives"][0];

@@ -26,6 +26,24 @@ bool parseLightMode(const std::string& text, LightMode& mode) {
   return false;
 }
 
+const char* toString(ObjectMode mode) {
+  switch (mode) {
+    case ObjectMode::Baked: return "baked";
+    case ObjectMode::ShadowOnly: return "shadow-only";
+    case ObjectMode::Probes: return "probes";
+    case ObjectMode::Off: return "off";
+  }
+  return "baked";
+}
+
+bool parseObjectMode(const std::string& text, ObjectMode& mode) {
+  for (ObjectMode m : {ObjectMode::Baked, ObjectMode::ShadowOnly, ObjectMode::Probes, ObjectMode::Off})
+    if (text == toString(m)) {
+      mode = m;
+      return true;
+    }
+  return false;
+}
 
 namespace {
 

@@ -99,6 +99,15 @@ struct LightmapRef {
   int width = 0, height = 0;   // page size in texels
 };
 
+// How an object takes part in the bake (extras.irbake.mode on its node, an ancestor node or its mesh; docs/guide.md
+// "Per-object settings"). Baked: casts, bounces and gets map texels. ShadowOnly: casts and bounces, no texels.
+// Probes: as ShadowOnly, and the clients light it from the irradiance probes. Off: not in the bake at all (the
+// pipeline takes it out of the scene it bakes and hands it back to the export unchanged).
+enum class ObjectMode { Baked, ShadowOnly, Probes, Off };
+const char* toString(ObjectMode mode);
+// "baked", "shadow-only", "probes" or "off"; false for anything else.
+bool parseObjectMode(const std::string& text, ObjectMode& mode);
+
 // One glTF primitive instanced by one node, flattened to world space.
 // Vertex i is accessor vertex i of the source primitive (strips and fans are triangulated in indices),
 // or sourceVertex[i] where vertices were split (flat normals for a primitive without NORMAL; atlas seams).
@@ -125,6 +134,8 @@ struct Primitive {
   std::vector<uint32_t> sourceVertex;
   LightmapRef lightmap;
   float lightmapScale = 1.0f;  // texel density multiplier (extras.irbake.lightmapScale on the node or mesh)
+  ObjectMode mode = ObjectMode::Baked;  // extras.irbake.mode on the node (nearest ancestor) or the mesh
+  bool getsLightmap() const { return mode == ObjectMode::Baked; }
   size_t triangleCount() const { return indices.size() / 3; }
 };
 

@@ -20,6 +20,28 @@ export function addProbeObjects(gltf, objects, sceneName) {
   });
 }
 
+// Probe-lit objects (extras.irbake.mode "probes" in the source; the export marks their primitives with
+// extras.lightProbes, docs/export.md): each such mesh is lit by the probes over its bounding sphere
+// (IrbakeProbeGrid.lightObject), as irview does. Without probes in the file they keep their material, with a
+// warning. Returns how many meshes were lit.
+export function lightProbeLitMeshes(gltf, sceneName) {
+  const json = gltf.parser.json;
+  const meshes = [];
+  gltf.scene.traverse(o => {
+    if (!o.isMesh) return;
+    const source = gltf.parser.associations.get(o);
+    const prim = source && json.meshes?.[source.meshes]?.primitives?.[source.primitives ?? 0];
+    if (prim?.extras?.lightProbes === true) meshes.push(o);
+  });
+  const grid = gltf.userData?.irbakeLightProbes;
+  if (meshes.length && !grid) {
+    console.warn(`${sceneName}: ${meshes.length} probe-lit object(s) but no IRBAKE_light_probes: drawn without light`);
+    return 0;
+  }
+  for (const mesh of meshes) grid.lightObject(mesh);
+  return meshes.length;
+}
+
 // A perspective camera at `eye` looking at `target` (+Y up), vertical fov in degrees.
 export function lookAtCamera({ eye, target, fov, aspect = 1 }) {
   const cam = new THREE.PerspectiveCamera(fov, aspect, 0.01, 1000);

@@ -8,7 +8,7 @@
 //          [--plugin none: the client's glTF loader without our MOZ_lightmap plugin, as any viewer (the portable GLB);
 //           moz-only: MOZ_lightmap without irbake_shadowmask.js's mixed lights]
 //          [--min-runtime-lights N, --min-masked N: fail unless three.js shaded N lights in real time, N materials
-//           with a shadow mask]
+//           with a shadow mask; --min-probe-lit N: unless N meshes were lit by the probes (probe-lit objects)]
 //          [--client three|babylon|spec (default three; spec: three.js reading MOZ_lightmap from its specification
 //           alone, spec_reader.html; --standard 0 shades it with Lambert instead of MeshStandardMaterial)]
 //          [--region-a A.png --region-b B.png [--region-min 8] [--min-region-pixels N]: the mean over the pixels
@@ -135,7 +135,8 @@ try {
     console.error(`render_compare: mean absolute difference ${result.meanAbs.toFixed(3)} > ${maxMeanAbs} (web ${args.out}, irview ${args.reference})`);
     code = 1;
   }
-  for (const [option, field] of [['min-runtime-lights', 'runtimeLights'], ['min-masked', 'maskedMaterials'], ['min-region-pixels', 'pixels']])
+  for (const [option, field] of [['min-runtime-lights', 'runtimeLights'], ['min-masked', 'maskedMaterials'],
+                                 ['min-region-pixels', 'pixels'], ['min-probe-lit', 'probeLit']])
     if (args[option] !== undefined && !(result[field] >= Number(args[option]))) {
       console.error(`render_compare: ${field} ${result[field]}, expected at least ${args[option]}`);
       code = 1;

@@ -6,7 +6,7 @@ import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 import { IrbakeShadowmaskExtension } from './irbake_shadowmask.js';
 import { IrbakeLightProbesExtension } from './irbake_light_probes.js';
-import { addProbeObjects, lookAtCamera } from './probe_objects.js';
+import { addProbeObjects, lightProbeLitMeshes, lookAtCamera } from './probe_objects.js';
 import { overviewCamera } from './overview_camera.js';
 
 // lightmapMode: 'sh' (default) shades directional maps with the normal map, 'l0' shows the plain map.
@@ -44,6 +44,7 @@ export async function showBakedScene({ scene, camera = null, width, height, ligh
 
   const overview = !view && camera === null && gltf.cameras.length === 0;
   const bounds = overview ? new THREE.Box3().setFromObject(gltf.scene, true) : null;  // before the probe spheres
+  const probeLit = plugin ? lightProbeLitMeshes(gltf, scene) : 0;
   const probes = addProbeObjects(gltf, probeObjects, scene);
   const cam = view ? lookAtCamera(view) : overview ? overviewCamera(bounds) : gltf.cameras[camera ?? 0];
   if (!cam) throw new Error(`${scene}: no camera ${camera}: the file has ${gltf.cameras.length} (leave the camera out for the overview)`);
@@ -59,7 +60,7 @@ export async function showBakedScene({ scene, camera = null, width, height, ligh
   return { width, height, overview, lights: lights.length, lightmapMode, plugin,
            runtimeLights: shadowmask?.runtimeLights.length ?? 0, maskedMaterials: shadowmask?.maskedMaterials ?? 0,
            directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
-           generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes };
+           generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes, probeLit };
 }
 
 export { canvasPixels } from './canvas_pixels.js';

@@ -11,6 +11,7 @@
 # finite, unsorted cells and a negative sun irradiance. glTF-Transform optimize (meshopt) with runtime/web's config must keep
 # the sun level's accessors bit for bit (gltf_transform_check.mjs survives) and its refusals of bad sun data,
 # and the Khronos validator finds no error in the bake (validate.mjs); skipped when the CLI is not installed.
+# A probe-lit object (the short block, extras.irbake.mode "probes") is shaded from the probes by both clients alike.
 # Usage (from ctest): web_probes_test.sh IRBAKE IRVIEW MODULES_DIR WORK_DIR
 set -euo pipefail
 irbake="$1" irview="$2" modules="$3" work="$4"
@@ -44,6 +45,22 @@ node -e "const e = JSON.parse(require('fs').readFileSync('$work/bake/scene.gltf'
 refuses "$work/bake/scene_emitter_positions.gltf" "IRBAKE_light_probes.emitters[0].positions: accessor of componentType 5126 SCALAR, expected 5126 VEC3"
 refuses "$work/bake/scene_emitter_radiance.gltf" "IRBAKE_light_probes.emitters[0].radiance: not finite"
 refuses "$work/bake/scene_emitter_visibility.gltf" "IRBAKE_light_probes.emitters[0].visibility: "
+
+# A probe-lit object (extras.irbake.mode "probes" on the short block): no map texels, its primitives marked
+# extras.lightProbes, and lit by the probes (and the exact ceiling emitter) in both clients, which agree.
+node -e "const fs = require('fs'), d = JSON.parse(fs.readFileSync('$work/samples/cornell_box.gltf'));
+         d.nodes.find(n => n.name === 'short_block').extras = { irbake: { mode: 'probes' } };
+         fs.writeFileSync('$work/samples/cornell_probe_lit.gltf', JSON.stringify(d));"
+"$irbake" bake "$work/samples/cornell_probe_lit.gltf" -o "$work/probe_lit" --vpls 512 --texels-per-unit 60 --quiet \
+  > "$work/probe_lit.log" 2>&1
+node -e "const d = JSON.parse(require('fs').readFileSync('$work/probe_lit/scene.gltf'));
+         const p = d.meshes[d.nodes.find(n => n.name === 'short_block').mesh].primitives[0];
+         if (p.extras?.lightProbes !== true || p.attributes.TEXCOORD_1 !== undefined) {
+           console.error('the short block is not exported as a probe-lit object'); process.exit(1); }"
+"$irview" "$work/probe_lit/scene.gltf" --camera 0 --width $w --height $h --screenshot "$work/irview_probe_lit.png" \
+  > "$work/irview_probe_lit.log" 2>&1
+node "$here/render_compare.mjs" --modules "$modules" --scene "$work/probe_lit/scene.gltf" --camera 0 --width $w --height $h \
+  --reference "$work/irview_probe_lit.png" --out "$work/web_probe_lit.png" --max-mean-abs 2 --min-probe-lit 1
 
 # The sun level (with --directional, which gltf_transform_check.mjs refusals needs): probes every 0.5 m,
 # x = ..., 0.25, 0.75, ...; the shadow edge x = 0.5 crosses that cell.

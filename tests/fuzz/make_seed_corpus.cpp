@@ -161,6 +161,31 @@ std::string glb(json doc, const fs::path& folder) {
   return out;
 }
 
+// Per-object settings (extras.irbake on nodes and meshes): every mode and a texel scale on the nodes in turn,
+// a scale and a mode on the first mesh, and a parent node whose setting its children inherit.
+bool addObjectSettings(json& doc) {
+  if (!doc.contains("nodes") || !doc["nodes"].is_array() || doc["nodes"].empty()) return false;
+  const char* const modes[] = {"baked", "shadow-only", "probes", "off"};
+  size_t i = 0;
+  for (json& node : doc["nodes"])
+    if (node.contains("mesh")) {
+      node["extras"]["irbake"] = {{"mode", modes[i % 4]}, {"lightmapScale", 0.5 * double(1 + i % 4)}};
+      ++i;
+    }
+  if (doc.contains("meshes") && doc["meshes"].is_array() && !doc["meshes"].empty())
+    doc["meshes"][0]["extras"]["irbake"] = {{"mode", "shadow-only"}, {"lightmapScale", 2.0}};
+  json parent = {{"name", "settings parent"}, {"extras", {{"irbake", {{"mode", "probes"}, {"lightmapScale", 0.25}}}}},
+                 {"children", json::array()}};
+  const int scene = doc.value("scene", 0);
+  if (!doc.contains("scenes") || !doc["scenes"].is_array() || int(doc["scenes"].size()) <= scene) return i > 0;
+  json& roots = doc["scenes"][scene]["nodes"];
+  if (!roots.is_array() || roots.empty()) return i > 0;
+  parent["children"].push_back(roots.back());
+  doc["nodes"].push_back(parent);
+  roots.back() = doc["nodes"].size() - 1;
+  return true;
+}
+
 // A small LM-63 profile (type C, quadrant symmetry, TILT=INCLUDE) for the EXT_lights_ies seeds.
 const char kIesProfile[] =
     "IESNA:LM-63-2002\n[TEST] seed\nTILT=INCLUDE\n1\n2\n0 90\n1 1\n"
@@ -233,7 +258,8 @@ int main(int argc, char** argv) {
         seeds += 2;
       }
       const std::pair<const char*, bool (*)(json&)> variants[] = {
-          {"_gpu_instancing", addGpuInstancing}, {"_texture_transform", addTextureTransforms}, {"_webp", addWebpSources}};
+          {"_gpu_instancing", addGpuInstancing}, {"_texture_transform", addTextureTransforms}, {"_webp", addWebpSources},
+          {"_object_settings", addObjectSettings}};
       for (const auto& [suffix, add] : variants) {
         json variant = doc;
         if (!add(variant)) continue;
