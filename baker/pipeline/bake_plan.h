@@ -80,7 +80,7 @@ BakePlan planBake(const Scene& scene, const RayTracer& rayTracer, const BakeOpti
 // that gets no channel falls back to indirect with a warning naming it. Throws Error(Usage) for a bad name or
 // a mode other than baked with the reference backend or --directional (not supported yet).
 void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& scene,
-                      const std::vector<TexelSamples>& texels);
+                      const std::vector<TexelSamples>& texels, const LightGrid* grid = nullptr);
 // The checks of settleLightModes that need no texels, made before anything is traced.
 void checkLightModes(const BakeOptions& options, const Scene& scene);
 
