@@ -24,7 +24,7 @@ BAKE = ["--quality", "preview", "--sun", "0.35,-1,0.2,5", "--sky", "0.4,0.5,0.7"
 
 
 def timed_bake(irbake, scene, out, cull, tpu):
-    cmd = ["/usr/bin/time", "-v", irbake, "bake", scene, out, "--light-cull", str(cull)] + BAKE
+    cmd = ["/usr/bin/time", "-v", irbake, "bake", scene, "-o", out, "--light-cull", str(cull)] + BAKE
     if tpu:
         cmd += ["--texels-per-unit", str(tpu)]
     p = subprocess.run(cmd, capture_output=True, text=True)
