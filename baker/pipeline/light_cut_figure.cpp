@@ -47,27 +47,30 @@ void measureLightCut(BakeState& s, const std::vector<Lightmap>& maps, nlohmann::
   for (size_t p = 0, k = 0; p < maps.size() && p < s.texels.size(); ++p)
     for (size_t t = 0; t < maps[p].size() && t < maps[p].valid.size(); ++t)
       if (maps[p].valid[t] && s.texels[p].positionWeight[t].w > 0.0f && k++ % stride == 0) picked.emplace_back(p, t);
-  std::vector<double> dropped(picked.size(), 0.0), kept(picked.size(), 0.0);
+  // Per texel: what the cut took with no shadow (a bound) and with each light's shadow ray (what it took).
+  std::vector<double> bound(picked.size(), 0.0), taken(picked.size(), 0.0), kept(picked.size(), 0.0);
+  const RayTracer& rt = *s.rayTracer;
   tbb::parallel_for(size_t(0), picked.size(), [&](size_t k) {
     const auto [p, t] = picked[k];
     const glm::vec3 x(s.texels[p].positionWeight[t]), n(s.texels[p].normal[t]);
-    glm::vec3 d(0.0f);
-    for (const auto& [faded, whole] : cut) d += punctualDirect(whole, x, n).mapValue - punctualDirect(*faded, x, n).mapValue;
-    dropped[k] = channelMean(glm::max(d, glm::vec3(0.0f)));
+    for (const auto& [faded, whole] : cut) {
+      const PunctualContribution w = punctualDirect(whole, x, n);
+      const double d = channelMean(w.mapValue - punctualDirect(*faded, x, n).mapValue);
+      if (!(d > 0.0)) continue;
+      bound[k] += d;
+      if (!rt.occluded(x + n * rt.epsilon(), w.toLight, 0.0f, w.distance - rt.epsilon())) taken[k] += d;
+    }
     kept[k] = channelMean(maps[p].texels[t]);
   });
-  double sumSquares = 0.0, sumDropped = 0.0, sumKept = 0.0;
-  for (size_t k = 0; k < picked.size(); ++k) {
-    sumSquares += dropped[k] * dropped[k];
-    sumDropped += dropped[k];
-    sumKept += kept[k];
-  }
-  const double meanKept = picked.empty() ? 0.0 : sumKept / double(picked.size());
-  if (meanKept > 0.0) s.lightCutBound = std::sqrt(sumSquares / double(picked.size())) / meanKept;
-  j["cutBound"] = {{"relative", s.lightCutBound}, {"relativeMean", meanKept > 0.0 ? sumDropped / sumKept : 0.0},
-                   {"texels", picked.size()},
-                   {"covers", "the light the cut lights leave out with no shadow (at least what the cut took), RMS over "
-                              "the texels over the map's mean"}};
+  auto rmsOverMean = [&](const std::vector<double>& v) {
+    double squares = 0.0, mean = 0.0;
+    for (size_t k = 0; k < v.size(); ++k) squares += v[k] * v[k], mean += kept[k];
+    return mean > 0.0 ? std::sqrt(squares / double(v.size())) / (mean / double(v.size())) : 0.0;
+  };
+  s.lightCutBound = rmsOverMean(taken);
+  j["cutBound"] = {{"relative", s.lightCutBound}, {"unshadowedRelative", rmsOverMean(bound)}, {"texels", picked.size()},
+                   {"covers", "the light the cut lights' fade took at the texels (relative: with their shadow rays; "
+                              "unshadowedRelative: without, a bound), RMS over the texels over the map's mean"}};
 }
 
 }  // namespace irbake
