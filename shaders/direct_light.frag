@@ -19,6 +19,7 @@ uniform vec3 lightDirection;   // direction light travels (spot, directional); I
 uniform vec3 lightAxisX;       // IES: the profile's horizontal angle 0 (unit, orthogonal to lightDirection)
 uniform vec3 lightIntensity;   // colour × intensity (W/sr or W/m²)
 uniform float lightRange;      // 0: infinite (rangeWindow)
+uniform float lightCutoff;     // the bake's cut of a light without range (Light::cutoff); 0: none
 uniform float cosOuter, spotScale;  // spot falloff: t = clamp((cos − cosOuter)·spotScale, 0, 1), I·t²
 uniform mat4 shadowClip;       // 2D maps: world → clip
 uniform mat4 shadowClipInverse;  // 2D maps: clip → world (contact check)
@@ -169,6 +170,7 @@ void main() {
         I *= iesCandela(-toLight);
       }
       e = I / (r * r) * window;
+      if (lightCutoff > 0.0) e *= 1.0 - smoothstep(0.75 * lightCutoff, lightCutoff, r);
     }
     float cosTheta = dot(n, toLight);
     vec3 ng = texelFetch(gGeomNormal, ivec3(px, l), 0).xyz;

@@ -292,6 +292,10 @@ void addLightRows(std::vector<OptionDescriptor>& t) {
                                  shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)",
                              opt([](BakeOptions& o) { return &o.shadowEdges.subSamples; })),
                      knob(&QualityPreset::shadowEdgeSamples)));
+  t.push_back(number("--light-cull", 0.0, 1.0, kLights, "F",
+                     "each light's work only where it reaches: its range, or where its light\nfalls to F × the scene's "
+                     "reference (default " + shown(LightCullOptions{}.fraction) + ", docs/units.md); 0: every light everywhere",
+                     opt([](BakeOptions& o) { return &o.lightCull.fraction; })));
   t.push_back(text("--env", kCommon, "FILE", "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky",
                    arg(&BakeArguments::env), kPath));
   t.push_back(number("--env-intensity", 0.0, kLargestLight, kLights, "S",

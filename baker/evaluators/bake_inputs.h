@@ -5,6 +5,7 @@
 
 #include "lightmap/lightmap.h"
 #include "common/progress.h"
+#include "lights/light_reach.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/footprint_albedo.h"
 #include "scene/scene.h"
@@ -42,6 +43,12 @@ struct BakeInputs {
   // interleave's mix, the sky, the compensation, the final gather); the pipeline makes one per bake. Null: each
   // filter makes its own (the same bits).
   SurfaceFilterCache* surfaceFilters = nullptr;
+  // The lights' reach spheres (lights/light_reach.h), built once per bake: every stage's per-light loop visits
+  // lightsNear(x) only. Null: every light everywhere.
+  const LightGrid* lightGrid = nullptr;
+  LightSpan lightsNear(const glm::vec3& x) const {
+    return lightGrid ? lightGrid->near(x) : LightSpan{nullptr, static_cast<uint32_t>(scene.lights.size())};
+  }
 };
 
 // A page's map with every texel 0 and invalid, sized like its texel samples.

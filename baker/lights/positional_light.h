@@ -9,7 +9,8 @@
 namespace irbake {
 
 // E = I(−l) · max(0, n_x·l) / r² · window(r), as irradiance / π, window(r) glTF's range (Light::rangeWindow);
-// intensityToward(light, dirFromLight) is the kind's.
+// intensityToward(light, dirFromLight) is the kind's. The bake's cut of a light without range (Light::cutoff)
+// fades it out as well.
 template <typename IntensityToward>
 PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, const glm::vec3& nx,
                                       IntensityToward intensityToward) {
@@ -20,7 +21,7 @@ PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, co
   float r = std::sqrt(r2);
   glm::vec3 l = d / r;
   float cosX = glm::dot(nx, l);
-  const float window = light.rangeWindow(r);
+  const float window = light.rangeWindow(r) * light.cutoffWindow(r);
   if (cosX <= 0.0f || window == 0.0f) return c;
   c.toLight = l;
   c.distance = r;
@@ -37,6 +38,7 @@ inline bool withinReach(const Light& light, float r2, float threshold, float pea
   if (!(peak > 0.0f)) return false;
   float reach2 = threshold > 0.0f ? peak / (3.14159265f * threshold) : INFINITY;
   if (light.range > 0.0f) reach2 = std::min(reach2, light.range * light.range);
+  if (light.cutoff > 0.0f) reach2 = std::min(reach2, light.cutoff * light.cutoff);
   return !(r2 > reach2);
 }
 

@@ -234,6 +234,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   if (target && estimate) stagesToTarget(sums, r);
   else rayStages(s, r, report, estimate);
   sums = {};
+  timed(s, "lightCull", [&] { measureLightCut(s, r.maps, report); });
   if (estimate) timed(s, "errorEstimate", [&] {
     reportFigure(s, report);
     r.standardError = std::move(s.figure.errorPages);

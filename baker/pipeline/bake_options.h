@@ -75,6 +75,7 @@ struct BakeOptions {
   ClampCompensationOptions compensation;  // the gather that recovers the clamped energy (eval.biasCompensation)
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   ShadowEdgeOptions shadowEdges;          // punctual lights' shadow edges area-averaged (subSamples ≤ 1: off)
+  LightCullOptions lightCull;             // each light's work only where it reaches (fraction 0: every light everywhere)
   FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (stages/gather)
   FinalGatherOptions gather;              // its rays and filter
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound

@@ -322,7 +322,7 @@ void checkLightModes(const BakeOptions& options, const Scene& scene) {
 }
 
 void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& scene,
-                      const std::vector<TexelSamples>& texels) {
+                      const std::vector<TexelSamples>& texels, const LightGrid* grid) {
   checkLightModes(options, scene);
   const std::vector<RequestedLightMode> modes = resolveLightModes(scene, options.lightModes);
   plan.lightModes.assign(modes.size(), LightMode::Baked);
@@ -331,7 +331,7 @@ void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& s
     plan.lightModes[i] = modes[i].mode;
     wants[i] = modes[i].mode == LightMode::ShadowMask;
   }
-  plan.maskChannels = assignShadowMaskChannels(scene, texels, wants, plan.shadowMask);
+  plan.maskChannels = assignShadowMaskChannels(scene, texels, wants, plan.shadowMask, grid);
   for (size_t i : plan.maskChannels.fellBack) {
     plan.lightModes[i] = LightMode::Indirect;
     log::warn("light '" + lightModeName(scene.lights[i]) + "' falls back from shadowmask to indirect: its light meets " +

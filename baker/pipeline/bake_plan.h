@@ -86,7 +86,7 @@ bool hasTransmissiveMaterial(const Scene& scene);
 // that gets no channel falls back to indirect with a warning naming it. Throws Error(Usage) for a bad name or
 // a mode other than baked with the reference backend or --directional (not supported yet).
 void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& scene,
-                      const std::vector<TexelSamples>& texels);
+                      const std::vector<TexelSamples>& texels, const LightGrid* grid = nullptr);
 // The checks of settleLightModes that need no texels, made before anything is traced.
 void checkLightModes(const BakeOptions& options, const Scene& scene);
 

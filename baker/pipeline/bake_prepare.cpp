@@ -22,6 +22,21 @@ void buildGeometry(BakeState& s) {
   });
 }
 
+// Each light's reach, the cut lights' fade and the grid every stage's per-light loop reads.
+void settleLightCull(BakeState& s) {
+  const Bounds3 bounds = s.scene.bounds();
+  s.lightReach = settleLightReach(s.scene, bounds, s.options.lightCull);
+  applyLightCutoffs(s.scene, s.lightReach);
+  s.lightGrid = std::make_unique<LightGrid>(s.scene, s.lightReach, bounds);
+  if (!s.lightGrid->culls()) return;
+  const size_t cut = s.lightReach.cutLights();
+  s.plan.settle("light-cull", s.options.lightCull.fraction,
+                cut ? std::to_string(cut) + " lights without range end where their light falls to the fraction of " +
+                          std::to_string(s.lightReach.reference) + " (docs/units.md)"
+                    : std::string("the lights' ranges"),
+                false);
+}
+
 // The plan and its evaluator (a GL context is made here where GL may run: its time counts to the backend).
 void chooseBackend(BakeState& s) {
   s.plan = planBake(s.scene, *s.rayTracer, s.options, [&] {
@@ -160,7 +175,8 @@ void prepare(BakeState& s) {
   // The backend first (the GL context is made here: its time counts to the backend, as it did): the
   // reference backend reads no VPLs, so it needs no VPL selection.
   timed(s, "backend", [&] { chooseBackend(s); });
-  settleLightModes(s.plan, s.options, s.scene, s.texels);
+  settleLightCull(s);
+  settleLightModes(s.plan, s.options, s.scene, s.texels, s.lightGrid.get());
   const bool autoDensity = !(s.options.atlas.texelsPerUnit > 0.0);
   s.plan.settle("texels-per-unit", s.atlas.stats.texelsPerUnit,
                 autoDensity ? "the density rule: the preset's texels per metre, more for a small scene, less to fit "

@@ -9,7 +9,9 @@ ProgressCallback withProgress(const BakeState& s, ProgressCallback cb) { return 
 
 BakeInputs inputs(const BakeState& s, const std::vector<TexelSamples>& pages, const VplSet& set,
                   const VplEvalOptions& e, ProgressCallback progress) {
-  return BakeInputs{s.scene, *s.rayTracer, pages, set, e, std::move(progress)};
+  BakeInputs in{s.scene, *s.rayTracer, pages, set, e, std::move(progress)};
+  in.lightGrid = s.lightGrid.get();
+  return in;
 }
 
 StageContext stageContext(BakeState& s, nlohmann::json& report) {

@@ -68,6 +68,9 @@ struct BakeState {
   std::unique_ptr<FootprintAlbedo> footprintAlbedo;  // hit albedo for the compensation and the gather (one for both)
   std::unique_ptr<BakeInputs> wholeInputs;           // every page and VPL: the sky and the gather read them
   std::unique_ptr<SurfaceFilterCache> surfaceFilters;  // each page's neighbour tests, made once for all filters
+  LightReach lightReach;                   // each light's reach (lights/light_reach.h)
+  std::unique_ptr<LightGrid> lightGrid;    // the lights near each point, for every stage's per-light loop
+  double lightCutBound = 0.0;              // the cut's bound, relative to the map's mean (measureLightCut)
 
   // The VPL blocks (walk_replicates.cpp, backend_maps.cpp).
   std::vector<std::vector<VplSet>> classVpls;  // per replicate of the walk, per interleave class
@@ -165,6 +168,9 @@ std::array<std::vector<Lightmap>, 2> mixedHalves(const BakeState& s, const Exact
 // gather; when estimating, each run a second time with another seed, then the figure (into s.figure).
 void rayStages(BakeState& s, BakeResult& r, nlohmann::json& report, bool estimate);
 void reportFigure(const BakeState& s, nlohmann::json& report);
+// light_cut_figure.cpp: the light the cut lights' fade leaves out, bounded at a subset of the texels against the
+// finished map, into report["lightCull"] and s.lightCutBound.
+void measureLightCut(BakeState& s, const std::vector<Lightmap>& maps, nlohmann::json& report);
 nlohmann::json roundEntry(const BakeState& s);
 void raiseStageRays(BakeState& s, double factor);
 std::string percent(double x);

@@ -122,6 +122,10 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
   nlohmann::json& j = report["estimatedError"] = e.toJson();
   j["replicates"] = s.replicates.size();
   j["breakdown"] = s.figure.breakdown;
+  if (s.lightCutBound > 0.0) {  // the cut's bias, independent of the noise: the squares add
+    j["breakdown"]["lightCut"] = s.lightCutBound;
+    j["relative"] = std::hypot(e.relative, s.lightCutBound);
+  }
   j["interior"] = s.figure.interior.toJson();
   j["interior"]["breakdown"] = s.figure.interiorBreakdown;
   j["interior"]["texels"] = "valid texels whose four neighbours are valid: the chart-border ring left out, as "
@@ -130,6 +134,7 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
   j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
                 "compensation's and final gather's own ray noise (each run again with another seed)";
   j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
+  if (s.lightCutBound > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the light cut's bound (lightCull.cutBound)";
   j["rounds"] = s.rounds;
   if (s.options.errorEstimate.targetError > 0.0) {
     j["targetError"] = s.options.errorEstimate.targetError;

@@ -180,6 +180,15 @@ struct Light {
     const float w = 1.0f - q2 * q2;  // at most 1
     return w > 0.0f ? w * w : 0.0f;
   }
+  // The bake's cut of a light without range (lights/light_reach.h): 0 (no cut), or the distance where its light
+  // ends, faded out by a smoothstep over the last quarter so the cut draws no ring.
+  float cutoff = 0.0f;
+  float cutoffWindow(float distance) const {
+    if (!(cutoff > 0.0f) || distance <= 0.75f * cutoff) return 1.0f;
+    if (distance >= cutoff) return 0.0f;
+    const float t = (distance - 0.75f * cutoff) / (0.25f * cutoff);
+    return 1.0f - t * t * (3.0f - 2.0f * t);
+  }
 };
 
 struct Camera {

@@ -124,7 +124,7 @@ void gatherVplBlock(const BakeInputs& in, float bound, const glm::vec3& x, const
 template <typename Visit>
 void visitDirect(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, Visit&& visit) {
   const float eps = in.rayTracer.epsilon();
-  for (size_t i = 0; i < in.scene.lights.size(); ++i) {
+  for (uint32_t i : in.lightsNear(x)) {
     if (!in.eval.directIncludes(i)) continue;
     PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
     if (c.mapValue == glm::vec3(0.0f)) continue;

@@ -72,6 +72,12 @@ class GlBaker {
   void renderVplCubes(size_t first, size_t count, const DepthAtlas& atlas, const GpuGeometry& geometry);
   void accumulateVplBatch(size_t first, size_t count, const DepthAtlas& atlas);
   void bakeDirect(const Light& light);
+  // Whether light i's reach meets the scene's bounds (lights/light_reach.h): a light that misses it renders nothing.
+  bool reachesScene(size_t i) {
+    if (!in_.lightGrid || !in_.lightGrid->culls()) return true;
+    if (!sceneBounds_) sceneBounds_ = in_.scene.bounds();
+    return in_.lightGrid->touches(i, sceneBounds_->min, sceneBounds_->max);
+  }
   void bindGBuffer(const GpuPage& page) const;
   void shadowPassState() const;
   void lightMapPassState() const;
@@ -108,6 +114,7 @@ class GlBaker {
   std::vector<const void*> drawOffsets_;
   std::vector<std::vector<uint8_t>> contactTexels_;
   std::unique_ptr<DepthAtlas> seeThroughAtlas_;  // the same cubes of the see-through primitives alone
+  std::optional<Bounds3> sceneBounds_;  // what reachesScene tests, once
   std::unique_ptr<DepthAtlas> atlas_;  // VPL depth cubes of one batch (created before the programs: its layout is compiled in)
 };
 
@@ -385,6 +392,7 @@ void GlBaker::bakeDirect(const Light& light) {
   if (shaderLight.code == BAKE_LIGHT_IES && light.profile) uploadIesProfile(*light.profile, profileTexture);
   glUniform3fv(p.uniform("lightIntensity"), 1, &shaderLight.intensity[0]);
   glUniform1f(p.uniform("lightRange"), light.range);
+  glUniform1f(p.uniform("lightCutoff"), light.cutoff);
   glUniform1f(p.uniform("cosOuter"), shaderLight.cosOuter);
   glUniform1f(p.uniform("spotScale"), shaderLight.spotScale);
   const glm::mat4 clip = view2d ? view2d->clip : glm::mat4(1.0f);
@@ -555,7 +563,7 @@ std::vector<Lightmap> GlBaker::run() {
     }
   }
   for (size_t i = 0; i < lightCount; ++i) {
-    if (in_.eval.directIncludes(i)) bakeDirect(in_.scene.lights[i]);
+    if (in_.eval.directIncludes(i) && reachesScene(i)) bakeDirect(in_.scene.lights[i]);
     ++stats_.passes;
     if (in_.progress) in_.progress("gl", double(vplCount + (i + 1) * vplsPerPass) / std::max<size_t>(1, totalWork));
   }

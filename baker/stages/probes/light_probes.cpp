@@ -178,7 +178,7 @@ bool clearOfSurfaces(const RayTracer& rt, const glm::vec3& p, float clearance, d
 // Every punctual light as a delta from its direction, times its visibility at the probe (`visibility`, one per
 // light: the fitted value, light_visibility_fit.h) and the colour of the see-through surfaces on the way.
 void addPunctualLights(const BakeInputs& in, const glm::vec3& p, const float* visibility, ShCoefficients& sh) {
-  for (size_t l = 0; l < in.scene.lights.size(); ++l) {
+  for (uint32_t l : in.lightsNear(p)) {
     const Light& light = in.scene.lights[l];
     if (!(visibility[l] > 0.0f)) continue;
     const PunctualContribution c = lightKind(light.type).atNormalIncidence(light, p);

@@ -37,6 +37,18 @@ float punctualVisibility(const BakeInputs& in, const Light& light, const glm::ve
   return channelMean(t);
 }
 
+namespace {
+
+// The lights whose reach meets the box [lo, hi], in index order (every light without a grid).
+std::vector<uint32_t> lightsReaching(const BakeInputs& in, const glm::vec3& lo, const glm::vec3& hi) {
+  if (in.lightGrid) return in.lightGrid->touching(lo, hi);
+  std::vector<uint32_t> all(in.scene.lights.size());
+  for (size_t l = 0; l < all.size(); ++l) all[l] = static_cast<uint32_t>(l);
+  return all;
+}
+
+}  // namespace
+
 LightVisibilityFit fitLightVisibility(const BakeInputs& in, const LightProbeGrid& g, int samplesPerAxis,
                                       uint32_t seed) {
   LightVisibilityFit fit;
@@ -51,18 +63,21 @@ LightVisibilityFit fitLightVisibility(const BakeInputs& in, const LightProbeGrid
   std::atomic<size_t> rays{0};
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
     if (!g.valid[i]) return;
-    size_t traced = m;
-    for (size_t l = 0; l < m; ++l) fit.pointVisibility[i * m + l] = punctualVisibility(in, lights[l], g.position(i));
-    Rng rng(hashSeed(seed, kFitStream, i));
     const glm::vec3 corner = g.position(i) - (i < g.offsets.size() ? g.offsets[i] : glm::vec3(0.0f)) - 0.5f * g.spacing;
+    // The lights that reach the probe or its cube; the others give it nothing and keep visibility 0.
+    const std::vector<uint32_t> reaching = lightsReaching(in, glm::min(corner, g.position(i)),
+                                                          glm::max(corner + g.spacing, g.position(i)));
+    size_t traced = reaching.size();
+    for (uint32_t l : reaching) fit.pointVisibility[i * m + l] = punctualVisibility(in, lights[l], g.position(i));
+    Rng rng(hashSeed(seed, kFitStream, i));
     for (size_t s = 0; s < perProbe; ++s) {
       const glm::vec3 cell(static_cast<float>(s % S), static_cast<float>(s / S % S), static_cast<float>(s / (S * S)));
       const glm::vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
       const glm::vec3 x = corner + g.spacing * (cell + jitter) / static_cast<float>(S);
       ++traced;
       if (!probeSees(in, g.position(i), x)) continue;
-      for (size_t l = 0; l < m; ++l) targets[(i * perProbe + s) * m + l] = punctualVisibility(in, lights[l], x);
-      traced += m;
+      for (uint32_t l : reaching) targets[(i * perProbe + s) * m + l] = punctualVisibility(in, lights[l], x);
+      traced += reaching.size();
       samples[i * perProbe + s] = blendSampleAt(g, x);
     }
     rays += traced;

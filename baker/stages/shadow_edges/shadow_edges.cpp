@@ -29,7 +29,7 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
       if (ts.primitive[t] < in.scene.primitives.size()) x = in.rayTracer.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
       glm::vec3 unshadowed(0.0f);
-      for (const Light& l : in.scene.lights) unshadowed += punctualDirect(l, x, n).mapValue;
+      for (uint32_t i : in.lightsNear(x)) unshadowed += punctualDirect(in.scene.lights[i], x, n).mapValue;
       const float u = channelMax(unshadowed);
       if (u > 0.0f) share[t] = channelMax(map.texels[t]) / u;
     }
@@ -49,8 +49,8 @@ void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::
       if (edge[t] || share[t] < 0.0f) continue;
       SquareMean mean;
       auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
-        for (const Light& l : in.scene.lights) {
-          const PunctualContribution c = punctualDirect(l, xs, nx);
+        for (uint32_t i : in.lightsNear(xs)) {
+          const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
           if (c.mapValue == glm::vec3(0.0f)) continue;
           values[1] += c.mapValue;
           const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
@@ -94,7 +94,7 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
         SquareMean mean;
         auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
           bool anyLit = false;
-          for (size_t i = 0; i < in.scene.lights.size(); ++i) {
+          for (uint32_t i : in.lightsNear(xs)) {
             const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
             if (c.mapValue == glm::vec3(0.0f)) continue;
             const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;

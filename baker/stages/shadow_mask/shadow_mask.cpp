@@ -121,7 +121,8 @@ nlohmann::json ShadowMaskChannels::toJson(const Scene& scene) const {
 }
 
 ShadowMaskChannels assignShadowMaskChannels(const Scene& scene, const std::vector<TexelSamples>& texels,
-                                            const std::vector<uint8_t>& wants, const ShadowMaskOptions& options) {
+                                            const std::vector<uint8_t>& wants, const ShadowMaskOptions& options,
+                                            const LightGrid* grid) {
   const size_t n = scene.lights.size();
   ShadowMaskChannels result;
   result.channel.assign(n, -1);
@@ -138,8 +139,10 @@ ShadowMaskChannels assignShadowMaskChannels(const Scene& scene, const std::vecto
       for (size_t s = r.begin(); s != r.end(); ++s) {
         if (ts.positionWeight[s].w <= 0.0f || !ts.valid[s % ts.layerSize()]) continue;
         reached.clear();
-        for (size_t i : asked)
-          if (lightInfluences(scene.lights[i], glm::vec3(ts.positionWeight[s]), options.influenceThreshold)) reached.push_back(i);
+        const glm::vec3 x(ts.positionWeight[s]);
+        const LightSpan near = grid ? grid->near(x) : LightSpan{nullptr, static_cast<uint32_t>(n)};
+        for (uint32_t i : near)
+          if (i < wants.size() && wants[i] && lightInfluences(scene.lights[i], x, options.influenceThreshold)) reached.push_back(i);
         for (size_t a : reached)
           for (size_t b : reached) overlap[a * n + b] = 1;
       }

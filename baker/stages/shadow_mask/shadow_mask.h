@@ -37,9 +37,11 @@ struct ShadowMaskChannels {
 };
 
 // Colours the overlap graph of the lights with wants[i] (two lights overlap where both reach one valid texel)
-// with at most four channels, brightest light first; a light no channel is free for falls back.
+// with at most four channels, brightest light first; a light no channel is free for falls back. With `grid`
+// each sample tests only the lights near it (lights/light_reach.h).
 ShadowMaskChannels assignShadowMaskChannels(const Scene& scene, const std::vector<TexelSamples>& texels,
-                                            const std::vector<uint8_t>& wants, const ShadowMaskOptions& options);
+                                            const std::vector<uint8_t>& wants, const ShadowMaskOptions& options,
+                                            const LightGrid* grid = nullptr);
 
 // Per map page, two pages: channels 0–2 in rgb, channel 3 in alpha (all three components); a texel no
 // channel's light reaches holds 1 (nothing shadows it).
