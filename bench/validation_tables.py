@@ -278,7 +278,7 @@ def levels_scale():
                     num(m("compensation_s"), 1), num(m("probes_s"), 1), num(other, 1),
                     f"{num(m('load_avg_start'), 1)} / {num(m('load_avg_end'), 1)}"])
     return table(["scene", "options", "triangles", "lights", "runs", "atlas texels", "pages", "wall (s)",
-                  "CPU (s)", "peak (MiB)", "backend", "shadow edges", "compensation", "probes",
+                  "CPU (s)", "peak (MiB)", "backend (with shadow edges)", "shadow edges", "compensation", "probes",
                   "atlas + texels + VPLs + sky + gather + post", "load average start / end"], out)
 
 

@@ -2,11 +2,13 @@
 """Time per stage and peak memory against texels x triangles, from levels_scale.sh's CSV.
 
 usage: python3 bench/levels/levels_scale_plot.py bench/results/levels_scale.csv docs/levels_scale.png
-One point per one-machine bake (the latest run of each scene name; shards + merge rows are left out), log-log.
-Left: the seconds of each stage that takes at least 2% of some bake, and the CPU seconds of the whole process.
+One point per one-machine bake (the latest run of each scene name; shards + merge rows are left out), log-log;
+lines join the town ladder, open squares are the lamp series and Sponza.
+Left: the seconds of each stage that takes at least 2% of some bake (backend includes its shadow edges,
+compensation its trace), and the CPU seconds of the whole process.
 Right: peak resident memory. The dotted line has slope 1 (time or memory proportional to texels x
-triangles). Prints each stage's log-log slope against triangles and against texels over the town ladder
-(town4 ... town32): a slope above 1 grows faster than linear in the level's size.
+triangles). Prints each stage's log-log slope against triangles, texels and texels x lights over the town
+ladder (town4 ... town32): a slope above 1 grows faster than linear in that measure of the level's size.
 """
 import csv
 import math
@@ -47,14 +49,21 @@ def main(src, dst):
     if not rows:
         sys.exit("levels_scale_plot: no one-machine rows in " + src)
     size = [int(r["texels"]) * int(r["triangles"]) for r in rows]
+    town = [i for i, r in enumerate(rows) if r["scene"] in TOWNS]
+    rest = [i for i, r in enumerate(rows) if r["scene"] not in TOWNS]
+    pick = lambda values, idx: [values[i] for i in idx]
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(14, 5.5))
     shown = [s for s in STAGES if any(float(r[s + "_s"]) >= 0.02 * float(r["wall_s"]) for r in rows)]
     for s in shown:
-        ax.plot(size, [max(float(r[s + "_s"]), 1e-2) for r in rows], "o-", label=s)
-    ax.plot(size, [float(r["cpu_s"]) for r in rows], "k^--", label="CPU seconds (process)")
-    for r, x in zip(rows, size):
-        ax.annotate(r["scene"], (x, float(r["cpu_s"])), textcoords="offset points", xytext=(4, 4), fontsize=7)
-    ref = [float(rows[0]["cpu_s"]) * x / size[0] for x in size]
+        ys = [max(float(r[s + "_s"]), 1e-2) for r in rows]
+        color = ax.plot(pick(size, town), pick(ys, town), "o-", label=s)[0].get_color()
+        ax.plot(pick(size, rest), pick(ys, rest), "s", color=color, mfc="none")
+    cpu = [float(r["cpu_s"]) for r in rows]
+    ax.plot(pick(size, town), pick(cpu, town), "k^--", label="CPU seconds (process)")
+    ax.plot(pick(size, rest), pick(cpu, rest), "k^", mfc="none")
+    for r, x, y in zip(rows, size, cpu):
+        ax.annotate(r["scene"], (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    ref = [cpu[0] * x / size[0] for x in size]
     ax.plot(size, ref, "k:", alpha=0.4, label="slope 1")
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -83,11 +92,13 @@ def main(src, dst):
     if len(towns) >= 2:
         tris = [int(r["triangles"]) for r in towns]
         tex = [int(r["texels"]) for r in towns]
-        print("log-log slope over %s: stage: against triangles / against texels" % " ".join(r["scene"] for r in towns))
+        lit = [int(r["texels"]) * int(r["lights"]) for r in towns]
+        print("log-log slope over %s: stage: against triangles / texels / texels x lights" %
+              " ".join(r["scene"] for r in towns))
         for s in STAGES + ["cpu", "peak_mib"]:
             col = s if s == "peak_mib" else s + "_s"
             ys = [float(r[col]) for r in towns]
-            print("  %-13s %5.2f / %5.2f" % (s, slope(tris, ys), slope(tex, ys)))
+            print("  %-13s %5.2f / %5.2f / %5.2f" % (s, slope(tris, ys), slope(tex, ys), slope(lit, ys)))
 
 
 if __name__ == "__main__":
