@@ -264,6 +264,32 @@ def t_levels():
                   "median wall (s)", "peak memory (MiB)", "load average"], out)
 
 
+def levels_scale():
+    """The level ladder (bench/levels/levels_scale.sh): per scene, the median of the runs of its latest commit."""
+    rows = read("levels_scale.csv")
+    commit = {}
+    for r in rows:
+        commit[r["scene"]] = r["commit"]
+    out = []
+    for scene, c in commit.items():
+        g = [r for r in rows if r["scene"] == scene and r["commit"] == c]
+        r = g[-1]
+        m = lambda k: median(x[k] for x in g)
+        other = sum(m(k + "_s") for k in ("atlas", "texels", "vpls", "sky", "finalGather", "post"))
+        out.append([scene, f"`{r['options']}`", int(r["triangles"]), int(r["lights"]), len(g),
+                    f"{int(r['texels']) / 1e6:.2f} M", r["pages"], num(m("wall_s"), 0), num(m("cpu_s"), 0),
+                    f"{m('peak_mib'):.0f}", num(m("backend_s"), 1), num(m("shadowEdges_s"), 1),
+                    num(m("compensation_s"), 1), num(m("probes_s"), 1), num(other, 1),
+                    f"{num(m('load_avg_start'), 1)} / {num(m('load_avg_end'), 1)}"])
+    return table(["scene", "options", "triangles", "lights", "runs", "atlas texels", "pages", "wall (s)",
+                  "CPU (s)", "peak (MiB)", "backend (with shadow edges)", "shadow edges", "compensation", "probes",
+                  "atlas + texels + VPLs + sky + gather + post", "load average start / end"], out)
+
+
+# Tables whose block is not yet in docs/validation.md: --print renders them, --check does not ask for them.
+UNPLACED = {"levels_scale": levels_scale}
+
+
 def t_memory():
     rows = read("memory.csv")
     label = rows[-1]["label"]
@@ -502,10 +528,11 @@ MARKER = re.compile(r"<!-- table:([a-z0-9_]+) -->\n(.*?)<!-- /table:\1 -->", re.
 
 
 def render(doc):
+    known = {**TABLES, **UNPLACED}
     missing = [name for name in TABLES if f"<!-- table:{name} -->" not in doc]
-    unknown = [m.group(1) for m in MARKER.finditer(doc) if m.group(1) not in TABLES]
-    new = MARKER.sub(lambda m: f"<!-- table:{m.group(1)} -->\n{TABLES[m.group(1)]()}\n<!-- /table:{m.group(1)} -->"
-                     if m.group(1) in TABLES else m.group(0), doc)
+    unknown = [m.group(1) for m in MARKER.finditer(doc) if m.group(1) not in known]
+    new = MARKER.sub(lambda m: f"<!-- table:{m.group(1)} -->\n{known[m.group(1)]()}\n<!-- /table:{m.group(1)} -->"
+                     if m.group(1) in known else m.group(0), doc)
     return new, missing, unknown
 
 
@@ -515,12 +542,12 @@ def main():
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--check", metavar="DOC")
     g.add_argument("--write", metavar="DOC")
-    g.add_argument("--print", metavar="NAME", choices=sorted(TABLES))
+    g.add_argument("--print", metavar="NAME", choices=sorted(TABLES) + sorted(UNPLACED))
     p.add_argument("--results", default=RESULTS)
     a = p.parse_args()
     RESULTS = a.results
     if a.print:
-        print(TABLES[a.print]())
+        print({**TABLES, **UNPLACED}[a.print]())
         return 0
     path = a.check or a.write
     with open(path, encoding="utf-8") as f:

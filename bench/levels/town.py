@@ -144,12 +144,15 @@ def build(args):
         light = {"type": "point", "name": "lamp_%d" % i, "color": [1.0, 0.78, 0.55], "intensity": args.intensity}
         if args.range > 0:
             light["range"] = args.range
+        triangles += post_tris
+        if args.no_lights:
+            nodes.append({"name": "lamp_%d" % i, "mesh": post, "translation": [x, 0.0, z]})
+            continue
         lights.append(light)
         nodes.append({"name": "lamp_%d" % i, "mesh": post, "translation": [x, 0.0, z],
                       "children": [len(nodes) + 1]})
         nodes.append({"name": "lamp_%d_light" % i, "translation": [0.0, 5.3, 0.0],
                       "extensions": {"KHR_lights_punctual": {"light": i}}})
-        triangles += post_tris
     roots = [i for i, n in enumerate(nodes) if not n["name"].endswith("_light")]
     doc = {"asset": {"version": "2.0", "generator": "irbake bench/levels/town.py"},
            "scene": 0, "scenes": [{"nodes": roots}], "nodes": nodes, "meshes": meshes, "materials": materials,
@@ -196,6 +199,8 @@ def main():
     ap.add_argument("--range", type=float, default=15.0, help="lamp range in metres; 0: none (default 15)")
     ap.add_argument("--intensity", type=float, default=400.0, help="lamp intensity in candela (default 400)")
     ap.add_argument("--cell", type=float, default=3.0, help="wall cell edge in metres (default 3)")
+    ap.add_argument("--no-lights", action="store_true",
+                    help="lamp posts without their point lights: the same geometry, lit by --sun/--sky alone")
     ap.add_argument("--seed", type=int, default=1, help="layout seed (default 1)")
     args = ap.parse_args()
     if args.blocks < 1 or args.lamps < 0 or args.cell <= 0:
