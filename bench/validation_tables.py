@@ -264,30 +264,56 @@ def t_levels():
                   "median wall (s)", "peak memory (MiB)", "load average"], out)
 
 
-def levels_scale():
-    """The level ladder (bench/levels/levels_scale.sh): per scene, the median of the runs of its latest commit."""
+def t_levels_scale():
+    """The level ladder (bench/levels/levels_scale.sh): per scene, the median of its latest commit's runs."""
     rows = read("levels_scale.csv")
-    commit = {}
+    latest_commit = {}
     for r in rows:
-        commit[r["scene"]] = r["commit"]
+        latest_commit[r["scene"]] = r["commit"]
     out = []
-    for scene, c in commit.items():
+    for scene, c in latest_commit.items():
         g = [r for r in rows if r["scene"] == scene and r["commit"] == c]
         r = g[-1]
         m = lambda k: median(x[k] for x in g)
-        other = sum(m(k + "_s") for k in ("atlas", "texels", "vpls", "sky", "finalGather", "post"))
-        out.append([scene, f"`{r['options']}`", int(r["triangles"]), int(r["lights"]), len(g),
-                    f"{int(r['texels']) / 1e6:.2f} M", r["pages"], num(m("wall_s"), 0), num(m("cpu_s"), 0),
-                    f"{m('peak_mib'):.0f}", num(m("backend_s"), 1), num(m("shadowEdges_s"), 1),
-                    num(m("compensation_s"), 1), num(m("probes_s"), 1), num(other, 1),
-                    f"{num(m('load_avg_start'), 1)} / {num(m('load_avg_end'), 1)}"])
-    return table(["scene", "options", "triangles", "lights", "runs", "atlas texels", "pages", "wall (s)",
-                  "CPU (s)", "peak (MiB)", "backend (with shadow edges)", "shadow edges", "compensation", "probes",
-                  "atlas + texels + VPLs + sky + gather + post", "load average start / end"], out)
+        out.append([scene, c, int(r["triangles"]), int(r["lights"]), f"{int(r['texels']) / 1e6:.2f} M", len(g),
+                    num(m("cpu_s"), 0), num(m("wall_s"), 0), f"{m('peak_mib'):.0f}", num(m("shadowEdges_s"), 1),
+                    num(m("probes_s"), 1), f"{num(m('load_avg_start'), 1)} / {num(m('load_avg_end'), 1)}"])
+    return table(["scene", "commit", "triangles", "lights", "texels", "runs", "CPU (s)", "wall (s)", "peak (MiB)",
+                  "shadow edges (s)", "probes (s)", "load start / end"], out)
 
 
-# Tables whose block is not yet in docs/validation.md: --print renders them, --check does not ask for them.
-UNPLACED = {"levels_scale": levels_scale}
+def t_light_cull():
+    """bench/results/light_cull.csv: per scene and --light-cull, the median CPU of its latest commit's runs, against
+    the same town's sun and sky alone, and the map's error against the brute-force bake (--light-cull 0)."""
+    rows = read("light_cull.csv")
+    keys = {}
+    for r in rows:
+        keys[(r["scene"], r["cull"])] = r["commit"]
+    cpu = {}
+    for (scene, cull), c in keys.items():
+        g = [float(r["cpu_s"]) for r in rows if (r["scene"], r["cull"], r["commit"]) == (scene, cull, c) and r["cpu_s"]]
+        cpu[(scene, cull)] = (statistics.median(g), len(g)) if g else (None, 0)
+    out = []
+    for (scene, cull), c in keys.items():
+        r = [x for x in rows if (x["scene"], x["cull"], x["commit"]) == (scene, cull, c)][-1]
+        own, runs = cpu[(scene, cull)]
+        base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull), (None, 0))[0]
+        ratio = f"{own / base:.2f}×" if own and base and not scene.endswith("sun") else ""
+        out.append([scene, r["lamps"], r["range"] if r["range"] != "0" else "none", cull if cull != "0" else "off (brute force)",
+                    c, runs, num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
+    return table(["scene", "lamps", "range (m)", "--light-cull", "commit", "runs", "CPU (s)", "CPU / sun and sky alone",
+                  "rel. RMSE against brute force"], out)
+
+
+def t_plan_accuracy():
+    """bench/levels/plan_accuracy.sh: `irbake plan`'s prediction against the bake, the latest date's rows."""
+    rows = read("plan_accuracy.csv")
+    last = max(r["date"] for r in rows)
+    out = [[r["scene"], r["role"], num(r["plan_s"], 1), num(r["predicted_cpu_s"], 1), num(r["measured_cpu_s"], 1),
+            f"**{num(r['time_ratio'])}**", r["predicted_mib"], r["measured_mib"], f"**{num(r['memory_ratio'])}**"]
+           for r in rows if r["date"] == last]
+    return table(["scene", "role", "plan (s)", "predicted CPU (s)", "measured CPU (s)", "time ratio",
+                  "predicted peak (MiB)", "measured peak (MiB)", "memory ratio"], out)
 
 
 def t_memory():
@@ -308,11 +334,11 @@ def gpu_table(name):
                   "compensation (s)", "peak (MiB)"], out)
 
 
-def t_gpu_h100():
+def gpu_h100():
     return gpu_table("gpu_h100.csv")
 
 
-def t_gpu_h200():
+def gpu_h200():
     return gpu_table("gpu_h200.csv")
 
 
@@ -524,6 +550,8 @@ def t_quality_presets():
 
 
 TABLES = {name[2:]: fn for name, fn in globals().items() if name.startswith("t_")}
+# Tables not in docs/validation.md (its size limit): --print renders them, --check does not ask for them.
+UNPLACED = {"gpu_h100": gpu_h100, "gpu_h200": gpu_h200}
 MARKER = re.compile(r"<!-- table:([a-z0-9_]+) -->\n(.*?)<!-- /table:\1 -->", re.S)
 
 
