@@ -66,7 +66,8 @@ TEST(SceneInvariance, ASunThatCannotEnterChangesNothingInside) {
 }
 
 // The sample box under a parent node scaled by 1e-3, 1 and 1e6: its emitter is a radiance, so the map is
-// the same at every scale (the default texel density follows the scene).
+// the same at every scale. The density rule counts texels per metre, so the test gives each scale the same
+// texels per box (60 per metre of the unscaled box).
 TEST(SceneInvariance, TheSameBoxInMillimetresOrKilometresBakesTheSameMap) {
   const fs::path dir = scratch("scales");
   nlohmann::json doc = nlohmann::json::parse(fileText(samples() / "cornell_box.gltf"));
@@ -82,7 +83,7 @@ TEST(SceneInvariance, TheSameBoxInMillimetresOrKilometresBakesTheSameMap) {
     std::ofstream(file) << scaled.dump();
     const fs::path out = dir / ("out_" + std::to_string(means.size()));
     const IrbakeRun run = runIrbake({"bake", file.string(), "-o", out.string(), "--vpls", "1024", "--backend", "embree",
-                                     "--quiet"}, out.string() + ".txt");
+                                     "--texels-per-unit", std::to_string(60.0 / scale), "--quiet"}, out.string() + ".txt");
     ASSERT_EQ(run.code, 0) << scale << ": " << run.output;
     means.push_back(mapMean(out));
   }
