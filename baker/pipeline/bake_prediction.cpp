@@ -86,7 +86,7 @@ BakePrediction predictBake(const Scene& scene, const BakeOptions& options, doubl
     return GlProbe{};  // a working software renderer, the machines' usual case
   });
   markSettledAtBake(p.plan, options, p.atlas, probedGl);
-  p.inputs = costInputs(scene, p.atlas, p.plan, cores);
+  p.inputs = costInputs(scene, p.atlas, p.plan, options.lightCull, cores);
   p.cost = predictCost(p.inputs);
   p.warnings = predictedWarnings(scene, options, p.atlas);
   return p;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "lights/light_kind.h"
@@ -14,31 +15,33 @@ namespace irbake {
 CostCoefficients calibratedCostCoefficients() {
   CostCoefficients c;
   // fit_cost_model.py: begin
-  c.loadPerTriangle = 2.5304e-07;
-  c.atlasPerTriangle = 3.34184e-06;
-  c.atlasPerPageTexel = 1.26379e-07;
-  c.raytracePerTriangle = 1.4308e-06;
-  c.texelsPerPageTexel = 1.05197e-06;
-  c.texelsPerTriangle = 1.96366e-06;
-  c.vplsPerPath = 1.31289e-05;
-  c.importancePerTexelPath = 1.21357e-10;
-  c.backendFixed = 0.847738;
-  c.backendPerTexelPath = 8.55067e-10;
-  c.backendPerLightTexel = 4.36667e-08;
-  c.shadowEdgesPerLightRay = 9.51939e-10;
-  c.skyPerRay = 1.17619e-07;
-  c.compensationPerRay = 5.04334e-09;
-  c.compensationPerTexel = 2.31682e-06;
-  c.gatherPerRay = 6.56773e-08;
-  c.gatherPerTexel = 2.13485e-06;
-  c.postPerPageTexel = 1.82561e-08;
-  c.probesPerRay = 2.99883e-06;
-  c.probesPerProbeLight = 1.08171e-05;
-  c.writePerPageTexel = 5.32289e-07;
+  c.loadPerTriangle = 2.94995e-07;
+  c.loadPerTexturePixel = 2.42625e-07;
+  c.atlasPerTriangle = 1.38222e-06;
+  c.atlasPerPageTexel = 1.39952e-07;
+  c.raytracePerTriangle = 1.01953e-06;
+  c.texelsPerPageTexel = 8.71483e-07;
+  c.texelsPerTriangle = 1.15456e-06;
+  c.vplsPerPath = 8.72265e-06;
+  c.importancePerTexelPath = 1.94688e-10;
+  c.backendFixed = 0.783383;
+  c.backendPerTexelPath = 3.5368e-10;
+  c.backendPerLightTexel = 8.35347e-07;
+  c.shadowEdgesPerLightRay = 9.37379e-09;
+  c.skyPerRay = 1.05747e-07;
+  c.compensationPerRay = 1.44518e-07;
+  c.compensationPerTexel = 1.9346e-06;
+  c.gatherPerRay = 1.9665e-08;
+  c.gatherPerTexel = 2.44967e-06;
+  c.postPerPageTexel = 2.46419e-08;
+  c.probesPerRay = 4.19065e-06;
+  c.probesPerProbeLight = 6.6148e-05;
+  c.writePerPageTexel = 3.10935e-07;
   c.parallelShare = 0.85;
-  c.memoryBaseMiB = 120.256;
-  c.memoryPerTriangle = 0.000593771;
-  c.memoryPerPageTexel = 0.000126465;
+  c.memoryBaseMiB = 106.33;
+  c.memoryPerTriangle = 0;
+  c.memoryPerTexturePixel = 0.000144937;
+  c.memoryPerPageTexel = 0.000111241;
   c.memoryPerTexelPath = 0;
   // fit_cost_model.py: end
   return c;
@@ -47,11 +50,13 @@ CostCoefficients calibratedCostCoefficients() {
 nlohmann::json CostInputs::toJson() const {
   return {{"triangles", triangles},         {"texels", texels},
           {"pageTexels", pageTexels},       {"pages", pages},
+          {"texturePixels", texturePixels},
           {"paths", paths},                 {"punctualLights", punctualLights},
           {"lightTexels", lightTexels},     {"skyRays", skyRays},
           {"compensationRays", compensationRays}, {"gatherRays", gatherRays},
           {"shadowEdgeRays", shadowEdgeRays}, {"probes", probes},
-          {"probeRays", probeRays},         {"cores", cores}};
+          {"probeRays", probeRays},         {"probeLights", probeLights},
+          {"cores", cores}};
 }
 
 nlohmann::json CostPrediction::toJson() const {
@@ -63,7 +68,7 @@ nlohmann::json CostPrediction::toJson() const {
 CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
   const double texelPaths = in.texels * in.paths;
   std::map<std::string, double> cpu;
-  cpu["load"] = c.loadPerTriangle * in.triangles;
+  cpu["load"] = c.loadPerTriangle * in.triangles + c.loadPerTexturePixel * in.texturePixels;
   cpu["atlas"] = c.atlasPerTriangle * in.triangles + c.atlasPerPageTexel * in.pageTexels;
   cpu["raytrace"] = c.raytracePerTriangle * in.triangles;
   cpu["texels"] = c.texelsPerPageTexel * in.pageTexels + c.texelsPerTriangle * in.triangles;
@@ -78,7 +83,7 @@ CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
   if (in.gatherRays > 0.0) cpu["finalGather"] = c.gatherPerRay * in.gatherRays + c.gatherPerTexel * in.texels;
   cpu["post"] = c.postPerPageTexel * in.pageTexels;
   if (in.probes > 0.0)
-    cpu["probes"] = c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probes * in.punctualLights;
+    cpu["probes"] = c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probeLights;
   cpu["write"] = c.writePerPageTexel * in.pageTexels;
   CostPrediction p;
   const double busyCores = std::max(1e-3, std::max(1.0, in.cores) * c.parallelShare);
@@ -88,8 +93,8 @@ CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
     p.cpuSeconds += std::max(0.0, s);
     p.seconds += wall;
   }
-  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryPerTriangle * in.triangles + c.memoryPerPageTexel * in.pageTexels +
-                    c.memoryPerTexelPath * texelPaths;
+  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryPerTriangle * in.triangles + c.memoryPerTexturePixel * in.texturePixels +
+                    c.memoryPerPageTexel * in.pageTexels + c.memoryPerTexelPath * texelPaths;
   return p;
 }
 
@@ -129,24 +134,25 @@ struct AreaGrid {
   }
 };
 
-// Cubes about a third of the smallest range on a side, and never so small that a light's sphere spans more
-// than a few thousand of them.
-double gridCell(const Scene& scene) {
-  double smallest = 0.0;
-  for (const Light& l : scene.lights)
-    if (l.range > 0.0f) smallest = smallest > 0.0 ? std::min(smallest, double(l.range)) : double(l.range);
-  return smallest / 3.0;
+// Cubes about a third of the smallest finite reach on a side, and never so small that the largest finite reach
+// spans more than about 24 of them (a few ten thousand cubes per light); 0 where no light has a finite reach.
+double gridCell(const LightReach& reach) {
+  double smallest = 0.0, largest = 0.0;
+  for (float r : reach.reach)
+    if (std::isfinite(r) && r > 0.0f) {
+      smallest = smallest > 0.0 ? std::min(smallest, double(r)) : double(r);
+      largest = std::max(largest, double(r));
+    }
+  return std::max(smallest / 3.0, largest / 12.0);
 }
 
 }  // namespace
 
-double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, bool reachOnly) {
-  double sum = 0.0;
-  bool anyRange = false;
-  for (const Light& l : scene.lights) anyRange |= l.range > 0.0f;
-  if (!reachOnly || !anyRange) return atlas.texels * double(scene.lights.size());
+double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, const LightReach* reach) {
+  const double cell = reach ? gridCell(*reach) : 0.0;
+  if (!(cell > 0.0)) return atlas.texels * double(scene.lights.size());
   AreaGrid grid;
-  grid.cell = gridCell(scene);
+  grid.cell = cell;
   for (const Primitive& p : scene.primitives)
     for (size_t t = 0; t < p.triangleCount(); ++t) {
       const glm::dvec3 c = (glm::dvec3(p.positions[p.indices[3 * t]]) + glm::dvec3(p.positions[p.indices[3 * t + 1]]) +
@@ -154,9 +160,47 @@ double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, bool reac
       grid.add(c, triangleArea(p, t));
     }
   const double perArea = atlas.texelsPerUnit * atlas.texelsPerUnit;
-  for (const Light& l : scene.lights)
-    sum += l.range > 0.0f && !lightKind(l.type).atInfinity() ? std::min(atlas.texels, grid.within(l.position, l.range) * perArea)
-                                                            : atlas.texels;
+  double sum = 0.0;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const float r = i < reach->reach.size() ? reach->reach[i] : std::numeric_limits<float>::infinity();
+    sum += std::isfinite(r) ? std::min(atlas.texels, grid.within(scene.lights[i].position, r) * perArea) : atlas.texels;
+  }
+  return sum;
+}
+
+double probeLightReach(const Scene& scene, const Bounds3& box, float spacing, const LightReach* reach) {
+  const glm::dvec3 extent = glm::dvec3(box.max) - glm::dvec3(box.min), centre = 0.5 * (glm::dvec3(box.max) + glm::dvec3(box.min));
+  const double s = spacing;
+  glm::dvec3 counts, origin;
+  for (int a = 0; a < 3; ++a) {
+    counts[a] = std::max(1.0, std::ceil(extent[a] / s - 1e-6));
+    origin[a] = centre[a] - 0.5 * s * (counts[a] - 1.0);
+  }
+  const double all = counts.x * counts.y * counts.z;
+  // The lattice indices along axis a within [lo, hi].
+  const auto span = [&](int a, double lo, double hi) {
+    const double first = std::max(0.0, std::ceil((lo - origin[a]) / s)), last = std::min(counts[a] - 1.0, std::floor((hi - origin[a]) / s));
+    return std::make_pair(first, last);
+  };
+  double sum = 0.0;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const float r = reach && i < reach->reach.size() ? reach->reach[i] : std::numeric_limits<float>::infinity();
+    if (!std::isfinite(r)) {
+      sum += all;
+      continue;
+    }
+    const glm::dvec3 p = scene.lights[i].position;
+    const double R = double(r) + 0.5 * std::sqrt(3.0) * s;  // the probe's cell meets the sphere
+    const auto [x0, x1] = span(0, p.x - R, p.x + R);
+    const auto [z0, z1] = span(2, p.z - R, p.z + R);
+    for (double ix = x0; ix <= x1; ++ix)
+      for (double iz = z0; iz <= z1; ++iz) {
+        const double dx = origin.x + s * ix - p.x, dz = origin.z + s * iz - p.z, h2 = R * R - dx * dx - dz * dz;
+        if (h2 < 0.0) continue;
+        const auto [y0, y1] = span(1, p.y - std::sqrt(h2), p.y + std::sqrt(h2));
+        sum += std::max(0.0, y1 - y0 + 1.0);
+      }
+  }
   return sum;
 }
 
@@ -170,7 +214,8 @@ double stageRays(double samples, int rays, int minRays, double budget) {
 }
 }  // namespace
 
-CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const BakePlan& plan, double cores) {
+CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const BakePlan& plan, const LightCullOptions& cull,
+                      double cores) {
   CostInputs in;
   in.triangles = double(scene.triangleCount());
   in.texels = atlas.texels;
@@ -179,7 +224,14 @@ CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const Bake
   const bool vpls = plan.backend != BackendKind::Reference && plan.eval.includeVpls;
   in.paths = vpls ? double(plan.walk.paths) : 0.0;
   in.punctualLights = double(scene.lights.size());
-  in.lightTexels = lightTexelReach(scene, atlas, calibratedCostCoefficients().cullsByReach);
+  for (const Texture& t : scene.textures) in.texturePixels += double(t.width) * double(t.height);
+  LightReach settled;
+  const LightReach* reach = nullptr;  // null: every light everywhere
+  if (calibratedCostCoefficients().cullsByReach) {
+    settled = settleLightReach(scene, scene.bounds(), cull);  // as the bake settles it
+    reach = &settled;
+  }
+  in.lightTexels = lightTexelReach(scene, atlas, reach);
   if (scene.environment.present()) in.skyRays = stageRays(in.texels, plan.sky.raysPerSample, plan.sky.minRays, plan.sky.maxRays);
   if (plan.compensate)
     in.compensationRays = stageRays(in.texels, plan.compensation.rays, plan.compensation.minRays, double(plan.compensation.rayBudget));
@@ -188,6 +240,7 @@ CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const Bake
   if (plan.probes.enabled && plan.probes.spacing && plan.probes.box) {
     in.probes = probeCountOver(*plan.probes.box, *plan.probes.spacing);
     in.probeRays = plan.probes.rays;
+    in.probeLights = probeLightReach(scene, *plan.probes.box, *plan.probes.spacing, reach);
   }
   in.cores = cores;
   return in;

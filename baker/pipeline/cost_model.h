@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atlas/atlas_estimate.h"
+#include "lights/light_reach.h"
 #include "pipeline/bake_plan.h"
 #include "scene/scene.h"
 
@@ -19,6 +20,7 @@ struct CostInputs {
   double texels = 0.0;            // chart texels (the texels the stages shade)
   double pageTexels = 0.0;        // page texels (what the pages hold in memory)
   double pages = 0.0;             // pages
+  double texturePixels = 0.0;     // the scene's decoded texture pixels (held as float RGBA)
   double paths = 0.0;             // light paths evaluated (0: no VPLs, as with the reference backend)
   double punctualLights = 0.0;    // point, spot and directional lights (the sun included)
   double lightTexels = 0.0;       // sum over punctual lights of the texels each one's direct term is computed for
@@ -28,6 +30,7 @@ struct CostInputs {
   double shadowEdgeRays = 0.0;    // the shadow-edge stage's rays per light texel (S×S; 0: the stage is off)
   double probes = 0.0;            // irradiance probes (0: none)
   double probeRays = 0.0;         // lattice rays per probe
+  double probeLights = 0.0;       // sum over punctual lights of the probes whose cell each one's reach meets
   double cores = 1.0;             // the cores the bake may use
   nlohmann::json toJson() const;
 };
@@ -35,6 +38,7 @@ struct CostInputs {
 // Each stage's CPU seconds are a sum of coefficient × feature; the wall time divides them over the cores.
 struct CostCoefficients {
   double loadPerTriangle = 0.0;          // s per triangle: reading and decoding the scene
+  double loadPerTexturePixel = 0.0;      // s per texture pixel: decoding the images
   double atlasPerTriangle = 0.0;         // s per triangle: charts and parameterisation
   double atlasPerPageTexel = 0.0;        // s per page texel: packing and rasterising the charts
   double raytracePerTriangle = 0.0;      // s per triangle: the BVH build
@@ -53,12 +57,13 @@ struct CostCoefficients {
   double gatherPerTexel = 0.0;           // s per texel: the gather's filter and its pre-pass map
   double postPerPageTexel = 0.0;         // s per page texel: dilation and seams
   double probesPerRay = 0.0;             // s per probe ray (the volume fit in proportion)
-  double probesPerProbeLight = 0.0;      // s per probe × punctual light: the lights' shadow rays and fit
+  double probesPerProbeLight = 0.0;      // s per probe × punctual light reaching it: its shadow rays and fit
   double writePerPageTexel = 0.0;        // s per page texel: the EXR and PNG pages, the glTF and the report
-  bool cullsByReach = false;             // the stages compute a light's direct term only within its range
+  bool cullsByReach = true;              // the stages compute a light's direct term only within its reach
   double parallelShare = 1.0;            // the share of the cores the bake keeps busy on an idle machine
   double memoryBaseMiB = 0.0;            // MiB: the process, its libraries and the scene's fixed parts
   double memoryPerTriangle = 0.0;        // MiB per triangle: the scene, its BVH and atlas meshes
+  double memoryPerTexturePixel = 0.0;    // MiB per texture pixel: the decoded images
   double memoryPerPageTexel = 0.0;       // MiB per page texel: texel samples, sums, maps and the gathers' copies
   double memoryPerTexelPath = 0.0;       // MiB per texel × path: the walk's VPLs held beside the pages
 };
@@ -77,12 +82,19 @@ struct CostPrediction {
 
 CostPrediction predictCost(const CostInputs& inputs, const CostCoefficients& c = calibratedCostCoefficients());
 
-// The texels each punctual light's direct term is computed for, summed over the lights: every texel for
-// each light (the bake evaluates every light at every texel), or with reachOnly the texels on surfaces within
-// each light's range (the surface area there × density²; lights without range reach every texel).
-double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, bool reachOnly);
+// The texels each punctual light's direct term is computed for, summed over the lights: the texels on surfaces
+// within each light's reach (the surface area there × density²), as the bake's light grid settles it
+// (lights/light_reach.h: the range, or the cut's distance for a light without range); every texel for a light
+// that reaches everywhere, and for every light where `reach` is null (no culling).
+double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, const LightReach* reach);
 
-// The inputs for a scene, its atlas estimate and plan on `cores` cores.
-CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const BakePlan& plan, double cores);
+// The probes each punctual light's work is done for, summed over the lights: the probes of the grid over `box`
+// at `spacing` (probeGridOver's lattice) whose cell a light's reach meets, every probe for a light that reaches
+// everywhere, and for every light where `reach` is null.
+double probeLightReach(const Scene& scene, const Bounds3& box, float spacing, const LightReach* reach);
+
+// The inputs for a scene, its atlas estimate and plan, with the bake's light cull, on `cores` cores.
+CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const BakePlan& plan, const LightCullOptions& cull,
+                      double cores);
 
 }  // namespace irbake

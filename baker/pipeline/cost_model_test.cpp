@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "common/error.h"
 #include "samples/sample_scenes.h"
@@ -33,6 +34,7 @@ CostInputs levelInputs() {
   in.shadowEdgeRays = 64;
   in.probes = 2048;
   in.probeRays = 256;
+  in.probeLights = 100 * in.probes;
   in.cores = 2;
   return in;
 }
@@ -80,14 +82,60 @@ TEST(CostModel, LightReachIsTheSurfaceWithinTheRange) {
   atlas.texelsPerUnit = 4.0;
   atlas.texels = 1e4 * 16.0;
   const double perArea = 16.0, pi = std::acos(-1.0);
-  const double both = lightTexelReach(s, atlas, true);
+  const double inf = std::numeric_limits<float>::infinity();
+  LightReach reach;
+  reach.reach = {6.0f, 6.0f};
+  const double both = lightTexelReach(s, atlas, &reach);
   s.lights = {onFloor};
-  EXPECT_NEAR(lightTexelReach(s, atlas, true) / (pi * 36.0 * perArea), 1.0, 0.2);
-  EXPECT_NEAR((both - lightTexelReach(s, atlas, true)) / (pi * 20.0 * perArea), 1.0, 0.2);
-  s.lights.push_back(pointLight(glm::vec3(0, 3, 0), 1.0f));  // no range: every texel
-  EXPECT_NEAR(lightTexelReach(s, atlas, true) - lightTexelReach(s, atlas, false) / 2.0, pi * 36.0 * perArea,
+  reach.reach = {6.0f};
+  EXPECT_NEAR(lightTexelReach(s, atlas, &reach) / (pi * 36.0 * perArea), 1.0, 0.2);
+  EXPECT_NEAR((both - lightTexelReach(s, atlas, &reach)) / (pi * 20.0 * perArea), 1.0, 0.2);
+  s.lights.push_back(pointLight(glm::vec3(0, 3, 0), 1.0f));  // reaching everywhere: every texel
+  reach.reach = {6.0f, float(inf)};
+  EXPECT_NEAR(lightTexelReach(s, atlas, &reach) - lightTexelReach(s, atlas, nullptr) / 2.0, pi * 36.0 * perArea,
               0.2 * pi * 36.0 * perArea);
-  EXPECT_DOUBLE_EQ(lightTexelReach(s, atlas, false), 2.0 * atlas.texels);  // every light at every texel
+  EXPECT_DOUBLE_EQ(lightTexelReach(s, atlas, nullptr), 2.0 * atlas.texels);  // every light at every texel
+}
+
+TEST(CostModel, LightWithoutRangeReachesTheCutsDistance) {
+  // Two lamps without range 2 m above a 100 m floor, 20 m apart, and a sun: the bake's cut (settleLightReach)
+  // ends each at a distance R, so each lights a disc of π (R² − 2²) m² of the floor, within 20%.
+  Scene s;
+  const int m = addMaterial(s, glm::vec3(0.5f));
+  addQuad(s, m, glm::vec3(-50, 0, -50), glm::vec3(100, 0, 0), glm::vec3(0, 0, 100), 200);
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = glm::vec3(0, -1, 0);
+  sun.intensity = 2.0f;
+  s.lights = {pointLight(glm::vec3(-10, 2, 0), 1.0f), pointLight(glm::vec3(10, 2, 0), 1.0f), sun};
+  const LightReach reach = settleLightReach(s, s.bounds(), LightCullOptions{});
+  ASSERT_EQ(reach.cutLights(), 2u);
+  const double r = reach.reach[0], pi = std::acos(-1.0);
+  ASSERT_GT(r, 4.0);
+  ASSERT_LT(r, 10.0);
+  AtlasEstimate atlas;
+  atlas.texelsPerUnit = 4.0;
+  atlas.texels = 1e4 * 16.0;
+  const double disc = pi * (r * r - 4.0) * 16.0;
+  EXPECT_NEAR((lightTexelReach(s, atlas, &reach) - atlas.texels) / (2.0 * disc), 1.0, 0.2);  // the sun: every texel
+}
+
+TEST(CostModel, ProbeLightsAreTheProbesWithinReach) {
+  // A 10 x 2 x 10 m box at 1 m spacing: 10 x 2 x 10 probes, at half-integer coordinates. A light reaching
+  // everywhere counts all 200, one reaching 0.1 m from a probe only that probe (its cell's half-diagonal is
+  // 0.87 m, the next probe 1 m away), one reaching 0.2 m from a probe of the bottom layer (1.07 m with the
+  // half-diagonal) that probe, its four neighbours in the layer and the one above it.
+  Scene s;
+  s.lights = {pointLight(glm::vec3(0.5f, 0.5f, 0.5f), 1.0f), pointLight(glm::vec3(-1.5f, 0.5f, 2.5f), 1.0f)};
+  Bounds3 box;
+  box.min = glm::vec3(-5, 0, -5);
+  box.max = glm::vec3(5, 2, 5);
+  EXPECT_DOUBLE_EQ(probeLightReach(s, box, 1.0f, nullptr), 400.0);
+  LightReach reach;
+  reach.reach = {std::numeric_limits<float>::infinity(), 0.1f};
+  EXPECT_DOUBLE_EQ(probeLightReach(s, box, 1.0f, &reach), 201.0);
+  reach.reach = {0.1f, 0.2f};
+  EXPECT_DOUBLE_EQ(probeLightReach(s, box, 1.0f, &reach), 1.0 + 6.0);
 }
 
 TEST(BakePrediction, CornellBoxIsPredictedWithEveryPart) {

@@ -28,7 +28,7 @@ import time
 
 # stage -> (coefficient, feature) pairs, as predictCost combines them.
 STAGES = {
-    "load": [("loadPerTriangle", "triangles")],
+    "load": [("loadPerTriangle", "triangles"), ("loadPerTexturePixel", "texturePixels")],
     "atlas": [("atlasPerTriangle", "triangles"), ("atlasPerPageTexel", "pageTexels")],
     "raytrace": [("raytracePerTriangle", "triangles")],
     "texels": [("texelsPerPageTexel", "pageTexels"), ("texelsPerTriangle", "triangles")],
@@ -43,8 +43,8 @@ STAGES = {
     "probes": [("probesPerRay", "probeRayCount"), ("probesPerProbeLight", "probeLights")],
     "write": [("writePerPageTexel", "pageTexels")],
 }
-MEMORY = [("memoryBaseMiB", "one"), ("memoryPerTriangle", "triangles"), ("memoryPerPageTexel", "pageTexels"),
-          ("memoryPerTexelPath", "texelPaths")]
+MEMORY = [("memoryBaseMiB", "one"), ("memoryPerTriangle", "triangles"), ("memoryPerTexturePixel", "texturePixels"),
+          ("memoryPerPageTexel", "pageTexels"), ("memoryPerTexelPath", "texelPaths")]
 # Where no bake ran under little load, the share of the cores a bake keeps busy on an idle machine.
 DEFAULT_PARALLEL_SHARE = 0.85
 
@@ -52,12 +52,13 @@ DEFAULT_PARALLEL_SHARE = 0.85
 def features(inputs):
     f = dict(inputs)
     f["one"] = 1.0
+    f.setdefault("texturePixels", 0.0)
     f["texelPaths"] = f["texels"] * f["paths"]
     f["lightRays"] = f["lightTexels"] * f["shadowEdgeRays"] if f["punctualLights"] > 0 else 0.0
     f["compensationTexels"] = f["texels"] if f["compensationRays"] > 0 else 0.0
     f["gatherTexels"] = f["texels"] if f["gatherRays"] > 0 else 0.0
     f["probeRayCount"] = f["probes"] * f["probeRays"]
-    f["probeLights"] = f["probes"] * f["punctualLights"]
+    f.setdefault("probeLights", f["probes"] * f["punctualLights"])
     return f
 
 

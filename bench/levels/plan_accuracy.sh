@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # The preflight against the bake on the level sizes: bakes the calibration levels (bench/levels/cost_bakes.py,
 # into build/calibration; a folder with a measured.json is kept, REBAKE=1 bakes again), then appends to
-# bench/results/plan_accuracy.csv one row per bake, and per row of the level ladder (levels_scale.csv): the
-# binary's `plan --json` prediction against the measured CPU seconds and peak memory, their ratios, the idle
-# machine's wall time the CPU time implies, the plan's own time and the load average. The machine is shared, so
-# the CPU time is compared and the wall time recorded. From the repository root after a Release build:
+# bench/results/plan_accuracy.csv one row per bake: the binary's `plan --json` prediction against the measured
+# CPU seconds and peak memory, their ratios, the idle machine's wall time the CPU time implies, the plan's own
+# time and the load average. The machine is shared, so the CPU time is compared and the wall time recorded.
+# The bakes: the sample box, Sponza, small towns at several densities, and the level ladder's towns
+# (bench/levels/levels_scale.sh's scenes and densities: town4, town8, the 16x16 town's 1,000 lamps with and
+# without range at --quality preview; LARGE=1 adds town32 with 2,000 lamps). From the repository root after a
+# Release build:
 #   HOLD_OUT=town8_sunsky_tpu3_preview,sponza_sunsky_preview bash bench/levels/plan_accuracy.sh [IRBAKE]
-# HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV another
-# level ladder's CSV.
+# HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV adds a
+# level ladder's CSV rows (measured with the binary that wrote them).
 set -euo pipefail
 IRBAKE=${1:-build/baker/irbake}
 W=build/calibration
@@ -32,9 +35,23 @@ bake town6_sun_tpu5_preview build/levels/town6.glb $SUN --texels-per-unit 5 --qu
 bake town8_sunsky_tpu3_preview build/levels/town8.glb $SUN $SKY --texels-per-unit 3 --quality preview
 bake sponza_sun $SHARED/dabrovic_sponza/sponza.glb $SUN
 bake sponza_sunsky_preview $SHARED/dabrovic_sponza/sponza.glb $SUN $SKY --quality preview
+town() {  # file town.py options...: the ladder's scene, made once
+  local file=build/levels/$1; shift
+  [[ -f $file ]] || python3 bench/levels/town.py "$file" "$@" > /dev/null
+  echo "$file"
+}
+bake town4_lamps "$(town ladder_town4.glb --blocks 4 --lamps 32)" $SUN $SKY --texels-per-unit 2.61
+bake town8_lamps "$(town ladder_town8.glb --blocks 8 --lamps 128)" $SUN $SKY --texels-per-unit 2.09
+bake town16_lamps_range "$(town ladder_lamps_range.glb --blocks 16 --lamps 1000)" $SUN $SKY --quality preview \
+  --texels-per-unit 1.331
+bake town16_lamps_norange "$(town ladder_lamps_norange.glb --blocks 16 --lamps 1000 --range 0)" $SUN $SKY \
+  --quality preview --texels-per-unit 1.331
+if [[ ${LARGE:-0} == 1 ]]; then
+  bake town32_lamps "$(town ladder_town32.glb --blocks 32 --lamps 2000 --cell 2.2)" $SUN $SKY --quality preview \
+    --texels-per-unit 0.67
+fi
 LEVELS=()
-LEVELS_CSV=${LEVELS_CSV:-bench/results/levels_scale.csv}
-[[ -f $LEVELS_CSV ]] && LEVELS=(--levels "$LEVELS_CSV")
+[[ -n ${LEVELS_CSV:-} ]] && LEVELS=(--levels "$LEVELS_CSV")
 python3 bench/levels/fit_cost_model.py "$IRBAKE" $W/*/ "${LEVELS[@]}" --hold-out "${HOLD_OUT:-}" \
   --accuracy bench/results/plan_accuracy.csv > /dev/null
 tail -n +2 bench/results/plan_accuracy.csv
