@@ -169,14 +169,15 @@ TEST(MixedLighting, CommandRefusesBadModesWithExit2AndNoOutput) {
   }
 }
 
-// Five point lights over one triangle, all reaching it: four get channels, the dimmest bakes as indirect with a
-// warning naming it, and the report and the export say so.
+// Five point lights over one triangle, all reaching it (a range, so the bake's cut of lights without one does not
+// decide the overlap): four get channels, the dimmest bakes as indirect with a warning naming it, and the report
+// and the export say so.
 TEST(MixedLighting, FifthOverlappingMaskLightFallsBackWithAWarning) {
   const std::filesystem::path dir = testFolder("mixed_lighting_fallback");
   GltfDocument doc = meshDocument({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2});
   nlohmann::json lights = nlohmann::json::array();
   for (int i = 0; i < 5; ++i) {
-    lights.push_back({{"type", "point"}, {"intensity", 10 - i}, {"name", "l" + std::to_string(i)}});
+    lights.push_back({{"type", "point"}, {"intensity", 10 - i}, {"range", 5.0}, {"name", "l" + std::to_string(i)}});
     doc.root["nodes"].push_back({{"translation", {0.1 * i, 0.2, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}});
     doc.root["scenes"][0]["nodes"].push_back(i + 1);
   }
