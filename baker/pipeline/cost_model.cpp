@@ -153,12 +153,15 @@ double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, const Lig
   if (!(cell > 0.0)) return atlas.texels * double(scene.lights.size());
   AreaGrid grid;
   grid.cell = cell;
-  for (const Primitive& p : scene.primitives)
+  for (const Primitive& p : scene.primitives) {
+    if (!p.getsLightmap()) continue;  // the texels the atlas estimate counts: mapped objects at their scale
+    const double scale2 = double(p.lightmapScale) * p.lightmapScale;
     for (size_t t = 0; t < p.triangleCount(); ++t) {
       const glm::dvec3 c = (glm::dvec3(p.positions[p.indices[3 * t]]) + glm::dvec3(p.positions[p.indices[3 * t + 1]]) +
                             glm::dvec3(p.positions[p.indices[3 * t + 2]])) / 3.0;
-      grid.add(c, triangleArea(p, t));
+      grid.add(c, triangleArea(p, t) * scale2);
     }
+  }
   const double perArea = atlas.texelsPerUnit * atlas.texelsPerUnit;
   double sum = 0.0;
   for (size_t i = 0; i < scene.lights.size(); ++i) {
