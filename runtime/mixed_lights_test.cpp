@@ -76,6 +76,21 @@ bool planeHit(const ViewCamera& cam, int w, int h, int x, int y, glm::vec3& hit)
 
 // The exports record the light for the client: the shadowmask bake with its channel, the indirect bake
 // without one (extras.irbake.mode on the KHR light), the baked one not at all.
+// A display's 8-bit sRGB code of a linear value.
+long srgbCode(float v) { return std::lround(255.0f * encodeSrgb(std::min(1.0f, std::max(0.0f, v)))); }
+
+// The fully baked scene, the shadowmask bake with its real-time lights, and that bake's map alone, from one camera.
+struct MixedRenders {
+  RgbaImage full, mixed, map;
+};
+MixedRenders renderFullMixedAndMap(const ViewerScene& baked, const ViewerScene& masked, const ViewCamera& cam, int w,
+                                   int h) {
+  ViewerScene mapOnly = masked;
+  mapOnly.scene.runtimeLights.clear();
+  return {ViewRenderer(baked).render(cam, w, h, {}), ViewRenderer(masked).render(cam, w, h, {}),
+          ViewRenderer(mapOnly).render(cam, w, h, {})};
+}
+
 TEST(MixedLights, ExportsRecordTheLightsLeftToTheClient) {
   const ViewerScene baked = loadViewerScene(bakeAndExport(LightMode::Baked, "record_baked"));
   const ViewerScene masked = loadViewerScene(bakeAndExport(LightMode::ShadowMask, "record_mask"));
@@ -101,17 +116,12 @@ TEST(MixedLights, ShadowmaskBakeInIrviewMatchesTheFullBake) {
   GlContext gl;
   const int w = 192, h = 144;
   const ViewCamera cam = downView(baked.scene.bounds());
-  const RgbaImage full = ViewRenderer(baked).render(cam, w, h, {});
-  const RgbaImage mixed = ViewRenderer(masked).render(cam, w, h, {});
-  ViewerScene mapOnly = masked;
-  mapOnly.scene.runtimeLights.clear();
-  const RgbaImage map = ViewRenderer(mapOnly).render(cam, w, h, {});
+  const auto [full, mixed, map] = renderFullMixedAndMap(baked, masked, cam, w, h);
   double sum = 0.0, mapSum = 0.0;
   for (size_t i = 0; i < full.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c) {
-      const auto code = [](float v) { return std::lround(255.0f * encodeSrgb(std::min(1.0f, std::max(0.0f, v)))); };
-      sum += std::abs(code(mixed.pixels[i][c]) - code(full.pixels[i][c]));
-      mapSum += std::abs(code(map.pixels[i][c]) - code(full.pixels[i][c]));
+      sum += std::abs(srgbCode(mixed.pixels[i][c]) - srgbCode(full.pixels[i][c]));
+      mapSum += std::abs(srgbCode(map.pixels[i][c]) - srgbCode(full.pixels[i][c]));
     }
   const double mad = sum / (3.0 * full.pixels.size()), mapMad = mapSum / (3.0 * full.pixels.size());
   std::printf("[ figure ] irview shadowmask bake vs full bake: MAD %.3f (8-bit sRGB); without the real-time light %.2f\n",
@@ -253,12 +263,7 @@ TEST(RangeWindow, ShadowmaskBakeInIrviewMatchesTheFullBakeAcrossTheRange) {
   GlContext gl;
   const int w = 192, h = 144;
   const ViewCamera cam = downView(baked.scene.bounds());
-  const RgbaImage full = ViewRenderer(baked).render(cam, w, h, {});
-  const RgbaImage mixed = ViewRenderer(masked).render(cam, w, h, {});
-  ViewerScene mapOnly = masked;
-  mapOnly.scene.runtimeLights.clear();
-  const RgbaImage map = ViewRenderer(mapOnly).render(cam, w, h, {});
-  const auto code = [](float v) { return std::lround(255.0f * encodeSrgb(std::min(1.0f, std::max(0.0f, v)))); };
+  const auto [full, mixed, map] = renderFullMixedAndMap(baked, masked, cam, w, h);
   double sum = 0.0, mapSum = 0.0, worst = -1.0;
   size_t pixels = 0;
   for (int y = 0; y < h; ++y)
@@ -268,8 +273,8 @@ TEST(RangeWindow, ShadowmaskBakeInIrviewMatchesTheFullBakeAcrossTheRange) {
       const float d = glm::length(glm::vec3(0, kHeight, 0) - p);
       if (d < 0.75f * R || d > 1.15f * R) continue;
       for (int c = 0; c < 3; ++c) {
-        sum += std::abs(code(mixed.at(x, y)[c]) - code(full.at(x, y)[c]));
-        mapSum += std::abs(code(map.at(x, y)[c]) - code(full.at(x, y)[c]));
+        sum += std::abs(srgbCode(mixed.at(x, y)[c]) - srgbCode(full.at(x, y)[c]));
+        mapSum += std::abs(srgbCode(map.at(x, y)[c]) - srgbCode(full.at(x, y)[c]));
       }
       // ρ/π · E, the map value being E/π
       const double near = kAlbedo * planeValue(d - 2e-3, R), far = kAlbedo * planeValue(d + 2e-3, R);
