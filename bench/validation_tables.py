@@ -283,26 +283,30 @@ def t_levels_scale():
 
 
 def t_light_cull():
-    """bench/results/light_cull.csv: per scene and --light-cull, the median CPU of its latest commit's runs, against
-    the same town's sun and sky alone, and the map's error against the brute-force bake (--light-cull 0)."""
+    """bench/results/light_cull.csv: per scene, --light-cull and --light-tail, the median CPU of its latest commit's
+    runs, against the same town's sun and sky alone, and the map's error against the brute-force bake (--light-cull 0)."""
     rows = read("light_cull.csv")
+    key = lambda r: (r["scene"], r["cull"], r.get("tail", "0") if r["cull"] != "0" else "0")
     keys = {}
     for r in rows:
-        keys[(r["scene"], r["cull"])] = r["commit"]
+        keys[key(r)] = r["commit"]
     cpu = {}
-    for (scene, cull), c in keys.items():
-        g = [float(r["cpu_s"]) for r in rows if (r["scene"], r["cull"], r["commit"]) == (scene, cull, c) and r["cpu_s"]]
-        cpu[(scene, cull)] = (statistics.median(g), len(g)) if g else (None, 0)
+    for k, c in keys.items():
+        g = [float(r["cpu_s"]) for r in rows if key(r) == k and r["commit"] == c and r["cpu_s"]]
+        cpu[k] = (statistics.median(g), len(g)) if g else (None, 0)
     out = []
-    for (scene, cull), c in keys.items():
-        r = [x for x in rows if (x["scene"], x["cull"], x["commit"]) == (scene, cull, c)][-1]
-        own, runs = cpu[(scene, cull)]
-        base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull), (None, 0))[0]
+    for k, c in keys.items():
+        scene, cull, tail = k
+        r = [x for x in rows if key(x) == k and x["commit"] == c][-1]
+        own, runs = cpu[k]
+        base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull, tail), (None, 0))[0]
+        if base is None:
+            base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull, "0"), (None, 0))[0]
         ratio = f"{own / base:.2f}×" if own and base and not scene.endswith("sun") else ""
         out.append([scene, r["lamps"], r["range"] if r["range"] != "0" else "none", cull if cull != "0" else "off (brute force)",
-                    c, runs, num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
-    return table(["scene", "lamps", "range (m)", "--light-cull", "commit", "runs", "CPU (s)", "CPU / sun and sky alone",
-                  "rel. RMSE against brute force"], out)
+                    tail if cull != "0" else "", c, runs, num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
+    return table(["scene", "lamps", "range (m)", "--light-cull", "--light-tail", "commit", "runs", "CPU (s)",
+                  "CPU / sun and sky alone", "rel. RMSE against brute force"], out)
 
 
 def t_plan_accuracy():

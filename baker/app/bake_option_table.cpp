@@ -296,6 +296,10 @@ void addLightRows(std::vector<OptionDescriptor>& t) {
                      "each light's work only where it reaches: its range, or where its light\nfalls to F × the scene's "
                      "reference (default " + shown(LightCullOptions{}.fraction) + ", docs/units.md); 0: every light everywhere",
                      opt([](BakeOptions& o) { return &o.lightCull.fraction; })));
+  t.push_back(integer("--light-tail", 0, 256, kLights, "N",
+                      "lights drawn per texel from a light tree to add back what the cut left\nout of lights without "
+                      "range (default " + shown(LightTailOptions{}.samples) + "; 0: left out)",
+                      opt([](BakeOptions& o) { return &o.lightTail.samples; })));
   t.push_back(text("--env", kCommon, "FILE", "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky",
                    arg(&BakeArguments::env), kPath));
   t.push_back(number("--env-intensity", 0.0, kLargestLight, kLights, "S",

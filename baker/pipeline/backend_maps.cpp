@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "pipeline/bake_state.h"
+#include "sampling/sampling.h"
 #include "stages/interleave/interleaved_sampling.h"
 
 namespace irbake {
@@ -54,6 +55,20 @@ std::vector<Lightmap> directCall(BakeState& s, L1Pages* l1, const std::vector<ui
   return maps;
 }
 
+// The cut lights' left-out light added back to the punctual lights' pages, after their shadow edges (which
+// refine the lights within reach) and before D is kept for the final gather. The L1 pages keep the lights within
+// reach: the tail comes from many far directions. Lights left out of the map keep their cut.
+void lightTailStage(BakeState& s, StageContext& ctx, std::vector<Lightmap>& maps) {
+  if (!s.plan.eval.includeDirect || !s.lightGrid || !s.lightGrid->culls() || s.lightReach.cutLights() == 0) return;
+  ctx.timed("lightTail", [&] {
+    LightTailOptions o = s.options.lightTail;
+    o.seed = hashSeed(s.options.walk.seed, 0x7a11);
+    s.lightTail = addLightTail(ctx.inputs, maps, o, s.plan.leftOut);
+    ctx.report["lightTail"] = s.lightTail.toJson();
+    ctx.report["lightTail"]["samples"] = o.samples;
+  });
+}
+
 std::vector<Lightmap> referenceStage(BakeState& s) { return s.evaluator->evaluate(inputs(s, s.texels, s.vpls, s.plan.eval)); }
 
 // The backend stage's result: punctual lights plus the VPL sums, classes mixed (or the reference). With
@@ -71,6 +86,7 @@ std::vector<Lightmap> backendMaps(BakeState& s, ExactVplSums& sums, nlohmann::js
   // On the punctual lights alone, before D is kept for the final gather: its sources see the same edges.
   StageContext ctx = stageContext(s, report);
   shadowEdgeStage(ctx, maps, l1, s.leftOutDirect.empty() ? nullptr : &s.leftOutDirect);
+  lightTailStage(s, ctx, maps);
   if (s.plan.finalGather) {
     s.directMaps = maps;
     for (size_t p = 0; p < s.directMaps.size(); ++p)

@@ -13,6 +13,7 @@
 #include "stages/error_estimate/error_estimate.h"
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/gather/final_gather.h"
+#include "stages/light_tail/light_tail.h"
 #include "stages/probes/light_probes.h"
 #include "stages/shadow_edges/shadow_edges.h"
 #include "stages/shadow_mask/shadow_mask.h"
@@ -76,6 +77,7 @@ struct BakeOptions {
   SkyLightOptions sky;                    // the sky's direct light (Scene::environment), traced
   ShadowEdgeOptions shadowEdges;          // punctual lights' shadow edges area-averaged (subSamples ≤ 1: off)
   LightCullOptions lightCull;             // each light's work only where it reaches (fraction 0: every light everywhere)
+  LightTailOptions lightTail;             // the cut lights' left-out light, sampled back (samples 0: left out)
   FinalGatherMode finalGather = FinalGatherMode::Off;  // bounced light gathered from the map (stages/gather)
   FinalGatherOptions gather;              // its rays and filter
   ClampMode clamp = ClampMode::Derived;  // the geometry-term bound: derived from the scene, off, or clampBound

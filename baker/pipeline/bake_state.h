@@ -71,6 +71,8 @@ struct BakeState {
   LightReach lightReach;                   // each light's reach (lights/light_reach.h)
   std::unique_ptr<LightGrid> lightGrid;    // the lights near each point, for every stage's per-light loop
   double lightCutBound = 0.0;              // the cut's bound, relative to the map's mean (measureLightCut)
+  LightTailStats lightTail;                // the left-out light sampled back (backendMaps)
+  double lightTailNoise = 0.0;             // its noise, relative to the map's mean (measureLightCut)
 
   // The VPL blocks (walk_replicates.cpp, backend_maps.cpp).
   std::vector<std::vector<VplSet>> classVpls;  // per replicate of the walk, per interleave class

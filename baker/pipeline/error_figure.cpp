@@ -124,7 +124,11 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
   j["breakdown"] = s.figure.breakdown;
   if (s.lightCutBound > 0.0) {  // the cut's bias, independent of the noise: the squares add
     j["breakdown"]["lightCut"] = s.lightCutBound;
-    j["relative"] = std::hypot(e.relative, s.lightCutBound);
+    j["relative"] = std::hypot(j["relative"].get<double>(), s.lightCutBound);
+  }
+  if (s.lightTailNoise > 0.0) {  // the sampled-back tail's noise, independent of the VPLs': the squares add
+    j["breakdown"]["lightTail"] = s.lightTailNoise;
+    j["relative"] = std::hypot(j["relative"].get<double>(), s.lightTailNoise);
   }
   j["interior"] = s.figure.interior.toJson();
   j["interior"]["breakdown"] = s.figure.interiorBreakdown;
@@ -135,6 +139,7 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
                 "compensation's and final gather's own ray noise (each run again with another seed)";
   j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
   if (s.lightCutBound > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the light cut's bound (lightCull.cutBound)";
+  if (s.lightTailNoise > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the sampled-back light tail's noise (lightCull.tailNoise)";
   j["rounds"] = s.rounds;
   if (s.options.errorEstimate.targetError > 0.0) {
     j["targetError"] = s.options.errorEstimate.targetError;

@@ -31,6 +31,7 @@ std::vector<std::pair<const Light*, Light>> uncutLights(const Scene& scene) {
 
 void measureLightCut(BakeState& s, const std::vector<Lightmap>& maps, nlohmann::json& report) {
   s.lightCutBound = 0.0;
+  s.lightTailNoise = 0.0;
   if (!s.lightGrid || !s.lightGrid->culls()) return;
   const auto cut = uncutLights(s.scene);
   nlohmann::json& j = report["lightCull"];
@@ -67,10 +68,22 @@ void measureLightCut(BakeState& s, const std::vector<Lightmap>& maps, nlohmann::
     for (size_t k = 0; k < v.size(); ++k) squares += v[k] * v[k], mean += kept[k];
     return mean > 0.0 ? std::sqrt(squares / double(v.size())) / (mean / double(v.size())) : 0.0;
   };
-  s.lightCutBound = rmsOverMean(taken);
-  j["cutBound"] = {{"relative", s.lightCutBound}, {"unshadowedRelative", rmsOverMean(bound)}, {"texels", picked.size()},
+  const double takenRelative = rmsOverMean(taken);
+  j["cutBound"] = {{"relative", takenRelative}, {"unshadowedRelative", rmsOverMean(bound)}, {"texels", picked.size()},
                    {"covers", "the light the cut lights' fade took at the texels (relative: with their shadow rays; "
                               "unshadowedRelative: without, a bound), RMS over the texels over the map's mean"}};
+  // Sampled back (stages/light_tail), the cut leaves no bias, only the samples' noise: RMS over the texels of
+  // the estimate's standard deviation, over the map's mean (before the post's filters, which only lower it).
+  if (s.lightTail.texels > 0) {
+    double mean = 0.0;
+    for (double k : kept) mean += k;
+    mean /= double(std::max<size_t>(1, kept.size()));
+    s.lightTailNoise = mean > 0.0 ? std::sqrt(s.lightTail.variance / double(s.lightTail.texels)) / mean : 0.0;
+    j["tailNoise"] = {{"relative", s.lightTailNoise},
+                      {"covers", "the sampled-back left-out light's noise, RMS over the texels over the map's mean"}};
+  } else {
+    s.lightCutBound = takenRelative;
+  }
 }
 
 }  // namespace irbake

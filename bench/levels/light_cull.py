@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """light_cull.py IRBAKE OUTROOT CASE... [--runs N] [--csv bench/results/light_cull.csv]: the lamp targets.
 
-Each CASE is NAME=SCENE.glb:LAMPS:RANGE:CULL (CULL: --light-cull's fraction, 0 = brute force). Every case is
+Each CASE is NAME=SCENE.glb:LAMPS:RANGE:CULL[:TAIL] (CULL: --light-cull's fraction, 0 = brute force; TAIL:
+--light-tail's draws per texel, the binary's default when left out). Every case is
 baked at --quality preview with --sun 0.35,-1,0.2,5 --sky 0.4,0.5,0.7, each run under /usr/bin/time -v (CPU =
 user + sys), and one row per run goes into the CSV: the wall and CPU seconds, the report's seconds per stage,
 the load average when it started, and, for a culled case whose brute-force twin (same scene, CULL 0) was baked
@@ -18,13 +19,15 @@ import os
 import re
 import subprocess
 
-FIELDS = ["date", "commit", "scene", "lamps", "range", "cull", "run", "wall_s", "cpu_s", "texels", "stage_seconds",
+FIELDS = ["date", "commit", "scene", "lamps", "range", "cull", "tail", "run", "wall_s", "cpu_s", "texels", "stage_seconds",
           "load_avg", "rel_rmse_vs_brute"]
 BAKE = ["--quality", "preview", "--sun", "0.35,-1,0.2,5", "--sky", "0.4,0.5,0.7", "--quiet"]
 
 
-def timed_bake(irbake, scene, out, cull, tpu):
+def timed_bake(irbake, scene, out, cull, tail, tpu):
     cmd = ["/usr/bin/time", "-v", irbake, "bake", scene, "-o", out, "--light-cull", str(cull)] + BAKE
+    if tail != "":
+        cmd += ["--light-tail", tail]
     if tpu:
         cmd += ["--texels-per-unit", str(tpu)]
     p = subprocess.run(cmd, capture_output=True, text=True)
@@ -66,12 +69,16 @@ def main():
             w.writeheader()
         for case in args.cases:
             name, spec = case.split("=", 1)
-            scene, lamps, rng, cull = spec.rsplit(":", 3)
+            parts = spec.split(":")
+            scene, lamps, rng, cull = parts[:4]
+            tail = parts[4] if len(parts) > 4 else ""
             for run in range(1, args.runs + 1):
-                out = os.path.join(args.outroot, "%s-cull%s-run%d" % (name, cull, run))
+                out = os.path.join(args.outroot, "%s-cull%s-tail%s-run%d" % (name, cull, tail or "d", run))
                 load = os.getloadavg()[0]
-                wall, cpu = timed_bake(args.irbake, scene, out, cull, args.texels_per_unit)
+                wall, cpu = timed_bake(args.irbake, scene, out, cull, tail, args.texels_per_unit)
                 report = json.load(open(os.path.join(out, "report.json")))
+                if tail == "":
+                    tail = str(report.get("lightTail", {}).get("samples", ""))
                 stages = report["timings"]["seconds"]
                 if float(cull) == 0.0 and run == 1:
                     brute[scene] = out
@@ -79,12 +86,12 @@ def main():
                 if float(cull) > 0.0 and scene in brute:
                     err = rel_rmse(args.irbake, out, brute[scene])
                 w.writerow({"date": datetime.date.today().isoformat(), "commit": commit, "scene": name,
-                            "lamps": lamps, "range": rng, "cull": cull, "run": run, "wall_s": "%.1f" % wall,
+                            "lamps": lamps, "range": rng, "cull": cull, "tail": tail, "run": run, "wall_s": "%.1f" % wall,
                             "cpu_s": "%.1f" % cpu, "texels": report.get("texels", {}).get("valid", ""),
                             "stage_seconds": ";".join("%s=%.1f" % (k, v) for k, v in sorted(stages.items())),
                             "load_avg": "%.2f" % load, "rel_rmse_vs_brute": err})
                 f.flush()
-                print("%s cull %s run %d: wall %.1f s, cpu %.1f s, load %.1f %s" % (name, cull, run, wall, cpu, load,
+                print("%s cull %s tail %s run %d: wall %.1f s, cpu %.1f s, load %.1f %s" % (name, cull, tail, run, wall, cpu, load,
                                                                                   err))
 
 

@@ -1,0 +1,103 @@
+// A binary tree over positional lights that picks one in proportion to what it gives a point, for sampling many
+// lights stochastically (after Conty Estevez and Kulla, "Importance Sampling of Many Lights", 2018, without
+// orientation cones: the lights here are points). Each node keeps its lights' bounding box, their summed power and
+// the band over which its lights' values rise from nothing (the light a cut leaves out rises over the cut's fade).
+// Sampling walks down from the root choosing a child in proportion to an estimate of what its lights give the
+// point; a child that is a single light is weighed by the caller's exact value.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace irbake {
+
+struct LightTreeEntry {
+  uint32_t light = 0;       // the caller's index
+  glm::vec3 position{0.0f};
+  float power = 0.0f;       // the light's intensity (W/sr, the caller's channel weighting): its value at distance d
+                            // and normal incidence is power / (π d²), on the scale of the caller's exact values
+  float near = 0.0f;        // within this distance the light gives nothing the caller samples
+  float far = 0.0f;         // beyond it, all of its value; in between a share that rises no faster than
+                            // smoothstep((d − near) / (far − near)) (far ≤ near: a step at near)
+};
+
+class LightTree {
+ public:
+  LightTree() = default;
+  explicit LightTree(std::vector<LightTreeEntry> entries);
+  bool empty() const { return nodes_.empty(); }
+  size_t size() const { return entries_.size(); }
+
+  struct Choice {
+    uint32_t light = UINT32_MAX;  // UINT32_MAX: no light gives the point anything
+    double pmf = 0.0;             // the probability of this light
+  };
+  // One light for the point x with unit normal n, from a uniform u in [0, 1); exact(light) is the non-negative
+  // value that light gives x (it decides between a node's two children where one is a single light). Every light
+  // whose exact value is positive has a positive probability, so value / pmf is unbiased.
+  template <class Exact>
+  Choice sample(const glm::vec3& x, const glm::vec3& n, double u, Exact&& exact) const {
+    Choice c;
+    if (nodes_.empty()) return c;
+    int32_t at = 0;
+    double pmf = 1.0;
+    while (nodes_[size_t(at)].left >= 0) {
+      const Node& node = nodes_[size_t(at)];
+      const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
+      if (!(a + b > 0.0)) return c;
+      const double pa = a / (a + b);
+      if (u < pa) {
+        at = node.left, pmf *= pa, u = pa > 0.0 ? u / pa : 0.0;
+      } else {
+        at = node.right, pmf *= 1.0 - pa, u = pa < 1.0 ? (u - pa) / (1.0 - pa) : 0.0;
+      }
+      u = u < 1.0 ? u : 0x1.fffffffffffffp-1;
+    }
+    const LightTreeEntry& e = entries_[nodes_[size_t(at)].entry];
+    if (nodes_.size() == 1 && !(exact(e.light) > 0.0)) return c;
+    c.light = e.light;
+    c.pmf = pmf;
+    return c;
+  }
+  // The probability that sample() picks `light` at (x, n) (0 for a light not in the tree).
+  template <class Exact>
+  double pmf(const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {
+    if (nodes_.empty()) return 0.0;
+    return pmfBelow(0, x, n, light, exact);
+  }
+
+ private:
+  struct Node {
+    glm::vec3 lo{0.0f}, hi{0.0f};
+    float power = 0.0f, near = 0.0f, width = 0.0f;  // the lights' smallest near and far − near
+    int32_t left = -1, right = -1;  // children; -1: a leaf holding entries_[entry]
+    uint32_t entry = 0;
+  };
+  int32_t build(size_t begin, size_t end);
+  // An estimate of what the node's lights give x, on the scale of a single light's value: 0 where every light
+  // lies behind the plane of (x, n) or within its own near distance of x.
+  double importance(const Node& node, const glm::vec3& x, const glm::vec3& n) const;
+  template <class Exact>
+  double weight(int32_t child, const glm::vec3& x, const glm::vec3& n, Exact&& exact) const {
+    const Node& node = nodes_[size_t(child)];
+    if (node.left < 0) {
+      const double v = exact(entries_[node.entry].light);
+      return v > 0.0 ? v : 0.0;
+    }
+    return importance(node, x, n);
+  }
+  template <class Exact>
+  double pmfBelow(int32_t at, const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {
+    const Node& node = nodes_[size_t(at)];
+    if (node.left < 0) return entries_[node.entry].light == light ? 1.0 : 0.0;
+    const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
+    if (!(a + b > 0.0)) return 0.0;
+    return a / (a + b) * pmfBelow(node.left, x, n, light, exact) + b / (a + b) * pmfBelow(node.right, x, n, light, exact);
+  }
+
+  std::vector<LightTreeEntry> entries_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace irbake

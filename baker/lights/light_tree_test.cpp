@@ -1,0 +1,98 @@
+// The light tree's choice: a light that gives the point anything is never left out, the probabilities sum to at
+// most one (the rest: a walk that ends in a node whose lights give nothing, an estimate of 0), and drawn choices
+// follow the probabilities.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "lights/light_tree.h"
+#include "common/maths.h"
+#include "sampling/sampling.h"
+
+namespace irbake {
+namespace {
+
+struct Lamps {
+  std::vector<LightTreeEntry> entries;
+  // What lamp i gives (x, n): I cosθ / (π d²) beyond its near distance, else 0.
+  double value(uint32_t i, const glm::vec3& x, const glm::vec3& n) const {
+    const LightTreeEntry& e = entries[i];
+    const glm::vec3 d = e.position - x;
+    const float r = glm::length(d);
+    if (r <= e.near) return 0.0;
+    return std::max(0.0, double(glm::dot(n, d / r))) * e.power / (kPi * r * r);
+  }
+};
+
+Lamps scatteredLamps(size_t count, uint64_t seed) {
+  Lamps l;
+  Rng rng(seed);
+  for (size_t i = 0; i < count; ++i) {
+    const glm::vec3 p(float(rng.uniform() * 40.0 - 20.0), float(rng.uniform() * 3.0), float(rng.uniform() * 40.0 - 20.0));
+    l.entries.push_back({static_cast<uint32_t>(i), p, float(1.0 + 9.0 * rng.uniform()), float(2.0 + 4.0 * rng.uniform())});
+  }
+  return l;
+}
+
+TEST(LightTree, ProbabilitiesCoverEveryContributingLightAndSumToAtMostOne) {
+  const Lamps lamps = scatteredLamps(37, 5);
+  const LightTree tree(lamps.entries);
+  ASSERT_EQ(tree.size(), 37u);
+  Rng rng(11);
+  int contributing = 0;
+  for (int k = 0; k < 50; ++k) {
+    const glm::vec3 x(float(rng.uniform() * 40.0 - 20.0), 0.0f, float(rng.uniform() * 40.0 - 20.0));
+    const glm::vec3 n = k % 5 == 0 ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    auto exact = [&](uint32_t i) { return lamps.value(i, x, n); };
+    double sum = 0.0;
+    bool any = false;
+    for (uint32_t i = 0; i < 37; ++i) {
+      const double p = tree.pmf(x, n, i, exact);
+      sum += p;
+      if (exact(i) > 0.0) {
+        any = true;
+        EXPECT_GT(p, 0.0) << "point " << k << " lamp " << i;
+      }
+    }
+    if (any) {
+      ++contributing;
+      EXPECT_LE(sum, 1.0 + 1e-9) << "point " << k;
+      EXPECT_GT(sum, 0.3) << "point " << k;
+    }
+  }
+  EXPECT_GT(contributing, 40);
+}
+
+TEST(LightTree, DrawsFollowTheProbabilitiesAndTheEstimateIsUnbiased) {
+  const Lamps lamps = scatteredLamps(64, 9);
+  const LightTree tree(lamps.entries);
+  const glm::vec3 x(1.0f, 0.0f, -2.0f), n(0, 1, 0);
+  auto exact = [&](uint32_t i) { return lamps.value(i, x, n); };
+  double truth = 0.0;
+  for (uint32_t i = 0; i < 64; ++i) truth += exact(i);
+  ASSERT_GT(truth, 0.0);
+  const int draws = 200000;
+  std::map<uint32_t, int> counts;
+  double sum = 0.0, squares = 0.0;
+  for (int k = 0; k < draws; ++k) {
+    const LightTree::Choice c = tree.sample(x, n, (k + 0.5) / draws, exact);
+    ASSERT_NE(c.light, UINT32_MAX);
+    ++counts[c.light];
+    const double v = exact(c.light) / c.pmf;
+    sum += v, squares += v * v;
+  }
+  for (const auto& [light, count] : counts)
+    EXPECT_NEAR(double(count) / draws, tree.pmf(x, n, light, exact), 2e-4) << "lamp " << light;
+  const double mean = sum / draws, deviation = std::sqrt(std::max(0.0, squares / draws - mean * mean));
+  EXPECT_NEAR(mean, truth, 1e-3 * truth);
+  // The importance follows the value: one draw's relative deviation stays well below a uniform choice's.
+  double uniformSquares = 0.0;
+  for (uint32_t i = 0; i < 64; ++i) uniformSquares += 64.0 * exact(i) * exact(i);
+  const double uniformDeviation = std::sqrt(uniformSquares - truth * truth);
+  std::printf("[ figure ] one draw's deviation / mean: tree %.3f, uniform %.3f\n", deviation / truth, uniformDeviation / truth);
+  EXPECT_LT(deviation, 0.5 * uniformDeviation);
+}
+
+}  // namespace
+}  // namespace irbake

@@ -1,0 +1,144 @@
+#include "stages/light_tail/light_tail.h"
+
+#include <atomic>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "common/maths.h"
+#include "common/progress.h"
+#include "lights/light_tree.h"
+#include "sampling/sampling.h"
+#include "transport/geometry_term.h"
+
+namespace irbake {
+
+namespace {
+
+// The light's intensity as channelMean weighs the map (an IES light's at its brightest candela).
+float peakIntensity(const Light& light) {
+  float peak = static_cast<float>(channelMean(light.color)) * light.intensity;
+  if (light.type == LightType::Ies) peak *= light.profile ? static_cast<float>(light.profile->maxCandela) : 0.0f;
+  return std::max(0.0f, peak);
+}
+
+// The cut lights as they would be without the cut, by scene index (empty where not cut or skipped).
+struct CutLights {
+  std::vector<Light> whole;
+  std::vector<uint8_t> cut;
+  LightTree tree;
+};
+
+CutLights cutLights(const Scene& scene, const VplEvalOptions& eval, const std::vector<uint8_t>& skip) {
+  CutLights c;
+  c.whole = scene.lights;
+  c.cut.assign(scene.lights.size(), 0);
+  std::vector<LightTreeEntry> entries;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (!(l.cutoff > 0.0f) || !eval.directIncludes(i) || (i < skip.size() && skip[i])) continue;
+    c.whole[i].cutoff = 0.0f;
+    c.cut[i] = 1;
+    // Light::cutoffWindow is 1 up to three quarters of the cutoff (nothing is left out nearer) and falls to 0 at the
+    // cutoff by a smoothstep: what it leaves out rises by that smoothstep.
+    entries.push_back({static_cast<uint32_t>(i), l.position, peakIntensity(l), 0.75f * l.cutoff, l.cutoff});
+  }
+  c.tree = LightTree(std::move(entries));
+  return c;
+}
+
+// What the cut took from light i at (x, n), before its shadow: its light whole less its light faded.
+struct LeftOut {
+  glm::vec3 value{0.0f};
+  PunctualContribution whole;
+};
+LeftOut leftOutLight(const Scene& scene, const CutLights& c, uint32_t i, const glm::vec3& x, const glm::vec3& n) {
+  LeftOut out;
+  out.whole = punctualDirect(c.whole[i], x, n);
+  if (out.whole.mapValue == glm::vec3(0.0f)) return out;
+  out.value = out.whole.mapValue * (1.0f - scene.lights[i].cutoffWindow(out.whole.distance));
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json LightTailStats::toJson() const {
+  return {{"lights", lights}, {"texels", texels}, {"rays", rays}, {"addedMean", texels ? added / double(texels) : 0.0},
+          {"noiseRms", texels ? std::sqrt(variance / double(texels)) : 0.0}};
+}
+
+LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
+                            const std::vector<uint8_t>& skip) {
+  LightTailStats stats;
+  Stopwatch watch;
+  const CutLights c = cutLights(in.scene, in.eval, skip);
+  stats.lights = c.tree.size();
+  if (c.tree.empty() || options.samples <= 0) return stats;
+  const int samples = options.samples;
+  const float eps = in.rayTracer.epsilon();
+  std::atomic<size_t> rays{0};
+  for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p) {
+    const TexelSamples& ts = in.texels[p];
+    Lightmap& map = maps[p];
+    const size_t layer = ts.layerSize();
+    std::vector<double> variance(layer, -1.0), added(layer, 0.0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 256), [&](const tbb::blocked_range<size_t>& range) {
+      size_t traced = 0;
+      for (size_t t = range.begin(); t < range.end(); ++t) {
+        if (t >= ts.valid.size() || !ts.valid[t]) continue;
+        Rng rng(hashSeed(options.seed, p, t));
+        // The draws stratified over the tree's unit interval (its order is spatial), one slot of the texel's
+        // samples after another.
+        const double shift = rng.uniform();
+        const int layers = ts.supersample * ts.supersample;
+        glm::dvec3 sum(0.0);
+        double squares = 0.0, weight = 0.0;
+        for (int k = 0; k < samples; ++k) {
+          const size_t s = static_cast<size_t>(k % layers) * layer + t;
+          const float w = ts.positionWeight[s].w;
+          if (!(w > 0.0f)) continue;
+          glm::vec3 x(ts.positionWeight[s]);
+          if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size() &&
+              ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
+            x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+          const glm::vec3 n(ts.normal[s]);
+          auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
+          const double u = (k + shift) / samples;
+          const LightTree::Choice choice = c.tree.sample(x, n, u, exact);
+          glm::dvec3 v(0.0);
+          if (choice.light != UINT32_MAX && choice.pmf > 0.0) {
+            const LeftOut lo = leftOutLight(in.scene, c, choice.light, x, n);
+            if (lo.value != glm::vec3(0.0f)) {
+              const glm::vec3 origin = x + n * eps;
+              const float tmax = std::isinf(lo.whole.distance) ? 1e30f : lo.whole.distance - eps;
+              ++traced;
+              if (!(tmax > 0.0f) || !in.rayTracer.occluded(origin, lo.whole.toLight, 0.0f, tmax)) {
+                const glm::vec3 tr = tmax > 0.0f ? in.rayTracer.transmittance(origin, lo.whole.toLight, 0.0f, tmax)
+                                                 : glm::vec3(1.0f);
+                v = glm::dvec3(lo.value * tr) / choice.pmf;
+              }
+            }
+          }
+          sum += double(w) * v;
+          squares += double(w) * channelMean(glm::vec3(v)) * channelMean(glm::vec3(v));
+          weight += double(w);
+        }
+        if (!(weight > 0.0)) continue;
+        const glm::dvec3 mean = sum / weight;
+        const double m = channelMean(glm::vec3(mean));
+        // The variance of the mean of `samples` draws (0 with one draw: nothing to tell it from).
+        variance[t] = samples > 1 ? std::max(0.0, squares / weight - m * m) / double(samples - 1) : 0.0;
+        added[t] = m;
+        map.texels[t] += glm::vec3(mean);
+      }
+      rays += traced;
+    });
+    for (size_t t = 0; t < layer; ++t)
+      if (variance[t] >= 0.0) ++stats.texels, stats.variance += variance[t], stats.added += added[t];
+  }
+  stats.rays = rays.load();
+  stats.seconds = watch.seconds();
+  return stats;
+}
+
+}  // namespace irbake

@@ -1,0 +1,39 @@
+// The light the cut takes back, sampled. A light without range is cut where its light falls to a share of the
+// scene's reference (lights/light_reach.h): every evaluator gives it only up to its reach, faded out over the last
+// quarter. Many such lights (a town's lamps) leave many small tails whose sum is not small. Here each texel gets
+// an unbiased estimate of that sum: N lights drawn from a light tree (lights/light_tree.h) over the cut lights,
+// each in proportion to a bound on what it gives the texel, its left-out light (its light without the cut less its
+// faded light) traced with one shadow ray and divided by its probability. The estimate's variance is kept for the
+// error figure. docs/units.md, "Light reach".
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "evaluators/bake_inputs.h"
+#include "lightmap/lightmap.h"
+
+namespace irbake {
+
+struct LightTailOptions {
+  int samples = 8;     // lights drawn per texel (0: the cut light stays left out)
+  uint64_t seed = 0;   // the draws' seed (the walk's)
+};
+
+struct LightTailStats {
+  size_t lights = 0;          // cut lights in the tree
+  size_t texels = 0;          // texels given an estimate
+  size_t rays = 0;            // shadow rays traced
+  double added = 0.0;         // sum over those texels of the added map value (channel mean)
+  double variance = 0.0;      // sum over those texels of the estimate's variance (channel mean, of the mean)
+  double seconds = 0.0;
+  nlohmann::json toJson() const;
+};
+
+// Adds to each page of `maps` (the punctual lights' direct pages, one per in.texels page) the cut lights' left-out
+// light. skip: per scene light, 1: leave it alone (a light whose direct light is not in these pages); may be empty.
+LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
+                            const std::vector<uint8_t>& skip = {});
+
+}  // namespace irbake
