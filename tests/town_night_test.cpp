@@ -116,7 +116,9 @@ bool traceProfile(const Scene& s, const RayTracer& rt, const std::vector<Lightma
                   int lamp, glm::vec2 direction, Profile& out) {
   const Light& l = s.lights[lamp];
   const float h = l.position.y, reach = std::sqrt(kRange * kRange - h * h);
-  out = Profile{lamp, direction};
+  out = Profile();
+  out.lamp = lamp;
+  out.direction = direction;
   std::vector<int32_t> mapOfPage;
   for (const Lightmap& m : maps) {
     if (m.page >= static_cast<int>(mapOfPage.size())) mapOfPage.resize(m.page + 1, -1);
