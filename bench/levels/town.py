@@ -4,7 +4,8 @@
 N x N blocks of four buildings each; the buildings are instances (nodes) of eight shared box meshes, walls cut
 into cells of --cell metres, turned by quarter turns. A ground plane covers the town; street lamps stand along
 the streets, each a shared post mesh and a KHR_lights_punctual point light at its top, with `range` unless
---no-range. Sun and sky are the bake's options (--sun, --sky), not part of the file. Deterministic for a seed.
+--no-range. Sun and sky are the bake's options (--sun, --sky), not part of the file. --camera adds a glTF camera
+(irview's --camera 0). Deterministic for a seed.
 
   python3 bench/levels/town.py build/levels/town16.glb --blocks 16 --lamps 1000
 """
@@ -153,14 +154,50 @@ def build(args):
                       "children": [len(nodes) + 1]})
         nodes.append({"name": "lamp_%d_light" % i, "translation": [0.0, 5.3, 0.0],
                       "extensions": {"KHR_lights_punctual": {"light": i}}})
+    cameras = []
+    if args.camera:
+        eye, target = args.camera[:3], args.camera[3:]
+        nodes.append({"name": "camera", "camera": 0, "translation": eye, "rotation": look_rotation(eye, target)})
+        cameras.append({"type": "perspective", "perspective": {"yfov": math.radians(args.fov), "znear": 0.1}})
     roots = [i for i, n in enumerate(nodes) if not n["name"].endswith("_light")]
     doc = {"asset": {"version": "2.0", "generator": "irbake bench/levels/town.py"},
            "scene": 0, "scenes": [{"nodes": roots}], "nodes": nodes, "meshes": meshes, "materials": materials,
            "accessors": buf.accessors, "bufferViews": buf.views, "buffers": [{"byteLength": len(buf.data)}]}
+    if cameras:
+        doc["cameras"] = cameras
     if lights:
         doc["extensionsUsed"] = ["KHR_lights_punctual"]
         doc["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
     return doc, bytes(buf.data), triangles, len(lights)
+
+
+def look_rotation(eye, target):
+    """The unit quaternion (x, y, z, w) that turns a glTF camera (looking down its -z, +y up) at `eye` towards
+    `target`, its right vector kept level."""
+    f = [t - e for e, t in zip(eye, target)]
+    n = math.sqrt(sum(c * c for c in f))
+    f = [c / n for c in f]
+    r = [-f[2], 0.0, f[0]]  # forward x up(0, 1, 0)
+    rn = math.sqrt(r[0] ** 2 + r[2] ** 2)
+    if rn < 1e-9:
+        raise ValueError("--camera: the view may not be vertical")
+    r = [c / rn for c in r]
+    u = [r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]]  # right x forward
+    b = [-c for c in f]  # the camera's +z
+    m = [[r[0], u[0], b[0]], [r[1], u[1], b[1]], [r[2], u[2], b[2]]]  # columns: the camera's axes
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        return [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s]
+    i = max(range(3), key=lambda k: m[k][k])
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(1.0 + m[i][i] - m[j][j] - m[k][k])
+    q = [0.0] * 4
+    q[i] = 0.25 * s
+    q[j] = (m[j][i] + m[i][j]) / s
+    q[k] = (m[k][i] + m[i][k]) / s
+    q[3] = (m[k][j] - m[j][k]) / s
+    return q
 
 
 def ground_mesh(size, cells):
@@ -202,9 +239,23 @@ def main():
     ap.add_argument("--no-lights", action="store_true",
                     help="lamp posts without their point lights: the same geometry, lit by --sun/--sky alone")
     ap.add_argument("--seed", type=int, default=1, help="layout seed (default 1)")
+    ap.add_argument("--camera", type=str, default="", metavar="EX,EY,EZ,TX,TY,TZ",
+                    help="add a glTF camera at EX,EY,EZ looking at TX,TY,TZ (metres)")
+    ap.add_argument("--fov", type=float, default=50.0, help="the camera's vertical field of view in degrees (default 50)")
     args = ap.parse_args()
     if args.blocks < 1 or args.lamps < 0 or args.cell <= 0:
         ap.error("--blocks must be at least 1, --lamps at least 0, --cell positive")
+    if args.camera:
+        try:
+            args.camera = [float(v) for v in args.camera.split(",")]
+        except ValueError:
+            args.camera = []
+        if len(args.camera) != 6 or not all(math.isfinite(v) for v in args.camera):
+            ap.error("--camera needs six finite numbers EX,EY,EZ,TX,TY,TZ")
+        if math.hypot(args.camera[3] - args.camera[0], args.camera[5] - args.camera[2]) < 1e-6:
+            ap.error("--camera: the view may not be vertical (the eye above or below the target)")
+    if not 0.0 < args.fov < 180.0:
+        ap.error("--fov must lie between 0 and 180 degrees")
     doc, binary, triangles, lamps = build(args)
     write_glb(args.out, doc, binary)
     print("%s: %d blocks, %d triangles, %d lamps" % (args.out, args.blocks ** 2, triangles, lamps))
