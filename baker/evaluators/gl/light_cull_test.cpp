@@ -11,26 +11,16 @@
 #include "evaluators/gl/gl_backend.h"
 #include "lights/light_kind.h"
 #include "lights/light_reach.h"
-#include "raytrace/ray_tracer.h"
+#include "testing/cut_lights.h"
 #include "testing/scenes.h"
 
 namespace irbake {
 namespace {
 
-struct CullCase {
-  Scene whole, culled;
-  LightReach reach;
-  std::unique_ptr<LightGrid> grid;
-  std::vector<TexelSamples> pages;
-  VplSet vpls;
-  size_t farLamp = 0;
-};
-
 // A 40 m floor (z = 0) under 5×5 lamps 1.5 m up, 8 m apart, every other one with a range of 5 m, a sun, and one
-// lamp 1 km away with a range of 2 m; sampled 64×64.
-CullCase lampsOverFloor() {
-  CullCase c;
-  Scene& s = c.whole;
+// lamp 1 km away with a range of 2 m (the last light); cut at 5%, sampled 64×64.
+std::unique_ptr<testing::CutLightsCase> lampsOverFloor() {
+  Scene s;
   testing::addQuad(s, testing::addMaterial(s, glm::vec3(0.0f)), {-20, -20, 0}, {40, 0, 0}, {0, 40, 0}, 8);
   s.lights.push_back(testing::directionalLight(glm::normalize(glm::vec3(0.2f, 0.1f, -1.0f)), 2.0f));
   for (int j = 0; j < 5; ++j)
@@ -41,20 +31,12 @@ CullCase lampsOverFloor() {
     }
   Light far = testing::pointLight({1000.0f, 1000.0f, 1.0f}, 30.0f);
   far.range = 2.0f;
-  c.farLamp = s.lights.size();
   s.lights.push_back(far);
-  c.culled = s;
-  LightCullOptions o;
-  o.fraction = 0.05f;
-  c.reach = settleLightReach(c.culled, c.culled.bounds(), o);
-  applyLightCutoffs(c.culled, c.reach);
-  c.grid = std::make_unique<LightGrid>(c.culled, c.reach, c.culled.bounds());
-  c.pages.push_back(testing::gridSamples({-20, -20, 0}, {40, 0, 0}, {0, 40, 0}, 64, 64));
-  return c;
+  return testing::cutLightsCase(std::move(s), 0.05f, testing::gridSamples({-20, -20, 0}, {40, 0, 0}, {0, 40, 0}, 64, 64));
 }
 
 // What the cut's fade takes from texel t: the cut lamps' light without the cut less their light with it.
-double cutBound(const CullCase& c, size_t t) {
+double cutBound(const testing::CutLightsCase& c, size_t t) {
   const glm::vec3 x(c.pages[0].positionWeight[t]), n(c.pages[0].normal[t]);
   double bound = 0.0;
   for (size_t i = 0; i < c.culled.lights.size(); ++i) {
@@ -68,16 +50,12 @@ double cutBound(const CullCase& c, size_t t) {
 
 template <typename Bake>
 void expectWithinTheCutBound(const char* name, Bake bake) {
-  CullCase c = lampsOverFloor();
+  const auto cc = lampsOverFloor();
+  const testing::CutLightsCase& c = *cc;
+  const size_t farLamp = c.whole.lights.size() - 1;
   ASSERT_TRUE(c.grid->culls());
   ASSERT_EQ(c.reach.cutLights(), 13u);
-  VplEvalOptions eval;
-  eval.includeVpls = false;
-  RayTracer wholeRt(c.whole), culledRt(c.culled);
-  BakeInputs brute{c.whole, wholeRt, c.pages, c.vpls, eval, {}};
-  BakeInputs culled{c.culled, culledRt, c.pages, c.vpls, eval, {}};
-  culled.lightGrid = c.grid.get();
-  const std::vector<Lightmap> a = bake(brute), b = bake(culled);
+  const std::vector<Lightmap> a = bake(c.bruteInputs()), b = bake(c.culledInputs());
   double worst = 0.0, faded = 0.0, sum = 0.0;
   for (size_t t = 0; t < a[0].size(); ++t) {
     if (!a[0].valid[t]) continue;
@@ -87,7 +65,7 @@ void expectWithinTheCutBound(const char* name, Bake bake) {
     worst = std::max(worst, diff / a[0].texels[t].x);
     faded += bound;
     sum += a[0].texels[t].x;
-    for (uint32_t i : c.grid->near(glm::vec3(c.pages[0].positionWeight[t]))) ASSERT_NE(i, c.farLamp);
+    for (uint32_t i : c.grid->near(glm::vec3(c.pages[0].positionWeight[t]))) ASSERT_NE(i, farLamp);
   }
   std::printf("[ figure ] %s: largest relative change %.2e, faded share %.2e\n", name, worst, faded / sum);
   EXPECT_GT(faded, 0.0);  // the fade takes something: the bound is exercised

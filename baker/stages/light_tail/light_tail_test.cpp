@@ -8,50 +8,31 @@
 #include <cstdio>
 
 #include "evaluators/embree/embree_backend.h"
-#include "lights/light_reach.h"
-#include "raytrace/ray_tracer.h"
 #include "stages/light_tail/light_tail.h"
+#include "testing/cut_lights.h"
 #include "testing/scenes.h"
 
 namespace irbake {
 namespace {
 
-struct TailCase {
-  Scene whole, culled;
-  LightReach reach;
-  std::unique_ptr<LightGrid> grid;
-  std::vector<TexelSamples> pages;
-  VplSet vpls;
-};
-
-TailCase lampsAndWall() {
-  TailCase c;
-  Scene& s = c.whole;
+// A 42 m floor (z = 0) under 7×7 lamps 1.5 m up, 6 m apart, and a wall across its middle; cut at 5%, sampled
+// 64×64.
+std::unique_ptr<testing::CutLightsCase> lampsAndWall() {
+  Scene s;
   const int m = testing::addMaterial(s, glm::vec3(0.5f));
   testing::addQuad(s, m, {-21, -21, 0}, {42, 0, 0}, {0, 42, 0}, 8);
   testing::addQuad(s, m, {1, -12, 0}, {0, 24, 0}, {0, 0, 4}, 2);
   for (int j = 0; j < 7; ++j)
     for (int i = 0; i < 7; ++i) s.lights.push_back(testing::pointLight({-18.0f + 6.0f * i, -18.0f + 6.0f * j, 1.5f}, 30.0f));
-  c.culled = s;
-  LightCullOptions o;
-  o.fraction = 0.05f;
-  c.reach = settleLightReach(c.culled, c.culled.bounds(), o);
-  applyLightCutoffs(c.culled, c.reach);
-  c.grid = std::make_unique<LightGrid>(c.culled, c.reach, c.culled.bounds());
-  c.pages.push_back(testing::gridSamples({-21, -21, 0}, {42, 0, 0}, {0, 42, 0}, 64, 64));
-  return c;
+  return testing::cutLightsCase(std::move(s), 0.05f, testing::gridSamples({-21, -21, 0}, {42, 0, 0}, {0, 42, 0}, 64, 64));
 }
 
 TEST(LightTail, SampledBackTailRemovesTheCutsBiasWithTheNoiseItReports) {
-  TailCase c = lampsAndWall();
+  const auto cc = lampsAndWall();
+  const testing::CutLightsCase& c = *cc;
   ASSERT_TRUE(c.grid->culls());
   ASSERT_EQ(c.reach.cutLights(), 49u);
-  VplEvalOptions eval;
-  eval.includeVpls = false;
-  RayTracer wholeRt(c.whole), culledRt(c.culled);
-  BakeInputs brute{c.whole, wholeRt, c.pages, c.vpls, eval, {}};
-  BakeInputs culled{c.culled, culledRt, c.pages, c.vpls, eval, {}};
-  culled.lightGrid = c.grid.get();
+  const BakeInputs brute = c.bruteInputs(), culled = c.culledInputs();
   const std::vector<Lightmap> a = bakeEmbree(brute, EmbreeOptions{}), b = bakeEmbree(culled, EmbreeOptions{});
   std::vector<Lightmap> tail = b;
   LightTailOptions options;
@@ -85,14 +66,11 @@ TEST(LightTail, SampledBackTailRemovesTheCutsBiasWithTheNoiseItReports) {
 }
 
 TEST(LightTail, NothingCutNothingAddedAndNoSamplesLeaveTheCut) {
-  TailCase c = lampsAndWall();
-  VplEvalOptions eval;
-  eval.includeVpls = false;
-  RayTracer wholeRt(c.whole), culledRt(c.culled);
+  const auto cc = lampsAndWall();
+  const testing::CutLightsCase& c = *cc;
   std::vector<Lightmap> maps = {blankLightmap(c.pages[0])};
-  BakeInputs brute{c.whole, wholeRt, c.pages, c.vpls, eval, {}};
-  EXPECT_EQ(addLightTail(brute, maps, LightTailOptions{}).texels, 0u);  // no light is cut
-  BakeInputs culled{c.culled, culledRt, c.pages, c.vpls, eval, {}};
+  EXPECT_EQ(addLightTail(c.bruteInputs(), maps, LightTailOptions{}).texels, 0u);  // no light is cut
+  const BakeInputs culled = c.culledInputs();
   LightTailOptions none;
   none.samples = 0;
   EXPECT_EQ(addLightTail(culled, maps, none).texels, 0u);
