@@ -503,6 +503,13 @@ std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<f
   // Inputs first: the scene and its files, --env's map, and what the command reads besides (merge's partials).
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.lights.environment.empty()) inputs.push_back(c.lights.environment);
+  // --atlas-from's bake and its files: a bake into its own folder would overwrite what it reads.
+  if (!c.options.atlasFrom.empty()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(c.options.atlasFrom, ec)) throw Error(ErrorCode::Io, c.options.atlasFrom, "--atlas-from: no such file");
+    const std::vector<fs::path> baked = sceneInputFiles(c.options.atlasFrom);
+    inputs.insert(inputs.end(), baked.begin(), baked.end());
+  }
   inputs.insert(inputs.end(), moreInputs.begin(), moreInputs.end());
   guard->addInputs(inputs);
   // The names the bake picks in OUTDIR (pages, its lock, checkpoint and partials), then each named output.
