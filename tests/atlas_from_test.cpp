@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,28 @@ TEST(AtlasFrom, AnotherLightKeepsTheAtlasAndTheSameLightGivesTheSameMap) {
   // The same lights and seed on the same atlas: the same scene reaches every stage, so the same map.
   ASSERT_EQ(mapAgain.width, mapA.width);
   EXPECT_LE(relativeMaxDifference(mapA, mapAgain), 1e-6);
+}
+
+TEST(AtlasFrom, APrimitiveSpreadOverSeveralPagesKeepsEveryPage) {
+  const fs::path samples = testing::sampleScenes("atlas_from");
+  const fs::path dir = testing::scratchFolder("atlas_from", "pages");
+  const fs::path scene = samples / "cornell_box.gltf";
+  // Small pages at a fine density: the blocks' charts land on several pages, one exported part per page.
+  ASSERT_EQ(runIrbakeIn(dir, bakeArgs(scene, dir / "a", {"--page-size", "128", "--texels-per-unit", "300"})).code, 0);
+  const json a = json::parse(fileText(dir / "a" / "scene.gltf"));
+  std::map<json, int> partsOf;
+  for (const json& mesh : a["meshes"])
+    for (const json& prim : mesh["primitives"]) ++partsOf[prim["extras"]["lightmap"]["source"]];
+  ASSERT_TRUE(std::any_of(partsOf.begin(), partsOf.end(), [](const auto& p) { return p.second > 1; }));
+  const auto b = runIrbakeIn(dir, bakeArgs(scene, dir / "b", {"--atlas-from", (dir / "a" / "scene.gltf").string()}));
+  ASSERT_EQ(b.code, 0) << b.output;
+  EXPECT_EQ(texcoord1Bytes(dir / "b" / "scene.gltf"), texcoord1Bytes(dir / "a" / "scene.gltf"));
+  const size_t pages = a["extras"]["irbakeAtlas"]["pages"].size();
+  ASSERT_GT(pages, 1u);
+  for (size_t page = 0; page < pages; ++page) {
+    const std::string name = "lightmap_" + std::to_string(page) + ".exr";
+    EXPECT_LE(relativeMaxDifference(readExr(dir / "a" / name), readExr(dir / "b" / name)), 1e-6) << name;
+  }
 }
 
 // Byte offset of vertex 0's x in the POSITION accessor of the mesh named `name`.
