@@ -427,10 +427,11 @@ std::string partialName(int k, int n) {
   return "partial_" + std::to_string(k) + "_of_" + std::to_string(n) + ".vplsum";
 }
 
-// The scene's identity: its files, and the environment map's when --env names one.
+// The scene's identity: its files, the environment map's when --env names one, and --atlas-from's bake's.
 std::string sceneIdentity(const BakeCommand& c) {
   std::string hash = hashSceneFiles(c.scene);
   if (!c.lights.environment.empty()) hash = hashText(hash + hashSceneFiles(c.lights.environment));
+  if (!c.options.atlasFrom.empty()) hash = hashText(hash + hashSceneFiles(c.options.atlasFrom));
   return hash;
 }
 
@@ -573,6 +574,7 @@ int runBake(const Args& args) {
   header.shardCount = c.shardCount;
   header.command = {{"scene", fs::absolute(c.scene).string()},
                     {"env", c.lights.environment.empty() ? std::string() : fs::absolute(c.lights.environment).string()},
+                    {"atlasFrom", c.options.atlasFrom.empty() ? std::string() : fs::absolute(c.options.atlasFrom).string()},
                     {"args", c.arguments}};
 
   ExactVplSums sums = staged.emptySums();
