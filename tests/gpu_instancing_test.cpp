@@ -186,3 +186,32 @@ TEST(GpuInstancing, EachInstanceHasItsOwnRegionAndTheMapsOfPlainNodes) {
   EXPECT_TRUE(fs::exists(dir / "instanced.png"));
 #endif
 }
+
+// --atlas-from on an instanced scene: the export wrote each instance as a node with a mesh of its own, and its
+// parts name their source (node, mesh, primitive, instance), so the second bake finds every instance's region
+// and, with the same options, gives the same map.
+TEST(GpuInstancing, AtlasFromFindsEveryInstancesRegion) {
+  const fs::path dir = fs::current_path() / "test_scratch" / "gpu_instancing_atlas_from";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  irbake::testing::writeDocument(squares(true), dir / "instanced.gltf");
+  const std::vector<std::string> common = {"bake", (dir / "instanced.gltf").string(), "--backend", "embree", "--vpls", "64",
+                                           "--seed", "3", "--probes", "off", "--quiet"};
+  std::vector<std::string> first = common, second = common;
+  first.insert(first.end(), {"-o", (dir / "a").string(), "--texels-per-unit", "16"});
+  second.insert(second.end(), {"-o", (dir / "b").string(), "--atlas-from", (dir / "a" / "scene.gltf").string()});
+  std::string log;
+  ASSERT_EQ(run(IRBAKE_EXE, first, dir / "a_log.txt", &log), 0) << log;
+  ASSERT_EQ(run(IRBAKE_EXE, second, dir / "b_log.txt", &log), 0) << log;
+  const Lightmap a = readExr(dir / "a" / "lightmap_0.exr"), b = readExr(dir / "b" / "lightmap_0.exr");
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  float peak = 0.0f, diff = 0.0f;
+  for (size_t i = 0; i < a.texels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      peak = std::max(peak, a.texels[i][c]);
+      diff = std::max(diff, std::abs(a.texels[i][c] - b.texels[i][c]));
+    }
+  EXPECT_GT(peak, 0.0f);
+  EXPECT_LE(diff, 1e-6f * peak);
+}

@@ -181,6 +181,11 @@ void addWalkRows(std::vector<OptionDescriptor>& t) {
                           "smallest power of two from " + shown(kMinAutoPageSize) + " to " + shown(kMaxAutoPageSize) +
                           " that holds the atlas twice over, else " + shown(kMaxAutoPageSize) + ")",
                       opt([](BakeOptions& o) { return &o.atlas.maxPageSize; })));
+  t.push_back(text("--atlas-from", kTexels, "BAKED.gltf",
+                   "bake onto the atlas of an earlier bake of the same geometry (its\n"
+                   "TEXCOORD_1 and pages, no unwrap): lighting scenarios that share the\n"
+                   "light-map UVs (docs/guide.md, \"Scenarios\")",
+                   opt([](BakeOptions& o) { return &o.atlasFrom; }), kPath));
   t.push_back(integer("--supersample", 1, 8, kTexels, "S", "S×S samples per texel (default " + shown(d.texels.supersample) + ")",
                       opt([](BakeOptions& o) { return &o.texels.supersample; })));
 }

@@ -427,10 +427,11 @@ std::string partialName(int k, int n) {
   return "partial_" + std::to_string(k) + "_of_" + std::to_string(n) + ".vplsum";
 }
 
-// The scene's identity: its files, and the environment map's when --env names one.
+// The scene's identity: its files, the environment map's when --env names one, and --atlas-from's bake's.
 std::string sceneIdentity(const BakeCommand& c) {
   std::string hash = hashSceneFiles(c.scene);
   if (!c.lights.environment.empty()) hash = hashText(hash + hashSceneFiles(c.lights.environment));
+  if (!c.options.atlasFrom.empty()) hash = hashText(hash + hashSceneFiles(c.options.atlasFrom));
   return hash;
 }
 
@@ -503,6 +504,13 @@ std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<f
   // Inputs first: the scene and its files, --env's map, and what the command reads besides (merge's partials).
   std::vector<fs::path> inputs = sceneInputFiles(c.scene);
   if (!c.lights.environment.empty()) inputs.push_back(c.lights.environment);
+  // --atlas-from's bake and its files: a bake into its own folder would overwrite what it reads.
+  if (!c.options.atlasFrom.empty()) {
+    std::error_code ec;
+    if (!fs::is_regular_file(c.options.atlasFrom, ec)) throw Error(ErrorCode::Io, c.options.atlasFrom, "--atlas-from: no such file");
+    const std::vector<fs::path> baked = sceneInputFiles(c.options.atlasFrom);
+    inputs.insert(inputs.end(), baked.begin(), baked.end());
+  }
   inputs.insert(inputs.end(), moreInputs.begin(), moreInputs.end());
   guard->addInputs(inputs);
   // The names the bake picks in OUTDIR (pages, its lock, checkpoint and partials), then each named output.
@@ -566,6 +574,7 @@ int runBake(const Args& args) {
   header.shardCount = c.shardCount;
   header.command = {{"scene", fs::absolute(c.scene).string()},
                     {"env", c.lights.environment.empty() ? std::string() : fs::absolute(c.lights.environment).string()},
+                    {"atlasFrom", c.options.atlasFrom.empty() ? std::string() : fs::absolute(c.options.atlasFrom).string()},
                     {"args", c.arguments}};
 
   ExactVplSums sums = staged.emptySums();

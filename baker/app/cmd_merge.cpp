@@ -138,6 +138,7 @@ int runMerge(const Args& args) {
   c.scene = first.command.value("scene", c.scene);
   if (!c.lights.environment.empty())
     c.lights.environment = first.command.value("env", c.lights.environment.string());
+  if (!c.options.atlasFrom.empty()) c.options.atlasFrom = first.command.value("atlasFrom", c.options.atlasFrom);
   c.out = out;
   c.report = report;
   c.noGltf = noGltf;

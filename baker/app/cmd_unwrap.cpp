@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/quality.h"
 #include "atlas/atlas.h"
+#include "atlas/atlas_from_bake.h"
 #include "common/command_line.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -107,6 +108,7 @@ int runUnwrap(const Args& args) {
   exportOptions.writeExrPages = false;
   exportOptions.inputs = sceneFiles;
   exportOptions.guard = &guard;
+  exportOptions.atlasRecord = atlasRecordJson(result);
   if (!report.empty()) {
     const std::string text = reportJson(input, result).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
     exportOptions.alsoWrite.push_back({report, [text, report](const std::filesystem::path& tmp) {

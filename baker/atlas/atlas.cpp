@@ -1,5 +1,6 @@
 #include "atlas/atlas.h"
 #include "atlas/atlas_estimate.h"
+#include "atlas/atlas_from_bake.h"
 #include "scene/triangle_area.h"
 
 #include <algorithm>
@@ -470,6 +471,8 @@ AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options) {
   checkTexelEstimate(scene, options);
   const Stopwatch total;
   AtlasResult result;
+  result.padding = options.padding;
+  result.sources = recordSourcePrimitives(scene);
   AtlasStats& stats = result.stats;
   auto progress = [&](double f) {
     if (options.progress) options.progress("atlas", f);

@@ -60,9 +60,20 @@ struct AtlasStats {
   std::vector<std::string> warnings;
 };
 
+// A primitive the atlas mapped, as it was before the atlas split it: what a later bake onto the same atlas
+// (--atlas-from, atlas/atlas_from_bake.h) checks its own geometry against.
+struct SourcePrimitiveRecord {
+  int node = -1, mesh = -1, primitive = -1, instance = -1;  // the source glTF's node, mesh, primitive, GPU instance
+  std::string name;                  // the primitive's name (its mesh's), for messages
+  size_t vertices = 0, triangles = 0;
+  std::string positions;             // XXH3-64 (hex) of its world positions and then its triangles' indices
+};
+
 struct AtlasResult {
   std::vector<AtlasPage> pages;
   AtlasStats stats;
+  int padding = 0;                               // empty texels around every chart
+  std::vector<SourcePrimitiveRecord> sources;    // the mapped primitives before the atlas, in scene order
   nlohmann::json toJson() const {  // report "atlas": page sizes and the figures a user checks
     nlohmann::json sizes = nlohmann::json::array();
     for (const auto& pg : pages) sizes.push_back({{"width", pg.width}, {"height", pg.height}});

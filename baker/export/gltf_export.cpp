@@ -159,10 +159,14 @@ constexpr MapEncodingKind kLightmapImageEncoding = MapEncodingKind::Png8;
 std::string pageUri(const ExportOptions& options, int page) { return options.exrPrefix + "_" + std::to_string(page) + ".exr"; }
 
 // The light-map record of one output primitive (extras.lightmap), kept beside the source extras.
-void setLightmapRecord(json& prim, const LightmapRef& ref) {
+// source: the scene primitive it is a part of, [node, mesh, primitive, GPU instance] of the source document (a
+// later bake onto this atlas matches its primitives by it, docs/export.md "irbakeAtlas").
+void setLightmapRecord(json& prim, const Primitive& part) {
+  const LightmapRef& ref = part.lightmap;
   if (ref.page < 0) return;
   if (!prim.contains("extras") || !prim["extras"].is_object()) prim["extras"] = json::object();
-  prim["extras"]["lightmap"] = {{"page", ref.page}, {"width", ref.width}, {"height", ref.height}};
+  prim["extras"]["lightmap"] = {{"page", ref.page}, {"width", ref.width}, {"height", ref.height},
+                                {"source", {part.node, part.gltfMesh, part.gltfPrimitive, part.instance}}};
 }
 
 // A probe-lit object (extras.irbake.mode "probes"): its primitives say so, for the clients (docs/export.md,
@@ -331,7 +335,7 @@ class SourceExport {
     const int material = outputMaterial(part);
     if (material >= 0) prim["material"] = material;
     else prim.erase("material");
-    setLightmapRecord(prim, part.lightmap);
+    setLightmapRecord(prim, part);
     setProbeLitRecord(prim, part);
     return prim;
   }
@@ -552,6 +556,8 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   if (rootExtrasIsObject && fromSource && !pageUris.empty()) doc.root["extras"]["lightmapPages"] = pageUris;
   // The sky the bake used, for viewers (irview draws it behind the scene) and for a bake of this export.
   if (rootExtrasIsObject && scene.environment.present()) doc.root["extras"]["irbakeSky"] = skyJson(scene.environment);
+  // The atlas, for a later bake onto it (--atlas-from); only where the parts name their source document's primitives.
+  if (rootExtrasIsObject && fromSource && !options.atlasRecord.is_null()) doc.root["extras"]["irbakeAtlas"] = options.atlasRecord;
   const bool directional = options.directional && !(*options.directional)[0].empty();
   if (directional) {
     for (const auto& axis : *options.directional) checkMaps(axis, file);

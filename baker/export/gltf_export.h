@@ -34,6 +34,9 @@ struct ExportOptions {
   const ShadowMaskExport* shadowMask = nullptr;
   // Each scene light's settled mode (recordLightModes), or null: nothing recorded.
   const std::vector<LightMode>* lightModes = nullptr;
+  // The atlas's record (atlas/atlas_from_bake.h: atlasRecordJson), written as the root extras "irbakeAtlas" of an
+  // export of a source document, so a later bake can reuse the atlas (--atlas-from); null: not written.
+  nlohmann::json atlasRecord;
   // Files never to overwrite (the scene's own): an image whose name one of them has takes another, and
   // any other output that would land on one is refused with Error(Usage).
   std::vector<std::filesystem::path> inputs;

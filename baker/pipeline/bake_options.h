@@ -65,6 +65,8 @@ inline VplEvalOptions compensatedEval() {
 struct BakeOptions {
   BackendKind backend = BackendKind::Auto;  // auto (default), gl, embree, reference
   AtlasOptions atlas;                     // texel density, padding, page size
+  std::string atlasFrom;                  // an earlier bake's glTF/GLB whose atlas this bake reuses instead of
+                                          // unwrapping (atlas/atlas_from_bake.h); "": unwrap
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
   std::optional<int> finalGatherPaths;    // the walk's paths where the final gather runs (unset: walk.paths)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "atlas/atlas_from_bake.h"
 #include "pipeline/bake_state.h"
 
 namespace irbake {
@@ -12,7 +13,8 @@ void buildGeometry(BakeState& s) {
   timed(s, "atlas", [&] {
     AtlasOptions o = s.options.atlas;
     o.progress = withProgress(s, o.progress);
-    s.atlas = buildAtlas(s.scene, o);
+    s.atlas = s.options.atlasFrom.empty() ? buildAtlas(s.scene, o)
+                                          : atlasFromBake(s.scene, readBakedAtlas(s.options.atlasFrom), o);
   });
   timed(s, "raytrace", [&] { s.rayTracer = std::make_unique<RayTracer>(s.scene); });
   timed(s, "texels", [&] {
@@ -179,10 +181,11 @@ void prepare(BakeState& s) {
   settleLightModes(s.plan, s.options, s.scene, s.texels, s.lightGrid.get());
   const bool autoDensity = !(s.options.atlas.texelsPerUnit > 0.0);
   s.plan.settle("texels-per-unit", s.atlas.stats.texelsPerUnit,
-                autoDensity ? "the density rule: the preset's texels per metre, more for a small scene, less to fit "
+                !s.options.atlasFrom.empty() ? "the atlas of --atlas-from's bake"
+                : autoDensity ? "the density rule: the preset's texels per metre, more for a small scene, less to fit "
                               "--max-texels (docs/guide.md, \"Texel density\")"
                             : "asked for",
-                autoDensity);
+                autoDensity && s.options.atlasFrom.empty());  // --atlas-from's density is not given again
   timed(s, "vpls", [&] { walkVpls(s); });
   settleWalk(s);
   if (s.plan.importanceFactor > 1.0) timed(s, "vplImportance", [&] { selectByImportance(s); });

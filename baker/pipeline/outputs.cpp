@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "atlas/atlas_from_bake.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 #include "common/log.h"
@@ -160,6 +161,7 @@ void writeGltfAndPages(const BakeResult& result, const std::filesystem::path& gl
   ex.probes = &result.probes;
   if (!mask.empty()) ex.shadowMask = &mask;
   ex.lightModes = &result.lightModes;
+  ex.atlasRecord = atlasRecordJson(result.atlas);
   exportGltf(result.scene, result.maps, ex);
 }
 
