@@ -283,9 +283,14 @@ def t_levels_scale():
 
 
 def t_light_cull():
-    """bench/results/light_cull.csv: per scene, --light-cull and --light-tail, the median CPU of its latest commit's
-    runs, against the same town's sun and sky alone, and the map's error against the brute-force bake (--light-cull 0)."""
+    """bench/results/light_cull.csv: per scene at its latest texel count, --light-cull and --light-tail, the median
+    CPU of its latest commit's runs, against the same town's sun and sky alone at about the same texels (within 5%),
+    and the map's error against the brute-force bake (--light-cull 0)."""
     rows = read("light_cull.csv")
+    latest = {}
+    for r in rows:
+        latest[r["scene"]] = r["texels"]
+    rows = [r for r in rows if r["texels"] == latest[r["scene"]]]
     key = lambda r: (r["scene"], r["cull"], r.get("tail", "0") if r["cull"] != "0" else "0")
     keys = {}
     for r in rows:
@@ -299,13 +304,15 @@ def t_light_cull():
         scene, cull, tail = k
         r = [x for x in rows if key(x) == k and x["commit"] == c][-1]
         own, runs = cpu[k]
-        base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull, tail), (None, 0))[0]
-        if base is None:
-            base = cpu.get((re.match(r"town\d+", scene).group(0) + "sun", cull, "0"), (None, 0))[0]
+        town = re.match(r"town\d+", scene).group(0) + "sun"
+        base = None
+        if town in latest and abs(float(latest[town]) / float(r["texels"]) - 1.0) < 0.05:
+            base = cpu.get((town, cull, tail), cpu.get((town, cull, "0"), (None, 0)))[0]
         ratio = f"{own / base:.2f}×" if own and base and not scene.endswith("sun") else ""
-        out.append([scene, r["lamps"], r["range"] if r["range"] != "0" else "none", cull if cull != "0" else "off (brute force)",
-                    tail if cull != "0" else "", c, runs, num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
-    return table(["scene", "lamps", "range (m)", "--light-cull", "--light-tail", "commit", "runs", "CPU (s)",
+        out.append([scene, r["lamps"], r["range"] if r["range"] != "0" else "none", f"{float(r['texels']) / 1e6:.2f} M",
+                    cull if cull != "0" else "off (brute force)", tail if cull != "0" else "", c, runs,
+                    num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
+    return table(["scene", "lamps", "range (m)", "texels", "--light-cull", "--light-tail", "commit", "runs", "CPU (s)",
                   "CPU / sun and sky alone", "rel. RMSE against brute force"], out)
 
 
