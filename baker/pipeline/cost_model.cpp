@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "lights/light_kind.h"
+#include "pipeline/ray_pilot.h"
 #include "scene/triangle_area.h"
 #include "stages/probes/light_probes.h"
 
@@ -56,7 +57,8 @@ nlohmann::json CostInputs::toJson() const {
           {"compensationRays", compensationRays}, {"gatherRays", gatherRays},
           {"shadowEdgeRays", shadowEdgeRays}, {"probes", probes},
           {"probeRays", probeRays},         {"probeLights", probeLights},
-          {"cores", cores}};
+          {"cores", cores},                 {"rayCost", rayCost},
+          {"pilotHitFraction", pilotHitFraction}, {"glBackend", glBackend}};
 }
 
 nlohmann::json CostPrediction::toJson() const {
@@ -66,25 +68,28 @@ nlohmann::json CostPrediction::toJson() const {
 }
 
 CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
-  const double texelPaths = in.texels * in.paths;
+  const double texelPaths = in.texels * in.paths, traced = in.rayCost, gl = in.glBackend;
   std::map<std::string, double> cpu;
   cpu["load"] = c.loadPerTriangle * in.triangles + c.loadPerTexturePixel * in.texturePixels;
   cpu["atlas"] = c.atlasPerTriangle * in.triangles + c.atlasPerPageTexel * in.pageTexels;
   cpu["raytrace"] = c.raytracePerTriangle * in.triangles;
-  cpu["texels"] = c.texelsPerPageTexel * in.pageTexels + c.texelsPerTriangle * in.triangles;
+  cpu["texels"] = (c.texelsPerPageTexel + c.texelsPerTracedPageTexel * traced) * in.pageTexels +
+                  c.texelsPerTriangle * in.triangles;
   cpu["vpls"] = c.vplsPerPath * in.paths;
   if (in.gatherRays > 0.0) cpu["vplImportance"] = c.importancePerTexelPath * texelPaths;
-  cpu["backend"] = c.backendFixed + c.backendPerTexelPath * texelPaths + c.backendPerLightTexel * in.lightTexels;
+  cpu["backend"] = c.backendFixed + c.backendGlFixed * gl +
+                   (c.backendPerTexelPath * (1.0 - gl) + c.backendGlPerTexelPath * gl) * texelPaths +
+                   c.backendPerLightTexel * in.lightTexels * traced;
   if (in.shadowEdgeRays > 0.0 && in.punctualLights > 0.0)
-    cpu["shadowEdges"] = c.shadowEdgesPerLightRay * in.lightTexels * in.shadowEdgeRays;
-  if (in.skyRays > 0.0) cpu["sky"] = c.skyPerRay * in.skyRays;
+    cpu["shadowEdges"] = c.shadowEdgesPerLightRay * in.lightTexels * in.shadowEdgeRays * traced;
+  if (in.skyRays > 0.0) cpu["sky"] = c.skyPerRay * in.skyRays * traced;
   if (in.compensationRays > 0.0)
-    cpu["compensation"] = c.compensationPerRay * in.compensationRays + c.compensationPerTexel * in.texels;
-  if (in.gatherRays > 0.0) cpu["finalGather"] = c.gatherPerRay * in.gatherRays + c.gatherPerTexel * in.texels;
+    cpu["compensation"] = c.compensationPerRay * in.compensationRays * traced + c.compensationPerTexel * in.texels;
+  if (in.gatherRays > 0.0) cpu["finalGather"] = c.gatherPerRay * in.gatherRays * traced + c.gatherPerTexel * in.texels;
   cpu["post"] = c.postPerPageTexel * in.pageTexels;
   if (in.probes > 0.0)
-    cpu["probes"] = c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probeLights;
-  cpu["write"] = c.writePerPageTexel * in.pageTexels;
+    cpu["probes"] = (c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probeLights) * traced;
+  cpu["write"] = c.writeFixed + c.writePerPageTexel * in.pageTexels;
   CostPrediction p;
   const double busyCores = std::max(1e-3, std::max(1.0, in.cores) * c.parallelShare);
   for (const auto& [stage, s] : cpu) {
@@ -93,7 +98,8 @@ CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
     p.cpuSeconds += std::max(0.0, s);
     p.seconds += wall;
   }
-  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryPerTriangle * in.triangles + c.memoryPerTexturePixel * in.texturePixels +
+  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryGlContextMiB * gl + c.memoryPerTriangle * in.triangles +
+                    c.memoryPerTexturePixel * in.texturePixels + c.memoryPerTexel * in.texels +
                     c.memoryPerPageTexel * in.pageTexels + c.memoryPerTexelPath * texelPaths;
   return p;
 }
@@ -246,6 +252,10 @@ CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const Bake
     in.probeLights = probeLightReach(scene, *plan.probes.box, *plan.probes.spacing, reach);
   }
   in.cores = cores;
+  const RayPilot pilot = measureRayPilot(scene);
+  in.rayCost = pilot.rayCost;
+  in.pilotHitFraction = pilot.hitFraction;
+  in.glBackend = plan.backend == BackendKind::Gl ? 1.0 : 0.0;
   return in;
 }
 

@@ -6,8 +6,9 @@ Each DIR is a measured bake as bench/levels/cost_bakes.py leaves it (report.json
 the rows of bench/results/levels_scale.csv whose towns bench/levels/town.py makes again (their density given
 as measured, so the plan predicts the atlas they had). The inputs
 of each are what `IRBAKE plan --json` predicts for the same scene and options (so the fit sees the model's
-own features); the targets are the report's stage times turned into CPU seconds (each stage's wall time x the
-bake's CPU time / wall time, which takes out a shared machine's load) and its peak memory. Every stage is
+own features); the targets are the report's CPU seconds per stage (timings.cpuSeconds; for an older report,
+each stage's wall time x the bake's CPU time / wall time), which take out a shared machine's load, and its peak
+memory. Every stage is
 fitted by non-negative least squares on relative errors. Prints the coefficients as the body of
 calibratedCostCoefficients() (baker/pipeline/cost_model.cpp); --write pastes them there.
 
@@ -26,25 +27,29 @@ import subprocess
 import sys
 import time
 
-# stage -> (coefficient, feature) pairs, as predictCost combines them.
+# stage -> (coefficient, feature) pairs, as predictCost combines them. A feature ending in "Traced" is the count
+# times the ray pilot's cost per ray (inputs.rayCost), "Gl" and "Embree" split the VPL sum by its evaluator.
 STAGES = {
     "load": [("loadPerTriangle", "triangles"), ("loadPerTexturePixel", "texturePixels")],
     "atlas": [("atlasPerTriangle", "triangles"), ("atlasPerPageTexel", "pageTexels")],
     "raytrace": [("raytracePerTriangle", "triangles")],
-    "texels": [("texelsPerPageTexel", "pageTexels"), ("texelsPerTriangle", "triangles")],
+    "texels": [("texelsPerPageTexel", "pageTexels"), ("texelsPerTracedPageTexel", "pageTexelsTraced"),
+               ("texelsPerTriangle", "triangles")],
     "vpls": [("vplsPerPath", "paths")],
     "vplImportance": [("importancePerTexelPath", "texelPaths")],
-    "backend": [("backendFixed", "one"), ("backendPerTexelPath", "texelPaths"), ("backendPerLightTexel", "lightTexels")],
-    "shadowEdges": [("shadowEdgesPerLightRay", "lightRays")],
-    "sky": [("skyPerRay", "skyRays")],
-    "compensation": [("compensationPerRay", "compensationRays"), ("compensationPerTexel", "compensationTexels")],
-    "finalGather": [("gatherPerRay", "gatherRays"), ("gatherPerTexel", "gatherTexels")],
+    "backend": [("backendFixed", "one"), ("backendGlFixed", "gl"), ("backendPerTexelPath", "texelPathsEmbree"),
+                ("backendGlPerTexelPath", "texelPathsGl"), ("backendPerLightTexel", "lightTexelsTraced")],
+    "shadowEdges": [("shadowEdgesPerLightRay", "lightRaysTraced")],
+    "sky": [("skyPerRay", "skyRaysTraced")],
+    "compensation": [("compensationPerRay", "compensationRaysTraced"), ("compensationPerTexel", "compensationTexels")],
+    "finalGather": [("gatherPerRay", "gatherRaysTraced"), ("gatherPerTexel", "gatherTexels")],
     "post": [("postPerPageTexel", "pageTexels")],
-    "probes": [("probesPerRay", "probeRayCount"), ("probesPerProbeLight", "probeLights")],
-    "write": [("writePerPageTexel", "pageTexels")],
+    "probes": [("probesPerRay", "probeRayCountTraced"), ("probesPerProbeLight", "probeLightsTraced")],
+    "write": [("writeFixed", "one"), ("writePerPageTexel", "pageTexels")],
 }
-MEMORY = [("memoryBaseMiB", "one"), ("memoryPerTriangle", "triangles"), ("memoryPerTexturePixel", "texturePixels"),
-          ("memoryPerPageTexel", "pageTexels"), ("memoryPerTexelPath", "texelPaths")]
+MEMORY = [("memoryBaseMiB", "one"), ("memoryGlContextMiB", "gl"), ("memoryPerTriangle", "triangles"),
+          ("memoryPerTexturePixel", "texturePixels"), ("memoryPerTexel", "texels"), ("memoryPerPageTexel", "pageTexels"),
+          ("memoryPerTexelPath", "texelPaths")]
 # Where no bake ran under little load, the share of the cores a bake keeps busy on an idle machine.
 DEFAULT_PARALLEL_SHARE = 0.85
 
@@ -59,6 +64,13 @@ def features(inputs):
     f["gatherTexels"] = f["texels"] if f["gatherRays"] > 0 else 0.0
     f["probeRayCount"] = f["probes"] * f["probeRays"]
     f.setdefault("probeLights", f["probes"] * f["punctualLights"])
+    f["gl"] = f.get("glBackend", 0.0)
+    f["texelPathsGl"] = f["texelPaths"] * f["gl"]
+    f["texelPathsEmbree"] = f["texelPaths"] * (1.0 - f["gl"])
+    scale = f.get("rayCost", 1.0)
+    for name in ("pageTexels", "lightTexels", "lightRays", "skyRays", "compensationRays", "gatherRays", "probeRayCount",
+                 "probeLights"):
+        f[name + "Traced"] = f[name] * scale
     return f
 
 
@@ -106,11 +118,16 @@ def run_plan(irbake, scene, options):
     return json.loads(out), time.time() - t0
 
 
-def make_run(irbake, measured, seconds, memory):
-    """measured: name, scene, options, wall_s, cpu_s, cores, load_before; seconds: the stages' wall seconds."""
+def make_run(irbake, measured, seconds, memory, cpu_seconds=None):
+    """measured: name, scene, options, wall_s, cpu_s, cores, load_before; seconds: the stages' wall seconds;
+    cpu_seconds: their CPU seconds where the report has them (timings.cpuSeconds), else each stage's wall time x the
+    bake's CPU time / wall time."""
     plan, plan_s = run_plan(irbake, measured["scene"], measured["options"])
     cpu_per_wall = measured["cpu_s"] / measured["wall_s"]  # the process's busy cores, whatever the load
-    cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
+    if cpu_seconds:
+        cpu = {stage: cpu_seconds.get(stage, 0.0) for stage in STAGES}
+    else:
+        cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
     return {"name": measured["name"], "measured": measured, "features": features(plan["inputs"]), "cpu": cpu,
             "memory": memory, "plan": plan, "plan_s": plan_s}
 
@@ -120,7 +137,10 @@ def load(irbake, folder):
     report = json.load(open(os.path.join(folder, "report.json")))
     seconds = dict(report["timings"]["seconds"])
     seconds["write"] = max(0.0, measured["wall_s"] - seconds.get("bake", 0.0) - seconds.get("load", 0.0))
-    run = make_run(irbake, measured, seconds, report["timings"]["memoryPeakMiB"])
+    cpu_seconds = dict(report["timings"].get("cpuSeconds", {}))
+    if cpu_seconds:  # the rest of the process: its start, the plan, the outputs, the exit
+        cpu_seconds["write"] = max(0.0, measured["cpu_s"] - cpu_seconds.get("bake", 0.0) - cpu_seconds.get("load", 0.0))
+    run = make_run(irbake, measured, seconds, report["timings"]["memoryPeakMiB"], cpu_seconds)
     run["density"] = report["atlas"]["texelsPerUnit"]
     return run
 
