@@ -68,7 +68,8 @@ nlohmann::json CostPrediction::toJson() const {
 }
 
 CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
-  const double texelPaths = in.texels * in.paths, traced = in.rayCost, gl = in.glBackend;
+  const double texelPaths = in.texels * in.paths, gl = in.glBackend;
+  const double traced = std::pow(std::max(0.0, in.rayCost), c.rayCostExponent);
   std::map<std::string, double> cpu;
   cpu["load"] = c.loadPerTriangle * in.triangles + c.loadPerTexturePixel * in.texturePixels;
   cpu["atlas"] = c.atlasPerTriangle * in.triangles + c.atlasPerPageTexel * in.pageTexels;

@@ -39,8 +39,8 @@ struct CostInputs {
 };
 
 // Each stage's CPU seconds are a sum of coefficient × feature; the wall time divides them over the cores. A
-// "traced" count is multiplied by the ray pilot's rayCost: the coefficient is per ray of the pilot's reference
-// scene, and a scene whose rays cost twice as much costs twice as much per ray.
+// "traced" count is multiplied by the ray pilot's rayCost to the power rayCostExponent: the coefficient is per
+// ray of the pilot's reference scene.
 struct CostCoefficients {
   double loadPerTriangle = 0.0;          // s per triangle: reading and decoding the scene
   double loadPerTexturePixel = 0.0;      // s per texture pixel: decoding the images
@@ -68,6 +68,10 @@ struct CostCoefficients {
   double probesPerProbeLight = 0.0;      // s per probe × punctual light reaching it, traced: its shadow rays and fit
   double writeFixed = 0.0;               // s: the process's start and exit, the plan, the glTF and the report
   double writePerPageTexel = 0.0;        // s per page texel: the EXR and PNG pages
+  // The pilot's rays run warm in cache; the bake's stages stream texels and maps between rays, which evicts
+  // the BVH, so a scene whose pilot rays cost twice as much costs more than twice as much per bake ray: its
+  // traced counts are weighed by rayCost^rayCostExponent (1: in proportion).
+  double rayCostExponent = 1.0;
   bool cullsByReach = true;              // the stages compute a light's direct term only within its reach
   double parallelShare = 1.0;            // the share of the cores the bake keeps busy on an idle machine
   double memoryBaseMiB = 0.0;            // MiB: the process, its libraries and the scene's fixed parts

@@ -114,6 +114,11 @@ TEST(CostModel, ScenesTwiceAsCostlyPerRayCostTwiceAsMuchInTheirRays) {
   EXPECT_NEAR(b.perStage.at("backend") - a.perStage.at("backend"), c.backendPerLightTexel * one.lightTexels, 1e-9);
   EXPECT_DOUBLE_EQ(b.perStage.at("write"), a.perStage.at("write"));  // nothing traced
   EXPECT_DOUBLE_EQ(b.memoryPeakMiB, a.memoryPeakMiB);
+  // With the exponent 1.5 the same scene's rays weigh 2^1.5; at rayCost 1 nothing changes.
+  CostCoefficients steeper = c;
+  steeper.rayCostExponent = 1.5;
+  EXPECT_NEAR(predictCost(two, steeper).perStage.at("finalGather"), std::pow(2.0, 1.5) * gatherRays + gatherTexels, 1e-9);
+  EXPECT_NEAR(predictCost(one, steeper).perStage.at("finalGather"), a.perStage.at("finalGather"), 1e-12);
 }
 
 TEST(CostModel, GlEvaluatorHasItsOwnSetUpCostAndMemory) {

@@ -128,17 +128,22 @@ RayPilot measureRayPilot(const Scene& scene, const RayPilotOptions& options) {
   const Scene reference = rayPilotReferenceScene();
   const RayTracer referenceRt(reference);
   const PilotPoints referencePoints = pilotPoints(reference, referenceRt, options);
+  // Each round pairs the scene's rays with the reference's, traced one after the other, so that what the
+  // machine's load does to both cancels in their ratio; the median ratio over the rounds counts.
   double best = std::numeric_limits<double>::infinity(), referenceBest = best;
+  std::vector<double> ratios;
   for (int round = 0; round < std::max(1, options.rounds); ++round) {
     const Round r = traceRound(rt, points, options), ref = traceRound(referenceRt, referencePoints, options);
     best = std::min(best, r.seconds / double(r.rays));
     referenceBest = std::min(referenceBest, ref.seconds / double(ref.rays));
+    ratios.push_back(rayCostScale(r.seconds / double(r.rays), ref.seconds / double(ref.rays)));
     pilot.rays = r.rays;
     pilot.hitFraction = double(r.hits) / double(r.rays);
   }
+  std::nth_element(ratios.begin(), ratios.begin() + ptrdiff_t(ratios.size() / 2), ratios.end());
   pilot.secondsPerRay = best;
   pilot.referenceSecondsPerRay = referenceBest;
-  pilot.rayCost = rayCostScale(best, referenceBest);
+  pilot.rayCost = ratios[ratios.size() / 2];
   return pilot;
 }
 

@@ -14,12 +14,13 @@ namespace irbake {
 struct RayPilotOptions {
   int points = 512;       // surface points, area-weighted over the mapped triangles
   int raysPerPoint = 16;  // cosine rays from each point (the final gather's count per sample)
-  int rounds = 5;         // each scene's rays are traced this many times, alternately; the fastest round counts
+  int rounds = 7;         // each scene's rays are traced this many times, alternately; the median ratio counts
   uint64_t seed = 1;      // the points' and the rays' random numbers
 };
 
 struct RayPilot {
-  double rayCost = 1.0;       // this scene's CPU seconds per ray over the reference scene's (1: no mapped surface)
+  double rayCost = 1.0;       // this scene's CPU seconds per ray over the reference scene's, the median over the
+                              // rounds (1: no mapped surface)
   double hitFraction = 0.0;   // the share of this scene's pilot rays that hit a surface
   double secondsPerRay = 0.0;           // this scene's fastest round, CPU seconds per ray
   double referenceSecondsPerRay = 0.0;  // the reference scene's, in the same rounds

@@ -28,7 +28,7 @@ import sys
 import time
 
 # stage -> (coefficient, feature) pairs, as predictCost combines them. A feature ending in "Traced" is the count
-# times the ray pilot's cost per ray (inputs.rayCost), "Gl" and "Embree" split the VPL sum by its evaluator.
+# times the ray pilot's cost per ray to the power rayCostExponent (inputs.rayCost), "Gl" and "Embree" split the VPL sum by its evaluator.
 STAGES = {
     "load": [("loadPerTriangle", "triangles"), ("loadPerTexturePixel", "texturePixels")],
     "atlas": [("atlasPerTriangle", "triangles"), ("atlasPerPageTexel", "pageTexels")],
@@ -54,7 +54,11 @@ MEMORY = [("memoryBaseMiB", "one"), ("memoryGlContextMiB", "gl"), ("memoryPerTri
 DEFAULT_PARALLEL_SHARE = 0.85
 
 
-def features(inputs):
+# The exponents of the pilot's cost per ray the fit tries (rayCostExponent): the one that fits best is kept.
+RAY_COST_EXPONENTS = [1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 2.75, 3.0]
+
+
+def features(inputs, exponent=1.0):
     f = dict(inputs)
     f["one"] = 1.0
     f.setdefault("texturePixels", 0.0)
@@ -67,7 +71,7 @@ def features(inputs):
     f["gl"] = f.get("glBackend", 0.0)
     f["texelPathsGl"] = f["texelPaths"] * f["gl"]
     f["texelPathsEmbree"] = f["texelPaths"] * (1.0 - f["gl"])
-    scale = f.get("rayCost", 1.0)
+    scale = f.get("rayCost", 1.0) ** exponent
     for name in ("pageTexels", "lightTexels", "lightRays", "skyRays", "compensationRays", "gatherRays", "probeRayCount",
                  "probeLights"):
         f[name + "Traced"] = f[name] * scale
@@ -177,7 +181,7 @@ def load_levels(irbake, path):
     return runs
 
 
-def fit(runs):
+def fit_stages(runs):
     coefficients = {}
     for stage, terms in STAGES.items():
         rows, targets = [], []
@@ -196,6 +200,22 @@ def fit(runs):
              if r["measured"]["load_before"] < r["measured"]["cores"] + 0.5]
     coefficients["parallelShare"] = min(1.0, max(quiet)) if quiet else DEFAULT_PARALLEL_SHARE
     return coefficients
+
+
+def fit(runs):
+    """Every stage at each exponent of the pilot's cost per ray; keeps the exponent whose predicted CPU seconds (the
+    stages' sum) come closest to the measured, in relative error over the runs, and sets the runs' features to it."""
+    best, best_err = None, float("inf")
+    for k in RAY_COST_EXPONENTS:
+        for r in runs:
+            r["features"] = features(r["plan"]["inputs"], k)
+        c = fit_stages(runs)
+        err = sum((predict(c, r["features"])[0] / sum(r["cpu"].values()) - 1.0) ** 2 for r in runs)
+        if err < best_err:
+            best, best_err = dict(c, rayCostExponent=k), err
+    for r in runs:
+        r["features"] = features(r["plan"]["inputs"], best["rayCostExponent"])
+    return best
 
 
 def predict(c, f):
@@ -225,7 +245,8 @@ def accuracy_rows(runs, held, path):
 
 def initialiser(c):
     lines = ["  // fit_cost_model.py: begin"]
-    for name in [n for terms in STAGES.values() for n, _ in terms] + ["parallelShare"] + [n for n, _ in MEMORY]:
+    for name in ([n for terms in STAGES.values() for n, _ in terms] + ["parallelShare", "rayCostExponent"] +
+                 [n for n, _ in MEMORY]):
         lines.append("  c.%s = %.6g;" % (name, c[name]))
     lines.append("  // fit_cost_model.py: end")
     return "\n".join(lines)
@@ -259,6 +280,8 @@ def main():
     if a.accuracy:
         accuracy_rows(runs, held, a.accuracy)
     c = fit([r for r in runs if r["name"] not in held])
+    for r in runs:  # the held-out runs too, at the fitted exponent
+        r["features"] = features(r["plan"]["inputs"], c["rayCostExponent"])
     print(initialiser(c))
     for r in runs:
         cpu, memory = predict(c, r["features"])
