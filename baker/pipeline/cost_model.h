@@ -54,10 +54,10 @@ struct CostCoefficients {
   double importancePerTexelPath = 0.0;   // s per texel × path: the importance pilot and selection (final gather only)
   double backendPerTexelPath = 0.0;      // s per texel × path: the VPL sums on the CPU (Embree) evaluator
   double backendGlPerTexelPath = 0.0;    // s per texel × path: the VPL sums on the GL evaluator (a software rasteriser)
-  double backendPerLightTexel = 0.0;     // s per light texel, traced: the punctual lights' direct term and shadows
+  double backendPerLightTexel = 0.0;     // s per light texel: the punctual lights' direct term and shadows
   double backendFixed = 0.0;             // s: the evaluator's set-up
   double backendGlFixed = 0.0;           // s: the GL evaluator's context and programs, besides backendFixed
-  double shadowEdgesPerLightRay = 0.0;   // s per light texel × S², traced: the edge texels' area-averaged visibility
+  double shadowEdgesPerLightRay = 0.0;   // s per light texel × S²: the edge texels' area-averaged visibility
   double skyPerRay = 0.0;                // s per sky ray, traced
   double compensationPerRay = 0.0;       // s per compensation ray, traced (the refinement and sweeps in proportion)
   double compensationPerTexel = 0.0;     // s per texel: the compensation's sweeps and filter

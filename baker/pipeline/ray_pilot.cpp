@@ -22,7 +22,9 @@ double threadCpuSeconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-// Ray origins (offset off the surface) and their front normals, area-weighted over the mapped triangles.
+// Ray origins (offset off the surface) and their front normals: triangles area-weighted over the mapped ones,
+// pointsPerTriangle points on each, traced one after the other as neighbouring texels are, so that their rays
+// find the BVH's nodes in cache as the bake's rays do.
 struct PilotPoints {
   std::vector<glm::vec3> origins, normals;
 };
@@ -45,8 +47,10 @@ PilotPoints pilotPoints(const Scene& scene, const RayTracer& rt, const RayPilotO
   PilotPoints points;
   if (cdf.empty()) return points;
   Rng rng(hashSeed(o.seed, 0x7069));
+  size_t k = 0;
   for (int i = 0; i < o.points; ++i) {
-    const size_t k = std::min(cdf.size() - 1, size_t(std::upper_bound(cdf.begin(), cdf.end(), rng.uniform() * total) - cdf.begin()));
+    if (i % std::max(1, o.pointsPerTriangle) == 0)
+      k = std::min(cdf.size() - 1, size_t(std::upper_bound(cdf.begin(), cdf.end(), rng.uniform() * total) - cdf.begin()));
     const auto [p, t] = triangles[k];
     const Primitive& prim = scene.primitives[p];
     const glm::vec3 a = prim.positions[prim.indices[3 * t]], b = prim.positions[prim.indices[3 * t + 1]],

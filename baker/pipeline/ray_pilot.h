@@ -13,8 +13,9 @@ namespace irbake {
 
 struct RayPilotOptions {
   int points = 512;       // surface points, area-weighted over the mapped triangles
+  int pointsPerTriangle = 8;  // of them on each triangle drawn, traced in turn (neighbours, as the bake's texels)
   int raysPerPoint = 16;  // cosine rays from each point (the final gather's count per sample)
-  int rounds = 7;         // each scene's rays are traced this many times, alternately; the median ratio counts
+  int rounds = 15;        // each scene's rays are traced this many times, alternately; the median ratio counts
   uint64_t seed = 1;      // the points' and the rays' random numbers
 };
 

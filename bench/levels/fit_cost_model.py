@@ -38,8 +38,8 @@ STAGES = {
     "vpls": [("vplsPerPath", "paths")],
     "vplImportance": [("importancePerTexelPath", "texelPaths")],
     "backend": [("backendFixed", "one"), ("backendGlFixed", "gl"), ("backendPerTexelPath", "texelPathsEmbree"),
-                ("backendGlPerTexelPath", "texelPathsGl"), ("backendPerLightTexel", "lightTexelsTraced")],
-    "shadowEdges": [("shadowEdgesPerLightRay", "lightRaysTraced")],
+                ("backendGlPerTexelPath", "texelPathsGl"), ("backendPerLightTexel", "lightTexels")],
+    "shadowEdges": [("shadowEdgesPerLightRay", "lightRays")],
     "sky": [("skyPerRay", "skyRaysTraced")],
     "compensation": [("compensationPerRay", "compensationRaysTraced"), ("compensationPerTexel", "compensationTexels")],
     "finalGather": [("gatherPerRay", "gatherRaysTraced"), ("gatherPerTexel", "gatherTexels")],
@@ -48,8 +48,9 @@ STAGES = {
     "write": [("writeFixed", "one"), ("writePerPageTexel", "pageTexels")],
 }
 MEMORY = [("memoryBaseMiB", "one"), ("memoryGlContextMiB", "gl"), ("memoryPerTriangle", "triangles"),
-          ("memoryPerTexturePixel", "texturePixels"), ("memoryPerTexel", "texels"), ("memoryPerPageTexel", "pageTexels"),
-          ("memoryPerTexelPath", "texelPaths")]
+          ("memoryPerTexturePixel", "texturePixels"), ("memoryPerTexel", "texels"), ("memoryPerTexelPath", "texelPaths")]
+# memoryPerPageTexel stays 0: the peak follows the texels the charts cover, not the estimate's page texels (which
+# the charts of a large level fill only in part).
 # Where no bake ran under little load, the share of the cores a bake keeps busy on an idle machine.
 DEFAULT_PARALLEL_SHARE = 0.85
 
@@ -72,8 +73,7 @@ def features(inputs, exponent=1.0):
     f["texelPathsGl"] = f["texelPaths"] * f["gl"]
     f["texelPathsEmbree"] = f["texelPaths"] * (1.0 - f["gl"])
     scale = f.get("rayCost", 1.0) ** exponent
-    for name in ("pageTexels", "lightTexels", "lightRays", "skyRays", "compensationRays", "gatherRays", "probeRayCount",
-                 "probeLights"):
+    for name in ("pageTexels", "skyRays", "compensationRays", "gatherRays", "probeRayCount", "probeLights"):
         f[name + "Traced"] = f[name] * scale
     return f
 
@@ -196,6 +196,7 @@ def fit_stages(runs):
         coefficients.update({name: v for (name, _), v in zip(terms, x)})
     rows = [[r["features"][f] for _, f in MEMORY] for r in runs]
     coefficients.update({name: v for (name, _), v in zip(MEMORY, nnls(rows, [r["memory"] for r in runs]))})
+    coefficients["memoryPerPageTexel"] = 0.0
     quiet = [r["measured"]["cpu_s"] / (r["measured"]["wall_s"] * r["measured"]["cores"]) for r in runs
              if r["measured"]["load_before"] < r["measured"]["cores"] + 0.5]
     coefficients["parallelShare"] = min(1.0, max(quiet)) if quiet else DEFAULT_PARALLEL_SHARE
@@ -246,7 +247,7 @@ def accuracy_rows(runs, held, path):
 def initialiser(c):
     lines = ["  // fit_cost_model.py: begin"]
     for name in ([n for terms in STAGES.values() for n, _ in terms] + ["parallelShare", "rayCostExponent"] +
-                 [n for n, _ in MEMORY]):
+                 [n for n, _ in MEMORY] + ["memoryPerPageTexel"]):
         lines.append("  c.%s = %.6g;" % (name, c[name]))
     lines.append("  // fit_cost_model.py: end")
     return "\n".join(lines)
