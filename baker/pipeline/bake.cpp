@@ -264,7 +264,8 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   report["timings"]["cpuSeconds"] = s.cpuSeconds;
   report["timings"]["backendParts"] = s.backendParts;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
-  report["prediction"] = s.prediction.cost.toJson();  // the preflight's, beside the measured timings
+  // The preflight's, beside the measured timings: its time weighs the rays by the ray pilot, timed in this run.
+  report["timings"]["prediction"] = s.prediction.cost.toJson();
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);
   s.gather = {};
