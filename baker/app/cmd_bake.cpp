@@ -552,7 +552,7 @@ int runBake(const Args& args) {
   removeStaleTemps(outDir);
   Stopwatch loadTime;
   Scene scene = loadBakeScene(c);
-  const double loadSeconds = loadTime.seconds();
+  const double loadSeconds = loadTime.seconds(), loadCpuSeconds = loadTime.cpuSeconds();
 
   TerminalProgress progress;
   c.options.progress = progress.callback();
@@ -639,6 +639,7 @@ int runBake(const Args& args) {
   staged.refineToTarget(sums);
   BakeResult result = staged.finish(std::move(sums));
   result.report["timings"]["seconds"]["load"] = loadSeconds;
+  result.report["timings"]["cpuSeconds"]["load"] = loadCpuSeconds;
   result.report["options"] = c.resultOptions;
   writeFinishedBake(c, result, progress, *guard);
   removeCheckpoint(checkpoint, *guard);

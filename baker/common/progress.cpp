@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <mutex>
+#include <time.h>
 #include <unistd.h>
 
 #include "common/log.h"
@@ -46,6 +47,12 @@ void TerminalProgress::update(const char* stage, double fraction) {
 void TerminalProgress::finish() {
   if (enabled_ && !stage_.empty()) log::endStatusLine();
   stage_.clear();
+}
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 }  // namespace irbake

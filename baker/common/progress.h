@@ -25,17 +25,26 @@ class TerminalProgress {
   std::chrono::steady_clock::time_point lastDraw_;
 };
 
-// Wall-clock stopwatch for per-stage timings in reports.
+// This process's CPU seconds so far, every thread (a software GL renderer's too): unlike the wall clock, what
+// a stage costs whatever else the machine runs.
+double processCpuSeconds();
+
+// Wall-clock stopwatch for per-stage timings in reports, with the process's CPU seconds over the same span.
 class Stopwatch {
  public:
-  Stopwatch() : start_(std::chrono::steady_clock::now()) {}
+  Stopwatch() : start_(std::chrono::steady_clock::now()), cpuStart_(processCpuSeconds()) {}
   double seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
-  void reset() { start_ = std::chrono::steady_clock::now(); }
+  double cpuSeconds() const { return processCpuSeconds() - cpuStart_; }
+  void reset() {
+    start_ = std::chrono::steady_clock::now();
+    cpuStart_ = processCpuSeconds();
+  }
 
  private:
   std::chrono::steady_clock::time_point start_;
+  double cpuStart_ = 0.0;
 };
 
 }  // namespace irbake

@@ -254,15 +254,18 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   probeStage(ctx, r.maps, r.probes);
   if (!r.shadowMask.empty()) shadowMaskPostStage(ctx, r.shadowMask);
   s.seconds["bake"] = s.total.seconds();
+  s.cpuSeconds["bake"] = s.total.cpuSeconds();
   describeBake(BakeFacts{s.scene, s.atlas, s.texels, s.vpls, s.options, s.plan, *s.evaluator, s.interleaveStats,
                          s.blocks.size(), s.importanceStats, post},
                report);
   // Everything that differs between two runs of the same bake lives in "timings" (wall clock per stage,
   // the GL stage split, peak memory); the rest of the report is the same bytes every time.
   report["timings"]["seconds"] = s.seconds;
+  report["timings"]["cpuSeconds"] = s.cpuSeconds;
   report["timings"]["backendParts"] = s.backendParts;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
-  report["prediction"] = s.prediction.cost.toJson();  // the preflight's, beside the measured timings
+  // The preflight's, beside the measured timings: its time weighs the rays by the ray pilot, timed in this run.
+  report["timings"]["prediction"] = s.prediction.cost.toJson();
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);
   s.gather = {};

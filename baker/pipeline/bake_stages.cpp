@@ -15,6 +15,7 @@ void StageContext::timed(const char* name, const std::function<void()>& stage) {
   Stopwatch watch;
   stage();
   seconds[name] = seconds.value(name, 0.0) + watch.seconds();
+  cpuSeconds[name] = cpuSeconds.value(name, 0.0) + watch.cpuSeconds();
 }
 
 void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1, std::vector<Lightmap>* leftOut) {
@@ -22,6 +23,7 @@ void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1
   if (!plan.eval.includeDirect || ctx.scene.lights.empty() || plan.shadowEdges.subSamples <= 1) return;
   // The L1 pages keep the centre's direction, scaled with the value per channel so that |L1| stays within
   // what L0 allows (a refined texel's light comes from the same lights; where the centre was dark, L1 is 0).
+  const Stopwatch watch;
   std::vector<Lightmap> before;
   if (l1) before = maps;
   ShadowEdgePart part{&plan.leftOut, leftOut};
@@ -35,6 +37,7 @@ void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1
       for (int k = 0; k < 3; ++k) (*l1)[k][p].texels[t] *= scale;
     }
   ctx.seconds["shadowEdges"] = st.seconds;
+  ctx.cpuSeconds["shadowEdges"] = watch.cpuSeconds();
   ctx.report["shadowEdges"] = {{"subSamples", plan.shadowEdges.subSamples}, {"edgeTexels", st.edgeTexels},
                                {"subPoints", st.subPoints}, {"droppedInside", st.droppedInside}};
 }

@@ -17,8 +17,8 @@
 
 namespace irbake {
 
-// What the stages share: the scene, every page and VPL (BakeInputs), the plan; each stage adds its wall time
-// to `seconds` and its stats, as its own object, to `report`.
+// What the stages share: the scene, every page and VPL (BakeInputs), the plan; each stage adds its wall and CPU
+// time to `seconds` and `cpuSeconds` and its stats, as its own object, to `report`.
 struct StageContext {
   const Scene& scene;
   const BakeInputs& inputs;
@@ -26,6 +26,7 @@ struct StageContext {
   const ClampCompensationOptions& askedCompensation;  // as given (the plan records what auto chose)
   const ProgressCallback& progress;
   nlohmann::json& seconds;
+  nlohmann::json& cpuSeconds;  // the process's CPU seconds per stage, beside `seconds`
   nlohmann::json& report;
 
   void timed(const char* name, const std::function<void()>& stage);

@@ -15,7 +15,8 @@ BakeInputs inputs(const BakeState& s, const std::vector<TexelSamples>& pages, co
 }
 
 StageContext stageContext(BakeState& s, nlohmann::json& report) {
-  return StageContext{s.scene, *s.wholeInputs, s.plan, s.options.compensation, s.options.progress, s.seconds, report};
+  return StageContext{s.scene, *s.wholeInputs, s.plan, s.options.compensation, s.options.progress, s.seconds, s.cpuSeconds,
+                      report};
 }
 
 bool estimating(const BakeState& s) {

@@ -107,18 +107,20 @@ struct BakeState {
   nlohmann::json stageNoiseInterior = nlohmann::json::object();  // the same on interior bins (BinTexels)
   ErrorFigure figure;                                             // the last one measured
 
-  // Wall clock (report "timings").
+  // Wall clock and the process's CPU time per stage (report "timings": seconds, cpuSeconds).
   nlohmann::json seconds = nlohmann::json::object();
+  nlohmann::json cpuSeconds = nlohmann::json::object();
   nlohmann::json backendParts = nlohmann::json::object();  // the backend stage's split (timings.backendParts)
   Stopwatch total;
 };
 
-// Each stage records its wall time under its name.
+// Each stage records its wall and CPU time under its name.
 template <class Stage>
 void timed(BakeState& s, const char* name, Stage&& stage) {
   Stopwatch watch;
   stage();
   s.seconds[name] = s.seconds.value(name, 0.0) + watch.seconds();
+  s.cpuSeconds[name] = s.cpuSeconds.value(name, 0.0) + watch.cpuSeconds();
 }
 // A part of the backend stage (inside its timed call): the GL context, the blocks' plan, the evaluator
 // calls, the maps (the punctual lights' "direct" call, their shadow edges and the classes' mix).

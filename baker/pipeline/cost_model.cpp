@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "lights/light_kind.h"
+#include "pipeline/ray_pilot.h"
 #include "scene/triangle_area.h"
 #include "stages/probes/light_probes.h"
 
@@ -15,34 +16,41 @@ namespace irbake {
 CostCoefficients calibratedCostCoefficients() {
   CostCoefficients c;
   // fit_cost_model.py: begin
-  c.loadPerTriangle = 2.94995e-07;
-  c.loadPerTexturePixel = 2.42625e-07;
-  c.atlasPerTriangle = 1.38222e-06;
-  c.atlasPerPageTexel = 1.39952e-07;
-  c.raytracePerTriangle = 1.01953e-06;
-  c.texelsPerPageTexel = 8.71483e-07;
-  c.texelsPerTriangle = 1.15456e-06;
-  c.vplsPerPath = 8.72265e-06;
-  c.importancePerTexelPath = 1.94688e-10;
-  c.backendFixed = 0.783383;
-  c.backendPerTexelPath = 3.5368e-10;
-  c.backendPerLightTexel = 8.35347e-07;
-  c.shadowEdgesPerLightRay = 9.37379e-09;
-  c.skyPerRay = 1.05747e-07;
-  c.compensationPerRay = 1.44518e-07;
-  c.compensationPerTexel = 1.9346e-06;
-  c.gatherPerRay = 1.9665e-08;
-  c.gatherPerTexel = 2.44967e-06;
-  c.postPerPageTexel = 2.46419e-08;
-  c.probesPerRay = 4.19065e-06;
-  c.probesPerProbeLight = 6.6148e-05;
-  c.writePerPageTexel = 3.10935e-07;
+  c.loadPerTriangle = 3.36714e-07;
+  c.loadPerTexturePixel = 3.54921e-07;
+  c.atlasPerTriangle = 1.93942e-06;
+  c.atlasPerPageTexel = 1.39429e-07;
+  c.raytracePerTriangle = 1.36312e-06;
+  c.texelsPerPageTexel = 8.04022e-07;
+  c.texelsPerTracedPageTexel = 0;
+  c.texelsPerTriangle = 0;
+  c.vplsPerPath = 1.24122e-05;
+  c.importancePerTexelPath = 2.50017e-10;
+  c.backendFixed = 0.424022;
+  c.backendGlFixed = 0.281368;
+  c.backendPerTexelPath = 5.35746e-10;
+  c.backendGlPerTexelPath = 2.14472e-09;
+  c.backendPerLightTexel = 8.90199e-07;
+  c.shadowEdgesPerLightRay = 9.22265e-09;
+  c.skyPerRay = 1.57909e-07;
+  c.compensationPerRay = 3.85757e-07;
+  c.compensationPerTexel = 1.64971e-06;
+  c.gatherPerRay = 2.13532e-07;
+  c.gatherPerTexel = 1.23053e-06;
+  c.postPerPageTexel = 1.52439e-08;
+  c.probesPerRay = 4.97772e-06;
+  c.probesPerProbeLight = 0;
+  c.writeFixed = 0.698613;
+  c.writePerPageTexel = 1.25627e-07;
   c.parallelShare = 0.85;
-  c.memoryBaseMiB = 106.33;
-  c.memoryPerTriangle = 0;
-  c.memoryPerTexturePixel = 0.000144937;
-  c.memoryPerPageTexel = 0.000111241;
+  c.rayCostExponent = 2;
+  c.memoryBaseMiB = 24.8489;
+  c.memoryGlContextMiB = 91.6174;
+  c.memoryPerTriangle = 0.000628746;
+  c.memoryPerTexturePixel = 0.000126214;
+  c.memoryPerTexel = 0.000182404;
   c.memoryPerTexelPath = 0;
+  c.memoryPerPageTexel = 0;
   // fit_cost_model.py: end
   return c;
 }
@@ -56,7 +64,8 @@ nlohmann::json CostInputs::toJson() const {
           {"compensationRays", compensationRays}, {"gatherRays", gatherRays},
           {"shadowEdgeRays", shadowEdgeRays}, {"probes", probes},
           {"probeRays", probeRays},         {"probeLights", probeLights},
-          {"cores", cores}};
+          {"cores", cores},                 {"rayCost", rayCost},
+          {"pilotHitFraction", pilotHitFraction}, {"glBackend", glBackend}};
 }
 
 nlohmann::json CostPrediction::toJson() const {
@@ -66,25 +75,29 @@ nlohmann::json CostPrediction::toJson() const {
 }
 
 CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
-  const double texelPaths = in.texels * in.paths;
+  const double texelPaths = in.texels * in.paths, gl = in.glBackend;
+  const double traced = std::pow(std::max(0.0, in.rayCost), c.rayCostExponent);
   std::map<std::string, double> cpu;
   cpu["load"] = c.loadPerTriangle * in.triangles + c.loadPerTexturePixel * in.texturePixels;
   cpu["atlas"] = c.atlasPerTriangle * in.triangles + c.atlasPerPageTexel * in.pageTexels;
   cpu["raytrace"] = c.raytracePerTriangle * in.triangles;
-  cpu["texels"] = c.texelsPerPageTexel * in.pageTexels + c.texelsPerTriangle * in.triangles;
+  cpu["texels"] = (c.texelsPerPageTexel + c.texelsPerTracedPageTexel * traced) * in.pageTexels +
+                  c.texelsPerTriangle * in.triangles;
   cpu["vpls"] = c.vplsPerPath * in.paths;
   if (in.gatherRays > 0.0) cpu["vplImportance"] = c.importancePerTexelPath * texelPaths;
-  cpu["backend"] = c.backendFixed + c.backendPerTexelPath * texelPaths + c.backendPerLightTexel * in.lightTexels;
+  cpu["backend"] = c.backendFixed + c.backendGlFixed * gl +
+                   (c.backendPerTexelPath * (1.0 - gl) + c.backendGlPerTexelPath * gl) * texelPaths +
+                   c.backendPerLightTexel * in.lightTexels;  // short shadow rays, unlike the pilot's
   if (in.shadowEdgeRays > 0.0 && in.punctualLights > 0.0)
     cpu["shadowEdges"] = c.shadowEdgesPerLightRay * in.lightTexels * in.shadowEdgeRays;
-  if (in.skyRays > 0.0) cpu["sky"] = c.skyPerRay * in.skyRays;
+  if (in.skyRays > 0.0) cpu["sky"] = c.skyPerRay * in.skyRays * traced;
   if (in.compensationRays > 0.0)
-    cpu["compensation"] = c.compensationPerRay * in.compensationRays + c.compensationPerTexel * in.texels;
-  if (in.gatherRays > 0.0) cpu["finalGather"] = c.gatherPerRay * in.gatherRays + c.gatherPerTexel * in.texels;
+    cpu["compensation"] = c.compensationPerRay * in.compensationRays * traced + c.compensationPerTexel * in.texels;
+  if (in.gatherRays > 0.0) cpu["finalGather"] = c.gatherPerRay * in.gatherRays * traced + c.gatherPerTexel * in.texels;
   cpu["post"] = c.postPerPageTexel * in.pageTexels;
   if (in.probes > 0.0)
-    cpu["probes"] = c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probeLights;
-  cpu["write"] = c.writePerPageTexel * in.pageTexels;
+    cpu["probes"] = (c.probesPerRay * in.probes * in.probeRays + c.probesPerProbeLight * in.probeLights) * traced;
+  cpu["write"] = c.writeFixed + c.writePerPageTexel * in.pageTexels;
   CostPrediction p;
   const double busyCores = std::max(1e-3, std::max(1.0, in.cores) * c.parallelShare);
   for (const auto& [stage, s] : cpu) {
@@ -93,7 +106,8 @@ CostPrediction predictCost(const CostInputs& in, const CostCoefficients& c) {
     p.cpuSeconds += std::max(0.0, s);
     p.seconds += wall;
   }
-  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryPerTriangle * in.triangles + c.memoryPerTexturePixel * in.texturePixels +
+  p.memoryPeakMiB = c.memoryBaseMiB + c.memoryGlContextMiB * gl + c.memoryPerTriangle * in.triangles +
+                    c.memoryPerTexturePixel * in.texturePixels + c.memoryPerTexel * in.texels +
                     c.memoryPerPageTexel * in.pageTexels + c.memoryPerTexelPath * texelPaths;
   return p;
 }
@@ -246,6 +260,10 @@ CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const Bake
     in.probeLights = probeLightReach(scene, *plan.probes.box, *plan.probes.spacing, reach);
   }
   in.cores = cores;
+  const RayPilot pilot = measureRayPilot(scene);
+  in.rayCost = pilot.rayCost;
+  in.pilotHitFraction = pilot.hitFraction;
+  in.glBackend = plan.backend == BackendKind::Gl ? 1.0 : 0.0;
   return in;
 }
 

@@ -68,6 +68,85 @@ TEST(CostModel, WallTimeIsTheCpuTimeOverTheBusyCores) {
   EXPECT_NEAR(sum, a.seconds, 1e-9 * a.seconds);
 }
 
+// Coefficients of round values, one per term the closed forms below read.
+CostCoefficients roundCoefficients() {
+  CostCoefficients c;
+  c.gatherPerRay = 1e-7;
+  c.gatherPerTexel = 1e-6;
+  c.skyPerRay = 2e-7;
+  c.compensationPerRay = 3e-7;
+  c.compensationPerTexel = 2e-6;
+  c.probesPerRay = 4e-6;
+  c.probesPerProbeLight = 5e-5;
+  c.texelsPerPageTexel = 1e-6;
+  c.texelsPerTracedPageTexel = 2e-6;
+  c.backendFixed = 0.5;
+  c.backendGlFixed = 0.25;
+  c.backendPerTexelPath = 1e-10;
+  c.backendGlPerTexelPath = 4e-10;
+  c.backendPerLightTexel = 1e-6;
+  c.writeFixed = 0.75;
+  c.writePerPageTexel = 1e-7;
+  c.parallelShare = 1.0;
+  c.memoryBaseMiB = 100.0;
+  c.memoryGlContextMiB = 40.0;
+  c.memoryPerTexel = 1e-4;
+  c.memoryPerPageTexel = 1e-5;
+  return c;
+}
+
+TEST(CostModel, ScenesTwiceAsCostlyPerRayCostTwiceAsMuchInTheirRays) {
+  // The pilot's rayCost multiplies every traced count: at 2 the gather costs its rays twice and its texels once.
+  const CostCoefficients c = roundCoefficients();
+  CostInputs one = levelInputs();
+  one.cores = 1;
+  CostInputs two = one;
+  two.rayCost = 2.0;
+  const CostPrediction a = predictCost(one, c), b = predictCost(two, c);
+  const double gatherRays = c.gatherPerRay * one.gatherRays, gatherTexels = c.gatherPerTexel * one.texels;
+  EXPECT_NEAR(a.perStage.at("finalGather"), gatherRays + gatherTexels, 1e-9);
+  EXPECT_NEAR(b.perStage.at("finalGather"), 2.0 * gatherRays + gatherTexels, 1e-9);
+  EXPECT_NEAR(b.perStage.at("sky") / a.perStage.at("sky"), 2.0, 1e-12);
+  EXPECT_NEAR(b.perStage.at("probes") / a.perStage.at("probes"), 2.0, 1e-12);
+  EXPECT_NEAR(b.perStage.at("compensation") - a.perStage.at("compensation"), c.compensationPerRay * one.compensationRays,
+              1e-9);
+  EXPECT_NEAR(b.perStage.at("texels") - a.perStage.at("texels"), c.texelsPerTracedPageTexel * one.pageTexels, 1e-9);
+  for (const char* stage : {"backend", "shadowEdges", "write"})  // the lights' short shadow rays, and nothing traced
+    EXPECT_DOUBLE_EQ(b.perStage.at(stage), a.perStage.at(stage)) << stage;
+  EXPECT_DOUBLE_EQ(b.memoryPeakMiB, a.memoryPeakMiB);
+  // With the exponent 1.5 the same scene's rays weigh 2^1.5; at rayCost 1 nothing changes.
+  CostCoefficients steeper = c;
+  steeper.rayCostExponent = 1.5;
+  EXPECT_NEAR(predictCost(two, steeper).perStage.at("finalGather"), std::pow(2.0, 1.5) * gatherRays + gatherTexels, 1e-9);
+  EXPECT_NEAR(predictCost(one, steeper).perStage.at("finalGather"), a.perStage.at("finalGather"), 1e-12);
+}
+
+TEST(CostModel, GlEvaluatorHasItsOwnSetUpCostAndMemory) {
+  const CostCoefficients c = roundCoefficients();
+  CostInputs embree = levelInputs();
+  embree.cores = 1;
+  embree.lightTexels = 0.0;
+  CostInputs gl = embree;
+  gl.glBackend = 1.0;
+  const double texelPaths = embree.texels * embree.paths;
+  EXPECT_NEAR(predictCost(embree, c).perStage.at("backend"), 0.5 + 1e-10 * texelPaths, 1e-9);
+  EXPECT_NEAR(predictCost(gl, c).perStage.at("backend"), 0.5 + 0.25 + 4e-10 * texelPaths, 1e-9);
+  EXPECT_NEAR(predictCost(gl, c).memoryPeakMiB - predictCost(embree, c).memoryPeakMiB, 40.0, 1e-9);
+  EXPECT_NEAR(predictCost(embree, c).perStage.at("write"), 0.75 + 1e-7 * embree.pageTexels, 1e-9);  // per bake + per texel
+}
+
+TEST(CostModel, MemoryFollowsTheChartTexelsOnAPartlyFilledPage) {
+  // The same 16.8M-texel page filled with 2.5M or 10M chart texels: the peak grows by memoryPerTexel per chart texel.
+  const CostCoefficients c = roundCoefficients();
+  CostInputs sparse;
+  sparse.pageTexels = 4096.0 * 4096.0;
+  sparse.texels = 2.5e6;
+  CostInputs full = sparse;
+  full.texels = 1e7;
+  EXPECT_NEAR(predictCost(sparse, c).memoryPeakMiB, 100.0 + 1e-4 * 2.5e6 + 1e-5 * sparse.pageTexels, 1e-9);
+  EXPECT_NEAR(predictCost(full, c).memoryPeakMiB - predictCost(sparse, c).memoryPeakMiB, 1e-4 * 7.5e6, 1e-9);
+}
+
 TEST(CostModel, LightReachIsTheSurfaceWithinTheRange) {
   // A 100 m floor in 0.5 m quads; a lamp of range 6 m on it lights a disc of π 6² m², a lamp of range 6 m 4 m
   // above it a disc of π (6² − 4²) m², a lamp without range all of it. The area is binned in cubes of a third of

@@ -6,8 +6,9 @@ Each DIR is a measured bake as bench/levels/cost_bakes.py leaves it (report.json
 the rows of bench/results/levels_scale.csv whose towns bench/levels/town.py makes again (their density given
 as measured, so the plan predicts the atlas they had). The inputs
 of each are what `IRBAKE plan --json` predicts for the same scene and options (so the fit sees the model's
-own features); the targets are the report's stage times turned into CPU seconds (each stage's wall time x the
-bake's CPU time / wall time, which takes out a shared machine's load) and its peak memory. Every stage is
+own features); the targets are the report's CPU seconds per stage (timings.cpuSeconds; for an older report,
+each stage's wall time x the bake's CPU time / wall time), which take out a shared machine's load, and its peak
+memory. Every stage is
 fitted by non-negative least squares on relative errors. Prints the coefficients as the body of
 calibratedCostCoefficients() (baker/pipeline/cost_model.cpp); --write pastes them there.
 
@@ -26,30 +27,39 @@ import subprocess
 import sys
 import time
 
-# stage -> (coefficient, feature) pairs, as predictCost combines them.
+# stage -> (coefficient, feature) pairs, as predictCost combines them. A feature ending in "Traced" is the count
+# times the ray pilot's cost per ray to the power rayCostExponent (inputs.rayCost), "Gl" and "Embree" split the VPL sum by its evaluator.
 STAGES = {
     "load": [("loadPerTriangle", "triangles"), ("loadPerTexturePixel", "texturePixels")],
     "atlas": [("atlasPerTriangle", "triangles"), ("atlasPerPageTexel", "pageTexels")],
     "raytrace": [("raytracePerTriangle", "triangles")],
-    "texels": [("texelsPerPageTexel", "pageTexels"), ("texelsPerTriangle", "triangles")],
+    "texels": [("texelsPerPageTexel", "pageTexels"), ("texelsPerTracedPageTexel", "pageTexelsTraced"),
+               ("texelsPerTriangle", "triangles")],
     "vpls": [("vplsPerPath", "paths")],
     "vplImportance": [("importancePerTexelPath", "texelPaths")],
-    "backend": [("backendFixed", "one"), ("backendPerTexelPath", "texelPaths"), ("backendPerLightTexel", "lightTexels")],
+    "backend": [("backendFixed", "one"), ("backendGlFixed", "gl"), ("backendPerTexelPath", "texelPathsEmbree"),
+                ("backendGlPerTexelPath", "texelPathsGl"), ("backendPerLightTexel", "lightTexels")],
     "shadowEdges": [("shadowEdgesPerLightRay", "lightRays")],
-    "sky": [("skyPerRay", "skyRays")],
-    "compensation": [("compensationPerRay", "compensationRays"), ("compensationPerTexel", "compensationTexels")],
-    "finalGather": [("gatherPerRay", "gatherRays"), ("gatherPerTexel", "gatherTexels")],
+    "sky": [("skyPerRay", "skyRaysTraced")],
+    "compensation": [("compensationPerRay", "compensationRaysTraced"), ("compensationPerTexel", "compensationTexels")],
+    "finalGather": [("gatherPerRay", "gatherRaysTraced"), ("gatherPerTexel", "gatherTexels")],
     "post": [("postPerPageTexel", "pageTexels")],
-    "probes": [("probesPerRay", "probeRayCount"), ("probesPerProbeLight", "probeLights")],
-    "write": [("writePerPageTexel", "pageTexels")],
+    "probes": [("probesPerRay", "probeRayCountTraced"), ("probesPerProbeLight", "probeLightsTraced")],
+    "write": [("writeFixed", "one"), ("writePerPageTexel", "pageTexels")],
 }
-MEMORY = [("memoryBaseMiB", "one"), ("memoryPerTriangle", "triangles"), ("memoryPerTexturePixel", "texturePixels"),
-          ("memoryPerPageTexel", "pageTexels"), ("memoryPerTexelPath", "texelPaths")]
+MEMORY = [("memoryBaseMiB", "one"), ("memoryGlContextMiB", "gl"), ("memoryPerTriangle", "triangles"),
+          ("memoryPerTexturePixel", "texturePixels"), ("memoryPerTexel", "texels"), ("memoryPerTexelPath", "texelPaths")]
+# memoryPerPageTexel stays 0: the peak follows the texels the charts cover, not the estimate's page texels (which
+# the charts of a large level fill only in part).
 # Where no bake ran under little load, the share of the cores a bake keeps busy on an idle machine.
 DEFAULT_PARALLEL_SHARE = 0.85
 
 
-def features(inputs):
+# The exponents of the pilot's cost per ray the fit tries (rayCostExponent): the one that fits best is kept.
+RAY_COST_EXPONENTS = [1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 2.75, 3.0]
+
+
+def features(inputs, exponent=1.0):
     f = dict(inputs)
     f["one"] = 1.0
     f.setdefault("texturePixels", 0.0)
@@ -59,6 +69,12 @@ def features(inputs):
     f["gatherTexels"] = f["texels"] if f["gatherRays"] > 0 else 0.0
     f["probeRayCount"] = f["probes"] * f["probeRays"]
     f.setdefault("probeLights", f["probes"] * f["punctualLights"])
+    f["gl"] = f.get("glBackend", 0.0)
+    f["texelPathsGl"] = f["texelPaths"] * f["gl"]
+    f["texelPathsEmbree"] = f["texelPaths"] * (1.0 - f["gl"])
+    scale = f.get("rayCost", 1.0) ** exponent
+    for name in ("pageTexels", "skyRays", "compensationRays", "gatherRays", "probeRayCount", "probeLights"):
+        f[name + "Traced"] = f[name] * scale
     return f
 
 
@@ -106,11 +122,16 @@ def run_plan(irbake, scene, options):
     return json.loads(out), time.time() - t0
 
 
-def make_run(irbake, measured, seconds, memory):
-    """measured: name, scene, options, wall_s, cpu_s, cores, load_before; seconds: the stages' wall seconds."""
+def make_run(irbake, measured, seconds, memory, cpu_seconds=None):
+    """measured: name, scene, options, wall_s, cpu_s, cores, load_before; seconds: the stages' wall seconds;
+    cpu_seconds: their CPU seconds where the report has them (timings.cpuSeconds), else each stage's wall time x the
+    bake's CPU time / wall time."""
     plan, plan_s = run_plan(irbake, measured["scene"], measured["options"])
     cpu_per_wall = measured["cpu_s"] / measured["wall_s"]  # the process's busy cores, whatever the load
-    cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
+    if cpu_seconds:
+        cpu = {stage: cpu_seconds.get(stage, 0.0) for stage in STAGES}
+    else:
+        cpu = {stage: seconds.get(stage, 0.0) * cpu_per_wall for stage in STAGES}
     return {"name": measured["name"], "measured": measured, "features": features(plan["inputs"]), "cpu": cpu,
             "memory": memory, "plan": plan, "plan_s": plan_s}
 
@@ -120,7 +141,10 @@ def load(irbake, folder):
     report = json.load(open(os.path.join(folder, "report.json")))
     seconds = dict(report["timings"]["seconds"])
     seconds["write"] = max(0.0, measured["wall_s"] - seconds.get("bake", 0.0) - seconds.get("load", 0.0))
-    run = make_run(irbake, measured, seconds, report["timings"]["memoryPeakMiB"])
+    cpu_seconds = dict(report["timings"].get("cpuSeconds", {}))
+    if cpu_seconds:  # the rest of the process: its start, the plan, the outputs, the exit
+        cpu_seconds["write"] = max(0.0, measured["cpu_s"] - cpu_seconds.get("bake", 0.0) - cpu_seconds.get("load", 0.0))
+    run = make_run(irbake, measured, seconds, report["timings"]["memoryPeakMiB"], cpu_seconds)
     run["density"] = report["atlas"]["texelsPerUnit"]
     return run
 
@@ -157,7 +181,7 @@ def load_levels(irbake, path):
     return runs
 
 
-def fit(runs):
+def fit_stages(runs):
     coefficients = {}
     for stage, terms in STAGES.items():
         rows, targets = [], []
@@ -172,10 +196,27 @@ def fit(runs):
         coefficients.update({name: v for (name, _), v in zip(terms, x)})
     rows = [[r["features"][f] for _, f in MEMORY] for r in runs]
     coefficients.update({name: v for (name, _), v in zip(MEMORY, nnls(rows, [r["memory"] for r in runs]))})
+    coefficients["memoryPerPageTexel"] = 0.0
     quiet = [r["measured"]["cpu_s"] / (r["measured"]["wall_s"] * r["measured"]["cores"]) for r in runs
              if r["measured"]["load_before"] < r["measured"]["cores"] + 0.5]
     coefficients["parallelShare"] = min(1.0, max(quiet)) if quiet else DEFAULT_PARALLEL_SHARE
     return coefficients
+
+
+def fit(runs):
+    """Every stage at each exponent of the pilot's cost per ray; keeps the exponent whose predicted CPU seconds (the
+    stages' sum) come closest to the measured, in relative error over the runs, and sets the runs' features to it."""
+    best, best_err = None, float("inf")
+    for k in RAY_COST_EXPONENTS:
+        for r in runs:
+            r["features"] = features(r["plan"]["inputs"], k)
+        c = fit_stages(runs)
+        err = sum((predict(c, r["features"])[0] / sum(r["cpu"].values()) - 1.0) ** 2 for r in runs)
+        if err < best_err:
+            best, best_err = dict(c, rayCostExponent=k), err
+    for r in runs:
+        r["features"] = features(r["plan"]["inputs"], best["rayCostExponent"])
+    return best
 
 
 def predict(c, f):
@@ -205,7 +246,8 @@ def accuracy_rows(runs, held, path):
 
 def initialiser(c):
     lines = ["  // fit_cost_model.py: begin"]
-    for name in [n for terms in STAGES.values() for n, _ in terms] + ["parallelShare"] + [n for n, _ in MEMORY]:
+    for name in ([n for terms in STAGES.values() for n, _ in terms] + ["parallelShare", "rayCostExponent"] +
+                 [n for n, _ in MEMORY] + ["memoryPerPageTexel"]):
         lines.append("  c.%s = %.6g;" % (name, c[name]))
     lines.append("  // fit_cost_model.py: end")
     return "\n".join(lines)
@@ -239,6 +281,8 @@ def main():
     if a.accuracy:
         accuracy_rows(runs, held, a.accuracy)
     c = fit([r for r in runs if r["name"] not in held])
+    for r in runs:  # the held-out runs too, at the fitted exponent
+        r["features"] = features(r["plan"]["inputs"], c["rayCostExponent"])
     print(initialiser(c))
     for r in runs:
         cpu, memory = predict(c, r["features"])

@@ -8,7 +8,8 @@
 # (bench/levels/levels_scale.sh's scenes and densities: town4, town8, the 16x16 town's 1,000 lamps with and
 # without range at --quality preview; LARGE=1 adds town32 with 2,000 lamps). From the repository root after a
 # Release build:
-#   HOLD_OUT=town8_sunsky_tpu3_preview,sponza_sunsky_preview bash bench/levels/plan_accuracy.sh [IRBAKE]
+#   HOLD_OUT=sponza_sunsky_preview,town16_lamps_range,town8_lamps,town8_sunsky_tpu3_preview LARGE=1 \
+#     bash bench/levels/plan_accuracy.sh [IRBAKE]
 # HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV adds a
 # level ladder's CSV rows (measured with the binary that wrote them).
 set -euo pipefail
