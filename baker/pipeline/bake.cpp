@@ -264,8 +264,7 @@ BakeResult StagedBake::finish(ExactVplSums sums) {
   report["timings"]["cpuSeconds"] = s.cpuSeconds;
   report["timings"]["backendParts"] = s.backendParts;
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
-  // The preflight's, beside the measured timings: its time weighs the rays by the ray pilot, timed in this run.
-  report["timings"]["prediction"] = s.prediction.cost.toJson();
+  report["prediction"] = s.prediction.cost.toJson();  // the preflight's, beside the measured timings
   r.atlas = std::move(s.atlas);
   r.vpls = std::move(s.vpls);
   s.gather = {};
