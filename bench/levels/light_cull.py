@@ -59,10 +59,12 @@ def main():
     ap.add_argument("--texels-per-unit", type=float, default=0.0,
                     help="one density for every case (the sun-only town has no lamp posts, so fewer triangles)")
     ap.add_argument("--csv", default="bench/results/light_cull.csv")
+    ap.add_argument("--brute", action="append", default=[], metavar="SCENE=DIR",
+                    help="an earlier brute-force bake of SCENE (its output folder) to measure the error against")
     args = ap.parse_args()
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     new = not os.path.exists(args.csv)
-    brute = {}
+    brute = dict(b.split("=", 1) for b in args.brute)
     with open(args.csv, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=FIELDS)
         if new:

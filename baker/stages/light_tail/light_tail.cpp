@@ -9,6 +9,7 @@
 #include "common/progress.h"
 #include "lights/light_tree.h"
 #include "sampling/sampling.h"
+#include "texels/surface_filter_cache.h"
 #include "transport/geometry_term.h"
 
 namespace irbake {
@@ -67,6 +68,56 @@ nlohmann::json LightTailStats::toJson() const {
           {"noiseRms", texels ? std::sqrt(variance / double(texels)) : 0.0}};
 }
 
+namespace {
+
+// One texel's draws: `count` stratified over the tree's unit interval (its order is spatial) from `shift`, one slot
+// of the texel's samples after another; the weighted mean of the drawn lights' left-out light, shadowed.
+struct TexelDraws {
+  glm::dvec3 mean{0.0};
+  bool any = false;
+};
+TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, size_t t, int first, int count,
+                     double shift, size_t& traced) {
+  const size_t layer = ts.layerSize();
+  const int layers = ts.supersample * ts.supersample;
+  const float eps = in.rayTracer.epsilon();
+  glm::dvec3 sum(0.0);
+  double weight = 0.0;
+  for (int k = 0; k < count; ++k) {
+    const size_t s = static_cast<size_t>((first + k) % layers) * layer + t;
+    const float w = ts.positionWeight[s].w;
+    if (!(w > 0.0f)) continue;
+    glm::vec3 x(ts.positionWeight[s]);
+    if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size() &&
+        ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
+      x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+    const glm::vec3 n(ts.normal[s]);
+    auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
+    const LightTree::Choice choice = c.tree.sample(x, n, (k + shift) / count, exact);
+    glm::dvec3 v(0.0);
+    if (choice.light != UINT32_MAX && choice.pmf > 0.0) {
+      const LeftOut lo = leftOutLight(in.scene, c, choice.light, x, n);
+      if (lo.value != glm::vec3(0.0f)) {
+        const glm::vec3 origin = x + n * eps;
+        const float tmax = std::isinf(lo.whole.distance) ? 1e30f : lo.whole.distance - eps;
+        ++traced;
+        if (!(tmax > 0.0f) || !in.rayTracer.occluded(origin, lo.whole.toLight, 0.0f, tmax)) {
+          const glm::vec3 tr =
+              tmax > 0.0f ? in.rayTracer.transmittance(origin, lo.whole.toLight, 0.0f, tmax) : glm::vec3(1.0f);
+          v = glm::dvec3(lo.value * tr) / choice.pmf;
+        }
+      }
+    }
+    sum += double(w) * v;
+    weight += double(w);
+  }
+  TexelDraws d;
+  if (weight > 0.0) d.mean = sum / weight, d.any = true;
+  return d;
+}
+
+}  // namespace
+
 LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
                             const std::vector<uint8_t>& skip) {
   LightTailStats stats;
@@ -74,67 +125,42 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
   const CutLights c = cutLights(in.scene, in.eval, skip);
   stats.lights = c.tree.size();
   if (c.tree.empty() || options.samples <= 0) return stats;
-  const int samples = options.samples;
-  const float eps = in.rayTracer.epsilon();
+  // Two independent halves of the draws, each stratified with its own shift: their difference tells the noise of
+  // their mean, filtered or not. One draw cannot be split: it is its own half and reports no noise.
+  const int halfA = std::max(1, options.samples / 2), halfB = options.samples - halfA;
   std::atomic<size_t> rays{0};
   for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
     Lightmap& map = maps[p];
     const size_t layer = ts.layerSize();
-    std::vector<double> variance(layer, -1.0), added(layer, 0.0);
+    std::vector<glm::vec3> a(layer, glm::vec3(0.0f)), b(layer, glm::vec3(0.0f));
+    std::vector<uint8_t> valid(layer, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 256), [&](const tbb::blocked_range<size_t>& range) {
       size_t traced = 0;
       for (size_t t = range.begin(); t < range.end(); ++t) {
         if (t >= ts.valid.size() || !ts.valid[t]) continue;
+        valid[t] = 1;  // the page's own validity, so the bake's filter plan serves it
         Rng rng(hashSeed(options.seed, p, t));
-        // The draws stratified over the tree's unit interval (its order is spatial), one slot of the texel's
-        // samples after another.
-        const double shift = rng.uniform();
-        const int layers = ts.supersample * ts.supersample;
-        glm::dvec3 sum(0.0);
-        double squares = 0.0, weight = 0.0;
-        for (int k = 0; k < samples; ++k) {
-          const size_t s = static_cast<size_t>(k % layers) * layer + t;
-          const float w = ts.positionWeight[s].w;
-          if (!(w > 0.0f)) continue;
-          glm::vec3 x(ts.positionWeight[s]);
-          if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size() &&
-              ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
-            x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
-          const glm::vec3 n(ts.normal[s]);
-          auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
-          const double u = (k + shift) / samples;
-          const LightTree::Choice choice = c.tree.sample(x, n, u, exact);
-          glm::dvec3 v(0.0);
-          if (choice.light != UINT32_MAX && choice.pmf > 0.0) {
-            const LeftOut lo = leftOutLight(in.scene, c, choice.light, x, n);
-            if (lo.value != glm::vec3(0.0f)) {
-              const glm::vec3 origin = x + n * eps;
-              const float tmax = std::isinf(lo.whole.distance) ? 1e30f : lo.whole.distance - eps;
-              ++traced;
-              if (!(tmax > 0.0f) || !in.rayTracer.occluded(origin, lo.whole.toLight, 0.0f, tmax)) {
-                const glm::vec3 tr = tmax > 0.0f ? in.rayTracer.transmittance(origin, lo.whole.toLight, 0.0f, tmax)
-                                                 : glm::vec3(1.0f);
-                v = glm::dvec3(lo.value * tr) / choice.pmf;
-              }
-            }
-          }
-          sum += double(w) * v;
-          squares += double(w) * channelMean(glm::vec3(v)) * channelMean(glm::vec3(v));
-          weight += double(w);
-        }
-        if (!(weight > 0.0)) continue;
-        const glm::dvec3 mean = sum / weight;
-        const double m = channelMean(glm::vec3(mean));
-        // The variance of the mean of `samples` draws (0 with one draw: nothing to tell it from).
-        variance[t] = samples > 1 ? std::max(0.0, squares / weight - m * m) / double(samples - 1) : 0.0;
-        added[t] = m;
-        map.texels[t] += glm::vec3(mean);
+        const double shiftA = rng.uniform(), shiftB = rng.uniform();
+        const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, shiftA, traced);
+        const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, shiftB, traced) : da;
+        if (da.any && db.any) a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean);
       }
       rays += traced;
     });
-    for (size_t t = 0; t < layer; ++t)
-      if (variance[t] >= 0.0) ++stats.texels, stats.variance += variance[t], stats.added += added[t];
+    if (options.filterRadius > 0) {
+      TexelFilterOptions fo;
+      fo.radius = options.filterRadius;
+      auto filtered = filterOnSurface(in.surfaceFilters, ts, std::vector<const std::vector<glm::vec3>*>{&a, &b}, valid, fo);
+      a = std::move(filtered[0]), b = std::move(filtered[1]);
+    }
+    for (size_t t = 0; t < layer; ++t) {
+      if (!valid[t] || t >= map.valid.size() || !map.valid[t]) continue;
+      const glm::vec3 mean = 0.5f * (a[t] + b[t]);
+      const double half = halfB > 0 ? 0.5 * channelMean(a[t] - b[t]) : 0.0;
+      map.texels[t] += mean;
+      ++stats.texels, stats.variance += half * half, stats.added += channelMean(mean);
+    }
   }
   stats.rays = rays.load();
   stats.seconds = watch.seconds();

@@ -1,10 +1,11 @@
 // The light the cut takes back, sampled. A light without range is cut where its light falls to a share of the
 // scene's reference (lights/light_reach.h): every evaluator gives it only up to its reach, faded out over the last
 // quarter. Many such lights (a town's lamps) leave many small tails whose sum is not small. Here each texel gets
-// an unbiased estimate of that sum: N lights drawn from a light tree (lights/light_tree.h) over the cut lights,
-// each in proportion to a bound on what it gives the texel, its left-out light (its light without the cut less its
-// faded light) traced with one shadow ray and divided by its probability. The estimate's variance is kept for the
-// error figure. docs/units.md, "Light reach".
+// an estimate of that sum: N lights drawn from a light tree (lights/light_tree.h) over the cut lights, each in
+// proportion to a bound on what it gives the texel, its left-out light (its light without the cut less its faded
+// light) traced with one shadow ray and divided by its probability. The tail is faint and smooth (far lights), so
+// the estimate is filtered on the surface like the sky; two independent halves of the draws, filtered alike, tell
+// its remaining noise for the error figure. docs/units.md, "Light reach".
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -17,8 +18,9 @@
 namespace irbake {
 
 struct LightTailOptions {
-  int samples = 8;     // lights drawn per texel (0: the cut light stays left out)
-  uint64_t seed = 0;   // the draws' seed (the walk's)
+  int samples = 8;       // lights drawn per texel (0: the cut light stays left out)
+  int filterRadius = 4;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
+  uint64_t seed = 0;     // the draws' seed (the walk's)
 };
 
 struct LightTailStats {
@@ -26,7 +28,7 @@ struct LightTailStats {
   size_t texels = 0;          // texels given an estimate
   size_t rays = 0;            // shadow rays traced
   double added = 0.0;         // sum over those texels of the added map value (channel mean)
-  double variance = 0.0;      // sum over those texels of the estimate's variance (channel mean, of the mean)
+  double variance = 0.0;      // sum over those texels of the estimate's variance (channel mean, after the filter)
   double seconds = 0.0;
   nlohmann::json toJson() const;
 };
