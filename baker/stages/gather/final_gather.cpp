@@ -20,6 +20,8 @@ namespace {
 
 constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotations (forEachSampleLattice)
 constexpr uint64_t kPreGatherStream = 0xfa;     // the first pass's (independent of the final pass's)
+constexpr int kSpreadPasses = 3;  // the outliers' excess: box filters of radius 5 in turn, a soft ~31-texel window
+                                  // whose centre keeps 1/214 of a texel's excess (1/121 for one or two passes)
 
 }  // namespace
 
@@ -129,6 +131,76 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
 
 namespace {
 
+// value's texels above ratio × their window's mean (radius r, the texel in it) held there; three rounds, so
+// that the mean a texel is held to no longer carries its own outlier (the excess shrinks by about ratio / n a
+// round, n the window's texels). Returns per texel the share kept (1 where untouched).
+std::vector<float> holdOutliers(SurfaceFilterCache* cache, const TexelSamples& ts, std::vector<glm::vec3>& value,
+                                const std::vector<uint8_t>& valid, float ratio, int r) {
+  std::vector<float> kept(value.size(), 1.0f);
+  TexelFilterOptions fo;
+  fo.radius = r;
+  fo.symmetric = false;  // a texel at a chart border or corner is held against the neighbours it has
+  for (int round = 0; round < 3; ++round) {
+    const std::vector<glm::vec3> mean = filterOnSurface(cache, ts, value, valid, fo);
+    tbb::parallel_for(size_t(0), value.size(), [&](size_t t) {
+      const float v = channelMean(value[t]), limit = ratio * channelMean(mean[t]);
+      if (!valid[t] || !(v > limit) || !std::isfinite(v)) return;
+      const float share = limit / v;
+      value[t] *= share;
+      kept[t] *= share;
+    });
+  }
+  return kept;
+}
+
+// A page's gathered sets (the light, then its L1 axes if any) filtered as options say. With outlierRatio, the
+// light's outliers are held first (holdOutliers; the L1 axes scaled alike) and what was taken is spread by
+// passes of the widest window (kSpreadPasses of SurfaceFilterPlan::kMaxRadius) and added
+// back: one ray on a tiny, very bright surface is seen as a faint wide glow instead of a bright square.
+// stats: outlierTexels counted; spread: Σ channelMean of the light spread.
+void filterGathered(SurfaceFilterCache* cache, const TexelSamples& ts, const std::vector<std::vector<glm::vec3>*>& sets,
+                    const std::vector<uint8_t>& valid, const FinalGatherOptions& options, bool holdThem,
+                    FinalGatherStats& stats, double& spread) {
+  std::vector<std::vector<glm::vec3>> excess;
+  if (holdThem && options.outlierRatio > 0.0f) {
+    const std::vector<glm::vec3> before = *sets[0];
+    const std::vector<float> kept = holdOutliers(cache, ts, *sets[0], valid, options.outlierRatio,
+                                                 std::max(1, options.filterRadius));
+    excess.assign(sets.size(), std::vector<glm::vec3>(before.size(), glm::vec3(0.0f)));
+    for (size_t t = 0; t < kept.size(); ++t) {
+      if (kept[t] >= 1.0f) continue;
+      ++stats.outlierTexels;
+      spread += channelMean(before[t] - (*sets[0])[t]);
+      excess[0][t] = before[t] - (*sets[0])[t];
+      for (size_t k = 1; k < sets.size(); ++k) {
+        excess[k][t] = (*sets[k])[t] * (1.0f - kept[t]);
+        (*sets[k])[t] *= kept[t];
+      }
+    }
+  }
+  TexelFilterOptions fo;
+  fo.radius = options.filterRadius;
+  if (fo.radius > 0) {
+    const std::vector<const std::vector<glm::vec3>*> in(sets.begin(), sets.end());
+    std::vector<std::vector<glm::vec3>> filtered = filterOnSurface(cache, ts, in, valid, fo);
+    for (size_t k = 0; k < sets.size(); ++k) *sets[k] = std::move(filtered[k]);
+  }
+  if (excess.empty()) return;
+  TexelFilterOptions wide;
+  wide.radius = SurfaceFilterPlan::kMaxRadius;
+  wide.symmetric = false;  // every neighbour takes its share, up to a chart border
+  std::vector<const std::vector<glm::vec3>*> excessSets;
+  for (const auto& e : excess) excessSets.push_back(&e);
+  std::vector<std::vector<glm::vec3>> spreadSets;
+  for (int pass = 0; pass < kSpreadPasses; ++pass) {
+    spreadSets = filterOnSurface(cache, ts, excessSets, valid, wide);
+    for (size_t k = 0; k < spreadSets.size(); ++k) excess[k] = std::move(spreadSets[k]);
+  }
+  for (size_t k = 0; k < sets.size(); ++k)
+    for (size_t t = 0; t < excess[k].size(); ++t)
+      if (valid[t]) (*sets[k])[t] += excess[k][t];
+}
+
 // One gather: maps ← D + gather(source) at valid texels, the lattice rotations from stream.
 // albedo: texelAlbedo(in), made once for both passes.
 void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const std::vector<Lightmap>& source,
@@ -146,6 +218,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
   std::vector<std::vector<glm::vec3>> gathered(maps.size());
   std::array<std::vector<std::vector<glm::vec3>>, 3> gatheredL1;
   const std::vector<PackedLightmap> packedSource = packReflected(source, albedo);
+  double spread = 0.0;  // Σ channelMean of the outliers' light spread (filterGathered)
   if (directional)
     for (auto& axis : gatheredL1) axis.resize(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) {
@@ -167,28 +240,19 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
       if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value[t]);
     });
-    if (options.filterRadius > 0) {
-      TexelFilterOptions fo;
-      fo.radius = options.filterRadius;
-      value = filterOnSurface(in.surfaceFilters, ts, value, valid, fo);
-    }
-    if (directional) {
-      std::array<std::vector<glm::vec3>, 3> axes;
+    std::vector<std::vector<glm::vec3>*> sets = {&value};
+    std::array<std::vector<glm::vec3>, 3> axes;
+    if (directional)
       for (int k = 0; k < 3; ++k) {
         axes[k].assign(ts.layerSize(), glm::vec3(0.0f));
         tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
           if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotVector[s][k]; }, axes[k][t]);
         });
+        sets.push_back(&axes[k]);
       }
-      if (options.filterRadius > 0) {  // the map's filter, the three axes in one pass
-        TexelFilterOptions fo;
-        fo.radius = options.filterRadius;
-        std::vector<std::vector<glm::vec3>> filtered =
-            filterOnSurface(in.surfaceFilters, ts, {&axes[0], &axes[1], &axes[2]}, valid, fo);
-        for (int k = 0; k < 3; ++k) axes[k] = std::move(filtered[k]);
-      }
+    filterGathered(in.surfaceFilters, ts, sets, valid, options, stream == kGatherStream, stats, spread);
+    if (directional)
       for (int k = 0; k < 3; ++k) gatheredL1[k][p] = std::move(axes[k]);
-    }
   }
   double total = 0.0, gatheredSum = 0.0, change = 0.0, before = 0.0;
   for (size_t p = 0; p < maps.size(); ++p)
@@ -212,6 +276,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
   stats.filterRadius = options.filterRadius;
   stats.gatheredFraction = total > 0.0 ? gatheredSum / total : 0.0;
   stats.changeFraction = before > 0.0 ? change / before : 0.0;
+  stats.outlierFraction = total > 0.0 ? spread / total : 0.0;
 }
 
 }  // namespace
