@@ -79,11 +79,11 @@ std::vector<PackedLightmap> packReflected(const std::vector<Lightmap>& maps,
 // gatherAt over ρ M packed (the gather's passes pack their source once).
 glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>& maps, const std::vector<int32_t>& mapOfPage,
                          const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                         const glm::vec3& missRadiance, L1Vectors* tangential) {
+                         const glm::vec3& missRadiance, L1Vectors* tangential, glm::vec3* emitted = nullptr) {
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
   const glm::vec3 origin = x + n * rt.epsilon();
-  glm::vec3 sum(0.0f);
+  glm::vec3 sum(0.0f), emittedSum(0.0f);
   L1Vectors t{};
   CosineLattice lattice(n, rays, r1, r2);
   constexpr int kChunk = 32;  // rays traced together, 8 to a packet (one origin: the packets stay coherent)
@@ -103,6 +103,7 @@ glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>
       if (hit.backFace) continue;  // back faces hold no map
       const Primitive& prim = scene.primitives[hit.primitive];
       glm::vec3 L = scene.emissionAt(prim, hit.triangle, hit.barycentric);
+      emittedSum += L;
       const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
       if (point.map >= 0 && static_cast<size_t>(point.map) < maps.size())
         L += maps[point.map].read(point.texel);  // ρ M, the albedo at the texel's footprint folded in
@@ -118,6 +119,7 @@ glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>
   const float inv = 1.0f / static_cast<float>(std::max(1, rays));
   if (tangential)
     for (int a = 0; a < 3; ++a) (*tangential)[a] = t[a] * inv;
+  if (emitted) *emitted = emittedSum * inv;
   return sum * inv;
 }
 
@@ -154,27 +156,33 @@ std::vector<float> holdOutliers(SurfaceFilterCache* cache, const TexelSamples& t
 }
 
 // A page's gathered sets (the light, then its L1 axes if any) filtered as options say. With outlierRatio, the
-// light's outliers are held first (holdOutliers; the L1 axes scaled alike) and what was taken is spread by
+// outliers of the light less its emitted part are held first (holdOutliers; the L1 axes scaled alike: emitters
+// are the pipeline's reason to leave the gather off, and forced on their light is left as it was) and what was taken is spread by
 // passes of the widest window (kSpreadPasses of SurfaceFilterPlan::kMaxRadius) and added
 // back: one ray on a tiny, very bright surface is seen as a faint wide glow instead of a bright square.
 // stats: outlierTexels counted; spread: Σ channelMean of the light spread.
 void filterGathered(SurfaceFilterCache* cache, const TexelSamples& ts, const std::vector<std::vector<glm::vec3>*>& sets,
-                    const std::vector<uint8_t>& valid, const FinalGatherOptions& options, bool holdThem,
-                    FinalGatherStats& stats, double& spread) {
+                    const std::vector<glm::vec3>& emitted, const std::vector<uint8_t>& valid,
+                    const FinalGatherOptions& options, bool holdThem, FinalGatherStats& stats, double& spread) {
   std::vector<std::vector<glm::vec3>> excess;
   if (holdThem && options.outlierRatio > 0.0f) {
     const std::vector<glm::vec3> before = *sets[0];
-    const std::vector<float> kept = holdOutliers(cache, ts, *sets[0], valid, options.outlierRatio,
+    std::vector<glm::vec3>& value = *sets[0];
+    for (size_t t = 0; t < value.size(); ++t) value[t] -= emitted[t];
+    const std::vector<float> kept = holdOutliers(cache, ts, value, valid, options.outlierRatio,
                                                  std::max(1, options.filterRadius));
+    for (size_t t = 0; t < value.size(); ++t) value[t] += emitted[t];
     excess.assign(sets.size(), std::vector<glm::vec3>(before.size(), glm::vec3(0.0f)));
     for (size_t t = 0; t < kept.size(); ++t) {
       if (kept[t] >= 1.0f) continue;
       ++stats.outlierTexels;
-      spread += channelMean(before[t] - (*sets[0])[t]);
-      excess[0][t] = before[t] - (*sets[0])[t];
+      spread += channelMean(before[t] - value[t]);
+      excess[0][t] = before[t] - value[t];
+      const float before1 = channelMean(before[t]);
+      const float share = before1 > 0.0f ? channelMean(value[t]) / before1 : 1.0f;  // the L1 scaled alike
       for (size_t k = 1; k < sets.size(); ++k) {
-        excess[k][t] = (*sets[k])[t] * (1.0f - kept[t]);
-        (*sets[k])[t] *= kept[t];
+        excess[k][t] = (*sets[k])[t] * (1.0f - share);
+        (*sets[k])[t] *= share;
       }
     }
   }
@@ -223,7 +231,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     for (auto& axis : gatheredL1) axis.resize(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
-    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
+    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f)), slotEmitted(ts.slotCount(), glm::vec3(0.0f));
     std::vector<L1Vectors> slotVector(directional ? ts.slotCount() : 0, L1Vectors{});
     // Interleaved rotations (sample_lattice.h): every filter window averages one stratified lattice of rays
     // instead of independent rays per sample, so the filter removes more of their noise.
@@ -231,7 +239,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     forEachSampleLattice(in.rayTracer, ts, options.seed, stream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
                            slotValue[s] = gatherAtPacked(in, packedSource, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
-                                                   directional ? &slotVector[s] : nullptr);
+                                                   directional ? &slotVector[s] : nullptr, &slotEmitted[s]);
                          },
                          &interleaved);
     std::vector<glm::vec3>& value = gathered[p];
@@ -239,6 +247,10 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     const std::vector<uint8_t>& valid = maps[p].valid;
     tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
       if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value[t]);
+    });
+    std::vector<glm::vec3> emitted(ts.layerSize(), glm::vec3(0.0f));  // the emitters' share, not held
+    tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
+      if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotEmitted[s]; }, emitted[t]);
     });
     std::vector<std::vector<glm::vec3>*> sets = {&value};
     std::array<std::vector<glm::vec3>, 3> axes;
@@ -250,7 +262,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
         });
         sets.push_back(&axes[k]);
       }
-    filterGathered(in.surfaceFilters, ts, sets, valid, options, stream == kGatherStream, stats, spread);
+    filterGathered(in.surfaceFilters, ts, sets, emitted, valid, options, stream == kGatherStream, stats, spread);
     if (directional)
       for (int k = 0; k < 3; ++k) gatheredL1[k][p] = std::move(axes[k]);
   }
