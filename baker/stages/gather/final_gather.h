@@ -48,10 +48,11 @@ struct FinalGatherOptions {
                                // final rays see them, which lowers the error against Cycles for few rays
                                // more. 0: off
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
-  float outlierRatio = 4.0f;   // final pass: a texel's gathered light above this × its window's mean (the
-                               // filter's window, at least 3×3, the texel in it) is held there before the
-                               // filter, and the excess spread over a ~31-texel soft window (filterGathered):
-                               // one ray on a tiny, very bright surface no longer makes a bright square. 0: off
+  float outlierRatio = 4.0f;   // final pass: a texel's gathered light less its emitted part (Le at the hits)
+                               // above this × its window's mean (the filter's window, at least 3×3, the texel
+                               // in it) is held there before the filter, and the excess spread over a ~31-texel
+                               // soft window (filterGathered): one ray on a tiny, very bright surface no longer
+                               // makes a bright square. 0: off
 };
 
 struct FinalGatherStats {
