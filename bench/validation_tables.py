@@ -560,9 +560,17 @@ def t_quality_presets():
                   "mean ours/Cycles"], out)
 
 
+def gather_outliers():
+    rows = latest(read("gather_outliers.csv"), lambda r: (r["scene"], r["gather_outliers"]))
+    return table(["scene", "`--gather-outliers`", "final gather (s)", "texels held", "light moved", "mean / unheld",
+                  "texels > 1.10× / > 1.25× the other bake's"],
+                 [[r["scene"], r["gather_outliers"], r["final_gather_s"], r["outlier_texels"], pct(r["outlier_fraction"]),
+                   num(r["mean_vs_unheld"], 4), f"{r['above_other_10pct']} / {r['above_other_25pct']}"] for r in rows])
+
+
 TABLES = {name[2:]: fn for name, fn in globals().items() if name.startswith("t_")}
 # Tables not in docs/validation.md (its size limit): --print renders them, --check does not ask for them.
-UNPLACED = {"gpu_h100": gpu_h100, "gpu_h200": gpu_h200}
+UNPLACED = {"gpu_h100": gpu_h100, "gpu_h200": gpu_h200, "gather_outliers": gather_outliers}
 MARKER = re.compile(r"<!-- table:([a-z0-9_]+) -->\n(.*?)<!-- /table:\1 -->", re.S)
 
 

@@ -44,7 +44,7 @@ TEST(BakeOptions, HelpFitsAScreenAndHelpAllListsEveryOption) {
   for (const char* option : {"--paths", "--vpls", "--bounces", "--walk-split", "--vpl-importance", "--vpl-probes", "--vpl-keep",
                              "--max-texels", "--supersample", "--clamp", "--clamp-k", "--no-bias-compensation", "--comp-rays",
                              "--comp-refine", "--comp-ray-budget", "--comp-filter", "--final-gather", "--gather-rays",
-                             "--gather-pre-rays", "--gather-ray-budget", "--gather-filter", "--interleave", "--cube-face",
+                             "--gather-pre-rays", "--gather-ray-budget", "--gather-filter", "--gather-outliers", "--interleave", "--cube-face",
                              "--spp", "--sky-rays", "--sky-ray-budget", "--shadow-edge-samples", "--env-intensity",
                              "--env-rotation", "--backend", "--no-gltf", "--dump-config", "--verbose", "--shard", "--resume",
                              "--checkpoint-seconds", "--vpl-block", "--no-leak-control", "--no-dilate", "--no-seams"})

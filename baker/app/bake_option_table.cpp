@@ -252,6 +252,10 @@ void addGatherRows(std::vector<OptionDescriptor>& t) {
                       "final gather: the gathered light averaged over (2R+1)² texels on\nthe same surface (default " +
                           shown(d.gather.filterRadius) + "; 0 = none)",
                       opt([](BakeOptions& o) { return &o.gather.filterRadius; })));
+  t.push_back(number("--gather-outliers", 0.0, 1e6, kGather, "K",
+                     "final gather: a texel's gathered light above K × its filter window's mean\nis held there and the "
+                     "excess spread ~4x wider (default " + shown(d.gather.outlierRatio) + "; 0 = off)",
+                     opt([](BakeOptions& o) { return &o.gather.outlierRatio; })));
   t.push_back(orAuto(integer("--interleave", 1, 8, kTexels, "N|auto",
                              "interleaved sampling: each texel of an N×N block sees 1/N²\n"
                              "of the VPLs, then a filter on the surface mixes them\n"

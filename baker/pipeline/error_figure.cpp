@@ -140,6 +140,12 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
   j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
   if (s.lightCutBound > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the light cut's bound (lightCull.cutBound)";
   if (s.lightTailNoise > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the sampled-back light tail's noise (lightCull.tailNoise)";
+  const double moved = report.contains("finalGather") ? report["finalGather"].value("outlierFraction", 0.0) : 0.0;
+  if (moved > 0.0) {  // light moved, not lost: a bias in where it lands, not in the map's mean
+    j["gatherOutliersMoved"] = moved;
+    j["notCovered"] = j["notCovered"].get<std::string>() + ", the final gather's outlier spread (gatherOutliersMoved: the "
+                      "share of the map's light moved by up to ~15 texels)";
+  }
   j["rounds"] = s.rounds;
   if (s.options.errorEstimate.targetError > 0.0) {
     j["targetError"] = s.options.errorEstimate.targetError;

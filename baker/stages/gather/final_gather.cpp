@@ -20,6 +20,8 @@ namespace {
 
 constexpr uint64_t kGatherStream = 0xf9;        // the gather's lattice rotations (forEachSampleLattice)
 constexpr uint64_t kPreGatherStream = 0xfa;     // the first pass's (independent of the final pass's)
+constexpr int kSpreadPasses = 3;  // the outliers' excess: box filters of radius 5 in turn, a soft ~31-texel window
+                                  // whose centre keeps 1/214 of a texel's excess (1/121 for one or two passes)
 
 }  // namespace
 
@@ -77,11 +79,11 @@ std::vector<PackedLightmap> packReflected(const std::vector<Lightmap>& maps,
 // gatherAt over ρ M packed (the gather's passes pack their source once).
 glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>& maps, const std::vector<int32_t>& mapOfPage,
                          const glm::vec3& x, const glm::vec3& n, int rays, double r1, double r2,
-                         const glm::vec3& missRadiance, L1Vectors* tangential) {
+                         const glm::vec3& missRadiance, L1Vectors* tangential, glm::vec3* emitted = nullptr) {
   const Scene& scene = in.scene;
   const RayTracer& rt = in.rayTracer;
   const glm::vec3 origin = x + n * rt.epsilon();
-  glm::vec3 sum(0.0f);
+  glm::vec3 sum(0.0f), emittedSum(0.0f);
   L1Vectors t{};
   CosineLattice lattice(n, rays, r1, r2);
   constexpr int kChunk = 32;  // rays traced together, 8 to a packet (one origin: the packets stay coherent)
@@ -101,6 +103,7 @@ glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>
       if (hit.backFace) continue;  // back faces hold no map
       const Primitive& prim = scene.primitives[hit.primitive];
       glm::vec3 L = scene.emissionAt(prim, hit.triangle, hit.barycentric);
+      emittedSum += L;
       const MapPoint point = mapPointOf(scene, mapOfPage, in.texels, hit);
       if (point.map >= 0 && static_cast<size_t>(point.map) < maps.size())
         L += maps[point.map].read(point.texel);  // ρ M, the albedo at the texel's footprint folded in
@@ -116,6 +119,7 @@ glm::vec3 gatherAtPacked(const BakeInputs& in, const std::vector<PackedLightmap>
   const float inv = 1.0f / static_cast<float>(std::max(1, rays));
   if (tangential)
     for (int a = 0; a < 3; ++a) (*tangential)[a] = t[a] * inv;
+  if (emitted) *emitted = emittedSum * inv;
   return sum * inv;
 }
 
@@ -128,6 +132,82 @@ glm::vec3 gatherAt(const BakeInputs& in, const std::vector<Lightmap>& maps, cons
 }
 
 namespace {
+
+// value's texels above ratio × their window's mean (radius r, the texel in it) held there; three rounds, so
+// that the mean a texel is held to no longer carries its own outlier (the excess shrinks by about ratio / n a
+// round, n the window's texels). Returns per texel the share kept (1 where untouched).
+std::vector<float> holdOutliers(SurfaceFilterCache* cache, const TexelSamples& ts, std::vector<glm::vec3>& value,
+                                const std::vector<uint8_t>& valid, float ratio, int r) {
+  std::vector<float> kept(value.size(), 1.0f);
+  TexelFilterOptions fo;
+  fo.radius = r;
+  fo.symmetric = false;  // a texel at a chart border or corner is held against the neighbours it has
+  for (int round = 0; round < 3; ++round) {
+    const std::vector<glm::vec3> mean = filterOnSurface(cache, ts, value, valid, fo);
+    tbb::parallel_for(size_t(0), value.size(), [&](size_t t) {
+      const float v = channelMean(value[t]), limit = ratio * channelMean(mean[t]);
+      if (!valid[t] || !(v > limit) || !std::isfinite(v)) return;
+      const float share = limit / v;
+      value[t] *= share;
+      kept[t] *= share;
+    });
+  }
+  return kept;
+}
+
+// A page's gathered sets (the light, then its L1 axes if any) filtered as options say. With outlierRatio, the
+// outliers of the light less its emitted part are held first (holdOutliers; the L1 axes scaled alike: emitters
+// are the pipeline's reason to leave the gather off, and forced on their light is left as it was) and what was taken is spread by
+// passes of the widest window (kSpreadPasses of SurfaceFilterPlan::kMaxRadius) and added
+// back: one ray on a tiny, very bright surface is seen as a faint wide glow instead of a bright square.
+// stats: outlierTexels counted; spread: Σ channelMean of the light spread.
+void filterGathered(SurfaceFilterCache* cache, const TexelSamples& ts, const std::vector<std::vector<glm::vec3>*>& sets,
+                    const std::vector<glm::vec3>& emitted, const std::vector<uint8_t>& valid,
+                    const FinalGatherOptions& options, bool holdThem, FinalGatherStats& stats, double& spread) {
+  std::vector<std::vector<glm::vec3>> excess;
+  if (holdThem && options.outlierRatio > 0.0f) {
+    const std::vector<glm::vec3> before = *sets[0];
+    std::vector<glm::vec3>& value = *sets[0];
+    for (size_t t = 0; t < value.size(); ++t) value[t] -= emitted[t];
+    const std::vector<float> kept = holdOutliers(cache, ts, value, valid, options.outlierRatio,
+                                                 std::max(1, options.filterRadius));
+    for (size_t t = 0; t < value.size(); ++t) value[t] += emitted[t];
+    excess.assign(sets.size(), std::vector<glm::vec3>(before.size(), glm::vec3(0.0f)));
+    for (size_t t = 0; t < kept.size(); ++t) {
+      if (kept[t] >= 1.0f) continue;
+      ++stats.outlierTexels;
+      spread += channelMean(before[t] - value[t]);
+      excess[0][t] = before[t] - value[t];
+      const float before1 = channelMean(before[t]);
+      const float share = before1 > 0.0f ? channelMean(value[t]) / before1 : 1.0f;  // the L1 scaled alike
+      for (size_t k = 1; k < sets.size(); ++k) {
+        excess[k][t] = (*sets[k])[t] * (1.0f - share);
+        (*sets[k])[t] *= share;
+      }
+    }
+  }
+  TexelFilterOptions fo;
+  fo.radius = options.filterRadius;
+  if (fo.radius > 0) {
+    const std::vector<const std::vector<glm::vec3>*> in(sets.begin(), sets.end());
+    std::vector<std::vector<glm::vec3>> filtered = filterOnSurface(cache, ts, in, valid, fo);
+    for (size_t k = 0; k < sets.size(); ++k) *sets[k] = std::move(filtered[k]);
+  }
+  if (excess.empty()) return;
+  TexelFilterOptions wide;
+  wide.radius = SurfaceFilterPlan::kMaxRadius;
+  wide.symmetric = false;  // every neighbour takes its share, up to a chart border
+  std::vector<const std::vector<glm::vec3>*> excessSets;
+  for (const auto& e : excess) excessSets.push_back(&e);
+  std::vector<std::vector<glm::vec3>> spreadSets;
+  for (int pass = 0; pass < kSpreadPasses; ++pass) {
+    spreadSets = filterOnSurface(cache, ts, excessSets, valid, wide);
+    for (size_t k = 0; k < spreadSets.size(); ++k) excess[k] = std::move(spreadSets[k]);
+  }
+  for (size_t k = 0; k < sets.size(); ++k)
+    for (size_t t = 0; t < excess[k].size(); ++t)
+      if (valid[t]) (*sets[k])[t] += excess[k][t];
+}
 
 // One gather: maps ← D + gather(source) at valid texels, the lattice rotations from stream.
 // albedo: texelAlbedo(in), made once for both passes.
@@ -146,11 +226,12 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
   std::vector<std::vector<glm::vec3>> gathered(maps.size());
   std::array<std::vector<std::vector<glm::vec3>>, 3> gatheredL1;
   const std::vector<PackedLightmap> packedSource = packReflected(source, albedo);
+  double spread = 0.0;  // Σ channelMean of the outliers' light spread (filterGathered)
   if (directional)
     for (auto& axis : gatheredL1) axis.resize(maps.size());
   for (size_t p = 0; p < maps.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
-    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f));
+    std::vector<glm::vec3> slotValue(ts.slotCount(), glm::vec3(0.0f)), slotEmitted(ts.slotCount(), glm::vec3(0.0f));
     std::vector<L1Vectors> slotVector(directional ? ts.slotCount() : 0, L1Vectors{});
     // Interleaved rotations (sample_lattice.h): every filter window averages one stratified lattice of rays
     // instead of independent rays per sample, so the filter removes more of their noise.
@@ -158,7 +239,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     forEachSampleLattice(in.rayTracer, ts, options.seed, stream,
                          [&](size_t s, const glm::vec3& x, const glm::vec3& n, double r1, double r2) {
                            slotValue[s] = gatherAtPacked(in, packedSource, mapOfPage, x, n, rays, r1, r2, options.missRadiance,
-                                                   directional ? &slotVector[s] : nullptr);
+                                                   directional ? &slotVector[s] : nullptr, &slotEmitted[s]);
                          },
                          &interleaved);
     std::vector<glm::vec3>& value = gathered[p];
@@ -167,28 +248,23 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
     tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
       if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotValue[s]; }, value[t]);
     });
-    if (options.filterRadius > 0) {
-      TexelFilterOptions fo;
-      fo.radius = options.filterRadius;
-      value = filterOnSurface(in.surfaceFilters, ts, value, valid, fo);
-    }
-    if (directional) {
-      std::array<std::vector<glm::vec3>, 3> axes;
+    std::vector<glm::vec3> emitted(ts.layerSize(), glm::vec3(0.0f));  // the emitters' share, not held
+    tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
+      if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotEmitted[s]; }, emitted[t]);
+    });
+    std::vector<std::vector<glm::vec3>*> sets = {&value};
+    std::array<std::vector<glm::vec3>, 3> axes;
+    if (directional)
       for (int k = 0; k < 3; ++k) {
         axes[k].assign(ts.layerSize(), glm::vec3(0.0f));
         tbb::parallel_for(size_t(0), ts.layerSize(), [&](size_t t) {
           if (valid[t]) texelMean(ts, t, [&](size_t s) { return slotVector[s][k]; }, axes[k][t]);
         });
+        sets.push_back(&axes[k]);
       }
-      if (options.filterRadius > 0) {  // the map's filter, the three axes in one pass
-        TexelFilterOptions fo;
-        fo.radius = options.filterRadius;
-        std::vector<std::vector<glm::vec3>> filtered =
-            filterOnSurface(in.surfaceFilters, ts, {&axes[0], &axes[1], &axes[2]}, valid, fo);
-        for (int k = 0; k < 3; ++k) axes[k] = std::move(filtered[k]);
-      }
+    filterGathered(in.surfaceFilters, ts, sets, emitted, valid, options, stream == kGatherStream, stats, spread);
+    if (directional)
       for (int k = 0; k < 3; ++k) gatheredL1[k][p] = std::move(axes[k]);
-    }
   }
   double total = 0.0, gatheredSum = 0.0, change = 0.0, before = 0.0;
   for (size_t p = 0; p < maps.size(); ++p)
@@ -212,6 +288,7 @@ void gatherPass(const BakeInputs& in, const std::vector<Lightmap>& direct, const
   stats.filterRadius = options.filterRadius;
   stats.gatheredFraction = total > 0.0 ? gatheredSum / total : 0.0;
   stats.changeFraction = before > 0.0 ? change / before : 0.0;
+  stats.outlierFraction = total > 0.0 ? spread / total : 0.0;
 }
 
 }  // namespace

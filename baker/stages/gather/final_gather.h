@@ -13,7 +13,11 @@
 // first bounce of the direct light, most of an indirectly lit region's light, is read from D, which is
 // exact. What remains is the rays' noise, independent texel to texel, which the texel filter averages.
 // Small bright emitters make the rays noisy (they are found by chance), so the pipeline uses it only in
-// scenes without emissive surfaces.
+// scenes without emissive surfaces. A small surface lit very brightly (a lamp's post top just under the lamp)
+// does the same through M: the rare texel whose ray met it would be spread by the filter into a bright
+// square. The final pass holds such a texel to outlierRatio × its window's mean and spreads the excess over a
+// window about four times as wide, with a soft edge: the light is moved (by up to ~15 texels), not removed,
+// so the map's mean keeps it; the moved share is the stats' outlierFraction (the error estimate lists it).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -44,6 +48,11 @@ struct FinalGatherOptions {
                                // final rays see them, which lowers the error against Cycles for few rays
                                // more. 0: off
   int preFilterRadius = 5;     // the first pass's filter (the widest SurfaceFilterCache plan serves it)
+  float outlierRatio = 4.0f;   // final pass: a texel's gathered light less its emitted part (Le at the hits)
+                               // above this × its window's mean (the filter's window, at least 3×3, the texel
+                               // in it) is held there before the filter, and the excess spread over a ~31-texel
+                               // soft window (filterGathered): one ray on a tiny, very bright surface no longer
+                               // makes a bright square. 0: off
 };
 
 struct FinalGatherStats {
@@ -53,10 +62,13 @@ struct FinalGatherStats {
   int filterRadius = 0;
   double gatheredFraction = 0;  // Σ gathered / Σ M' over valid texels (channel mean): the indirect share
   double changeFraction = 0;    // Σ |M' − M| / Σ M over valid texels: how much the gather moved the map
+  double outlierFraction = 0;   // Σ excess spread / Σ M' (channel mean): the light moved by the outlier spread
+  size_t outlierTexels = 0;     // texels held to outlierRatio × their window's mean
   double seconds = 0;
   nlohmann::json toJson() const {  // report "finalGather"
     return {{"rays", rays}, {"raysPerSample", raysPerSample}, {"preRaysPerSample", preRaysPerSample}, {"filterRadius", filterRadius},
-            {"gatheredFraction", gatheredFraction}, {"changeFraction", changeFraction}};
+            {"gatheredFraction", gatheredFraction}, {"changeFraction", changeFraction},
+            {"outlierFraction", outlierFraction}, {"outlierTexels", outlierTexels}};
   }
 };
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -196,6 +197,64 @@ TEST(FinalGather, InterleavedLatticesBeatIndependentRotationsBesideAWall) {
   }
   ASSERT_GT(errors[1].count, 2000u);
   expectInterleavingBeatsIndependent(errors);  // measured 0.0225 against 0.0409
+}
+
+// A closed room (4 × 4 × 3 m, ρ = 0.5, M = 1) with a 10 × 10 cm cap 0.5 m above the floor whose top holds
+// M = 2000 (a lamp's post top just under the lamp). One gather pass: a ceiling point x gathers exactly
+// ρ (1 + 1999 F(x)), F its view factor to the cap's top (5.1e-4 right above it: at most 2× the ρ it gathers
+// elsewhere), but a texel whose ray meets the cap (one in ~60 of them there) brings ~ρ 2000 / 64. Without
+// holding outliers the filter spreads each such texel into a 7 × 7 square (measured up to 14.7× the exact
+// gather); held and spread wide, what is left is the hits' own sparseness blurred over ~31 texels: no ceiling
+// texel above 2.5× its exact gather (measured 2.07), and the room's mean gather keeps the cap's light (within
+// 1% of the unheld one; the cap brings ~19% of it).
+TEST(FinalGather, ABrightTinyCapLeavesNoSquareAndKeepsItsLight) {
+  const float rho = 0.5f, bright = 2000.0f;
+  Scene s;
+  const int grey = addMaterial(s, glm::vec3(rho));
+  addBox(s, grey, glm::vec3(-2, -2, 0), glm::vec3(2, 2, 3), true);
+  const int cap = addQuad(s, grey, glm::vec3(-0.05f, -0.05f, 0.5f), glm::vec3(0.1f, 0, 0), glm::vec3(0, 0.1f, 0));
+  const std::vector<glm::dvec3> capTop = {{-0.05, -0.05, 0.5}, {0.05, -0.05, 0.5}, {0.05, 0.05, 0.5}, {-0.05, 0.05, 0.5}};
+  Atlased at(std::move(s), 256);
+  const std::vector<Lightmap> source =
+      at.maps([&](uint32_t p) { return glm::vec3(p == static_cast<uint32_t>(cap) ? bright : 1.0f); });
+  const std::vector<Lightmap> none = at.maps([](uint32_t) { return glm::vec3(0.0f); });
+  struct Figures { double worst = 0, mean = 0; size_t ceiling = 0, held = 0; double moved = 0; };
+  const auto gathered = [&](float outlierRatio) {
+    std::vector<Lightmap> maps = source;
+    FinalGatherOptions o;
+    o.preRays = 0;  // one pass: the exact gather is ρ (1 + 1999 F)
+    o.outlierRatio = outlierRatio;
+    FinalGatherStats stats;
+    finalGather(at.inputs(), none, maps, o, &stats);
+    Figures f;
+    size_t n = 0;
+    for (size_t p = 0; p < at.pages.size(); ++p)
+      for (size_t t = 0; t < maps[p].size(); ++t) {
+        if (!maps[p].valid[t] || at.pages[p].primitive[t] == static_cast<uint32_t>(cap)) continue;
+        const double g = channelMean(maps[p].texels[t]);
+        f.mean += g, ++n;
+        const glm::dvec3 x(at.pages[p].positionWeight[t]);
+        if (x.z < 2.99) continue;
+        const double exact = rho * (1.0 + (bright - 1.0) * polygonFormFactor(x, {0, 0, -1}, capTop));
+        f.worst = std::max(f.worst, g / exact);
+        ++f.ceiling;
+      }
+    f.mean /= std::max<size_t>(n, 1);
+    f.held = stats.outlierTexels;
+    f.moved = stats.outlierFraction;
+    return f;
+  };
+  const Figures unheld = gathered(0.0f), held = gathered(FinalGatherOptions{}.outlierRatio);
+  std::printf("[ figure ] bright cap: ceiling max gathered / exact %.3f unheld, %.3f held (%zu texels held, %.4f of "
+              "the map moved); room mean gather %.5f unheld, %.5f held (ρ = %.2f without the cap)\n",
+              unheld.worst, held.worst, held.held, held.moved, unheld.mean, held.mean, rho);
+  ASSERT_GT(held.ceiling, 1000u);
+  EXPECT_GT(unheld.worst, 5.0);  // the squares, without holding
+  EXPECT_LT(held.worst, 2.5);
+  EXPECT_GT(held.held, 0u);
+  EXPECT_EQ(unheld.held, 0u);
+  EXPECT_NEAR(held.mean / unheld.mean, 1.0, 0.01);
+  EXPECT_GT(unheld.mean, rho * 1.03);  // the cap's light is in the mean to be kept
 }
 
 // A single plane: every ray leaves the scene, so the map is D exactly, whatever M held.
