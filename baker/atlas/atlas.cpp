@@ -374,11 +374,11 @@ FaceCharts faceChartsOf(const Primitive& src, const PrimitiveCharts& range, cons
   return fc;
 }
 
-// The part of src whose charts landed on `page`: a vertex per (chart, input vertex), TEXCOORD_1 in [0, 1].
-Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& charts, const FaceCharts& fc,
-                          const atlas::PackResult& packed, int page, const AtlasPage& pg, bool nameThePage) {
+}  // namespace
+
+Primitive primitivePart(const Primitive& src, LightmapRef lightmap, bool nameThePage) {
   Primitive dst;
-  dst.name = nameThePage ? src.name + "#page" + std::to_string(page) : src.name;
+  dst.name = nameThePage ? src.name + "#page" + std::to_string(lightmap.page) : src.name;
   dst.material = src.material;
   dst.node = src.node;
   dst.instance = src.instance;
@@ -387,8 +387,18 @@ Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& char
   dst.gltfPrimitive = src.gltfPrimitive;
   dst.nodeToWorld = src.nodeToWorld;
   dst.normalsComputed = src.normalsComputed;
-  dst.lightmap = {page, pg.width, pg.height};
+  dst.lightmap = lightmap;
   dst.lightmapScale = src.lightmapScale;
+  dst.mode = src.mode;
+  return dst;
+}
+
+namespace {
+
+// The part of src whose charts landed on `page`: a vertex per (chart, input vertex), TEXCOORD_1 in [0, 1].
+Primitive primitiveOnPage(const Primitive& src, const std::vector<ChartUv>& charts, const FaceCharts& fc,
+                          const atlas::PackResult& packed, int page, const AtlasPage& pg, bool nameThePage) {
+  Primitive dst = primitivePart(src, {page, pg.width, pg.height}, nameThePage);
   const glm::dvec2 toUnit(1.0 / pg.width, 1.0 / pg.height);
   std::unordered_map<uint64_t, uint32_t> vertexOf;
   auto emit = [&](uint32_t inputVertex, glm::dvec2 texelUv) {

@@ -103,4 +103,8 @@ struct AtlasResult {
 // scaled by its lightmapScale (texel area × scale²).
 AtlasResult buildAtlas(Scene& scene, const AtlasOptions& options);
 
+// The part of `src` that lies on `lightmap`'s page, without vertices yet: src's material, node, instance, glTF
+// origin, lightmapScale and mode; named "<src>#page<N>" when nameThePage (src spread over several pages).
+Primitive primitivePart(const Primitive& src, LightmapRef lightmap, bool nameThePage);
+
 }  // namespace irbake

@@ -191,19 +191,7 @@ Primitive rebuiltPart(const Primitive& src, const Primitive& part, const std::ve
     }
   if (std::find(at.begin(), at.end(), kUnset) != at.end())
     throw Error(ErrorCode::InvalidData, file, what + ": the bake's part on page " + std::to_string(part.lightmap.page) + " has unused vertices");
-  Primitive dst;
-  dst.name = nameThePage ? src.name + "#page" + std::to_string(part.lightmap.page) : src.name;
-  dst.material = src.material;
-  dst.node = src.node;
-  dst.instance = src.instance;
-  dst.instanceToNode = src.instanceToNode;
-  dst.gltfMesh = src.gltfMesh;
-  dst.gltfPrimitive = src.gltfPrimitive;
-  dst.nodeToWorld = src.nodeToWorld;
-  dst.normalsComputed = src.normalsComputed;
-  dst.lightmap = part.lightmap;
-  dst.lightmapScale = src.lightmapScale;
-  dst.mode = src.mode;
+  Primitive dst = primitivePart(src, part.lightmap, nameThePage);
   const size_t n = src.positions.size();
   for (uint32_t v : at) {
     dst.positions.push_back(src.positions[v]);
