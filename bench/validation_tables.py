@@ -310,10 +310,10 @@ def t_light_cull():
             base = cpu.get((town, cull, tail), cpu.get((town, cull, "0"), (None, 0)))[0]
         ratio = f"{own / base:.2f}×" if own and base and not scene.endswith("sun") else ""
         out.append([scene, r["lamps"], r["range"] if r["range"] != "0" else "none", f"{float(r['texels']) / 1e6:.2f} M",
-                    cull if cull != "0" else "off (brute force)", tail if cull != "0" else "", c, runs,
+                    cull if cull != "0" else "off", tail if cull != "0" else "", c, runs,
                     num(own, 1) if own else "", ratio, pct(r["rel_rmse_vs_brute"])])
     return table(["scene", "lamps", "range (m)", "texels", "--light-cull", "--light-tail", "commit", "runs", "CPU (s)",
-                  "CPU / sun and sky alone", "rel. RMSE against brute force"], out)
+                  "CPU / sun + sky", "rel. RMSE vs brute force"], out)
 
 
 def t_plan_accuracy():
