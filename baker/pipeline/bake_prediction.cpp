@@ -7,6 +7,7 @@
 
 #include "common/error.h"
 #include "common/log.h"
+#include "pipeline/ray_pilot.h"
 
 namespace irbake {
 
@@ -75,7 +76,14 @@ nlohmann::json BakePrediction::toJson() const {
           {"warnings", warnings}};
 }
 
-BakePrediction predictBake(const Scene& scene, const BakeOptions& options, double cores) {
+void weighRays(BakePrediction& p, const Scene& scene, const RayTracer& rt) {
+  const RayPilot pilot = measureRayPilot(scene, rt);
+  p.inputs.rayCost = pilot.rayCost;
+  p.inputs.pilotHitFraction = pilot.hitFraction;
+  p.cost = predictCost(p.inputs);
+}
+
+BakePrediction predictBake(const Scene& scene, const BakeOptions& options, double cores, bool weighRays) {
   const QuietLog quiet;
   BakePrediction p;
   checkLightModes(options, scene);
@@ -88,6 +96,7 @@ BakePrediction predictBake(const Scene& scene, const BakeOptions& options, doubl
   markSettledAtBake(p.plan, options, p.atlas, probedGl);
   p.inputs = costInputs(scene, p.atlas, p.plan, options.lightCull, cores);
   p.cost = predictCost(p.inputs);
+  if (weighRays) irbake::weighRays(p, scene, RayTracer(scene));
   p.warnings = predictedWarnings(scene, options, p.atlas);
   return p;
 }

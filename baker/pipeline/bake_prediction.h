@@ -12,6 +12,7 @@
 #include "pipeline/bake_options.h"
 #include "pipeline/bake_plan.h"
 #include "pipeline/cost_model.h"
+#include "raytrace/ray_tracer.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -30,8 +31,13 @@ struct BakePrediction {
 inline const char* kSettledAtBake = "settled at bake";
 
 // Predicts the bake of `scene` (lights added) with `options` on `cores` cores. Logs nothing; throws Error(Usage)
-// where the bake would refuse the options before tracing (light modes, the probe budget).
-BakePrediction predictBake(const Scene& scene, const BakeOptions& options, double cores);
+// where the bake would refuse the options before tracing (light modes, the probe budget). Its rays are weighed by
+// the ray pilot over a tracer of its own, or, with weighRays false, left at the reference scene's cost (the bake
+// weighs them once it has built its tracer; the memory does not depend on them).
+BakePrediction predictBake(const Scene& scene, const BakeOptions& options, double cores, bool weighRays = true);
+
+// The ray pilot over `rt` (the scene's tracer) sets the prediction's cost per ray, and its time anew.
+void weighRays(BakePrediction& prediction, const Scene& scene, const RayTracer& rt);
 
 // The cores a bake uses here: TBB's limit (--threads sets it).
 double bakeCores();

@@ -171,9 +171,10 @@ void planBlocks(BakeState& s) {
 
 void prepare(BakeState& s) {
   // The preflight first: a bake predicted over --max-memory is refused before any work.
-  s.prediction = predictBake(s.scene, s.options, bakeCores());
+  s.prediction = predictBake(s.scene, s.options, bakeCores(), /*weighRays=*/false);
   checkMemoryLimit(s.prediction, s.options.maxMemoryGB, s.scene.sourcePath);
   buildGeometry(s);
+  weighRays(s.prediction, s.scene, *s.rayTracer);  // with the bake's own tracer
   // The backend first (the GL context is made here: its time counts to the backend, as it did): the
   // reference backend reads no VPLs, so it needs no VPL selection.
   timed(s, "backend", [&] { chooseBackend(s); });

@@ -7,7 +7,6 @@
 #include <unordered_map>
 
 #include "lights/light_kind.h"
-#include "pipeline/ray_pilot.h"
 #include "scene/triangle_area.h"
 #include "stages/probes/light_probes.h"
 
@@ -260,9 +259,6 @@ CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const Bake
     in.probeLights = probeLightReach(scene, *plan.probes.box, *plan.probes.spacing, reach);
   }
   in.cores = cores;
-  const RayPilot pilot = measureRayPilot(scene);
-  in.rayCost = pilot.rayCost;
-  in.pilotHitFraction = pilot.hitFraction;
   in.glBackend = plan.backend == BackendKind::Gl ? 1.0 : 0.0;
   return in;
 }

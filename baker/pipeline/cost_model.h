@@ -108,7 +108,8 @@ double lightTexelReach(const Scene& scene, const AtlasEstimate& atlas, const Lig
 // everywhere, and for every light where `reach` is null.
 double probeLightReach(const Scene& scene, const Bounds3& box, float spacing, const LightReach* reach);
 
-// The inputs for a scene, its atlas estimate and plan, with the bake's light cull, on `cores` cores.
+// The inputs for a scene, its atlas estimate and plan, with the bake's light cull, on `cores` cores; rayCost 1 until
+// the ray pilot weighs them (weighRays in bake_prediction.h).
 CostInputs costInputs(const Scene& scene, const AtlasEstimate& atlas, const BakePlan& plan, const LightCullOptions& cull,
                       double cores);
 

@@ -124,9 +124,8 @@ Scene rayPilotReferenceScene() {
   return s;
 }
 
-RayPilot measureRayPilot(const Scene& scene, const RayPilotOptions& options) {
+RayPilot measureRayPilot(const Scene& scene, const RayTracer& rt, const RayPilotOptions& options) {
   RayPilot pilot;
-  const RayTracer rt(scene);
   const PilotPoints points = pilotPoints(scene, rt, options);
   if (points.origins.empty()) return pilot;
   const Scene reference = rayPilotReferenceScene();

@@ -7,6 +7,7 @@
 #pragma once
 #include <cstdint>
 
+#include "raytrace/ray_tracer.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -28,8 +29,9 @@ struct RayPilot {
   long rays = 0;                        // rays traced in one round of this scene
 };
 
-// The pilot over `scene` (its mapped primitives are the origins; every primitive occludes).
-RayPilot measureRayPilot(const Scene& scene, const RayPilotOptions& options = {});
+// The pilot over `scene` (its mapped primitives are the origins; every primitive occludes), traced by `rt`, the
+// scene's own tracer (the bake's, so that no BVH is built twice).
+RayPilot measureRayPilot(const Scene& scene, const RayTracer& rt, const RayPilotOptions& options = {});
 
 // The scale of this scene's rays: its seconds per ray over the reference's (1 where either is not positive).
 double rayCostScale(double secondsPerRay, double referenceSecondsPerRay);

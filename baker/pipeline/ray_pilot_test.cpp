@@ -22,7 +22,7 @@ TEST(RayPilot, EveryRayHitsInsideABoxAndNoneAboveAPlane) {
   o.rounds = 1;
   Scene box;
   testing::addBox(box, testing::addMaterial(box, glm::vec3(0.5f)), glm::vec3(-1), glm::vec3(1), true, 2);
-  const RayPilot inside = measureRayPilot(box, o);
+  const RayPilot inside = measureRayPilot(box, RayTracer(box), o);
   EXPECT_EQ(inside.rays, 64 * 16);
   EXPECT_DOUBLE_EQ(inside.hitFraction, 1.0);
   EXPECT_GT(inside.secondsPerRay, 0.0);
@@ -30,10 +30,10 @@ TEST(RayPilot, EveryRayHitsInsideABoxAndNoneAboveAPlane) {
   Scene plane;  // facing up: the cosine rays leave into the empty half-space
   testing::addQuad(plane, testing::addMaterial(plane, glm::vec3(0.5f)), glm::vec3(-5, 0, -5), glm::vec3(0, 0, 10),
                    glm::vec3(10, 0, 0), 4);
-  EXPECT_DOUBLE_EQ(measureRayPilot(plane, o).hitFraction, 0.0);
+  EXPECT_DOUBLE_EQ(measureRayPilot(plane, RayTracer(plane), o).hitFraction, 0.0);
   Scene unmapped = box;  // no mapped surface to start from: the calibration's cost per ray
   for (Primitive& p : unmapped.primitives) p.mode = ObjectMode::ShadowOnly;
-  const RayPilot none = measureRayPilot(unmapped, o);
+  const RayPilot none = measureRayPilot(unmapped, RayTracer(unmapped), o);
   EXPECT_DOUBLE_EQ(none.rayCost, 1.0);
   EXPECT_EQ(none.rays, 0);
 }
