@@ -18,13 +18,6 @@ constexpr size_t kMaxCells = size_t(1) << 20;
 
 float channelMax(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 
-// The largest radiant intensity of a positional light (W/sr): an IES profile's largest candela.
-float peakIntensity(const Light& light) {
-  float peak = channelMax(light.color) * light.intensity;
-  if (light.type == LightType::Ies) peak *= light.profile ? static_cast<float>(light.profile->maxCandela) : 0.0f;
-  return std::max(0.0f, peak);
-}
-
 // What the lights at infinity and the sky give a surface facing them, as a map value: each directional light's
 // E/π and the sky's cosine-weighted mean radiance over the hemisphere about +Y (the glTF up axis).
 float infiniteReference(const Scene& scene) {
@@ -60,7 +53,7 @@ float neighbourReference(const Scene& scene) {
       if (j != i) best2 = std::min(best2, glm::dot(d, d));
     }
     if (!(best2 > 0.0f) || std::isinf(best2)) continue;  // lights at one point: no spacing to speak of
-    values.push_back(peakIntensity(scene.lights[i]) / (kPiF * best2));
+    values.push_back(channelMax(scene.lights[i].color) * peakIntensity(scene.lights[i]) / (kPiF * best2));
   }
   if (values.empty()) return 0.0f;
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
@@ -81,6 +74,12 @@ float boxDistance2(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& hi)
 
 }  // namespace
 
+float peakIntensity(const Light& light) {
+  float peak = light.intensity;
+  if (light.type == LightType::Ies) peak *= light.profile ? static_cast<float>(light.profile->maxCandela) : 0.0f;
+  return std::max(0.0f, peak);
+}
+
 size_t LightReach::cutLights() const {
   return static_cast<size_t>(std::count(cut.begin(), cut.end(), uint8_t(1)));
 }
@@ -100,7 +99,7 @@ LightReach settleLightReach(const Scene& scene, const Bounds3& bounds, const Lig
     float reach = l.range > 0.0f ? l.range : kEverywhere;
     bool cut = false;
     if (r.threshold > 0.0f && l.range <= 0.0f) {
-      reach = std::sqrt(peakIntensity(l) / (kPiF * r.threshold));
+      reach = std::sqrt(channelMax(l.color) * peakIntensity(l) / (kPiF * r.threshold));
       cut = true;
     }
     if (bounds.valid() && reach >= farthestCorner(l.position, bounds)) reach = kEverywhere, cut = false;

@@ -33,6 +33,10 @@ struct LightReach {
   size_t cutLights() const;
 };
 
+// The largest radiant intensity of a positional light per unit of colour (W/sr): its intensity, times an IES
+// profile's largest candela; ≥ 0. The reach weighs it by the colour's brightest channel, the light tail by its mean.
+float peakIntensity(const Light& light);
+
 // The reach of every light of `scene` whose geometry lies in `bounds`.
 LightReach settleLightReach(const Scene& scene, const Bounds3& bounds, const LightCullOptions& options);
 

@@ -7,6 +7,7 @@
 
 #include "common/maths.h"
 #include "common/progress.h"
+#include "lights/light_reach.h"
 #include "lights/light_tree.h"
 #include "sampling/sampling.h"
 #include "texels/surface_filter_cache.h"
@@ -15,13 +16,6 @@
 namespace irbake {
 
 namespace {
-
-// The light's intensity as channelMean weighs the map (an IES light's at its brightest candela).
-float peakIntensity(const Light& light) {
-  float peak = static_cast<float>(channelMean(light.color)) * light.intensity;
-  if (light.type == LightType::Ies) peak *= light.profile ? static_cast<float>(light.profile->maxCandela) : 0.0f;
-  return std::max(0.0f, peak);
-}
 
 // The cut lights as they would be without the cut, by scene index (empty where not cut or skipped).
 struct CutLights {
@@ -42,7 +36,8 @@ CutLights cutLights(const Scene& scene, const VplEvalOptions& eval, const std::v
     c.cut[i] = 1;
     // Light::cutoffWindow is 1 up to three quarters of the cutoff (nothing is left out nearer) and falls to 0 at the
     // cutoff by a smoothstep: what it leaves out rises by that smoothstep.
-    entries.push_back({static_cast<uint32_t>(i), l.position, peakIntensity(l), 0.75f * l.cutoff, l.cutoff});
+    entries.push_back({static_cast<uint32_t>(i), l.position,
+                       static_cast<float>(channelMean(l.color)) * peakIntensity(l), 0.75f * l.cutoff, l.cutoff});
   }
   c.tree = LightTree(std::move(entries));
   return c;
