@@ -115,6 +115,16 @@ TEST(AtlasFrom, APrimitiveSpreadOverSeveralPagesKeepsEveryPage) {
   EXPECT_EQ(texcoord1Bytes(dir / "b" / "scene.gltf"), texcoord1Bytes(dir / "a" / "scene.gltf"));
   const size_t pages = a["extras"]["irbakeAtlas"]["pages"].size();
   ASSERT_GT(pages, 1u);
+  // irbake plan with --atlas-from predicts that atlas as it is, not an unwrap at the default density.
+  const auto plan = runIrbakeIn(dir, {"plan", scene.string(), "--quality", "preview", "--json", "--atlas-from",
+                                      (dir / "a" / "scene.gltf").string()});
+  ASSERT_EQ(plan.code, 0) << plan.output;
+  const json predicted = json::parse(plan.output.substr(plan.output.find('{')))["atlas"];
+  double pageTexels = 0.0;
+  for (const json& p : a["extras"]["irbakeAtlas"]["pages"]) pageTexels += p["width"].get<double>() * p["height"].get<double>();
+  EXPECT_EQ(predicted["pages"].get<size_t>(), pages);
+  EXPECT_EQ(predicted["pageTexels"].get<double>(), pageTexels);
+  EXPECT_EQ(predicted["texelsPerMetre"].get<double>(), 300.0);
   for (size_t page = 0; page < pages; ++page) {
     const std::string name = "lightmap_" + std::to_string(page) + ".exr";
     EXPECT_LE(relativeMaxDifference(readExr(dir / "a" / name), readExr(dir / "b" / name)), 1e-6) << name;

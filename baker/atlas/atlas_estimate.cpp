@@ -62,8 +62,7 @@ int choosePageSize(double scaledArea, double texelsPerUnit, const AtlasOptions& 
   return kMaxAutoPageSize;
 }
 
-AtlasEstimate estimateAtlas(const Scene& scene, const AtlasOptions& options) {
-  AtlasEstimate estimate;
+double scaledLightmapArea(const Scene& scene) {
   double scaledArea = 0.0;
   for (const Primitive& p : scene.primitives) {
     if (!p.getsLightmap()) continue;  // shadow-only, probe-lit, off: no charts
@@ -71,6 +70,12 @@ AtlasEstimate estimateAtlas(const Scene& scene, const AtlasOptions& options) {
     for (size_t t = 0; t < p.triangleCount(); ++t) area += triangleArea(p, t);
     scaledArea += area * double(p.lightmapScale) * double(p.lightmapScale);
   }
+  return scaledArea;
+}
+
+AtlasEstimate estimateAtlas(const Scene& scene, const AtlasOptions& options) {
+  AtlasEstimate estimate;
+  const double scaledArea = scaledLightmapArea(scene);
   const DensityChoice density = chooseTexelsPerUnit(scaledArea, scene.triangleCount(), options);
   if (!density.warning.empty()) estimate.warnings.push_back(density.warning);
   estimate.texelsPerUnit = density.texelsPerUnit;

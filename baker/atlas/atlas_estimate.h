@@ -20,6 +20,8 @@ struct AtlasEstimate {
 };
 // The density rule and its page layout predicted from the surface areas alone, without unwrapping.
 AtlasEstimate estimateAtlas(const Scene& scene, const AtlasOptions& options);
+// The surface that gets light-map texels: each light-mapped primitive's area times its lightmapScale² (m²).
+double scaledLightmapArea(const Scene& scene);
 
 // The density rule. scaledArea: the surface to map, each primitive's area times its lightmapScale² (m²);
 // triangles: the scene's triangle count.

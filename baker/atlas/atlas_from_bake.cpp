@@ -313,4 +313,16 @@ AtlasResult atlasFromBake(Scene& scene, const BakedAtlas& baked, const AtlasOpti
   return result;
 }
 
+AtlasEstimate estimateBakedAtlas(const Scene& scene, const BakedAtlas& baked) {
+  AtlasEstimate estimate;
+  estimate.texelsPerUnit = baked.texelsPerUnit;
+  estimate.texels = scaledLightmapArea(scene) * baked.texelsPerUnit * baked.texelsPerUnit;
+  for (const AtlasPage& p : baked.pages) {
+    estimate.pageTexels += double(p.width) * double(p.height);
+    estimate.pageSize = std::max({estimate.pageSize, p.width, p.height});
+  }
+  estimate.pages = int(baked.pages.size());
+  return estimate;
+}
+
 }  // namespace irbake

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atlas/atlas.h"
+#include "atlas/atlas_estimate.h"
 #include "scene/scene.h"
 
 namespace irbake {
@@ -58,5 +59,9 @@ BakedAtlas readBakedAtlas(const std::filesystem::path& file);
 // `options` asks for an atlas of its own (texelsPerUnit, maxPageSize, keepUv1). lightmapScale is ignored, with a
 // warning where it is not 1.
 AtlasResult atlasFromBake(Scene& scene, const BakedAtlas& baked, const AtlasOptions& options);
+
+// What `irbake plan --atlas-from` predicts: the earlier bake's pages and density as they are, its chart texels
+// from the surface at that density (the charts hold each object's lightmapScale already).
+AtlasEstimate estimateBakedAtlas(const Scene& scene, const BakedAtlas& baked);
 
 }  // namespace irbake

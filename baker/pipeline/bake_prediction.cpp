@@ -5,6 +5,7 @@
 
 #include <tbb/global_control.h>
 
+#include "atlas/atlas_from_bake.h"
 #include "common/error.h"
 #include "common/log.h"
 #include "pipeline/ray_pilot.h"
@@ -87,7 +88,9 @@ BakePrediction predictBake(const Scene& scene, const BakeOptions& options, doubl
   const QuietLog quiet;
   BakePrediction p;
   checkLightModes(options, scene);
-  p.atlas = estimateAtlas(scene, options.atlas);
+  // --atlas-from: the earlier bake's pages, read back (the bake checks the geometry against them)
+  p.atlas = options.atlasFrom.empty() ? estimateAtlas(scene, options.atlas)
+                                      : estimateBakedAtlas(scene, readBakedAtlas(options.atlasFrom));
   bool probedGl = false;
   p.plan = planBake(scene, hasTransmissiveMaterial(scene), options, [&] {
     probedGl = true;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes a copy of a GLB with one KHR_lights_punctual point light added (for bakes of third-party levels that
+"""Writes a copy of a GLB with KHR_lights_punctual point lights added (for bakes of third-party levels that
 ship without lights, e.g. ../shared/scenes/sibenik: sky through the windows plus one interior lamp).
-Usage: add_point_light.py IN.glb OUT.glb X,Y,Z INTENSITY_CD [R,G,B]   (glTF units: metres, candela)"""
+Usage: add_point_light.py IN.glb OUT.glb X,Y,Z[;X,Y,Z...] INTENSITY_CD [R,G,B]   (glTF units: metres, candela)
+One position: the light is named "interior lamp"; several: "lamp 0", "lamp 1", ..."""
 import json
 import struct
 import sys
@@ -11,7 +12,7 @@ def main():
     if len(sys.argv) < 5:
         sys.exit(__doc__)
     src, dst = sys.argv[1], sys.argv[2]
-    pos = [float(v) for v in sys.argv[3].split(",")]
+    positions = [[float(v) for v in p.split(",")] for p in sys.argv[3].split(";") if p.strip()]
     intensity = float(sys.argv[4])
     color = [float(v) for v in sys.argv[5].split(",")] if len(sys.argv) > 5 else [1.0, 1.0, 1.0]
     data = open(src, "rb").read()
@@ -23,14 +24,15 @@ def main():
     rest = data[20 + jlen:]  # the BIN chunk, unchanged
     ext = doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {})
     lights = ext.setdefault("lights", [])
-    lights.append({"type": "point", "intensity": intensity, "color": color, "name": "interior lamp"})
+    for i, pos in enumerate(positions):
+        name = "interior lamp" if len(positions) == 1 else "lamp %d" % i
+        lights.append({"type": "point", "intensity": intensity, "color": color, "name": name})
+        doc.setdefault("nodes", []).append({"name": name, "translation": pos,
+                                            "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}})
+        doc["scenes"][doc.get("scene", 0)].setdefault("nodes", []).append(len(doc["nodes"]) - 1)
     used = doc.setdefault("extensionsUsed", [])
     if "KHR_lights_punctual" not in used:
         used.append("KHR_lights_punctual")
-    doc.setdefault("nodes", []).append({"name": "interior lamp", "translation": pos,
-                                        "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}})
-    scene = doc.get("scene", 0)
-    doc["scenes"][scene].setdefault("nodes", []).append(len(doc["nodes"]) - 1)
     j = json.dumps(doc, separators=(",", ":")).encode()
     j += b" " * ((4 - len(j) % 4) % 4)
     out = struct.pack("<III", magic, version, 12 + 8 + len(j) + len(rest)) + struct.pack("<II", len(j), jtype) + j + rest
