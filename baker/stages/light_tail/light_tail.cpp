@@ -107,19 +107,27 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
   }
   const int m = std::max(candidates, rays);
   room.lo.resize(size_t(m)), room.weight.resize(size_t(m)), room.upTo.resize(size_t(m));
-  const double shift = rng.uniform();
+  // The walk weighs a leaf by its exact light just before it hands that leaf over: the last two lights weighed are
+  // kept, so a candidate's light is not evaluated twice.
+  uint32_t seen[2] = {UINT32_MAX, UINT32_MAX};
+  LeftOut seenLo[2];
+  int next = 0;
+  auto weigh = [&](uint32_t i) {
+    seen[next] = i, seenLo[next] = leftOutLight(in.scene, c, i, x, n);
+    const double v = channelMean(seenLo[next].value);
+    next ^= 1;
+    return v;
+  };
+  std::fill(room.weight.begin(), room.weight.end(), 0.0);
+  c.tree.sampleStratified(x, n, rng.uniform(), m, weigh, [&](int j, const LightTree::Choice& choice) {
+    LeftOut& lo = room.lo[size_t(j)];
+    lo = seen[0] == choice.light ? seenLo[0] : seen[1] == choice.light ? seenLo[1]
+                                                                        : leftOutLight(in.scene, c, choice.light, x, n);
+    const double value = channelMean(lo.value);
+    if (value > 0.0 && choice.pmf > 0.0) room.weight[size_t(j)] = 1.0 / value, room.upTo[size_t(j)] = value / choice.pmf;
+  });
   double total = 0.0;
-  for (int j = 0; j < m; ++j) {
-    const LightTree::Choice choice = c.tree.sample(x, n, (j + shift) / m, exact);
-    double value = 0.0;
-    if (choice.light != UINT32_MAX && choice.pmf > 0.0) {
-      room.lo[size_t(j)] = leftOutLight(in.scene, c, choice.light, x, n);
-      value = channelMean(room.lo[size_t(j)].value);
-    }
-    room.weight[size_t(j)] = value > 0.0 ? 1.0 / value : 0.0;
-    if (value > 0.0) total += value / choice.pmf;
-    room.upTo[size_t(j)] = total;
-  }
+  for (int j = 0; j < m; ++j) total += room.weight[size_t(j)] > 0.0 ? room.upTo[size_t(j)] : 0.0, room.upTo[size_t(j)] = total;
   if (!(total > 0.0)) return sum;
   const double pick = rng.uniform();
   int j = 0, last = -1;
