@@ -306,7 +306,7 @@ void addLightRows(std::vector<OptionDescriptor>& t) {
                      "reference (default " + shown(LightCullOptions{}.fraction) + ", docs/units.md); 0: every light everywhere",
                      opt([](BakeOptions& o) { return &o.lightCull.fraction; })));
   t.push_back(integer("--light-tail", 0, 256, kLights, "N",
-                      "lights drawn per texel from a light tree to add back what the cut left\nout of lights without "
+                      "shadow rays per texel (to lights resampled from a light tree) adding back\nwhat the cut left out of lights without "
                       "range (default " + shown(LightTailOptions{}.samples) + "; 0: left out)",
                       opt([](BakeOptions& o) { return &o.lightTail.samples; })));
   t.push_back(text("--env", kCommon, "FILE", "an equirectangular environment (.exr/.hdr, +Y up) instead of --sky",

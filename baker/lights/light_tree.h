@@ -60,6 +60,19 @@ class LightTree {
     c.pmf = pmf;
     return c;
   }
+  // What sample() gives each of u_k = (k + shift) / m, k < m (stratified draws), walking every node once for all
+  // of them: take(k, choice) for each k whose light gives x anything, in order of k, right after the walk weighed
+  // that light by exact(light).
+  template <class Exact, class Take>
+  void sampleStratified(const glm::vec3& x, const glm::vec3& n, double shift, int m, Exact&& exact, Take&& take) const {
+    if (nodes_.empty() || m <= 0) return;
+    if (nodes_.size() == 1) {
+      if (exact(entries_[0].light) > 0.0)
+        for (int k = 0; k < m; ++k) take(k, Choice{entries_[0].light, 1.0});
+      return;
+    }
+    descend(0, 1.0, 0.0, 1.0, 0, m, shift, m, x, n, exact, take);
+  }
   // The probability that sample() picks `light` at (x, n) (0 for a light not in the tree).
   template <class Exact>
   double pmf(const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {
@@ -86,6 +99,23 @@ class LightTree {
       return v > 0.0 ? v : 0.0;
     }
     return importance(node, x, n);
+  }
+  // The draws k in [k0, k1), whose u lie in [lo, hi), through node `at` reached with probability pmf.
+  template <class Exact, class Take>
+  void descend(int32_t at, double pmf, double lo, double hi, int k0, int k1, double shift, int m, const glm::vec3& x,
+               const glm::vec3& n, Exact& exact, Take& take) const {
+    const Node& node = nodes_[size_t(at)];
+    if (node.left < 0) {
+      for (int k = k0; k < k1; ++k) take(k, Choice{entries_[node.entry].light, pmf});
+      return;
+    }
+    const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
+    if (!(a + b > 0.0)) return;
+    const double pa = a / (a + b), split = lo + pa * (hi - lo);
+    int ks = k0;
+    while (ks < k1 && (ks + shift) / m < split) ++ks;
+    if (ks > k0) descend(node.left, pmf * pa, lo, split, k0, ks, shift, m, x, n, exact, take);
+    if (k1 > ks) descend(node.right, pmf * (1.0 - pa), split, hi, ks, k1, shift, m, x, n, exact, take);
   }
   template <class Exact>
   double pmfBelow(int32_t at, const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {

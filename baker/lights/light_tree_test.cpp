@@ -94,5 +94,37 @@ TEST(LightTree, DrawsFollowTheProbabilitiesAndTheEstimateIsUnbiased) {
   EXPECT_LT(deviation, 0.5 * uniformDeviation);
 }
 
+// Stratified draws walked at once give each u_k = (k + shift) / m the light sample() gives it, with its
+// probability (to rounding: the walk splits intervals where sample() rescales u), each right after the walk
+// weighed that light.
+TEST(LightTree, StratifiedDrawsAtOnceAreTheDrawsOneByOne) {
+  const Lamps lamps = scatteredLamps(64, 9);
+  const LightTree tree(lamps.entries);
+  Rng rng(4);
+  int same = 0, taken = 0;
+  for (int p = 0; p < 20; ++p) {
+    const glm::vec3 x(float(rng.uniform() * 40.0 - 20.0), 0.0f, float(rng.uniform() * 40.0 - 20.0)), n(0, 1, 0);
+    uint32_t last[2] = {UINT32_MAX, UINT32_MAX};
+    int next = 0;
+    auto exact = [&](uint32_t i) { return last[next ^= 1] = i, lamps.value(i, x, n); };
+    auto plain = [&](uint32_t i) { return lamps.value(i, x, n); };
+    const double shift = rng.uniform();
+    const int m = 16;
+    int expect = 0;
+    tree.sampleStratified(x, n, shift, m, exact, [&](int k, const LightTree::Choice& c) {
+      EXPECT_TRUE(c.light == last[0] || c.light == last[1]) << "point " << p << " draw " << k;
+      EXPECT_GE(k, expect) << "in order of k";
+      expect = k + 1, ++taken;
+      const LightTree::Choice one = tree.sample(x, n, (k + shift) / m, plain);
+      if (one.light == c.light) {
+        ++same;
+        EXPECT_NEAR(c.pmf, one.pmf, 1e-9 * one.pmf);
+      }
+    });
+  }
+  EXPECT_GT(taken, 200);
+  EXPECT_GE(same, taken - 2);  // a u on a split's rounding edge may go the other way
+}
+
 }  // namespace
 }  // namespace irbake

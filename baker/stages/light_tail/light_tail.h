@@ -1,11 +1,12 @@
 // The light the cut takes back, sampled. A light without range is cut where its light falls to a share of the
 // scene's reference (lights/light_reach.h): every evaluator gives it only up to its reach, faded out over the last
 // quarter. Many such lights (a town's lamps) leave many small tails whose sum is not small. Here each texel gets
-// an estimate of that sum: N lights drawn from a light tree (lights/light_tree.h) over the cut lights, each in
-// proportion to a bound on what it gives the texel, its left-out light (its light without the cut less its faded
-// light) traced with one shadow ray and divided by its probability. The tail is faint and smooth (far lights), so
-// the estimate is filtered on the surface like the sky; two independent halves of the draws, filtered alike, tell
-// its remaining noise for the error figure. docs/units.md, "Light reach".
+// an estimate of that sum: candidate lights drawn from a light tree (lights/light_tree.h) over the cut lights, in
+// proportion to a bound on what each gives the texel, weighed by their exact unshadowed left-out light (their light
+// without the cut less their faded light); N shadow rays go to lights resampled among them in proportion to that
+// weight (resampled importance sampling), so the rays only find out the visibility. The tail is faint and smooth
+// (far lights), so the estimate is filtered on the surface like the sky; two independent halves of the candidates
+// and rays, filtered alike, tell its remaining noise for the error figure. docs/units.md, "Light reach".
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -18,7 +19,8 @@
 namespace irbake {
 
 struct LightTailOptions {
-  int samples = 8;       // lights drawn per texel (0: the cut light stays left out)
+  int samples = 8;       // shadow rays per texel (0: the cut light stays left out)
+  int candidates = 32;   // lights drawn per texel, among which the rays are resampled (0: each ray its own draw)
   int filterRadius = 4;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
   uint64_t seed = 0;     // the draws' seed (the walk's)
 };
