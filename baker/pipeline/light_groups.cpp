@@ -10,6 +10,7 @@
 #include "pipeline/bake_plan.h"
 #include "pipeline/light_modes.h"
 #include "stages/error_estimate/error_estimate.h"
+#include "stages/probes/light_probes.h"
 
 namespace irbake {
 
@@ -309,6 +310,10 @@ BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
 // where the whole would not.
   if (o.finalGather == FinalGatherMode::Auto) o.finalGather = finalGatherAutoOn(scene) ? FinalGatherMode::On : FinalGatherMode::Off;
   if (!(o.clampVplsPerMean > 0.0)) o.clampVplsPerMean = autoClampVplsPerMean(scene, o.eval.biasCompensation);
+  // The probe grid too: the layers' coefficients are summed probe by probe, and the automatic spacing follows the
+  // lights (a directional light's shadows ask for a finer grid than a group of lamps would get).
+  if (o.probes.enabled && !o.probes.spacing)
+    o.probes.spacing = chooseProbeSpacing(o.probes.box ? *o.probes.box : scene.bounds(), autoProbeCount(o.probes, scene.lights));
   const std::vector<Light> lights = scene.lights;
   const std::vector<Material> materials = scene.materials;
   const Environment environment = scene.environment;
