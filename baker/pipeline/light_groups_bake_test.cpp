@@ -297,3 +297,26 @@ TEST(LightGroups, RefusesDuplicatesBadNamesUnknownLightsAndSourcesInNoGroup) {
   EXPECT_NE(empty.find("'*'"), std::string::npos) << empty;
   EXPECT_EQ(resolveLightGroups(s, {request("a", {"left", "right"}), request("b", {"emissive:neon"})}).size(), 2u);
 }
+
+// The automatic probe spacing follows the lights (a directional light's shadows ask for a finer grid): a group with
+// the sun and one without would place grids of their own, whose coefficients cannot be summed. The grid is settled
+// once for the whole scene: every layer's probes are the ungrouped bake's grid, and they sum to the total's.
+TEST(LightGroups, TheProbeGridIsTheWholeScenesWhenOnlyOneGroupHasTheSun) {
+  Scene s;
+  const int grey = irbake::testing::addMaterial(s, glm::vec3(0.5f));
+  irbake::testing::addQuad(s, grey, {-2.0f, 0.0f, 2.0f}, {4.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -4.0f});  // floor, facing up
+  irbake::testing::addBox(s, grey, {-0.5f, 0.0f, -0.5f}, {0.5f, 1.0f, 0.5f}, false);
+  Light sun = irbake::testing::directionalLight(glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f)), 3.0f);
+  sun.name = "daylight";
+  s.lights = {sun, namedPoint("lamp", {1.2f, 1.5f, 0.0f}, 2.0f)};
+  BakeOptions o = roomBake();
+  o.walk.paths = 512;
+  o.errorEstimate.enabled = false;
+  const BakeResult all = bake(s, o);
+  o.lightGroups = {request("day", {"daylight"}), request("night", {"lamp"})};
+  const BakeResult sum = bakeLightGroups(s, o);
+  ASSERT_GT(all.probes.size(), 0u);
+  EXPECT_EQ(sum.probes.counts, all.probes.counts);
+  ASSERT_EQ(sum.layers.size(), 2u);
+  for (const auto& layer : sum.layers) EXPECT_EQ(layer.probes.size(), all.probes.size()) << layer.name;
+}
