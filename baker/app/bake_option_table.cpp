@@ -296,6 +296,12 @@ void addLightRows(std::vector<OptionDescriptor>& t) {
                   "(every punctual light); name:TEXT, index:I and option:sun never\n"
                   "mean another light; repeatable, beats extras.irbake.mode",
                   arg(&BakeArguments::lightModes)));
+  t.push_back(row("--light-group", OptionKind::Repeated, kLights, "NAME=LIGHTS",
+                  "bake these sources into a layer of their own (IRBAKE_lightmap_scenarios);\n"
+                  "LIGHTS: comma-separated light names, sun, sky, emissive, emissive:NAME,\n"
+                  "#I or * (every source no other group names); repeatable, beside\n"
+                  "extras.irbake.group; the maps hold the sum (docs/guide.md)",
+                  arg(&BakeArguments::lightGroups)));
   t.push_back(preset(integer("--shadow-edge-samples", 0, 16, kLights, "S",
                              "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
                                  shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)",

@@ -24,6 +24,7 @@ struct BakeArguments {
   std::string sun, sky, env;       // --sun, --sky, --env as given (BakeCommand::lights once checked)
   std::string probes = "auto", probeBox;  // --probes auto|off|SPACING, --probe-box as given
   std::vector<std::string> lightModes;  // --light-mode NAME=MODE as given
+  std::vector<std::string> lightGroups;  // --light-group NAME=LIGHTS as given
   std::string lightModeOrigin;          // "FILE: line N: key 'light-mode'" when the config file gave them
   double envIntensity = 1.0, envRotation = 0.0;
   bool helpAll = false;

@@ -30,6 +30,7 @@
 #include "export/light_probes_export.h"
 #include "pipeline/backend_choice.h"
 #include "pipeline/bake.h"
+#include "pipeline/light_groups.h"
 #include "pipeline/vpl_sum_file.h"
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/interleave/interleaved_sampling.h"
@@ -153,6 +154,22 @@ void checkOptionValues(BakeCommand& command, const BakeArguments& a) {
     request.origin = a.lightModeOrigin;
     o.lightModes.push_back(request);
   }
+  for (const std::string& entry : a.lightGroups) {
+    const size_t eq = entry.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == entry.size())
+      throw Error(ErrorCode::Usage, "", "--light-group needs NAME=LIGHTS, LIGHTS comma-separated (got " + quotedExcerpt(entry) + ")");
+    LightGroupRequest request;
+    request.name = entry.substr(0, eq);
+    for (size_t at = eq + 1; at <= entry.size();) {
+      const size_t comma = std::min(entry.find(',', at), entry.size());
+      if (comma == at) throw Error(ErrorCode::Usage, "", "--light-group " + quotedExcerpt(entry) + ": an empty light name");
+      request.sources.push_back(entry.substr(at, comma - at));
+      at = comma + 1;
+    }
+    o.lightGroups.push_back(request);
+  }
+  if (!o.lightGroups.empty() && command.shardIndex > 0)
+    throw Error(ErrorCode::Usage, "", "--light-group bakes each group apart: --shard does not split them yet");
 }
 
 // The parsed arguments as options; throws Error(Usage) for values and combinations CLI11 cannot check.
@@ -247,7 +264,7 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine,
     const OptionDescriptor* d = findBakeOption(e.key);
     if (!d || d->has(kNotInConfig)) fail("not an option of 'irbake bake' (see 'irbake bake --help-all')");
     if (givenOption(*given, *d)->count() > 0) continue;
-    if (e.array && d->kind != OptionKind::Repeated) fail("takes one value, not an array (only light-mode is repeated)");
+    if (e.array && d->kind != OptionKind::Repeated) fail("takes one value, not an array (only light-mode and light-group are repeated)");
     const bool positional = d->name == "SCENE";
     const std::string name = positional ? d->name : "--" + d->name;
     Args words;
@@ -272,7 +289,7 @@ Args configArguments(const std::filesystem::path& file, const Args& commandLine,
       for (const std::string& value : e.array ? e.items : std::vector<std::string>{e.value}) message = withExcerpt(message, value);
       fail(message);
     }
-    if (d->kind == OptionKind::Repeated) lightModeOrigin = file.string() + ": " + line;
+    if (d->name == "light-mode") lightModeOrigin = file.string() + ": " + line;
     out.insert(out.end(), words.begin(), words.end());
   }
   return out;
@@ -464,6 +481,11 @@ bool isPageName(const std::string& name) {
   while (at < name.size() && std::isdigit(static_cast<unsigned char>(name[at]))) ++at, ++digits;
   if (digits == 0) return false;
   const std::string rest = name.substr(at);
+  // A light group's layer: lightmap_<page>_<group>.exr / .png.
+  const size_t dot = rest.rfind('.');
+  if (rest.size() > 1 && rest[0] == '_' && dot != std::string::npos && (rest.substr(dot) == ".exr" || rest.substr(dot) == ".png") &&
+      validLayerName(rest.substr(1, dot - 1)))
+    return true;
   return rest == ".exr" || rest == ".png" || rest == "_l1x.exr" || rest == "_l1y.exr" || rest == "_l1z.exr" ||
          rest == "_l1x.png" || rest == "_l1y.png" || rest == "_l1z.png" || rest == "_shadowmask.exr" ||
          rest == "_shadowmask.png";
@@ -535,6 +557,21 @@ std::unique_ptr<OutputFolderLock> lockReportFolder(const BakeCommand& c) {
   return std::make_unique<OutputFolderLock>(folder);
 }
 
+namespace {
+// A bake with light groups (pipeline/light_groups.h): each group baked apart, in one process, no checkpoint.
+int runGroupedBake(BakeCommand& c, Scene scene, TerminalProgress& progress, const OutputGuard& guard, double loadSeconds,
+                   double loadCpuSeconds) {
+  if (c.shardIndex > 0 || c.resume)
+    throw Error(ErrorCode::Usage, c.scene, "light groups bake each group apart in one run: --shard and --resume do not split them yet");
+  BakeResult result = bakeLightGroups(std::move(scene), c.options);
+  result.report["timings"]["seconds"]["load"] = loadSeconds;
+  result.report["timings"]["cpuSeconds"]["load"] = loadCpuSeconds;
+  result.report["options"] = c.resultOptions;
+  writeFinishedBake(c, result, progress, guard);
+  return 0;
+}
+}  // namespace
+
 int runBake(const Args& args) {
   std::optional<BakeCommand> parsed = parseBakeCommand(args);
   if (!parsed) return 0;
@@ -556,6 +593,7 @@ int runBake(const Args& args) {
 
   TerminalProgress progress;
   c.options.progress = progress.callback();
+  if (!resolveLightGroups(scene, c.options.lightGroups).empty()) return runGroupedBake(c, std::move(scene), progress, *guard, loadSeconds, loadCpuSeconds);
   StagedBake staged(std::move(scene), c.options);
 
   // The blocks this process adds: all, or share K of N.

@@ -30,6 +30,7 @@
 #include "common/log.h"
 #include "export/gltf_compact.h"
 #include "export/directional_export.h"
+#include "export/light_layers.h"
 #include "export/light_probes_export.h"
 #include "export/map_encoding.h"
 #include "export/spec_gloss_conversion.h"
@@ -548,6 +549,7 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
 
   const bool fromSource = !scene.sourcePath.empty() && std::filesystem::exists(scene.sourcePath);
   GltfDocument doc = fromSource ? SourceExport(scene, maps, images, file).run() : documentFromScene(scene, maps, images, pageUris);
+  removeLightScenariosExtension(doc.root);  // a source's layers go: this bake writes its own, or none
   // glTF allows extras of any type: a source's non-object root extras is kept as it is, without our records.
   const bool rootExtrasIsObject = !doc.root.contains("extras") || doc.root["extras"].is_object();
   if (!rootExtrasIsObject && ((fromSource && !pageUris.empty()) || scene.environment.present()))
@@ -574,6 +576,14 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
       for (const Lightmap& m : *options.shadowMask->rgb) pageUris.push_back(shadowMaskPageUri(options.exrPrefix, m.page));
   }
 
+  const bool layered = options.layers && !options.layers->empty();
+  if (layered) {
+    addLightScenariosExtension(doc, *options.layers, options.lightmapEncoding, options.writeExrPages ? options.exrPrefix : std::string());
+    if (options.writeExrPages)
+      for (const LightLayer& layer : *options.layers)
+        for (const Lightmap& m : layer.maps) pageUris.push_back(layerPageUri(options.exrPrefix, m.page, layer.name));
+  }
+
   std::vector<PendingFile> files;
   const std::filesystem::path folder = options.output.parent_path();
   if (!hasExtension(options.output, ".glb")) {
@@ -592,6 +602,7 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
   // After the last compaction, which knows nothing of the probes' accessors; a source's own probes go.
   removeLightProbesExtension(doc.root);
   if (options.probes && options.probes->size() > 0) addLightProbesExtension(doc, *options.probes);
+  if (layered && options.probes) addLightScenarioProbes(doc, *options.layers, *options.probes);
   std::vector<PendingFile> docFiles = doc.files(options.output);
   files.insert(files.begin(), docFiles.begin(), docFiles.end());
   if (options.writeExrPages) {
@@ -608,6 +619,12 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
           const std::filesystem::path finalPath = folder / directionalPageUri(options.exrPrefix, m.page, k);
           files.push_back({finalPath, [exr, map, finalPath](const std::filesystem::path& temp) { exr->writeFile(*map, {}, temp, finalPath); }});
         }
+    for (size_t l = 0; layered && l < options.layers->size(); ++l)
+      for (const Lightmap& m : (*options.layers)[l].maps) {
+        const Lightmap* map = &m;
+        const std::filesystem::path finalPath = folder / layerPageUri(options.exrPrefix, m.page, (*options.layers)[l].name);
+        files.push_back({finalPath, [exr, map, finalPath](const std::filesystem::path& temp) { exr->writeFile(*map, {}, temp, finalPath); }});
+      }
     for (size_t i = 0; masked && i < options.shadowMask->rgb->size(); ++i) {
       const ShadowMaskExport* mask = options.shadowMask;
       const std::filesystem::path finalPath = folder / shadowMaskPageUri(options.exrPrefix, (*mask->rgb)[i].page);

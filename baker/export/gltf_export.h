@@ -14,6 +14,7 @@
 #include "common/atomic_file.h"
 #include "common/output_guard.h"
 #include "export/gltf_writer.h"
+#include "export/light_layers.h"
 #include "export/map_encoding.h"
 #include "export/shadow_mask_export.h"
 #include "scene/scene.h"
@@ -32,6 +33,9 @@ struct ExportOptions {
   const LightProbeGrid* probes = nullptr;
   // Shadow-mask pages and their lights (export/shadow_mask_export.h), or null: no extension, no files.
   const ShadowMaskExport* shadowMask = nullptr;
+  // Light groups' layers (export/light_layers.h): IRBAKE_lightmap_scenarios, each layer's PNG per page and, with
+  // writeExrPages, <prefix>_<page>_<layer>.exr; null (or empty): no extension. `maps` are their sum.
+  const std::vector<LightLayer>* layers = nullptr;
   // Each scene light's settled mode (recordLightModes), or null: nothing recorded.
   const std::vector<LightMode>* lightModes = nullptr;
   // The atlas's record (atlas/atlas_from_bake.h: atlasRecordJson), written as the root extras "irbakeAtlas" of an

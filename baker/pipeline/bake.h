@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atlas/atlas.h"
+#include "export/light_layers.h"
 #include "export/portable_export.h"
 #include "lightmap/lightmap.h"
 #include "pipeline/bake_options.h"
@@ -42,6 +43,8 @@ struct BakeResult {
   // With an error estimate: per page, the standard error of each texel's value (the two halves' spread; the
   // map's units, before post); empty otherwise.
   std::vector<Lightmap> standardError;
+  // With light groups (pipeline/light_groups.h): each group's layer; maps and probes hold their sum. Empty otherwise.
+  std::vector<LightLayer> layers;
   nlohmann::json report;             // times per stage, VPLs per bounce, power, texels, memory peak
 };
 

@@ -1,6 +1,7 @@
 // The bake's options: one struct per stage, each with its defaults; BakePlan (pipeline/bake_plan.h) settles
 // what they leave automatic.
 #pragma once
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,6 +56,14 @@ struct LightModeRequest {
   std::string origin = {};  // where it was given, for refusals: "" for the command line, "FILE: line N: key 'light-mode'"
 };
 
+// One --light-group NAME=LIGHTS (or the config file's light-group): sources are the comma-separated selectors of
+// pipeline/light_groups.h.
+struct LightGroupRequest {
+  std::string name;
+  std::vector<std::string> sources;
+  std::string origin = {};  // where it was given, for refusals: "" for the command line, "FILE: line N: key 'light-group'"
+};
+
 // The default evaluation: bias compensation on, direct and VPLs (the clamp is set by BakeOptions::clamp).
 inline VplEvalOptions compensatedEval() {
   VplEvalOptions e;
@@ -67,6 +76,8 @@ struct BakeOptions {
   AtlasOptions atlas;                     // texel density, padding, page size
   std::string atlasFrom;                  // an earlier bake's glTF/GLB whose atlas this bake reuses instead of
                                           // unwrapping (atlas/atlas_from_bake.h); "": unwrap
+  std::shared_ptr<const AtlasResult> atlasApplied;  // the scene already carries this atlas (uv1, pages): used as it
+                                                    // is (a light group's bake after the first); null: unwrap or atlasFrom
   TexelSampleOptions texels;              // supersampling, leak control
   WalkOptions walk;                       // VPL paths, bounces, seed
   std::optional<int> finalGatherPaths;    // the walk's paths where the final gather runs (unset: walk.paths)
@@ -103,6 +114,8 @@ struct BakeOptions {
   ShadowMaskOptions shadowMask;           // the shadow-mask lights' visibility pages (stages/shadow_mask)
   std::vector<LightModeRequest> lightModes;  // --light-mode in the order given (a name wins over "*", the last
                                             // of each over earlier ones; any over the glTF's extras.irbake.mode)
+  std::vector<LightGroupRequest> lightGroups;  // --light-group in the order given (pipeline/light_groups.h); with
+                                               // these or extras.irbake.group, bakeLightGroups bakes each group apart
   ErrorEstimateOptions errorEstimate;     // the bake's own error from independent replicates of the walk, and
                                           // --target-error's rounds (off: one walk, the same bytes as before)
   double maxMemoryGB = 0.0;               // refuse up front a bake predicted to need more memory at its peak

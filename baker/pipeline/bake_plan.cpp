@@ -355,4 +355,6 @@ void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& s
                 "the shadow-mask lights' overlap graph coloured with 4 channels, brightest first");
 }
 
+bool finalGatherAutoOn(const Scene& scene) { return !hasSmallEmitters(scene) && seeThroughMaterials(scene).empty(); }
+
 }  // namespace irbake

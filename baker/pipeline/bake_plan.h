@@ -69,6 +69,9 @@ struct BakePlan {
 // The first see-through material (MASK cut-outs, BLEND, transmission) a primitive uses, as a phrase for the
 // log; empty when there is none.
 std::string seeThroughMaterials(const Scene& scene);
+// FinalGatherMode::Auto's choice for the scene on a VPL backend: on without small emitters or see-through
+// surfaces (light groups settle it once for the whole scene, so that every group's bake gathers alike).
+bool finalGatherAutoOn(const Scene& scene);
 
 // Settles what the scene, the options and the machine decide before any light is traced: evaluator, final
 // gather, paths, compensation and its overlap, the sky's share, each stage's options. probeGl makes the GL

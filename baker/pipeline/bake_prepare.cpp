@@ -13,8 +13,9 @@ void buildGeometry(BakeState& s) {
   timed(s, "atlas", [&] {
     AtlasOptions o = s.options.atlas;
     o.progress = withProgress(s, o.progress);
-    s.atlas = s.options.atlasFrom.empty() ? buildAtlas(s.scene, o)
-                                          : atlasFromBake(s.scene, readBakedAtlas(s.options.atlasFrom), o);
+    if (s.options.atlasApplied) s.atlas = *s.options.atlasApplied;
+    else s.atlas = s.options.atlasFrom.empty() ? buildAtlas(s.scene, o)
+                                               : atlasFromBake(s.scene, readBakedAtlas(s.options.atlasFrom), o);
   });
   timed(s, "raytrace", [&] { s.rayTracer = std::make_unique<RayTracer>(s.scene); });
   timed(s, "texels", [&] {
@@ -182,11 +183,12 @@ void prepare(BakeState& s) {
   settleLightModes(s.plan, s.options, s.scene, s.texels, s.lightGrid.get());
   const bool autoDensity = !(s.options.atlas.texelsPerUnit > 0.0);
   s.plan.settle("texels-per-unit", s.atlas.stats.texelsPerUnit,
-                !s.options.atlasFrom.empty() ? "the atlas of --atlas-from's bake"
+                s.options.atlasApplied ? "the atlas of the first light group's bake"
+                : !s.options.atlasFrom.empty() ? "the atlas of --atlas-from's bake"
                 : autoDensity ? "the density rule: the preset's texels per metre, more for a small scene, less to fit "
                               "--max-texels (docs/guide.md, \"Texel density\")"
                             : "asked for",
-                autoDensity && s.options.atlasFrom.empty());  // --atlas-from's density is not given again
+                autoDensity && s.options.atlasFrom.empty() && !s.options.atlasApplied);  // --atlas-from's density is not given again
   timed(s, "vpls", [&] { walkVpls(s); });
   settleWalk(s);
   if (s.plan.importanceFactor > 1.0) timed(s, "vplImportance", [&] { selectByImportance(s); });

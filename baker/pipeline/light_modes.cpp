@@ -66,8 +66,7 @@ std::string requestText(const LightModeRequest& request) {
       throw Error(ErrorCode::Usage, scene.sourcePath,
                   what + ": " + name + " is an emissive surface, not a punctual light (emitters stay baked)");
   }
-  std::string known;
-  for (const Light& l : scene.lights) known += (known.empty() ? "" : ", ") + selectorOf(scene, l);
+  const std::string known = knownLightSelectors(scene);
   throw Error(ErrorCode::Usage, scene.sourcePath,
               what + ": no punctual light is named " + name + " (" +
                   (known.empty() ? std::string("the scene has none") : "its punctual lights: " + known) + ")");
@@ -75,7 +74,7 @@ std::string requestText(const LightModeRequest& request) {
 
 // The lights a selector other than "*" addresses. Throws Error(Usage) when a plain `sun` or `#I` also is the
 // glTF name of another light.
-std::vector<size_t> selectedLights(const Scene& scene, const LightModeRequest& request) {
+std::vector<size_t> selectedLights(const Scene& scene, const std::string& text, const std::string& what) {
   auto where = [&](auto&& test) {
     std::vector<size_t> found;
     for (size_t i = 0; i < scene.lights.size(); ++i)
@@ -85,7 +84,6 @@ std::vector<size_t> selectedLights(const Scene& scene, const LightModeRequest& r
   auto named = [&](const std::string& name) { return where([&](const Light& l) { return !isSun(l) && l.name == name; }); };
   auto indexed = [&](int index) { return where([&](const Light& l) { return index >= 0 && l.gltfLight == index; }); };
   auto sun = [&] { return where(isSun); };
-  const std::string& text = request.light;
   if (text.rfind("name:", 0) == 0) return named(text.substr(5));
   if (text.rfind("index:", 0) == 0) return indexed(lightIndex(text.substr(6)));
   if (text == "option:sun") return sun();
@@ -101,7 +99,7 @@ std::vector<size_t> selectedLights(const Scene& scene, const LightModeRequest& r
   const std::vector<size_t> byName = named(text);
   if (!keyword.empty() && !byName.empty() && keyword != byName)
     throw Error(ErrorCode::Usage, scene.sourcePath,
-                requestText(request) + ": '" + text + "' is ambiguous: it addresses " +
+                what + ": '" + text + "' is ambiguous: it addresses " +
                     describe(scene.lights[keyword[0]]) + " and the light named '" + text + "', " +
                     describe(scene.lights[byName[0]]) + "; write " + explicitForm + " for the first, name:" + text +
                     " for the second");
@@ -109,6 +107,18 @@ std::vector<size_t> selectedLights(const Scene& scene, const LightModeRequest& r
 }
 
 }  // namespace
+
+std::vector<size_t> lightsSelectedBy(const Scene& scene, const std::string& selector, const std::string& what) {
+  return selectedLights(scene, selector, what);
+}
+
+std::string knownLightSelectors(const Scene& scene) {
+  std::string known;
+  for (const Light& l : scene.lights) known += (known.empty() ? "" : ", ") + selectorOf(scene, l);
+  return known;
+}
+
+bool isCommandLineSun(const Light& light) { return isSun(light); }
 
 std::string lightModeName(const Light& light) {
   if (isSun(light)) return "sun";
@@ -133,7 +143,7 @@ std::vector<RequestedLightMode> resolveLightModes(const Scene& scene, const std:
       if (star) {
         for (size_t i = 0; i < scene.lights.size(); ++i) lights.push_back(i);
       } else {
-        lights = selectedLights(scene, r);
+        lights = selectedLights(scene, r.light, requestText(r));
       }
       if (lights.empty()) refuseName(scene, r);
       for (const size_t i : lights) modes[i] = {r.mode, requestText(r), true};

@@ -27,6 +27,14 @@ struct RequestedLightMode {
 // The name messages use for a light: "sun" for --sun's, else its glTF name (or "#i" when it has none).
 std::string lightModeName(const Light& light);
 
+// The scene lights a selector other than "*" addresses (empty: none); `what` names the option in the refusal
+// of an ambiguous plain `sun` or `#I` (Error(Usage)). Light groups (pipeline/light_groups.h) read the same selectors.
+std::vector<size_t> lightsSelectedBy(const Scene& scene, const std::string& selector, const std::string& what);
+// The scene's punctual lights as selectors ("sun, lamp, #2"), for a refusal's list; "" without lights.
+std::string knownLightSelectors(const Scene& scene);
+// The light of --sun (not a glTF light).
+bool isCommandLineSun(const Light& light);
+
 // Per scene light. Throws Error(Usage) naming the light for a selector no punctual light answers to, one that
 // names an emitter or the sky (those stay baked), an ambiguous one, or "*" in a scene without punctual lights.
 std::vector<RequestedLightMode> resolveLightModes(const Scene& scene, const std::vector<LightModeRequest>& requests);

@@ -161,6 +161,7 @@ void writeGltfAndPages(const BakeResult& result, const std::filesystem::path& gl
   ex.probes = &result.probes;
   if (!mask.empty()) ex.shadowMask = &mask;
   ex.lightModes = &result.lightModes;
+  if (!result.layers.empty()) ex.layers = &result.layers;
   ex.atlasRecord = atlasRecordJson(result.atlas);
   exportGltf(result.scene, result.maps, ex);
 }
@@ -183,6 +184,9 @@ std::vector<std::filesystem::path> writeBakeOutputs(const BakeResult& result, co
   for (int k = 0; k < 3; ++k)
     for (const Lightmap& m : result.directional[k])
       l1Exrs.push_back({outDir / directionalPageUri("lightmap", m.page, k), &m});
+  // Light groups: each layer's pages (lightmap_<page>_<group>.exr), before the shadow-mask pages.
+  for (const LightLayer& layer : result.layers)
+    for (const Lightmap& m : layer.maps) l1Exrs.push_back({outDir / layerPageUri("lightmap", m.page, layer.name), &m});
   const ShadowMaskExport mask = shadowMaskExport(result, outDir, l1Exrs);
   const fs::path reportPath = options.reportPath.empty() ? outDir / "report.json" : options.reportPath;
   OutputGuard unguarded;  // a caller without a command guard: one that knows the inputs

@@ -573,21 +573,32 @@ class Loader {
     scene_.cameras.push_back(cam);
   }
 
-  // extras: {"irbake": {"mode": "baked" | "indirect" | "shadowmask"}} on the glTF light. A bad value is a
-  // bake setting the user must fix (exit 2, as --light-mode's), not a broken file.
+  // extras: {"irbake": {"mode": "baked" | "indirect" | "shadowmask", "group": NAME}} on the glTF light (either
+  // or both). A bad value is a bake setting the user must fix (exit 2, as --light-mode's), not a broken file.
   void readExtrasMode(int li, const std::string& what, Light& light) const {
     const json* lights = path(src_.json, {"extensions", "KHR_lights_punctual", "lights"});
     if (!lights || !lights->is_array() || li >= static_cast<int>(lights->size())) return;
     const json* irbake = path((*lights)[static_cast<size_t>(li)], {"extras", "irbake"});
     if (!irbake) return;
     const json* mode = child(*irbake, "mode");
-    if (!mode)
-      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" (got " +
+    const json* group = child(*irbake, "group");
+    if (!mode && !group)
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake must be an object with a \"mode\" or a \"group\" (got " +
                                                irbake->dump().substr(0, 80) + ")");
+    if (group) light.group = extrasGroup(*group, what);
+    if (!mode) return;
     if (!mode->is_string() || !parseLightMode(mode->get<std::string>(), light.extrasMode))
       throw Error(ErrorCode::Usage, file_, what + ": extras.irbake.mode must be \"baked\", \"indirect\" or \"shadowmask\" (got " +
                                                mode->dump().substr(0, 80) + ")");
     light.hasExtrasMode = true;
+  }
+
+  // extras.irbake.group: a light group's name (pipeline/light_groups.h checks the name itself).
+  std::string extrasGroup(const json& group, const std::string& what) const {
+    if (!group.is_string() || group.get<std::string>().empty())
+      throw Error(ErrorCode::Usage, file_, what + ": extras.irbake.group must be a light group's name (got " +
+                                               group.dump().substr(0, 80) + ")");
+    return group.get<std::string>();
   }
 
   void addLight(int n, const json* lightRef, const glm::mat4& world) {
@@ -1054,6 +1065,8 @@ class Loader {
       if (sg && !child(*mj, "pbrMetallicRoughness")) readDiffuse(index, g.name, *sg, m);
       if (const json* moz = path(*mj, {"extensions", "MOZ_lightmap"})) readMozLightmap(index, g.name, *moz, m);
       if (options_.shadingMaps) readShadingMaps(g, *mj, m);
+      if (const json* group = path(*mj, {"extras", "irbake", "group"}))
+        m.group = extrasGroup(*group, "material " + std::to_string(index) + (g.name.empty() ? "" : " ('" + g.name + "')"));
     }
     if (g.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
     else if (g.alphaMode == "BLEND") m.alphaMode = AlphaMode::Blend;

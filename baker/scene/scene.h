@@ -69,6 +69,7 @@ struct Material {
   float transmission = 0.0f;        // KHR_materials_transmission transmissionFactor (texture not read)
   bool doubleSided = false;
   int gltfMaterial = -1;            // source index, -1 for the default material
+  std::string group;                // extras.irbake.group: the light group its emission is baked in ("": none named)
   int lightmapTexture = -1;         // MOZ_lightmap texture (index into Scene::textures), -1 none
   float lightmapIntensity = 1.0f;   // MOZ_lightmap intensity: map value = PNG value × intensity
   int lightmapTexCoord = 1;         // MOZ_lightmap texCoord as written (irview reads only TEXCOORD_1 and refuses others)
@@ -171,6 +172,7 @@ struct Light {
   glm::vec3 profileAxisX{1.0f, 0.0f, 0.0f};
   bool hasExtrasMode = false;          // the glTF light's extras.irbake.mode was given (then extrasMode holds it)
   LightMode extrasMode = LightMode::Baked;
+  std::string group;                   // the glTF light's extras.irbake.group: its light group ("": none named)
   // What multiplies the inverse square law at a distance from the light: glTF's range (KHR_lights_punctual) as
   // the smooth window three.js and Babylon apply, clamp(1 − (d/range)⁴, 0, 1)², so the light fades to zero at
   // the range with no step, and is zero beyond it. 1 without a range (range 0).
