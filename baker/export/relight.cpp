@@ -9,6 +9,7 @@
 #include "common/command_line.h"
 #include "common/error.h"
 #include "common/file_paths.h"
+#include "common/log.h"
 #include "common/maths.h"
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
@@ -26,14 +27,7 @@ using json = nlohmann::json;
 namespace {
 
 constexpr int kFloat = 5126;
-const std::string kExt = kLightmapScenariosExtension;
-
-bool validLayerName(const std::string& name) {
-  if (name.empty() || name.size() > 64) return false;
-  for (char c : name)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
-  return true;
-}
+const std::string kExt = kLightScenariosExtension;
 
 // A number the file holds as a finite value ≥ 0 (also as a 32-bit float).
 bool finiteNonNegative(const json& v) {
@@ -145,27 +139,6 @@ LightmapScenarios readLightmapScenarios(const json& root, const std::string& fil
   return out;
 }
 
-Lightmap combineLayerPages(const std::vector<Lightmap>& layers, const std::vector<glm::vec3>& weights,
-                           const std::vector<std::string>& names) {
-  Lightmap sum;
-  sum.page = layers.at(0).page;
-  sum.width = layers[0].width;
-  sum.height = layers[0].height;
-  for (size_t l = 0; l < layers.size(); ++l)
-    if (layers[l].width != sum.width || layers[l].height != sum.height || layers[l].texels.size() != sum.size())
-      throw Error(ErrorCode::InvalidData, names.at(l),
-                  std::to_string(layers[l].width) + "×" + std::to_string(layers[l].height) + " texels, but " + names[0] +
-                      " is " + std::to_string(sum.width) + "×" + std::to_string(sum.height) + ": not pages of one atlas");
-  sum.texels.resize(sum.size());
-  sum.valid.assign(sum.size(), 1);
-  for (size_t i = 0; i < sum.texels.size(); ++i) {
-    glm::dvec3 s(0.0);
-    for (size_t l = 0; l < layers.size(); ++l) s += glm::dvec3(weights[l]) * glm::dvec3(layers[l].texels[i]);
-    sum.texels[i] = glm::vec3(s);
-  }
-  return sum;
-}
-
 namespace {
 
 // The layers' names, for messages: "day, street".
@@ -188,17 +161,6 @@ std::vector<glm::vec3> vec3Accessor(const GltfDocument& doc, int index, size_t c
   for (const glm::vec3& v : out)
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
       throw Error(ErrorCode::InvalidData, file, what + ": a non-finite value");
-  return out;
-}
-
-// Σ_L weights[L] ⊙ values[L] per element, in double, rounded once.
-std::vector<glm::vec3> weightedSum(const std::vector<std::vector<glm::vec3>>& values, const std::vector<glm::vec3>& weights) {
-  std::vector<glm::vec3> out(values.at(0).size());
-  for (size_t i = 0; i < out.size(); ++i) {
-    glm::dvec3 s(0.0);
-    for (size_t l = 0; l < values.size(); ++l) s += glm::dvec3(weights[l]) * glm::dvec3(values[l][i]);
-    out[i] = glm::vec3(s);
-  }
   return out;
 }
 
@@ -307,22 +269,55 @@ std::vector<fs::path> Relight::outputs() const {
   return files;
 }
 
-// Per page: the layers' EXR pages summed with the weights, the MOZ_lightmap PNG encoded from the sum in place of
-// the page's image, and the intensity of every material whose MOZ_lightmap names the page's texture.
-void Relight::recombinePages(RelightSummary& summary, std::vector<Lightmap>& sums) {
-  const MapEncoding& png = mapEncoding(MapEncodingKind::Png8);
-  for (size_t p = 0; p < scenarios_.pages.size(); ++p) {
-    std::vector<Lightmap> layers;
-    std::vector<std::string> names;
-    for (const ScenarioLayer& l : scenarios_.layers) {
-      names.push_back((folder_ / l.exr[p]).string());
-      layers.push_back(readExr(folder_ / l.exr[p]));
-      summary.texels += layers.back().size();
+// Every layer's EXR pages (each the size of the first layer's, else refused naming the file) and probe
+// coefficients (the root's count, else refused).
+std::vector<LightLayer> Relight::readLayers(RelightSummary& summary) const {
+  const std::string file = options_.input.string();
+  const json& ext = doc_.root.value("extensions", json::object());
+  const bool hasProbes = ext.contains(kLightProbesExtension);
+  size_t withProbes = 0, count = 0;
+  for (const ScenarioLayer& l : scenarios_.layers) withProbes += l.probes >= 0 ? 1 : 0;
+  if ((hasProbes || withProbes > 0) && (!hasProbes || withProbes != scenarios_.layers.size()))
+    throw Error(ErrorCode::InvalidData, file, hasProbes ? "IRBAKE_light_probes, but not every layer of " + kExt + " has its probes"
+                                                        : kExt + " layers have probes, but the file has no IRBAKE_light_probes");
+  if (hasProbes) {
+    const json& probes = ext[kLightProbesExtension];
+    if (!probes.contains("coefficients") || !probes["coefficients"].is_number_integer())
+      throw Error(ErrorCode::InvalidData, file, "IRBAKE_light_probes.coefficients: no accessor index");
+    count = vec3Accessor(doc_, probes["coefficients"].get<int>(), 0, "IRBAKE_light_probes.coefficients", file).size();
+  }
+  std::vector<LightLayer> layers;
+  for (const ScenarioLayer& l : scenarios_.layers) {
+    LightLayer layer;
+    layer.name = l.name;
+    for (size_t p = 0; p < scenarios_.pages.size(); ++p) {
+      const fs::path page = folder_ / l.exr[p];
+      layer.maps.push_back(readExr(page));
+      layer.maps.back().page = static_cast<int>(p);
+      const Lightmap& m = layer.maps.back();
+      const Lightmap& first = layers.empty() ? m : layers.front().maps[p];
+      if (m.width != first.width || m.height != first.height)
+        throw Error(ErrorCode::InvalidData, page.string(),
+                    std::to_string(m.width) + "×" + std::to_string(m.height) + " texels, but " + (folder_ / scenarios_.layers[0].exr[p]).string() +
+                        " is " + std::to_string(first.width) + "×" + std::to_string(first.height) + ": not pages of one atlas");
+      summary.texels += m.size();
     }
-    Lightmap sum = combineLayerPages(layers, weights_, names);
-    sum.page = static_cast<int>(p);
-    layers.clear();
-    const EncodedMap encoded = png.encode(sum, MapEncodeOptions{});
+    if (count > 0) {
+      const std::vector<glm::vec3> c = vec3Accessor(doc_, l.probes, count, kExt + " layer '" + l.name + "' probes", file);
+      layer.probes.resize(count / kShCoefficients);
+      std::memcpy(layer.probes.data(), c.data(), layer.probes.size() * sizeof(ShCoefficients));
+    }
+    layers.push_back(std::move(layer));
+  }
+  return layers;
+}
+
+// Per page: the MOZ_lightmap PNG encoded from the sum in place of the page's image, and the intensity of every
+// material whose MOZ_lightmap names the page's texture.
+void Relight::encodePages(const std::vector<Lightmap>& sums, RelightSummary& summary) {
+  const MapEncoding& png = mapEncoding(MapEncodingKind::Png8);
+  for (size_t p = 0; p < sums.size(); ++p) {
+    const EncodedMap encoded = png.encode(sums[p], MapEncodeOptions{});
     const int texture = scenarios_.pages[p];
     json& t = doc_.root["textures"][texture];
     if (!t.contains("source") || !t["source"].is_number_integer() || t["source"].get<int>() < 0 ||
@@ -339,33 +334,26 @@ void Relight::recombinePages(RelightSummary& summary, std::vector<Lightmap>& sum
       if (moz.value("index", -1) == texture) moz["intensity"] = intensity;
     }
     summary.intensity.push_back(intensity);
-    sums.push_back(std::move(sum));
   }
-  summary.pages = static_cast<int>(scenarios_.pages.size());
+  summary.pages = static_cast<int>(sums.size());
 }
 
-// IRBAKE_light_probes: the coefficients Σ_L w_L ⊙ c_L, and the sun level's irradiance and SH the weight of the
+// IRBAKE_light_probes: the coefficients the layers' sum, and the sun level's irradiance and SH the weight of the
 // layer that holds the sun times that layer's.
-void Relight::recombineProbes(RelightSummary& summary) {
+void Relight::writeProbes(const std::vector<ShCoefficients>& sum, RelightSummary& summary) {
+  if (sum.empty()) return;
   const std::string file = options_.input.string();
-  const bool hasProbes = doc_.root.contains("extensions") && doc_.root["extensions"].contains(kLightProbesExtension);
-  size_t withProbes = 0;
-  for (const ScenarioLayer& l : scenarios_.layers) withProbes += l.probes >= 0 ? 1 : 0;
-  if (!hasProbes && withProbes == 0) return;
-  if (!hasProbes || withProbes != scenarios_.layers.size())
-    throw Error(ErrorCode::InvalidData, file, hasProbes ? "IRBAKE_light_probes, but not every layer of " + kExt + " has its probes"
-                                                        : kExt + " layers have probes, but the file has no IRBAKE_light_probes");
   json& probes = doc_.root["extensions"][kLightProbesExtension];
-  if (!probes.contains("coefficients") || !probes["coefficients"].is_number_integer())
-    throw Error(ErrorCode::InvalidData, file, "IRBAKE_light_probes.coefficients: no accessor index");
-  const int root = probes["coefficients"].get<int>();
-  const size_t count = vec3Accessor(doc_, root, 0, "IRBAKE_light_probes.coefficients", file).size();
-  std::vector<std::vector<glm::vec3>> layers;
-  for (const ScenarioLayer& l : scenarios_.layers)
-    layers.push_back(vec3Accessor(doc_, l.probes, count, kExt + " layer '" + l.name + "' probes", file));
+  const size_t emitters = probes.contains("emitters") && probes["emitters"].is_array() ? probes["emitters"].size() : 0;
+  if (emitters > 0 && weights_ != scenarios_.scenarios[scenarios_.defaultScenario].weights)
+    log::warn(file + ": IRBAKE_light_probes keeps its " + std::to_string(emitters) + " exact emitter(s) as baked: they are in no " +
+              "layer, so the new weights do not reach them");
   const std::set<int> shared = layerAccessors(scenarios_);
-  probes["coefficients"] = setVec3Accessor(doc_, root, weightedSum(layers, weights_), shared.count(root) > 0);
-  summary.probes = count / 9;
+  const int root = probes["coefficients"].get<int>();
+  std::vector<glm::vec3> flat(sum.size() * kShCoefficients);
+  std::memcpy(flat.data(), sum.data(), flat.size() * sizeof(glm::vec3));
+  probes["coefficients"] = setVec3Accessor(doc_, root, flat, shared.count(root) > 0);
+  summary.probes = sum.size();
   for (size_t l = 0; l < scenarios_.layers.size(); ++l) {
     const ScenarioLayer& layer = scenarios_.layers[l];
     if (!layer.hasSun) continue;
@@ -374,9 +362,10 @@ void Relight::recombineProbes(RelightSummary& summary) {
     json& sun = probes["sun"];
     const glm::vec3 e = weights_[l] * layer.sunIrradiance;
     sun["irradiance"] = {e.x, e.y, e.z};
-    const std::vector<glm::vec3> sh = vec3Accessor(doc_, layer.sunSh, 9, kExt + " layer '" + layer.name + "' sun.sh", file);
+    std::vector<glm::vec3> sh = vec3Accessor(doc_, layer.sunSh, kShCoefficients, kExt + " layer '" + layer.name + "' sun.sh", file);
+    for (glm::vec3& c : sh) c *= weights_[l];
     const int at = sun["sh"].get<int>();
-    sun["sh"] = setVec3Accessor(doc_, at, weightedSum({sh}, {weights_[l]}), shared.count(at) > 0);
+    sun["sh"] = setVec3Accessor(doc_, at, sh, shared.count(at) > 0);
   }
 }
 
@@ -386,9 +375,9 @@ RelightSummary Relight::write(const OutputGuard& guard) {
     summary.layers.push_back(scenarios_.layers[l].name);
     summary.weights.push_back(weights_[l]);
   }
-  std::vector<Lightmap> sums;
-  recombinePages(summary, sums);
-  recombineProbes(summary);
+  CombinedLayers sum = combineLayers(readLayers(summary), weights_);
+  encodePages(sum.maps, summary);
+  writeProbes(sum.probes, summary);
   json weights = json::object();
   for (size_t l = 0; l < weights_.size(); ++l) weights[scenarios_.layers[l].name] = {weights_[l].x, weights_[l].y, weights_[l].z};
   doc_.root["extensions"][kExt]["scenarios"][scenarios_.defaultScenario]["weights"] = weights;
@@ -409,7 +398,7 @@ RelightSummary Relight::write(const OutputGuard& guard) {
   const std::vector<PendingFile> docFiles = doc_.files(output);
   files.insert(files.begin(), docFiles.begin(), docFiles.end());
   const MapEncoding* exrEncoding = &mapEncoding(MapEncodingKind::Exr);
-  auto summed = std::make_shared<std::vector<Lightmap>>(std::move(sums));
+  auto summed = std::make_shared<std::vector<Lightmap>>(std::move(sum.maps));
   for (const std::string& name : exr) {
     const fs::path to = folder / name;
     size_t page = 0;

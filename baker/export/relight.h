@@ -1,6 +1,6 @@
 // irbake relight: a bake with light groups (IRBAKE_lightmap_scenarios, docs/export.md) written again with other
 // weights on its layers, without tracing a ray. The layers' float EXR pages are summed with the new RGB weights
-// into the default EXR pages, the MOZ_lightmap PNGs are encoded from that sum (the bake's encoding) with the
+// (combineLayers, the bake's own sum: at the bake's weights the pages come back bit for bit) into the default EXR pages, the MOZ_lightmap PNGs are encoded from that sum (the bake's encoding) with the
 // materials' intensity set to match, the probes' coefficients and sun level are summed the same way, and the
 // extension's default scenario gets the new weights; the layers and everything else of the document are kept.
 #pragma once
@@ -13,11 +13,10 @@
 
 #include "common/output_guard.h"
 #include "export/gltf_writer.h"
+#include "export/light_layers.h"
 #include "lightmap/lightmap.h"
 
 namespace irbake {
-
-constexpr const char* kLightmapScenariosExtension = "IRBAKE_lightmap_scenarios";
 
 // One layer of the extension: a light group's own light on every page.
 struct ScenarioLayer {
@@ -51,11 +50,6 @@ struct LightmapScenarios {
 // naming layers it has, the default scenario in range. Throws Error(InvalidData, file) naming the field; a
 // document without the extension: Error(InvalidData, file, "... has no IRBAKE_lightmap_scenarios ...").
 LightmapScenarios readLightmapScenarios(const nlohmann::json& root, const std::string& file);
-
-// Σ_L weights[L] ⊙ layers[L], texel by texel (each texel's sum in double, rounded once to float): every page the
-// same size (else Error(InvalidData) naming the page's file, `names[L]`). Every texel of the sum is valid.
-Lightmap combineLayerPages(const std::vector<Lightmap>& layers, const std::vector<glm::vec3>& weights,
-                           const std::vector<std::string>& names);
 
 // "NAME=W" of --group: the layer's name and its RGB weight, W one number (every channel) or R,G,B, each finite
 // and from 0 to 1e20. Throws Error(Usage) quoting the text.
@@ -94,8 +88,9 @@ class Relight {
 
  private:
   std::vector<std::string> exrNames() const;  // every EXR page the document names, relative to its folder
-  void recombinePages(RelightSummary& summary, std::vector<Lightmap>& sums);
-  void recombineProbes(RelightSummary& summary);
+  std::vector<LightLayer> readLayers(RelightSummary& summary) const;  // the layers' EXR pages and probe coefficients
+  void encodePages(const std::vector<Lightmap>& sums, RelightSummary& summary);
+  void writeProbes(const std::vector<ShCoefficients>& sum, RelightSummary& summary);
 
   RelightOptions options_;
   std::filesystem::path folder_;  // the input's folder

@@ -144,13 +144,13 @@ GroupedBake writeGroupedBake(const fs::path& dir) {
     layers.push_back(layer);
   }
   doc.root["extras"]["lightmapPages"] = exrPages;
-  doc.root["extensions"][kLightmapScenariosExtension] = {
+  doc.root["extensions"][kLightScenariosExtension] = {
       {"pages", pages},
       {"layers", layers},
       {"scenarios", {{{"name", "default"}, {"weights", {{"a", {1, 1, 1}}, {"b", {1, 1, 1}}}}},
                      {{"name", "b"}, {"weights", {{"b", {1, 1, 1}}}}}}},
       {"default", 0}};
-  doc.useExtension(kLightmapScenariosExtension);
+  doc.useExtension(kLightScenariosExtension);
   writeAllAtomically(doc.files(bake.file));
   return bake;
 }
@@ -220,7 +220,7 @@ TEST(Relight, HalfAndTwoAreTheWeightedSumInPagesPngsAndProbes) {
   const fs::path out = dir / "out" / "relit.glb";
   const RelightSummary s = relight(bake.file, out, {{"a", glm::vec3(0.5f)}, {"b", glm::vec3(2.0f)}});
   const json root = jsonOfGlb(out);
-  const json& ext = root["extensions"][kLightmapScenariosExtension];
+  const json& ext = root["extensions"][kLightScenariosExtension];
   EXPECT_EQ(ext["scenarios"][0]["weights"]["a"], json({0.5, 0.5, 0.5}));
   EXPECT_EQ(ext["scenarios"][0]["weights"]["b"], json({2.0, 2.0, 2.0}));
   EXPECT_EQ(ext["scenarios"][1]["weights"], json({{"b", {1, 1, 1}}}));  // other scenarios as they were
