@@ -357,4 +357,10 @@ void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& s
 
 bool finalGatherAutoOn(const Scene& scene) { return !hasSmallEmitters(scene) && seeThroughMaterials(scene).empty(); }
 
+double autoClampVplsPerMean(const Scene& scene, bool biasCompensation) {
+  return !biasCompensation ? kClampVplsPerMean
+         : hasSmallEmitters(scene) ? kCompensatedClampVplsPerMean
+                                   : kCompensatedClampVplsPerMeanNoEmitters;
+}
+
 }  // namespace irbake

@@ -72,6 +72,8 @@ std::string seeThroughMaterials(const Scene& scene);
 // FinalGatherMode::Auto's choice for the scene on a VPL backend: on without small emitters or see-through
 // surfaces (light groups settle it once for the whole scene, so that every group's bake gathers alike).
 bool finalGatherAutoOn(const Scene& scene);
+// The clamp's k (BakeOptions::clampVplsPerMean) where the options leave it 0, for the scene (same reason).
+double autoClampVplsPerMean(const Scene& scene, bool biasCompensation);
 
 // Settles what the scene, the options and the machine decide before any light is traced: evaluator, final
 // gather, paths, compensation and its overlap, the sky's share, each stage's options. probeGl makes the GL

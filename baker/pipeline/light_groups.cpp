@@ -79,14 +79,13 @@ class GroupResolver {
   }
 
   void extras() {
-    const std::string file = scene_.sourcePath.empty() ? std::string("the scene") : scene_.sourcePath;
     for (size_t s = 0; s < sources_.size(); ++s) {
       const Source& src = sources_[s];
       const std::string& name = src.kind == Source::LightSource ? scene_.lights[src.index].group
                                 : src.kind == Source::MaterialSource ? scene_.materials[src.index].group
                                                                       : std::string();
       if (name.empty()) continue;
-      const std::string what = file + ": " + describe(scene_, src) + "'s extras.irbake.group";
+      const std::string what = describe(scene_, src) + ": extras.irbake.group";  // the Error names the file
       assign(s, group(name, what), what);
     }
   }
@@ -306,8 +305,10 @@ BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
   checkGroupedOptions(scene, options);
   BakeOptions o = options;
   o.lightGroups.clear();
-  // Settled once for the whole scene: a group without the emitters would otherwise gather where the whole would not.
+  // Settled once for the whole scene: a group without the emitters would otherwise gather, and clamp tighter,
+// where the whole would not.
   if (o.finalGather == FinalGatherMode::Auto) o.finalGather = finalGatherAutoOn(scene) ? FinalGatherMode::On : FinalGatherMode::Off;
+  if (!(o.clampVplsPerMean > 0.0)) o.clampVplsPerMean = autoClampVplsPerMean(scene, o.eval.biasCompensation);
   const std::vector<Light> lights = scene.lights;
   const std::vector<Material> materials = scene.materials;
   const Environment environment = scene.environment;

@@ -17,7 +17,7 @@
 // Where the sum differs from one bake of every source (beyond noise): each group's bake derives its own clamp
 // bound from its own VPLs (a clamp is not linear; the compensation gathers the clamped part back, so what stays
 // is the compensation's residue), and each cuts its lights without range against its own map level (the light
-// tail samples the cut part back). FinalGatherMode::Auto is settled once for the whole scene.
+// tail samples the cut part back). FinalGatherMode::Auto and the clamp's k are settled once for the whole scene.
 #pragma once
 #include <string>
 #include <vector>

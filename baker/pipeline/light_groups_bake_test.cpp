@@ -36,14 +36,14 @@ Light namedPoint(const std::string& name, glm::vec3 position, float intensity) {
 }
 
 // A closed grey room, 2 × 1.5 × 2 m, with two point lights ("left", "right") and a small emissive panel
-// ("neon") on the ceiling: three sources whose light bounces.
+// ("neon") 10 cm under the ceiling, facing down: three sources whose light bounces.
 Scene room() {
   Scene s;
   const int grey = irbake::testing::addMaterial(s, glm::vec3(0.6f));
   const int neon = irbake::testing::addMaterial(s, glm::vec3(0.5f), glm::vec3(3.0f, 1.5f, 0.5f));
   s.materials[static_cast<size_t>(neon)].name = "neon";
   irbake::testing::addBox(s, grey, {-1.0f, 0.0f, -1.0f}, {1.0f, 1.5f, 1.0f}, true);
-  irbake::testing::addQuad(s, neon, {0.5f, 1.49f, 0.5f}, {0.0f, 0.0f, -0.3f}, {-0.3f, 0.0f, 0.0f});
+  irbake::testing::addQuad(s, neon, {0.5f, 1.4f, 0.5f}, {-0.3f, 0.0f, 0.0f}, {0.0f, 0.0f, -0.3f});  // facing down
   s.lights = {namedPoint("left", {-0.5f, 1.0f, 0.0f}, 2.0f), namedPoint("right", {0.5f, 0.8f, -0.3f}, 1.0f)};
   return s;
 }
