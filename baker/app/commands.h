@@ -14,4 +14,5 @@ int runDiff(const Args& args);
 int runSamples(const Args& args);
 int runProbe(const Args& args);
 int runPlan(const Args& args);
+int runRelight(const Args& args);
 }  // namespace irbake::app

@@ -21,6 +21,7 @@ const char* kUsage =
     "  diff A B                         compare two bakes of the same atlas\n"
     "  samples OUTDIR                   write the built-in sample scenes\n"
     "  probe GLTF --at X,Y,Z            the baked irradiance probes read at a point (JSON)\n"
+    "  relight BAKED --group N=W -o OUT a bake with light groups with other weights, no ray traced\n"
     "  --version                        print the version and exit\n"
     "run 'irbake <command> --help' for a command's options\n";
 }
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
     if (cmd == "diff") return irbake::app::runDiff(args);
     if (cmd == "samples") return irbake::app::runSamples(args);
     if (cmd == "probe") return irbake::app::runProbe(args);
+    if (cmd == "relight") return irbake::app::runRelight(args);
     std::fprintf(stderr, "irbake: error: unknown command '%s'\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const irbake::Error& e) {

@@ -285,7 +285,11 @@ void compactDocument(GltfDocument& doc) {
   }
   auto imageRefs = [](json& r, auto&& f) { forEachImageRef(r, f); };
   keepUsed(root, "images", usedBy(root, "images", imageRefs), imageRefs);
+  compactBufferViews(doc);
+}
 
+void compactBufferViews(GltfDocument& doc) {
+  json& root = doc.root;
   // Buffer views: keep the used ones, their bytes packed in view order (4-byte aligned) into buffer 0.
   auto viewRefs = [](json& r, auto&& f) { forEachViewRef(r, f); };
   std::vector<bool> usedViews = usedBy(root, "bufferViews", viewRefs);

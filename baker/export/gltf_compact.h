@@ -35,6 +35,9 @@ int addGatheredAccessor(GltfDocument& doc, const AccessorBytes& source, const st
 // images no texture uses and buffer views nothing uses, renumbering every reference; buffer 0 is
 // rebuilt from the kept views only (each 4-byte aligned).
 void compactDocument(GltfDocument& doc);
+// Only the last step of compactDocument: drops the buffer views nothing references (an accessor, an image, a
+// primitive extension) and rebuilds buffer 0 from the kept ones; every accessor is kept, wherever it is named.
+void compactBufferViews(GltfDocument& doc);
 
 // Key of an image's original URI while the document is being built (never written).
 inline constexpr const char* kSourceUriKey = "__irbakeSourceUri";

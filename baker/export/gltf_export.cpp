@@ -595,17 +595,7 @@ void exportGltf(const Scene& scene, const std::vector<Lightmap>& maps, const Exp
         taken.push_back(input.filename().string());
     auto images = externalizeImages(doc, taken);
     compactDocument(doc);
-    for (auto& [name, bytes] : images) {
-      auto data = std::make_shared<std::vector<uint8_t>>(std::move(bytes));
-      const std::string finalName = (folder / name).string();
-      files.push_back({folder / name, [data, finalName](const std::filesystem::path& temp) {
-                         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-                         if (!out) throw Error(ErrorCode::Io, finalName, "cannot open for writing");
-                         out.write(reinterpret_cast<const char*>(data->data()), static_cast<std::streamsize>(data->size()));
-                         out.close();
-                         if (!out) throw Error(ErrorCode::Io, finalName, "write failed (disk full?)");
-                       }});
-    }
+    for (auto& [name, bytes] : images) files.push_back(pendingBytes(folder / name, std::move(bytes)));
   }
   if (doc.root.contains("images"))
     for (auto& image : doc.root["images"]) image.erase(kSourceUriKey);

@@ -52,15 +52,6 @@ void writeUvTransform(GltfDocument& doc, json& textureInfo, const UvTransform& t
   doc.useExtension("KHR_texture_transform");
 }
 
-void writeBytes(const std::filesystem::path& path, const void* data, size_t size, const std::string& finalName) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(ErrorCode::Io, finalName, "cannot open for writing");
-  if (size) out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
-  out.close();
-  if (!out) throw Error(ErrorCode::Io, finalName, "write failed (disk full?)");
-}
-
-
 }  // namespace
 
 GltfDocument::GltfDocument() {
@@ -362,6 +353,20 @@ GltfDocument gltfFromScene(const Scene& scene, const GltfWriteOptions& options) 
 void writeGltf(const Scene& scene, const std::filesystem::path& path, const GltfWriteOptions& options) {
   GltfDocument doc = gltfFromScene(scene, options);
   writeAllAtomically(doc.files(path));
+}
+
+void writeBytes(const std::filesystem::path& path, const void* data, size_t size, const std::string& finalName) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(ErrorCode::Io, finalName, "cannot open for writing");
+  if (size) out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+  out.close();
+  if (!out) throw Error(ErrorCode::Io, finalName, "write failed (disk full?)");
+}
+
+PendingFile pendingBytes(const std::filesystem::path& finalPath, std::vector<uint8_t> bytes) {
+  auto data = std::make_shared<std::vector<uint8_t>>(std::move(bytes));
+  const std::string finalName = finalPath.string();
+  return {finalPath, [data, finalName](const std::filesystem::path& temp) { writeBytes(temp, data->data(), data->size(), finalName); }};
 }
 
 }  // namespace irbake

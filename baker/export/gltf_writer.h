@@ -46,6 +46,11 @@ struct GltfWriteOptions {
   std::vector<std::string> lightmapPages;  // relative URIs of float EXR pages, written to root extras
 };
 
+// Writes `size` bytes to `path` (a temp of a set); messages name `finalName`. Throws Error(Io).
+void writeBytes(const std::filesystem::path& path, const void* data, size_t size, const std::string& finalName);
+// A file of the set that writes `bytes` (an image, a copy of an input's file) under finalPath.
+PendingFile pendingBytes(const std::filesystem::path& finalPath, std::vector<uint8_t> bytes);
+
 // Scene → document: one mesh and one identity node per primitive (positions are world space),
 // materials (emission > 1 via KHR_materials_emissive_strength), textures as PNG (colour textures
 // sRGB-encoded, MOZ_lightmap textures linear), MOZ_lightmap, TEXCOORD_1 and extras.lightmap where

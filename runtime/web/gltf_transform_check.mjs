@@ -15,18 +15,24 @@
 //     prune + dedup keep every IRBAKE_shadowmask (texCoord 1 on a texture with an image, its exr) and the root's
 //     light → channel map exactly; a missing texture, texCoord ≠ 1, a channel outside 0..3 and a material mask
 //     without the root map are refused with an Error naming the material.
+//   scenarios --modules DIR --input BAKE.gltf --output OPT.glb   (a bake with --light-group)
+//     IRBAKE_lightmap_scenarios survives optimize: the same layers (names, lights, intensities, EXR names, sun
+//     irradiance), scenarios and default; its pages are the materials' MOZ_lightmap textures and each layer's textures
+//     the same images as in the bake; its probe and sun SH accessors' values bit for bit; a layer texture the file lacks
+//     and a negative intensity are refused naming the field.
 // Exit 0 when every check passes, 1 with the failures listed.
 import fs from 'node:fs';
 import path from 'node:path';
 import { countLightmappedTriangles, defineIrbakeExtensions, importPackage, IRBAKE_LIGHT_PROBES, IRBAKE_LIGHTMAP_DIRECTIONAL,
-  EMITTER_ACCESSORS, IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS, probeFields, SUN_ACCESSORS } from './gltf_transform_irbake.mjs';
+  EMITTER_ACCESSORS, IRBAKE_LIGHTMAP_SCENARIOS, IRBAKE_SHADOWMASK, MOZ_LIGHTMAP, PROBE_ACCESSORS, probeFields, SUN_ACCESSORS }
+  from './gltf_transform_irbake.mjs';
 
 const [mode, ...rest] = process.argv.slice(2);
 // --name value, or --name alone (a flag: true).
 const args = Object.fromEntries(rest.reduce((a, v, i, all) =>
   (v.startsWith('--') ? [...a, [v.slice(2), all[i + 1] === undefined || all[i + 1].startsWith('--') ? true : all[i + 1]]] : a), []));
-if (!['survives', 'refusals', 'shadowmask'].includes(mode) || !args.modules || !args.input) {
-  console.error('usage: gltf_transform_check.mjs survives|refusals|shadowmask --modules DIR --input FILE [--output FILE] [--directional]');
+if (!['survives', 'refusals', 'shadowmask', 'scenarios'].includes(mode) || !args.modules || !args.input) {
+  console.error('usage: gltf_transform_check.mjs survives|refusals|shadowmask|scenarios --modules DIR --input FILE [--output FILE] [--directional]');
   process.exit(2);
 }
 const modules = path.resolve(args.modules);
@@ -35,8 +41,9 @@ const { ALL_EXTENSIONS } = await importPackage(modules, '@gltf-transform/extensi
 const functions = await importPackage(modules, '@gltf-transform/functions');
 const { MeshoptDecoder } = await importPackage(modules, 'meshoptimizer');
 await MeshoptDecoder.ready;
-const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes } = defineIrbakeExtensions(core);
-const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes])
+const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, IrbakeLightmapScenarios } = defineIrbakeExtensions(core);
+const io = new core.NodeIO().registerExtensions([...ALL_EXTENSIONS, MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes,
+                                                 IrbakeLightmapScenarios])
   .registerDependencies({ 'meshopt.decoder': MeshoptDecoder });
 io.setLogger(new core.Logger(core.Logger.Verbosity.ERROR));
 
@@ -293,7 +300,48 @@ async function shadowmask() {
   console.log(JSON.stringify({ maskedMaterials: masked.length, refusalsChecked: refused }));
 }
 
-await (mode === 'survives' ? survives() : mode === 'refusals' ? refusals() : shadowmask());
+async function scenarios() {
+  const input = jsonOf(args.input), output = jsonOf(args.output);
+  const a = input.extensions?.[IRBAKE_LIGHTMAP_SCENARIOS], b = output.extensions?.[IRBAKE_LIGHTMAP_SCENARIOS];
+  check(a, `${args.input}: no ${IRBAKE_LIGHTMAP_SCENARIOS}`);
+  check(b, `${args.output}: ${IRBAKE_LIGHTMAP_SCENARIOS} lost`);
+  check((output.extensionsUsed ?? []).includes(IRBAKE_LIGHTMAP_SCENARIOS) && !(output.extensionsRequired ?? []).includes(IRBAKE_LIGHTMAP_SCENARIOS),
+        `${args.output}: ${IRBAKE_LIGHTMAP_SCENARIOS} not (only) in extensionsUsed`);
+  if (!a || !b) return;
+  // Everything but texture and accessor indices.
+  const fields = d => ({ ...d, pages: d.pages.length,
+                         layers: d.layers.map(l => ({ ...l, textures: l.textures.length, probes: l.probes !== undefined,
+                                                       sun: l.sun && { ...l.sun, sh: l.sun.sh !== undefined } })) });
+  check(same(fields(a), fields(b)), `${IRBAKE_LIGHTMAP_SCENARIOS}: fields ${JSON.stringify(fields(b))}`);
+  const mozTextures = new Set((output.materials ?? []).map(m => m.extensions?.[MOZ_LIGHTMAP]?.index).filter(i => i !== undefined));
+  check([...mozTextures].every(t => b.pages.includes(t)), `pages ${JSON.stringify(b.pages)}, MOZ_lightmap textures ${JSON.stringify([...mozTextures])}`);
+  const imageName = (json, t) => json.images?.[json.textures?.[t]?.source ?? Object.values(json.textures?.[t]?.extensions ?? {})[0]?.source]?.name;
+  // The same image as in the bake, or one dedup merged it with (the same bytes in the bake: a layer without light
+  // in view can equal another's PNG).
+  const inBytes = name => { const i = input.images.find(x => x.name === name); return i?.uri && fs.readFileSync(path.join(path.dirname(args.input), i.uri)); };
+  a.layers.forEach((layer, l) => layer.textures.forEach((t, p) => {
+    const info = { index: b.layers[l]?.textures?.[p] }, was = imageName(input, t), now = imageName(output, info.index);
+    check(hasImage(output, info) && (now === was || (inBytes(now) && inBytes(was)?.equals(inBytes(now)))),
+          `layer '${layer.name}' page ${p}: texture ${info.index} is image '${now}', the bake's '${was}'`);
+  }));
+  const [docA, docB] = await Promise.all([io.read(args.input), io.read(args.output)]);
+  const extA = docA.getRoot().getExtension(IRBAKE_LIGHTMAP_SCENARIOS), extB = docB.getRoot().getExtension(IRBAKE_LIGHTMAP_SCENARIOS);
+  let accessors = 0;
+  for (const key of a.layers.flatMap((l, i) => [l.probes !== undefined && `layer_${i}_probes`, l.sun && `layer_${i}_sun_sh`]).filter(Boolean)) {
+    const x = extA.getAccessor(key)?.getArray(), y = extB.getAccessor(key)?.getArray();
+    check(x && y && x.length === y.length && x.every((v, i) => Object.is(v, y[i])), `${IRBAKE_LIGHTMAP_SCENARIOS} ${key}: values differ`);
+    ++accessors;
+  }
+  const original = await io.readAsJSON(args.input);
+  const edited = edit => () => { const c = { json: structuredClone(original.json), resources: original.resources }; edit(c.json); return io.readJSON(c); };
+  await throws('layer texture 999', edited(j => { j.extensions[IRBAKE_LIGHTMAP_SCENARIOS].layers[0].textures[0] = 999; }),
+               `${IRBAKE_LIGHTMAP_SCENARIOS}.layers[0].textures[0]`, 'texture 999 does not exist');
+  await throws('layer intensity -1', edited(j => { j.extensions[IRBAKE_LIGHTMAP_SCENARIOS].layers[0].intensity[0] = -1; }),
+               `${IRBAKE_LIGHTMAP_SCENARIOS}.layers[0]`, 'intensity -1');
+  console.log(JSON.stringify({ output: args.output, layers: b.layers.length, pages: b.pages.length, accessors, refusalsChecked: refused }));
+}
+
+await (mode === 'survives' ? survives() : mode === 'refusals' ? refusals() : mode === 'scenarios' ? scenarios() : shadowmask());
 if (failures.length) {
   console.error(`gltf_transform_check ${mode}:\n  ${failures.join('\n  ')}`);
   process.exit(1);

@@ -1,5 +1,6 @@
 // irbake's light-map extensions for glTF-Transform (docs/export.md, "Optimisers"): MOZ_lightmap,
-// IRBAKE_lightmap_directional, IRBAKE_shadowmask and IRBAKE_light_probes as extension properties whose textures are real Texture references
+// IRBAKE_lightmap_directional, IRBAKE_shadowmask, IRBAKE_light_probes and IRBAKE_lightmap_scenarios (its pages' and
+// layers' textures, its layers' probe accessors) as extension properties whose textures are real Texture references
 // (TextureInfo, texCoord 1), so prune, dedup, resize and texture compression treat the maps as used textures and
 // keep TEXCOORD_1. Reading refuses what irbake's viewers would show wrongly (a missing texture, a texCoord other
 // than 1, a negative or non-numeric intensity, an incomplete directional extension) with an Error naming the
@@ -10,8 +11,9 @@
 //
 // The classes must extend the very @gltf-transform/core the caller (the CLI) uses, so they are made from it:
 //   const core = await importPackage(modulesDir, '@gltf-transform/core');
-//   const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes } = defineIrbakeExtensions(core);
-//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes]);
+//   const { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, IrbakeLightmapScenarios } =
+//     defineIrbakeExtensions(core);
+//   io.registerExtensions([MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, IrbakeLightmapScenarios]);
 import fs from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
@@ -42,6 +44,7 @@ export function probeFields(def) {
   return fields;
 }
 export const IRBAKE_SHADOWMASK = 'IRBAKE_shadowmask';
+export const IRBAKE_LIGHTMAP_SCENARIOS = 'IRBAKE_lightmap_scenarios';
 // The UV set of every light map (docs/export.md): TEXCOORD_1.
 export const LIGHTMAP_TEXCOORD = 1;
 const AXES = ['x', 'y', 'z'];
@@ -563,8 +566,124 @@ export function defineIrbakeExtensions(core) {
     }
   }
 
-  return { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, Lightmap, DirectionalLightmap, ShadowMask,
-           LightProbeGrid };
+  // IRBAKE_lightmap_scenarios on the root (docs/export.md, "Scenarios and light groups"): its page textures and
+  // each layer's textures as real Texture references (sRGB colour, as MOZ_lightmap's), each layer's probe
+  // coefficients and sun SH as Accessor references, the rest of the definition as read; the writer renumbers them.
+  class LightmapScenarios extends ExtensionProperty {
+    static EXTENSION_NAME = IRBAKE_LIGHTMAP_SCENARIOS;
+    init() {
+      this.extensionName = IRBAKE_LIGHTMAP_SCENARIOS;
+      this.propertyType = 'LightmapScenarios';
+      this.parentTypes = [PropertyType.ROOT];
+    }
+    getDefaults() { return Object.assign(super.getDefaults(), { fields: {}, pageCount: 0 }); }
+    getPageCount() { return this.get('pageCount'); }
+    setPageCount(n) { return this.set('pageCount', n); }
+    // key: page_P (the default scenario's page P) or layer_L_P; with the sampler its texture had.
+    getTexture(key) { return this.getRef(key); }
+    getTextureInfo(key) { return this.getRef(`${key}_info`); }
+    setTexture(key, texture, textureInfo) {
+      this.setRef(`${key}_info`, textureInfo);
+      return this.setRef(key, texture, { channels: RGB, isColor: true });
+    }
+    // key: layer_L_probes or layer_L_sun_sh.
+    getAccessor(key) { return this.getRef(key); }
+    setAccessor(key, accessor) { return this.setRef(key, accessor, { usage: 'OTHER' }); }
+    getFields() { return this.get('fields'); }  // the definition without texture and accessor indices
+    setFields(fields) { return this.set('fields', fields); }
+  }
+
+  class IrbakeLightmapScenarios extends Extension {
+    static EXTENSION_NAME = IRBAKE_LIGHTMAP_SCENARIOS;
+    extensionName = IRBAKE_LIGHTMAP_SCENARIOS;
+    prewriteTypes = [PropertyType.MESH];
+    textureIndices = null;  // key → texture index, made in prewrite (before texture extensions write theirs)
+
+    read(context) {
+      const json = context.jsonDoc.json, def = json.extensions?.[IRBAKE_LIGHTMAP_SCENARIOS];
+      if (def === undefined) return this;
+      const what = IRBAKE_LIGHTMAP_SCENARIOS;
+      if (!isObject(def) || !Array.isArray(def.pages) || def.pages.length === 0) throw new Error(`${what}.pages: needs one texture per page`);
+      if (!Array.isArray(def.layers) || def.layers.length === 0) throw new Error(`${what}.layers: needs at least one layer`);
+      const ext = new LightmapScenarios(this.document.getGraph());
+      const texture = (key, index, where) => {
+        const t = textureOf(context, { index }, where);
+        const info = new TextureInfo(this.document.getGraph(), `${key}_info`);
+        context.setTextureInfo(info, { index });
+        ext.setTexture(key, t, info);
+      };
+      def.pages.forEach((index, p) => texture(`page_${p}`, index, `${what}.pages[${p}]`));
+      const fields = structuredClone(def);
+      delete fields.pages;
+      fields.layers = def.layers.map((layer, l) => {
+        const where = `${what}.layers[${l}]`;
+        if (!isObject(layer) || !Array.isArray(layer.textures) || layer.textures.length !== def.pages.length)
+          throw new Error(`${where}.textures: needs one texture per page (${def.pages.length})`);
+        if (!Array.isArray(layer.intensity) || layer.intensity.length !== def.pages.length) throw new Error(`${where}.intensity: needs one per page`);
+        layer.intensity.forEach(i => checkIntensity(i, where));
+        layer.textures.forEach((index, p) => texture(`layer_${l}_${p}`, index, `${where}.textures[${p}]`));
+        const kept = without(layer, ['textures', 'probes']);
+        const accessor = (key, index, field) => {
+          const a = json.accessors?.[index];
+          if (!Number.isInteger(index) || a === undefined || a.componentType !== 5126 || a.type !== 'VEC3')
+            throw new Error(`${where}.${field}: accessor ${JSON.stringify(index)} is not a FLOAT VEC3 accessor of the file`);
+          ext.setAccessor(key, context.accessors[index]);
+        };
+        if (layer.probes !== undefined) accessor(`layer_${l}_probes`, layer.probes, 'probes');
+        if (layer.sun !== undefined) {
+          accessor(`layer_${l}_sun_sh`, layer.sun?.sh, 'sun.sh');
+          kept.sun = without(layer.sun, ['sh']);
+        }
+        return kept;
+      });
+      this.document.getRoot().setExtension(IRBAKE_LIGHTMAP_SCENARIOS, ext.setFields(fields).setPageCount(def.pages.length));
+      return this;
+    }
+
+    prewrite(context) {
+      const ext = this.document.getRoot().getExtension(IRBAKE_LIGHTMAP_SCENARIOS);
+      this.textureIndices = new Map();
+      if (!ext) return this;
+      for (const key of this.textureKeys(ext)) {
+        const texture = ext.getTexture(key);
+        if (!texture) throw new Error(`${IRBAKE_LIGHTMAP_SCENARIOS}: the texture of ${key} was lost`);
+        this.textureIndices.set(key, context.createTextureInfoDef(texture, ext.getTextureInfo(key)).index);
+      }
+      return this;
+    }
+
+    // Every texture key of the definition: page_P, then layer_L_P.
+    textureKeys(ext) {
+      const pages = [...Array(ext.getPageCount()).keys()];
+      return [...pages.map(p => `page_${p}`), ...ext.getFields().layers.flatMap((_, l) => pages.map(p => `layer_${l}_${p}`))];
+    }
+
+    write(context) {
+      const ext = this.document.getRoot().getExtension(IRBAKE_LIGHTMAP_SCENARIOS);
+      if (!ext) return this;
+      const fields = ext.getFields(), indices = this.textureIndices;
+      const accessorIndex = key => {
+        const index = context.accessorIndexMap.get(ext.getAccessor(key));
+        if (index === undefined) throw new Error(`${IRBAKE_LIGHTMAP_SCENARIOS}: the accessor of ${key} was lost`);
+        return index;
+      };
+      const pages = [...Array(ext.getPageCount()).keys()].map(p => indices.get(`page_${p}`));
+      const def = { ...fields, pages };
+      def.layers = fields.layers.map((layer, l) => {
+        const out = { ...layer, textures: pages.map((_, p) => indices.get(`layer_${l}_${p}`)) };
+        if (ext.getAccessor(`layer_${l}_probes`)) out.probes = accessorIndex(`layer_${l}_probes`);
+        if (ext.getAccessor(`layer_${l}_sun_sh`)) out.sun = { ...layer.sun, sh: accessorIndex(`layer_${l}_sun_sh`) };
+        return out;
+      });
+      const json = context.jsonDoc.json;
+      json.extensions = json.extensions ?? {};
+      json.extensions[IRBAKE_LIGHTMAP_SCENARIOS] = def;
+      return this;
+    }
+  }
+
+  return { MozLightmap, IrbakeLightmapDirectional, IrbakeShadowmask, IrbakeLightProbes, IrbakeLightmapScenarios, Lightmap,
+           DirectionalLightmap, ShadowMask, LightProbeGrid, LightmapScenarios };
 }
 
 // A reference's field name in messages: sun_sh → sun.sh, emitters_0_positions → emitters[0].positions.

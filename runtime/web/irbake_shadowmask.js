@@ -15,6 +15,7 @@
 // again whenever lights are added, removed or hidden: it maps three's per-type light order to channels).
 // Invalid data throws an Error naming the material or entry and the problem.
 import { Vector4, DirectionalLight, NoColorSpace, LinearFilter, ShaderChunk } from 'three';
+import { composeShaderPatch } from './shader_patch.js';
 
 export const IRBAKE_SHADOWMASK = 'IRBAKE_shadowmask';
 const KHR_LIGHTS = 'KHR_lights_punctual';
@@ -173,7 +174,7 @@ function directionalOf(j, what) {
 }
 
 // The material's light loops scale each light's directLight.color by dot(mask, weights[i]) + bias[i]. Composes
-// with another plugin's onBeforeCompile (moz_lightmap.js's directional maps), whichever is set first.
+// with the other plugins' shader patches (shader_patch.js), whichever is set first.
 function patchMaterial(material, mask, uniforms) {
   const begin = ShaderChunk.lights_fragment_begin;
   for (const kind of KINDS)
@@ -195,16 +196,5 @@ function patchMaterial(material, mask, uniforms) {
       .replace('#include <lightmap_pars_fragment>', `#include <lightmap_pars_fragment>\n${decls}`)
       .replace('#include <lights_fragment_begin>', `${read}\n${chunk}`);
   };
-  let inner = material.onBeforeCompile, innerKey = material.customProgramCacheKey;
-  Object.defineProperty(material, 'onBeforeCompile', {
-    get: () => (shader, renderer) => { inner?.call(material, shader, renderer); patch(shader); },
-    set: f => { inner = f; },
-    configurable: true,
-  });
-  Object.defineProperty(material, 'customProgramCacheKey', {
-    get: () => () => `${innerKey ? innerKey.call(material) : ''}+irbake-shadowmask${mask ? '' : '-none'}`,
-    set: f => { innerKey = f; },
-    configurable: true,
-  });
-  material.needsUpdate = true;
+  composeShaderPatch(material, `irbake-shadowmask${mask ? '' : '-none'}`, patch);
 }

@@ -14,6 +14,9 @@
 //          [--region-a A.png --region-b B.png [--region-min 8] [--min-region-pixels N]: the mean over the pixels
 //           where A and B (beside the reference) differ by at least region-min in some channel, and fail unless
 //           there are N of them]
+//          [--weights 'a=0.5;b=1,0.8,0.5', --scenario NAME: a bake with light groups blended at run time with these
+//           layer weights over that stored scenario (irbake_lightmap_scenarios.js); --scenarios off: its own maps,
+//           unblended; --min-blended N: fail unless N materials were blended]
 //          [--image X.png: compare that image (beside the reference, irview's own screenshot) instead of a render;
 //           --scene is then not read]
 import fs from 'node:fs';
@@ -64,6 +67,7 @@ try {
   const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene ?? ''))}`, width, height,
                                   lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz', standard: args.standard ?? '1' });
   if (camera !== undefined) q.set('camera', camera);  // none: the viewer's default (camera 0, or the overview)
+  for (const k of ['weights', 'scenario', 'scenarios']) if (args[k] !== undefined) q.set(k, args[k]);
   const imageUrl = image ? `/ref/${encodeURIComponent(path.basename(image))}` : null;
   let ready = {};
   if (image) {
@@ -136,7 +140,7 @@ try {
     code = 1;
   }
   for (const [option, field] of [['min-runtime-lights', 'runtimeLights'], ['min-masked', 'maskedMaterials'],
-                                 ['min-region-pixels', 'pixels'], ['min-probe-lit', 'probeLit']])
+                                 ['min-region-pixels', 'pixels'], ['min-probe-lit', 'probeLit'], ['min-blended', 'blendedMaterials']])
     if (args[option] !== undefined && !(result[field] >= Number(args[option]))) {
       console.error(`render_compare: ${field} ${result[field]}, expected at least ${args[option]}`);
       code = 1;

@@ -1,7 +1,8 @@
 // Runs the Khronos glTF-Validator (npm gltf-validator, validateBytes) on an export and, when given,
 // on its input. Passes (exit 0) when the export has 0 errors, no warning the input did not already
 // have (compared by code and count), and no UNUSED_OBJECT for a mesh or an accessor (but the accessors
-// IRBAKE_light_probes and its `sun` and `emitters` name: the validator does not know the extension). Prints the counts.
+// IRBAKE_light_probes and its `sun` and `emitters` name, and those of IRBAKE_lightmap_scenarios's layers: the
+// validator does not know the extensions). Prints the counts.
 // Usage: node validate.mjs --modules DIR --output OUT.gltf|.glb [--input IN.gltf|.glb]
 import fs from 'node:fs';
 import path from 'node:path';
@@ -57,6 +58,10 @@ const probeAccessors = new Set([
   ...(Array.isArray(probeExt.emitters) ? probeExt.emitters : []).flatMap(e => Object.entries(e ?? {}))
     .filter(([k]) => ['positions', 'visibility'].includes(k)),
 ].map(([, v]) => `/accessors/${v}`));
+// IRBAKE_lightmap_scenarios names each layer's probe coefficients and the sun layer's SH the same way (its
+// textures show as UNUSED_OBJECT infos, which pass).
+for (const layer of jsonOf(args.output).extensions?.IRBAKE_lightmap_scenarios?.layers ?? [])
+  for (const v of [layer?.probes, layer?.sun?.sh]) if (Number.isInteger(v)) probeAccessors.add(`/accessors/${v}`);
 for (const m of out.report.issues.messages)
   if (m.code === 'UNUSED_OBJECT' && /^\/(meshes|accessors)\/\d+$/.test(m.pointer ?? '') && !probeAccessors.has(m.pointer))
     problems.push(`unused ${m.pointer}`);

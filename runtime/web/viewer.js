@@ -6,6 +6,7 @@ import { MeshoptDecoder } from 'three/addons/libs/meshopt_decoder.module.js';
 import { MozLightmapExtension } from './moz_lightmap.js';
 import { IrbakeShadowmaskExtension } from './irbake_shadowmask.js';
 import { IrbakeLightProbesExtension } from './irbake_light_probes.js';
+import { IrbakeLightmapScenariosExtension } from './irbake_lightmap_scenarios.js';
 import { addProbeObjects, lightProbeLitMeshes, lookAtCamera } from './probe_objects.js';
 import { overviewCamera } from './overview_camera.js';
 
@@ -15,8 +16,13 @@ import { overviewCamera } from './overview_camera.js';
 // probeObjects: [[x, y, z, r], ...] white spheres lit by IRBAKE_light_probes (probe_objects.js); view: { eye,
 // target, fov } a look-at camera instead of glTF camera `camera`, as irview --eye/--target/--fov.
 // camera null: the file's camera 0, or irview's overview of the scene when it has none (as irview without --camera).
+// scenarios false: IRBAKE_lightmap_scenarios left unread (the document's own maps, its default scenario); else the
+// layers blended at run time (irbake_lightmap_scenarios.js) from `scenario` (a stored one's name; null: the
+// default) with `weights` ({ layer: w }, w one number or [r, g, b]) over it. The result's `controls` (null without
+// layers) change the blend and render again: { layers, scenarios, weights(), setWeights(w), useScenario(name) }.
 export async function showBakedScene({ scene, camera = null, width, height, lightmapMode = 'sh', plugin = true,
-                                       mixedLights = true, probeObjects = [], view = null }) {
+                                       mixedLights = true, probeObjects = [], view = null, scenarios = true,
+                                       scenario = null, weights = null }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
@@ -28,10 +34,12 @@ export async function showBakedScene({ scene, camera = null, width, height, ligh
   loader.setMeshoptDecoder(MeshoptDecoder);  // EXT_meshopt_compression: gltf-transform optimize's default
   let lightmapExtension = null;
   let shadowmask = null;  // mixed lighting: the lights the bake left to the client, shadowed by the mask pages
+  let layers = null;      // light groups' layers, blended at run time
   if (plugin) {
     loader.register(parser => (lightmapExtension = new MozLightmapExtension(parser, { lightmapMode })));
     loader.register(parser => new IrbakeLightProbesExtension(parser));
     if (mixedLights) loader.register(parser => (shadowmask = new IrbakeShadowmaskExtension(parser)));
+    if (scenarios) loader.register(parser => (layers = new IrbakeLightmapScenariosExtension(parser, { scenario, weights })));
   }
   const gltf = await loader.loadAsync(scene);
   // The light maps hold the baked lights' light already: drop those; keep the ones the bake left to the client
@@ -57,7 +65,12 @@ export async function showBakedScene({ scene, camera = null, width, height, ligh
   else
     renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);
-  return { width, height, overview, lights: lights.length, lightmapMode, plugin,
+  const rerender = f => x => { f(x); renderer.render(gltf.scene, cam); };
+  const controls = layers?.layers.length ? { layers: layers.layers, scenarios: layers.scenarios, weights: () => layers.weights(),
+                                              setWeights: rerender(w => layers.setWeights(w)),
+                                              useScenario: rerender(name => layers.useScenario(name)) } : null;
+  return { width, height, overview, lights: lights.length, lightmapMode, plugin, controls,
+           blendedMaterials: layers?.blendedMaterials ?? 0, weights: layers?.weights() ?? null,
            runtimeLights: shadowmask?.runtimeLights.length ?? 0, maskedMaterials: shadowmask?.maskedMaterials ?? 0,
            directionalMaterials: lightmapExtension?.directionalMaterials ?? 0,
            generatedTangents: lightmapExtension?.generatedTangents ?? 0, probes, probeLit };
