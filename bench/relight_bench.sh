@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # irbake relight against the bake it relights (docs/guide.md, "Relight"): Sponza (../shared/scenes) with one
 # interior lamp (bench/levels/add_point_light.py), --sun and --sky, baked with two light groups (day = sun, sky;
-# lamp = the rest; probes every metre: each group's bake must place the same grid), then relit RUNS times to a .gltf and a .glb with other weights. Per run: wall and CPU
+# lamp = the rest; probes every metre), then relit RUNS times to a .gltf and a .glb with other weights. Per run: wall and CPU
 # seconds (user + system), pages, texels summed and the 1-minute load average → bench/results/relight.csv
 # Usage: bench/relight_bench.sh BUILD_DIR [RUNS]
 set -euo pipefail
