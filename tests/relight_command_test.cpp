@@ -19,24 +19,22 @@ using json = nlohmann::json;
 
 namespace {
 
-// The grouped bake, made once for the suite.
-fs::path groupedBake() {
-  static const fs::path gltf = [] {
-    const fs::path dir = scratchFolder("relight_command", "grouped");
-    const fs::path samples = sampleScenes("relight_command");
-    const IrbakeRun r = runIrbakeIn(dir, {"bake", (samples / "cornell_box.gltf").string(), "-o", (dir / "out").string(),
-                                          "--vpls", "256", "--texels-per-unit", "40", "--sun", "0.2,-0.5,1,3", "--probes",
-                                          "0.1", "--light-group", "day=sun", "--light-group", "lamp=emissive", "--quiet"});
-    EXPECT_EQ(r.code, 0) << r.output;
-    return dir / "out" / "scene.gltf";
-  }();
-  return gltf;
+// The grouped bake, one per test: ctest runs each test in a process of its own, in parallel, and a folder shared
+// between them would be cleared by one while another reads it.
+fs::path groupedBake(const std::string& test) {
+  const fs::path dir = scratchFolder("relight_command", test + "_grouped");
+  const fs::path samples = sampleScenes("relight_command");
+  const IrbakeRun r = runIrbakeIn(dir, {"bake", (samples / "cornell_box.gltf").string(), "-o", (dir / "out").string(),
+                                        "--vpls", "256", "--texels-per-unit", "40", "--sun", "0.2,-0.5,1,3", "--probes",
+                                        "0.1", "--light-group", "day=sun", "--light-group", "lamp=emissive", "--quiet"});
+  EXPECT_EQ(r.code, 0) << r.output;
+  return dir / "out" / "scene.gltf";
 }
 
 }  // namespace
 
 TEST(RelightCommand, TheBakesWeightsGiveItsPagesAndProbesBackBitForBit) {
-  const fs::path in = groupedBake(), dir = scratchFolder("relight_command", "same");
+  const fs::path in = groupedBake("same"), dir = scratchFolder("relight_command", "same");
   const IrbakeRun r = runIrbakeIn(dir, {"relight", in.string(), "-o", (dir / "out" / "scene.glb").string()});
   ASSERT_EQ(r.code, 0) << r.output;
   const Lightmap a = readExr(in.parent_path() / "lightmap_0.exr"), b = readExr(dir / "out" / "lightmap_0.exr");
@@ -56,7 +54,7 @@ TEST(RelightCommand, TheBakesWeightsGiveItsPagesAndProbesBackBitForBit) {
 }
 
 TEST(RelightCommand, HalfAndTwoAreTheLayersWeightedSum) {
-  const fs::path in = groupedBake(), dir = scratchFolder("relight_command", "half_two");
+  const fs::path in = groupedBake("half_two"), dir = scratchFolder("relight_command", "half_two");
   const IrbakeRun r = runIrbakeIn(dir, {"relight", in.string(), "--group", "day=0.5", "--group", "lamp=2", "-o",
                                         (dir / "out" / "scene.gltf").string()});
   ASSERT_EQ(r.code, 0) << r.output;
@@ -77,7 +75,7 @@ TEST(RelightCommand, HalfAndTwoAreTheLayersWeightedSum) {
 }
 
 TEST(RelightCommand, RefusesNamingTheFile) {
-  const fs::path in = groupedBake(), dir = scratchFolder("relight_command", "refusals");
+  const fs::path in = groupedBake("refusals"), dir = scratchFolder("relight_command", "refusals");
   const std::string out = (dir / "out" / "scene.gltf").string();
   struct Case {
     std::vector<std::string> args;
