@@ -316,6 +316,27 @@ def t_light_cull():
                   "CPU / sun + sky", "rel. RMSE vs brute force"], out)
 
 
+def t_scenarios():
+    """bench/scenarios/day_night.py: per pair, its latest commit's seeds: the binned difference against the
+    root sum of squares of the two bakes' estimated errors; the relight's CPU against one bake of every light."""
+    rows = read("scenarios.csv")
+    last = rows[-1]["commit"]
+    rows = [r for r in rows if r["commit"] == last]
+    out = []
+    for pair in dict.fromkeys(r["pair"] for r in rows if float(r["expected"]) > 0):
+        g = [r for r in rows if r["pair"] == pair]
+        expected = [float(r["expected"]) for r in g if float(r["expected"]) > 0]
+        ratio = [float(r["ratio"]) for r in g if r["ratio"]]
+        out.append([pair.replace("_", " "), last, ", ".join(r["seed"] for r in g),
+                    pct(median([float(r["rel_rmse_4"]) for r in g]), 3), pct(median(expected), 3) if expected else "",
+                    num(max(ratio)) if ratio else ""])
+    relight = median([float(r["relight_cpu_s"]) for r in rows])
+    bake = median([float(r["all_cpu_s"]) for r in rows])
+    grouped = median([float(r["grouped_cpu_s"]) for r in rows])
+    return table(["pair", "commit", "seeds", "rel. RMSE, 4×4 bins", "estimates (RSS)", "worst ratio"], out) + \
+        f"\n\nrelight: {relight:.2f} s CPU, {100 * relight / bake:.1f}% of one bake ({bake:.0f} s)"
+
+
 def t_plan_accuracy():
     """bench/levels/plan_accuracy.sh: `irbake plan`'s prediction against the bake, the latest date's rows."""
     rows = read("plan_accuracy.csv")
