@@ -179,11 +179,10 @@ void setProbeLitRecord(json& prim, const Primitive& part) {
 }
 
 // MOZ_lightmap of one page as its specification defines it: the texture, TEXCOORD_1 written explicitly, and
-// the intensity that makes intensity × sRGBToLinear(texel) the irradiance E. The PNG holds map value (E/π) /
-// range, so the intensity is π × the range; the extras say the PNG is sRGB-encoded and carry the units
-// marker that tells these files from an older irbake's (scene/moz_lightmap_units.h, docs/export.md).
+// the intensity that makes intensity × sRGBToLinear(texel) the irradiance E (mozLightmapIntensity); the extras say
+// the PNG is sRGB-encoded and carry the units marker that tells these files from an older irbake's (scene/moz_lightmap_units.h, docs/export.md).
 json mozLightmap(int texture, const EncodedMap& image) {
-  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", kPi * double(image.metadata.intensity)}};
+  json moz = {{"index", texture}, {"texCoord", 1}, {"intensity", mozLightmapIntensity(image)}};
   if (image.metadata.srgb) moz["extras"]["colorSpace"] = "srgb";
   moz["extras"][kMozLightmapMarkerKey] = mozLightmapMarker();
   return moz;
@@ -372,12 +371,7 @@ class SourceExport {
     if (expandedNodes_.empty()) return;
     for (const json& n : doc_.root["nodes"])
       if (n.contains("extensions") && n["extensions"].is_object() && n["extensions"].contains("EXT_mesh_gpu_instancing")) return;
-    for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-      if (!doc_.root.contains(list) || !doc_.root[list].is_array()) continue;
-      json& names = doc_.root[list];
-      names.erase(std::remove(names.begin(), names.end(), json("EXT_mesh_gpu_instancing")), names.end());
-      if (names.empty()) doc_.root.erase(list);
-    }
+    unlistExtension(doc_.root, "EXT_mesh_gpu_instancing");
     log::warn(file_ + ": EXT_mesh_gpu_instancing: " + std::to_string(expandedNodes_.size()) + " instanced node(s) written as " +
               std::to_string(expandedInstances_) + " nodes, one per instance, each with its own light-map region; the extension is dropped");
   }

@@ -1,5 +1,6 @@
 #include "export/gltf_writer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -76,6 +77,23 @@ void GltfDocument::useExtension(const std::string& name) {
   for (const auto& e : root["extensionsUsed"])
     if (e == name) return;
   root["extensionsUsed"].push_back(name);
+}
+
+void unlistExtension(json& root, const std::string& name) {
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (!root.contains(list) || !root[list].is_array()) continue;
+    json& names = root[list];
+    names.erase(std::remove(names.begin(), names.end(), json(name)), names.end());
+    if (names.empty()) root.erase(list);
+  }
+}
+
+void removeRootExtension(json& root, const std::string& name) {
+  if (root.contains("extensions") && root["extensions"].is_object() && root["extensions"].contains(name)) {
+    root["extensions"].erase(name);
+    if (root["extensions"].empty()) root.erase("extensions");
+  }
+  unlistExtension(root, name);
 }
 
 int GltfDocument::addBufferView(const void* data, size_t size, int target) {

@@ -42,6 +42,13 @@ class GltfDocument {
   std::vector<PendingFile> files(const std::filesystem::path& path) const;
 };
 
+// Takes `name` out of the root's extensionsUsed and extensionsRequired (a list left empty goes): the inverse of
+// useExtension, for an extension the export no longer uses.
+void unlistExtension(nlohmann::json& root, const std::string& name);
+// Removes the root object's extension `name` (an "extensions" left empty goes) and unlists it; the objects it
+// referred to are left to compaction.
+void removeRootExtension(nlohmann::json& root, const std::string& name);
+
 struct GltfWriteOptions {
   std::vector<std::string> lightmapPages;  // relative URIs of float EXR pages, written to root extras
 };

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "common/error.h"
-#include "common/maths.h"
 
 namespace irbake {
 
@@ -104,7 +103,7 @@ void addLightScenariosExtension(GltfDocument& doc, const std::vector<LightLayer>
       const EncodedMap encoded = png8.encode(m, o);
       const int image = doc.addImage(encoded.bytes, encoded.stored.name, png8.mimeType());
       textures.push_back(doc.addTexture(image, doc.addSampler(WrapMode::ClampToEdge, WrapMode::ClampToEdge, true)));
-      intensity.push_back(kPi * double(encoded.metadata.intensity));  // as MOZ_lightmap's: E = sRGB⁻¹(texel) × intensity
+      intensity.push_back(mozLightmapIntensity(encoded));  // as MOZ_lightmap's
       if (!exrPrefix.empty()) exr.push_back(layerPageUri(exrPrefix, m.page, layer.name));
     }
     json entry = {{"name", layer.name}, {"lights", layer.lights}, {"textures", textures}, {"intensity", intensity}};
@@ -137,19 +136,6 @@ void addLightScenarioProbes(GltfDocument& doc, const std::vector<LightLayer>& la
   }
 }
 
-void removeLightScenariosExtension(json& root) {
-  if (root.contains("extensions") && root["extensions"].is_object() && root["extensions"].contains(kLightScenariosExtension)) {
-    root["extensions"].erase(kLightScenariosExtension);
-    if (root["extensions"].empty()) root.erase("extensions");
-  }
-  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-    if (!root.contains(list) || !root[list].is_array()) continue;
-    json kept = json::array();
-    for (const json& e : root[list])
-      if (e != kLightScenariosExtension) kept.push_back(e);
-    if (kept.empty()) root.erase(list);
-    else root[list] = std::move(kept);
-  }
-}
+void removeLightScenariosExtension(json& root) { removeRootExtension(root, kLightScenariosExtension); }
 
 }  // namespace irbake

@@ -240,21 +240,7 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
   doc.useExtension(kLightProbesExtension);
 }
 
-void removeLightProbesExtension(json& root) {
-  if (root.contains("extensions") && root["extensions"].is_object() && root["extensions"].contains(kLightProbesExtension)) {
-    root["extensions"].erase(kLightProbesExtension);
-    if (root["extensions"].empty()) root.erase("extensions");
-  }
-  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
-    if (!root.contains(list) || !root[list].is_array()) continue;
-    if (std::find(root[list].begin(), root[list].end(), json(kLightProbesExtension)) == root[list].end()) continue;
-    json kept = json::array();
-    for (const json& e : root[list])
-      if (e != kLightProbesExtension) kept.push_back(e);
-    if (kept.empty()) root.erase(list);
-    else root[list] = std::move(kept);
-  }
-}
+void removeLightProbesExtension(json& root) { removeRootExtension(root, kLightProbesExtension); }
 
 LightProbeGrid readLightProbes(const std::filesystem::path& path) {
   const std::string file = path.string();

@@ -5,8 +5,11 @@
 #include <iterator>
 
 #include "common/error.h"
+#include "common/maths.h"
 
 namespace irbake {
+
+double mozLightmapIntensity(const EncodedMap& image) { return kPi * double(image.metadata.intensity); }
 
 // Each encoding's instance, defined in its own file.
 const MapEncoding& png8MapEncoding();

@@ -51,6 +51,10 @@ struct EncodedMap {
   std::vector<uint8_t> bytes;  // the encoded file
 };
 
+// MOZ_lightmap's `intensity` for an 8-bit map: the PNG holds map value (E/π) / range, so intensity × sRGB⁻¹(texel)
+// is the irradiance E when the intensity is π × the range (docs/export.md, "MOZ_lightmap: what a client does").
+double mozLightmapIntensity(const EncodedMap& image);
+
 struct DecodedMap {
   Lightmap map;                // linear values (valid = 1 everywhere)
   std::vector<float> alpha;    // the fourth channel, empty when the file has none

@@ -10,7 +10,6 @@
 #include "common/error.h"
 #include "common/file_paths.h"
 #include "common/log.h"
-#include "common/maths.h"
 #include "export/exr_io.h"
 #include "export/gltf_compact.h"
 #include "export/gltf_export.h"
@@ -327,7 +326,7 @@ void Relight::encodePages(const std::vector<Lightmap>& sums, RelightSummary& sum
     image["bufferView"] = doc_.addBufferView(encoded.bytes.data(), encoded.bytes.size());
     image["mimeType"] = "image/png";
     image.erase("uri");
-    const double intensity = kPi * double(encoded.metadata.intensity);  // as the bake's MOZ_lightmap (gltf_export.cpp)
+    const double intensity = mozLightmapIntensity(encoded);
     for (json& m : doc_.root["materials"]) {
       if (!m.contains("extensions") || !m["extensions"].contains("MOZ_lightmap")) continue;
       json& moz = m["extensions"]["MOZ_lightmap"];

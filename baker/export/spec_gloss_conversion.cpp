@@ -90,14 +90,6 @@ int roughnessTexture(GltfDocument& doc, int source, double glossiness, const Spe
   return doc.append("textures", std::move(texture));
 }
 
-void dropFromList(json& root, const char* list, const char* name) {
-  if (!root.contains(list) || !root[list].is_array()) return;
-  json kept = json::array();
-  for (const json& e : root[list])
-    if (e != name) kept.push_back(e);
-  if (kept.empty()) root.erase(list);
-  else root[list] = std::move(kept);
-}
 
 }  // namespace
 
@@ -144,8 +136,7 @@ int convertSpecularGlossiness(GltfDocument& doc, const std::string& file) {
       ++converted;
     }
   }
-  dropFromList(doc.root, "extensionsUsed", kSpecularGlossinessExtension);
-  dropFromList(doc.root, "extensionsRequired", kSpecularGlossinessExtension);
+  unlistExtension(doc.root, kSpecularGlossinessExtension);
   if (converted > 0) {
     doc.useExtension("KHR_materials_specular");
     doc.useExtension("KHR_materials_ior");
