@@ -84,28 +84,11 @@ struct Candidates {
   std::vector<double> weight, upTo;  // 1 / its unshadowed value; running sum of unshadowed value / pmf
 };
 
-// The left-out light at (x, n), `rays` shadow rays. Without candidates each ray goes to its own light drawn from the
-// tree (stratified over its unit interval, its order spatial) and weighs value / pmf. With m candidates (m ≥ rays):
-// m lights drawn alike, each weighed by its unshadowed left-out light over its pmf (exact, no ray); the rays go to
-// lights resampled among them in proportion to those weights (systematic: a light picked twice is traced once), each
-// weighing its shadowed light over its unshadowed light times the weights' mean. Resampled importance sampling
-// (Talbot et al. 2005): unbiased, the unshadowed light is estimated from m draws for the price of tree walks and
-// the rays spend themselves on the visibility only.
-glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, int rays,
-                  int candidates, Rng& rng, Candidates& room, size_t& traced) {
-  auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
-  glm::dvec3 sum(0.0);
-  if (candidates <= 0) {
-    const double shift = rng.uniform();
-    for (int k = 0; k < rays; ++k) {
-      const LightTree::Choice choice = c.tree.sample(x, n, (k + shift) / rays, exact);
-      if (choice.light == UINT32_MAX || !(choice.pmf > 0.0)) continue;
-      const LeftOut lo = leftOutLight(in.scene, c, choice.light, x, n);
-      if (lo.value != glm::vec3(0.0f)) sum += glm::dvec3(shadowed(in, x, n, lo, traced)) / choice.pmf;
-    }
-    return sum / double(rays);
-  }
-  const int m = std::max(candidates, rays);
+// m candidate lights at (x, n) drawn from the tree (stratified over the unit interval from `shift`), each weighed by
+// its exact unshadowed left-out light over its pmf, no ray. room.upTo holds the running sum of those weights;
+// returns their sum, m times the unbiased estimate of the unshadowed left-out light.
+double drawCandidates(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, int m, double shift,
+                      Candidates& room) {
   room.lo.resize(size_t(m)), room.weight.resize(size_t(m)), room.upTo.resize(size_t(m));
   // The walk weighs a leaf by its exact light just before it hands that leaf over: the last two lights weighed are
   // kept, so a candidate's light is not evaluated twice.
@@ -119,7 +102,7 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
     return v;
   };
   std::fill(room.weight.begin(), room.weight.end(), 0.0);
-  c.tree.sampleStratified(x, n, rng.uniform(), m, weigh, [&](int j, const LightTree::Choice& choice) {
+  c.tree.sampleStratified(x, n, shift, m, weigh, [&](int j, const LightTree::Choice& choice) {
     LeftOut& lo = room.lo[size_t(j)];
     lo = seen[0] == choice.light ? seenLo[0] : seen[1] == choice.light ? seenLo[1]
                                                                         : leftOutLight(in.scene, c, choice.light, x, n);
@@ -128,17 +111,71 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
   });
   double total = 0.0;
   for (int j = 0; j < m; ++j) total += room.weight[size_t(j)] > 0.0 ? room.upTo[size_t(j)] : 0.0, room.upTo[size_t(j)] = total;
+  return total;
+}
+
+// How a position's rays are drawn.
+struct DrawShifts {
+  double walk = 0.0;   // the tree walk's stratified shift
+  double pick = 0.0;   // the resampling's systematic shift
+  double round = 0.0;  // the ray count's random rounding
+};
+
+// The left-out light at (x, n). Without candidates: `rays` shadow rays, each to its own light drawn from the tree
+// (stratified over its unit interval, its order spatial), weighing value / pmf. With m candidates (drawCandidates):
+// the rays go to lights resampled among them in proportion to their weights (systematic: a light picked twice is
+// traced once), each weighing its shadowed light over its unshadowed light times the weights' mean. Resampled
+// importance sampling (Talbot et al. 2005): unbiased, the unshadowed light is estimated from m draws for the price
+// of tree walks and the rays spend themselves on the visibility only. With raysPerUnit > 0 the ray count follows
+// that unshadowed estimate (rays × estimate × raysPerUnit, at most 8 × rays, randomly rounded; below one ray, one
+// ray by Russian roulette): the visibility's noise in absolute terms grows with the light it gates, so the rays go
+// where the tail is (Neyman's allocation). The estimate stays unbiased whatever the count, which depends on the
+// candidates only.
+glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, int rays,
+                  int candidates, double raysPerUnit, const DrawShifts& shifts, Candidates& room, size_t& traced) {
+  glm::dvec3 sum(0.0);
+  if (candidates <= 0) {
+    auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
+    for (int k = 0; k < rays; ++k) {
+      const LightTree::Choice choice = c.tree.sample(x, n, (k + shifts.walk) / rays, exact);
+      if (choice.light == UINT32_MAX || !(choice.pmf > 0.0)) continue;
+      const LeftOut lo = leftOutLight(in.scene, c, choice.light, x, n);
+      if (lo.value != glm::vec3(0.0f)) sum += glm::dvec3(shadowed(in, x, n, lo, traced)) / choice.pmf;
+    }
+    return sum / double(rays);
+  }
+  const int m = std::max(candidates, rays);
+  const double total = drawCandidates(in, c, x, n, m, shifts.walk, room);
   if (!(total > 0.0)) return sum;
-  const double pick = rng.uniform();
+  double scale = 1.0;  // the ray count's share of the estimate: 1 unless Russian roulette kept one ray
+  if (raysPerUnit > 0.0) {
+    const double want = std::min(double(rays) * total / double(m) * raysPerUnit, 8.0 * rays);
+    if (want < 1.0) {
+      if (!(shifts.round < want)) return sum;
+      rays = 1, scale = 1.0 / want;
+    } else {
+      rays = int(std::floor(want + shifts.round));
+    }
+  }
   int j = 0, last = -1;
   glm::dvec3 v(0.0);
   for (int k = 0; k < rays; ++k) {
-    const double at = (k + pick) / rays * total;
+    const double at = (k + shifts.pick) / rays * total;
     while (j + 1 < m && !(at < room.upTo[size_t(j)])) ++j;
     if (j != last) v = glm::dvec3(shadowed(in, x, n, room.lo[size_t(j)], traced)) * room.weight[size_t(j)], last = j;
     sum += v;
   }
-  return sum * (total / double(m)) / double(rays);
+  return sum * (scale * total / double(m)) / double(rays);
+}
+
+// A texel sample's position on its surface (inset into its triangle), or false where it has none.
+bool texelPosition(const BakeInputs& in, const TexelSamples& ts, size_t s, glm::vec3& x) {
+  if (!(ts.positionWeight[s].w > 0.0f)) return false;
+  x = glm::vec3(ts.positionWeight[s]);
+  if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size() &&
+      ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
+    x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+  return true;
 }
 
 // One texel's draws: `count` rays of the texel's samples from slot `first` on, one slot after another; a slot's
@@ -148,7 +185,7 @@ struct TexelDraws {
   bool any = false;
 };
 TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, size_t t, int first, int count,
-                     int candidates, Rng& rng, Candidates& room, size_t& traced) {
+                     int candidates, double raysPerUnit, Rng& rng, Candidates& room, size_t& traced) {
   const size_t layer = ts.layerSize();
   const int layers = ts.supersample * ts.supersample;
   glm::dvec3 sum(0.0);
@@ -157,18 +194,36 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
     const size_t s = static_cast<size_t>((first + k) % layers) * layer + t;
     const int rays = count / layers + (k < count % layers ? 1 : 0);
     const float w = ts.positionWeight[s].w * float(rays);
-    if (!(w > 0.0f)) continue;
-    glm::vec3 x(ts.positionWeight[s]);
-    if (s < ts.primitive.size() && ts.primitive[s] < in.scene.primitives.size() &&
-        ts.triangle[s] < in.scene.primitives[ts.primitive[s]].triangleCount())
-      x = in.rayTracer.insetPoint(ts.primitive[s], ts.triangle[s], x);
+    glm::vec3 x;
+    if (!texelPosition(in, ts, s, x)) continue;
     const int m = candidates > 0 ? (candidates * rays + count - 1) / count : 0;
-    sum += double(w) * drawAt(in, c, x, glm::vec3(ts.normal[s]), rays, m, rng, room, traced);
+    const DrawShifts shifts{rng.uniform(), rng.uniform(), rng.uniform()};
+    sum += double(w) * drawAt(in, c, x, glm::vec3(ts.normal[s]), rays, m, raysPerUnit, shifts, room, traced);
     weight += double(w);
   }
   TexelDraws d;
   if (weight > 0.0) d.mean = sum / weight, d.any = true;
   return d;
+}
+
+// 1 / the page's mean unshadowed left-out light, from m candidates at up to `pilots` texels spread over the page
+// (tree walks, no ray): the unit drawAt's ray allocation scales by. 0 where the tail is nothing.
+double raysPerUnit(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, int m, size_t pilots, uint64_t seed) {
+  std::vector<size_t> at;
+  for (size_t t = 0; t < ts.valid.size() && t < ts.layerSize(); ++t)
+    if (ts.valid[t]) at.push_back(t);
+  if (at.empty() || m <= 0) return 0.0;
+  const size_t step = std::max<size_t>(1, at.size() / pilots);
+  double sum = 0.0;
+  size_t count = 0;
+  Candidates room;
+  Rng rng(hashSeed(seed, 0x9170));
+  for (size_t i = 0; i < at.size(); i += step) {
+    glm::vec3 x;
+    ++count;
+    if (texelPosition(in, ts, at[i], x)) sum += drawCandidates(in, c, x, glm::vec3(ts.normal[at[i]]), m, rng.uniform(), room) / m;
+  }
+  return sum > 0.0 ? double(count) / sum : 0.0;
 }
 
 }  // namespace
@@ -194,6 +249,8 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
     const size_t layer = ts.layerSize();
     std::vector<glm::vec3> a(layer, glm::vec3(0.0f)), b(layer, glm::vec3(0.0f));
     std::vector<uint8_t> valid(layer, 0);
+    const double perUnit = options.allocate && candidates > 0
+                               ? raysPerUnit(in, c, ts, std::max(candidatesA, 4), 4096, hashSeed(options.seed, p)) : 0.0;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 256), [&](const tbb::blocked_range<size_t>& range) {
       size_t traced = 0;
       Candidates room;
@@ -201,8 +258,8 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
         if (t >= ts.valid.size() || !ts.valid[t]) continue;
         valid[t] = 1;  // the page's own validity, so the bake's filter plan serves it
         Rng rng(hashSeed(options.seed, p, t));
-        const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, candidatesA, rng, room, traced);
-        const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, candidatesB, rng, room, traced) : da;
+        const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, candidatesA, perUnit, rng, room, traced);
+        const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, candidatesB, perUnit, rng, room, traced) : da;
         if (da.any && db.any) a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean);
       }
       rays += traced;

@@ -4,7 +4,8 @@
 // an estimate of that sum: candidate lights drawn from a light tree (lights/light_tree.h) over the cut lights, in
 // proportion to a bound on what each gives the texel, weighed by their exact unshadowed left-out light (their light
 // without the cut less their faded light); N shadow rays go to lights resampled among them in proportion to that
-// weight (resampled importance sampling), so the rays only find out the visibility. The tail is faint and smooth
+// weight (resampled importance sampling), so the rays only find out the visibility; each texel's rays follow its
+// unshadowed estimate (the page's mean N). The tail is faint and smooth
 // (far lights), so the estimate is filtered on the surface like the sky; two independent halves of the candidates
 // and rays, filtered alike, tell its remaining noise for the error figure. docs/units.md, "Light reach".
 #pragma once
@@ -20,8 +21,10 @@ namespace irbake {
 
 struct LightTailOptions {
   int samples = 8;       // shadow rays per texel (0: the cut light stays left out)
-  int candidates = 32;   // lights drawn per texel, among which the rays are resampled (0: each ray its own draw)
+  int candidates = 64;   // lights drawn per texel, among which the rays are resampled (0: each ray its own draw)
   int filterRadius = 4;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
+  bool allocate = true;  // with candidates: rays per texel in proportion to its unshadowed tail, the page's mean
+                         // `samples` (false: `samples` everywhere)
   uint64_t seed = 0;     // the draws' seed (the walk's)
 };
 
