@@ -170,9 +170,6 @@ void checkOptionValues(BakeCommand& command, const BakeArguments& a) {
     }
     o.lightGroups.push_back(request);
   }
-  if (!o.onlyGroup.empty() && o.atlasFrom.empty())
-    throw Error(ErrorCode::Usage, a.scenes.empty() ? std::string() : a.scenes.front(),
-                "--only-group re-bakes one group on an earlier grouped bake: give --atlas-from BAKED.gltf");
   if (!o.onlyGroup.empty() && !validLayerName(o.onlyGroup))
     throw Error(ErrorCode::Usage, "", "--only-group " + quotedExcerpt(o.onlyGroup) + ": a group name is 1 to 64 of A-Z a-z 0-9 _ -");
   if (!o.lightGroups.empty() && command.shardIndex > 0)
