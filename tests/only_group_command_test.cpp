@@ -185,6 +185,25 @@ TEST(OnlyGroupCommand, RefusesNamingTheFileAndWritesNothing) {
     EXPECT_FALSE(fs::exists(dir / "out" / "scene.gltf"));
     EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
   }
+  // A relit file (its default scenario weighs lamp 2): its maps are not its layers' sum at weight 1.
+  ASSERT_EQ(runIrbakeIn(dir, {"relight", full.string(), "--group", "lamp=2", "-o", (dir / "relit" / "scene.gltf").string()}).code, 0);
+  // The probes: none where the bake has them, and a grid other than the bake's (known only once baked).
+  const std::vector<Case> late = {
+      {{"--atlas-from", (dir / "relit" / "scene.gltf").string(), "--probes", "0.1"},
+       (dir / "relit" / "scene.gltf").string() + ": --only-group: the default scenario weighs layer 'lamp' other than 1 (a relit file)"},
+      {{"--atlas-from", full.string(), "--probes", "off"}, full.string() + ": --only-group: this bake has probes, do not turn them off"},
+      {{"--atlas-from", full.string(), "--probes", "0.2"}, full.string() + ": --only-group: the probe grid came out as "},
+  };
+  for (const Case& c : late) {
+    std::vector<std::string> args = with({"bake", scene.string(), "-o", out, "--vpls", "64", "--sun", "0.2,-0.5,1,3", "--quiet",
+                                          "--only-group", "lamp"}, groups);
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const IrbakeRun r = runIrbakeIn(dir, args);
+    EXPECT_EQ(r.code, c.args.back() == "0.2" ? 5 : 2) << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out" / "scene.gltf"));
+    EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+  }
   // Into the earlier bake's folder: its layers' pages are inputs.
   const IrbakeRun onto = runIrbakeIn(dir, {"bake", scene.string(), "-o", (full.parent_path() / "again.gltf").string(), "--light-group",
                                            "day=sun,emissive", "--light-group", "lamp=bulb", "--sun", "0.2,-0.5,1,3", "--only-group",
