@@ -29,7 +29,7 @@ bool sameNumber(const std::string& a, const std::string& b) {
 const std::map<std::string, std::vector<std::string>> kTextExamples = {
     {"report", {"elsewhere/report.json"}}, {"env", {"sky.hdr"}},  {"portable", {"portable.glb"}},
     {"probes", {"0.5"}},                   {"shard", {"1/2"}},    {"light-mode", {"sun=shadowmask", "*=indirect"}},
-    {"atlas-from", {"day/scene.gltf"}},    {"light-group", {"day=sun,sky", "street=*"}},
+    {"atlas-from", {"day/scene.gltf"}},    {"light-group", {"day=sun,sky", "street=*"}}, {"only-group", {"street"}},
 };
 
 // A value the option accepts that is not its default: the range's ends, a choice, a list, or the examples

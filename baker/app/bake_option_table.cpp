@@ -302,6 +302,11 @@ void addLightRows(std::vector<OptionDescriptor>& t) {
                   "#I or * (every source no other group names); repeatable, beside\n"
                   "extras.irbake.group; the maps hold the sum (docs/guide.md)",
                   arg(&BakeArguments::lightGroups)));
+  t.push_back(text("--only-group", kLights, "NAME",
+                   "with --atlas-from BAKED.gltf, a grouped bake: bake light group NAME\n"
+                   "alone, carry the bake's other layers over, write the whole set\n"
+                   "(docs/guide.md, \"Scenarios and light groups\")",
+                   opt([](BakeOptions& o) { return &o.onlyGroup; })));
   t.push_back(preset(integer("--shadow-edge-samples", 0, 16, kLights, "S",
                              "punctual lights: S×S shadow rays over each texel a shadow edge\ncrosses (default " +
                                  shown(q.shadowEdgeSamples) + "; 0 or 1: the centre alone)",

@@ -31,6 +31,8 @@
 #include "pipeline/backend_choice.h"
 #include "pipeline/bake.h"
 #include "pipeline/light_groups.h"
+#include "pipeline/only_group.h"
+#include "export/light_layers.h"
 #include "pipeline/vpl_sum_file.h"
 #include "stages/compensation/clamp_compensation.h"
 #include "stages/interleave/interleaved_sampling.h"
@@ -168,6 +170,8 @@ void checkOptionValues(BakeCommand& command, const BakeArguments& a) {
     }
     o.lightGroups.push_back(request);
   }
+  if (!o.onlyGroup.empty() && !validLayerName(o.onlyGroup))
+    throw Error(ErrorCode::Usage, "", "--only-group " + quotedExcerpt(o.onlyGroup) + ": a group name is 1 to 64 of A-Z a-z 0-9 _ -");
   if (!o.lightGroups.empty() && command.shardIndex > 0)
     throw Error(ErrorCode::Usage, "", "--light-group bakes each group apart: --shard does not split them yet");
 }
@@ -532,6 +536,10 @@ std::shared_ptr<OutputGuard> bakeOutputGuard(BakeCommand& c, const std::vector<f
     if (!fs::is_regular_file(c.options.atlasFrom, ec)) throw Error(ErrorCode::Io, c.options.atlasFrom, "--atlas-from: no such file");
     const std::vector<fs::path> baked = sceneInputFiles(c.options.atlasFrom);
     inputs.insert(inputs.end(), baked.begin(), baked.end());
+    if (!c.options.onlyGroup.empty()) {  // its layers' pages and its report, read back
+      const std::vector<fs::path> layers = onlyGroupInputs(c.options.atlasFrom);
+      inputs.insert(inputs.end(), layers.begin(), layers.end());
+    }
   }
   inputs.insert(inputs.end(), moreInputs.begin(), moreInputs.end());
   guard->addInputs(inputs);
@@ -563,7 +571,7 @@ int runGroupedBake(BakeCommand& c, Scene scene, TerminalProgress& progress, cons
                    double loadCpuSeconds) {
   if (c.shardIndex > 0 || c.resume)
     throw Error(ErrorCode::Usage, c.scene, "light groups bake each group apart in one run: --shard and --resume do not split them yet");
-  BakeResult result = bakeLightGroups(std::move(scene), c.options);
+  BakeResult result = c.options.onlyGroup.empty() ? bakeLightGroups(std::move(scene), c.options) : bakeOnlyGroup(std::move(scene), c.options);
   result.report["timings"]["seconds"]["load"] = loadSeconds;
   result.report["timings"]["cpuSeconds"]["load"] = loadCpuSeconds;
   result.report["options"] = c.resultOptions;
@@ -593,7 +601,7 @@ int runBake(const Args& args) {
 
   TerminalProgress progress;
   c.options.progress = progress.callback();
-  if (!resolveLightGroups(scene, c.options.lightGroups).empty()) return runGroupedBake(c, std::move(scene), progress, *guard, loadSeconds, loadCpuSeconds);
+  if (!c.options.onlyGroup.empty() || !resolveLightGroups(scene, c.options.lightGroups).empty()) return runGroupedBake(c, std::move(scene), progress, *guard, loadSeconds, loadCpuSeconds);
   StagedBake staged(std::move(scene), c.options);
 
   // The blocks this process adds: all, or share K of N.

@@ -268,47 +268,53 @@ std::vector<fs::path> Relight::outputs() const {
   return files;
 }
 
-// Every layer's EXR pages (each the size of the first layer's, else refused naming the file) and probe
-// coefficients (the root's count, else refused).
-std::vector<LightLayer> Relight::readLayers(RelightSummary& summary) const {
-  const std::string file = options_.input.string();
-  const json& ext = doc_.root.value("extensions", json::object());
+std::vector<LightLayer> readScenarioLayers(const GltfDocument& doc, const LightmapScenarios& scenarios, const fs::path& folder,
+                                           const std::string& file, size_t* texels) {
+  const json& ext = doc.root.value("extensions", json::object());
   const bool hasProbes = ext.contains(kLightProbesExtension);
   size_t withProbes = 0, count = 0;
-  for (const ScenarioLayer& l : scenarios_.layers) withProbes += l.probes >= 0 ? 1 : 0;
-  if ((hasProbes || withProbes > 0) && (!hasProbes || withProbes != scenarios_.layers.size()))
+  for (const ScenarioLayer& l : scenarios.layers) withProbes += l.probes >= 0 ? 1 : 0;
+  if ((hasProbes || withProbes > 0) && (!hasProbes || withProbes != scenarios.layers.size()))
     throw Error(ErrorCode::InvalidData, file, hasProbes ? "IRBAKE_light_probes, but not every layer of " + kExt + " has its probes"
                                                         : kExt + " layers have probes, but the file has no IRBAKE_light_probes");
   if (hasProbes) {
     const json& probes = ext[kLightProbesExtension];
     if (!probes.contains("coefficients") || !probes["coefficients"].is_number_integer())
       throw Error(ErrorCode::InvalidData, file, "IRBAKE_light_probes.coefficients: no accessor index");
-    count = vec3Accessor(doc_, probes["coefficients"].get<int>(), 0, "IRBAKE_light_probes.coefficients", file).size();
+    count = vec3Accessor(doc, probes["coefficients"].get<int>(), 0, "IRBAKE_light_probes.coefficients", file).size();
   }
   std::vector<LightLayer> layers;
-  for (const ScenarioLayer& l : scenarios_.layers) {
+  for (const ScenarioLayer& l : scenarios.layers) {
     LightLayer layer;
     layer.name = l.name;
-    for (size_t p = 0; p < scenarios_.pages.size(); ++p) {
-      const fs::path page = folder_ / l.exr[p];
+    layer.holdsSun = l.hasSun;
+    if (l.exr.size() != scenarios.pages.size())
+      throw Error(ErrorCode::InvalidData, file, "layer '" + l.name + "' has no EXR pages (" + kExt + " exr): its float pages are " +
+                                                    "what is read, bake without --no-exr");
+    for (size_t p = 0; p < scenarios.pages.size(); ++p) {
+      const fs::path page = folder / l.exr[p];
       layer.maps.push_back(readExr(page));
       layer.maps.back().page = static_cast<int>(p);
       const Lightmap& m = layer.maps.back();
       const Lightmap& first = layers.empty() ? m : layers.front().maps[p];
       if (m.width != first.width || m.height != first.height)
         throw Error(ErrorCode::InvalidData, page.string(),
-                    std::to_string(m.width) + "×" + std::to_string(m.height) + " texels, but " + (folder_ / scenarios_.layers[0].exr[p]).string() +
+                    std::to_string(m.width) + "×" + std::to_string(m.height) + " texels, but " + (folder / scenarios.layers[0].exr[p]).string() +
                         " is " + std::to_string(first.width) + "×" + std::to_string(first.height) + ": not pages of one atlas");
-      summary.texels += m.size();
+      if (texels) *texels += m.size();
     }
     if (count > 0) {
-      const std::vector<glm::vec3> c = vec3Accessor(doc_, l.probes, count, kExt + " layer '" + l.name + "' probes", file);
+      const std::vector<glm::vec3> c = vec3Accessor(doc, l.probes, count, kExt + " layer '" + l.name + "' probes", file);
       layer.probes.resize(count / kShCoefficients);
       std::memcpy(layer.probes.data(), c.data(), layer.probes.size() * sizeof(ShCoefficients));
     }
     layers.push_back(std::move(layer));
   }
   return layers;
+}
+
+std::vector<LightLayer> Relight::readLayers(RelightSummary& summary) const {
+  return readScenarioLayers(doc_, scenarios_, folder_, options_.input.string(), &summary.texels);
 }
 
 // Per page: the MOZ_lightmap PNG encoded from the sum in place of the page's image, and the intensity of every

@@ -51,6 +51,13 @@ struct LightmapScenarios {
 // document without the extension: Error(InvalidData, file, "... has no IRBAKE_lightmap_scenarios ...").
 LightmapScenarios readLightmapScenarios(const nlohmann::json& root, const std::string& file);
 
+// Every layer's float EXR pages (read from `folder`, each the size of the first layer's, else refused naming the
+// page) and probe coefficients (the count of the root's IRBAKE_light_probes, else refused), in layer order, each
+// marked with whether it holds the probes' sun; `texels` (if given) adds every page's size. Throws
+// Error(InvalidData, file) naming the problem.
+std::vector<LightLayer> readScenarioLayers(const GltfDocument& doc, const LightmapScenarios& scenarios,
+                                           const std::filesystem::path& folder, const std::string& file, size_t* texels);
+
 // "NAME=W" of --group: the layer's name and its RGB weight, W one number (every channel) or R,G,B, each finite
 // and from 0 to 1e20. Throws Error(Usage) quoting the text.
 std::pair<std::string, glm::vec3> parseLayerWeight(const std::string& text);

@@ -116,6 +116,8 @@ struct BakeOptions {
                                             // of each over earlier ones; any over the glTF's extras.irbake.mode)
   std::vector<LightGroupRequest> lightGroups;  // --light-group in the order given (pipeline/light_groups.h); with
                                                // these or extras.irbake.group, bakeLightGroups bakes each group apart
+  std::string onlyGroup;                  // bake this light group alone on atlasFrom's bake and carry its other
+                                          // layers over (pipeline/only_group.h); "": every group
   ErrorEstimateOptions errorEstimate;     // the bake's own error from independent replicates of the walk, and
                                           // --target-error's rounds (off: one walk, the same bytes as before)
   double maxMemoryGB = 0.0;               // refuse up front a bake predicted to need more memory at its peak

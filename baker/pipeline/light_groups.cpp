@@ -190,21 +190,15 @@ void checkGroupedOptions(const Scene& scene, const BakeOptions& options) {
                       " has extras.irbake.mode \"" + toString(l.extrasMode) + "\"");
 }
 
-// A group's bake, kept for the sum: its layer and what its report says.
-struct GroupPart {
-  LightLayer layer;
-  json report;
-  ProbeSunLevel sun;
-  std::vector<ProbeEmitter> emitters;
-  std::vector<Lightmap> standardError;
-};
-
 // The sum's estimatedError: independent groups, so their absolute errors add in quadrature; relative to the
 // sum's own signal on the same bins.
 void combineErrors(const std::vector<GroupPart>& parts, const std::vector<Lightmap>& sum, json& report) {
   double noise2 = 0.0;
   for (const GroupPart& p : parts) {
-    if (!p.report.contains("estimatedError")) return;
+    if (!p.report.contains("estimatedError")) {  // an earlier bake's layer without its report: no sum to give
+      report.erase("estimatedError");
+      return;
+    }
     const json& e = p.report["estimatedError"];
     const double absolute = e.value("relative", 0.0) * e.value("signalRms", 0.0);
     noise2 += absolute * absolute;
@@ -232,6 +226,8 @@ std::vector<Lightmap> combinedStandardError(const std::vector<GroupPart>& parts)
   return out;
 }
 
+}  // namespace
+
 GroupPart groupPart(const LightGroup& group, const std::vector<Light>& lights, BakeResult& r) {
   GroupPart part;
   part.layer.name = group.name;
@@ -247,27 +243,33 @@ GroupPart groupPart(const LightGroup& group, const std::vector<Light>& lights, B
   return part;
 }
 
-// The sum of the parts into `total` (the first group's result: scene, atlas, probe grid).
-void sumParts(std::vector<GroupPart>& parts, BakeResult& total) {
-  std::vector<glm::vec3> ones(parts.size(), glm::vec3(1.0f));
+void sumParts(std::vector<GroupPart>& parts, BakeResult& total, const std::vector<glm::vec3>& weights, size_t reportFrom) {
   for (GroupPart& p : parts) total.layers.push_back(p.layer);
-  CombinedLayers sum = combineLayers(total.layers, ones);
+  CombinedLayers sum = combineLayers(total.layers, weights);
   total.maps = std::move(sum.maps);
   total.probes.coefficients = std::move(sum.probes);
   total.probes.sun = {};
   total.probes.emitters.clear();
-  for (const GroupPart& p : parts) {
-    if (p.layer.holdsSun) total.probes.sun = p.sun;
+  for (size_t g = 0; g < parts.size(); ++g) {
+    const GroupPart& p = parts[g];
+    if (p.layer.holdsSun) {
+      total.probes.sun = p.sun;
+      total.probes.sun.irradiance *= weights[g];
+      for (glm::vec3& c : total.probes.sun.sh) c *= weights[g];
+    }
     total.probes.emitters.insert(total.probes.emitters.end(), p.emitters.begin(), p.emitters.end());
   }
-  if (!parts.front().standardError.empty()) total.standardError = combinedStandardError(parts);
-  json& report = total.report = parts.front().report;
+  bool everyError = true;
+  for (const GroupPart& p : parts) everyError = everyError && !p.standardError.empty();
+  if (everyError) total.standardError = combinedStandardError(parts);
+  json& report = total.report = parts[reportFrom].report;
   json list = json::array();
   double seconds = 0.0, cpuSeconds = 0.0;
   for (const GroupPart& p : parts) {
     json entry = {{"name", p.layer.name}, {"lights", p.layer.lights}, {"timings", p.report["timings"]}};
     if (p.report.contains("estimatedError")) entry["estimatedError"] = p.report["estimatedError"];
     if (p.report.contains("vpls")) entry["vpls"] = p.report["vpls"];
+    if (p.carried) entry["carried"] = true;
     list.push_back(std::move(entry));
     seconds += p.report["timings"]["seconds"].value("bake", 0.0);
     cpuSeconds += p.report["timings"]["cpuSeconds"].value("bake", 0.0);
@@ -278,8 +280,6 @@ void sumParts(std::vector<GroupPart>& parts, BakeResult& total) {
   report["timings"]["memoryPeakMiB"] = peakMemoryMiB();
   if (report.contains("estimatedError")) combineErrors(parts, total.maps, report);
 }
-
-}  // namespace
 
 std::vector<LightGroup> resolveLightGroups(const Scene& scene, const std::vector<LightGroupRequest>& requests) {
   GroupResolver resolver(scene);
@@ -300,9 +300,7 @@ Scene groupScene(Scene scene, const LightGroup& group) {
   return scene;
 }
 
-BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
-  const std::vector<LightGroup> groups = resolveLightGroups(scene, options.lightGroups);
-  if (groups.empty()) return bake(std::move(scene), options);
+BakeOptions settleGroupedOptions(const Scene& scene, const BakeOptions& options) {
   checkGroupedOptions(scene, options);
   BakeOptions o = options;
   o.lightGroups.clear();
@@ -314,6 +312,13 @@ BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
   // lights (a directional light's shadows ask for a finer grid than a group of lamps would get).
   if (o.probes.enabled && !o.probes.spacing)
     o.probes.spacing = chooseProbeSpacing(o.probes.box ? *o.probes.box : scene.bounds(), autoProbeCount(o.probes, scene.lights));
+  return o;
+}
+
+BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
+  const std::vector<LightGroup> groups = resolveLightGroups(scene, options.lightGroups);
+  if (groups.empty()) return bake(std::move(scene), options);
+  const BakeOptions o = settleGroupedOptions(scene, options);
   const std::vector<Light> lights = scene.lights;
   const std::vector<Material> materials = scene.materials;
   const Environment environment = scene.environment;
@@ -344,7 +349,7 @@ BakeResult bakeLightGroups(Scene scene, const BakeOptions& options) {
   first.scene.environment = environment;
   first.lightModes.assign(lights.size(), LightMode::Baked);
   first.maskChannels = {};
-  sumParts(parts, first);
+  sumParts(parts, first, std::vector<glm::vec3>(parts.size(), glm::vec3(1.0f)), 0);
   return first;
 }
 

@@ -54,4 +54,26 @@ Scene groupScene(Scene scene, const LightGroup& group);
 // groups do not support yet: --directional, indirect or shadowmask lights.
 BakeResult bakeLightGroups(Scene scene, const BakeOptions& options);
 
+// Shared with the incremental bake of one group (pipeline/only_group.h).
+
+// A group's bake, kept for the sum: its layer and what its report says.
+struct GroupPart {
+  LightLayer layer;
+  nlohmann::json report;             // its bake's report (timings, estimatedError); a carried layer's: the earlier's
+  ProbeSunLevel sun;                 // the probes' sun level where the layer holds the sun
+  std::vector<ProbeEmitter> emitters;
+  std::vector<Lightmap> standardError;
+  bool carried = false;              // read from an earlier bake, not baked by this one
+};
+
+// `options` with what a grouped bake settles once for the whole scene (the final gather, the clamp's k, the
+// automatic probe spacing) where they are left automatic. Throws Error(Usage) for what groups do not support.
+BakeOptions settleGroupedOptions(const Scene& scene, const BakeOptions& options);
+// The group's bake `r` as a part (its maps, probes, standard error and report moved out of r).
+GroupPart groupPart(const LightGroup& group, const std::vector<Light>& lights, BakeResult& r);
+// The parts' sum into `total` (scene, atlas and probe grid already set): its layers, maps and probes (combineLayers
+// with `weights`, one per part), the probes' sun level (the sun's part's, times its weight), the exact emitters,
+// the report (part reportFrom's, with "lightGroups" and the sum's estimatedError, dropped where a part has none).
+void sumParts(std::vector<GroupPart>& parts, BakeResult& total, const std::vector<glm::vec3>& weights, size_t reportFrom);
+
 }  // namespace irbake
