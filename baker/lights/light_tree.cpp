@@ -28,6 +28,7 @@ int32_t LightTree::build(size_t begin, size_t end) {
     node.power += entries_[i].power;
     node.near = std::min(node.near, entries_[i].near);
   }
+  node.radius = 0.5f * glm::length(node.hi - node.lo);
   if (end - begin == 1) {
     node.entry = static_cast<uint32_t>(begin);
   } else {
@@ -56,24 +57,25 @@ double LightTree::importance(const Node& node, const glm::vec3& x, const glm::ve
   if (farthest2 <= near2) return 0.0;
   // The share of their value the lights give at most: their rise at the farthest corner, from the smallest near
   // over the narrowest band (both only raise it).
-  double share = 1.0;
+  float share = 1.0f;
   if (node.width > 0.0f) {
-    const double t = std::min(1.0, (std::sqrt(double(farthest2)) - node.near) / node.width);
-    share = t * t * (3.0 - 2.0 * t);
+    const float t = std::min(1.0f, (std::sqrt(farthest2) - node.near) / node.width);
+    share = t * t * (3.0f - 2.0f * t);
   }
   // A point light's own value at normal incidence, I/(π d²), from the box's centre, times a bound of the cosine
   // over the box (cos(θ − θb) ≤ cos θ + sin θb, θb the box's angular radius); d is kept from going below half the
   // box's diagonal (x inside the box) and the lights' near distance (where they give nothing), times the share. The
-  // same scale as a single light's exact value, so a leaf and an inner node weigh alike.
-  const glm::vec3 half = 0.5f * (node.hi - node.lo), towards = 0.5f * (node.lo + node.hi) - x;
-  const double centre2 = glm::dot(towards, towards), radius2 = glm::dot(half, half);
-  double cosine = 1.0;
+  // same scale as a single light's exact value, so a leaf and an inner node weigh alike. In float: an estimate
+  // that only steers the walk (the draws weigh by their exact light), at the walk's every node.
+  const glm::vec3 towards = 0.5f * (node.lo + node.hi) - x;
+  const float centre2 = glm::dot(towards, towards), radius2 = node.radius * node.radius;
+  float cosine = 1.0f;
   if (centre2 > radius2) {
-    const double c = double(glm::dot(n, towards)) / std::sqrt(centre2), sinBox = std::sqrt(radius2 / centre2);
-    cosine = std::clamp(c + sinBox, 0.0, 1.0);
+    const float inverse = 1.0f / std::sqrt(centre2);
+    cosine = std::clamp((glm::dot(n, towards) + node.radius) * inverse, 0.0f, 1.0f);
   }
-  const double d2 = std::max({centre2, radius2, double(near2), 1e-12});
-  return double(node.power) * share * cosine / (kPi * d2);
+  const float d2 = std::max({centre2, radius2, near2, 1e-12f});
+  return double(node.power * share * cosine / (float(kPi) * d2));
 }
 
 }  // namespace irbake
