@@ -17,6 +17,7 @@
 //          [--weights 'a=0.5;b=1,0.8,0.5', --scenario NAME: a bake with light groups blended at run time with these
 //           layer weights over that stored scenario (irbake_lightmap_scenarios.js); --scenarios off: its own maps,
 //           unblended; --min-blended N: fail unless N materials were blended]
+//          [--exposure EV: the three.js viewer's display exposure, as irview --exposure]
 //          [--image X.png: compare that image (beside the reference, irview's own screenshot) instead of a render;
 //           --scene is then not read]
 import fs from 'node:fs';
@@ -67,7 +68,7 @@ try {
   const q = new URLSearchParams({ scene: `/scene/${encodeURIComponent(path.basename(args.scene ?? ''))}`, width, height,
                                   lightmap: args.lightmap ?? 'sh', plugin: args.plugin ?? 'moz', standard: args.standard ?? '1' });
   if (camera !== undefined) q.set('camera', camera);  // none: the viewer's default (camera 0, or the overview)
-  for (const k of ['weights', 'scenario', 'scenarios']) if (args[k] !== undefined) q.set(k, args[k]);
+  for (const k of ['weights', 'scenario', 'scenarios', 'exposure']) if (args[k] !== undefined) q.set(k, args[k]);
   const imageUrl = image ? `/ref/${encodeURIComponent(path.basename(image))}` : null;
   let ready = {};
   if (image) {

@@ -20,14 +20,17 @@ import { overviewCamera } from './overview_camera.js';
 // layers blended at run time (irbake_lightmap_scenarios.js) from `scenario` (a stored one's name; null: the
 // default) with `weights` ({ layer: w }, w one number or [r, g, b]) over it. The result's `controls` (null without
 // layers) change the blend and render again: { layers, scenarios, weights(), setWeights(w), useScenario(name) }.
+// exposure: display exposure in stops, as irview --exposure (2^EV × the linear colour, clamped, then sRGB; the sky
+// behind the scene too).
 export async function showBakedScene({ scene, camera = null, width, height, lightmapMode = 'sh', plugin = true,
                                        mixedLights = true, probeObjects = [], view = null, scenarios = true,
-                                       scenario = null, weights = null }) {
+                                       scenario = null, weights = null, exposure = 0 }) {
   const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
   renderer.setPixelRatio(1);
   renderer.setSize(width, height);
   renderer.outputColorSpace = THREE.SRGBColorSpace;  // irview: exact sRGB encode, clamp, exposure 0
-  renderer.toneMapping = THREE.NoToneMapping;
+  renderer.toneMapping = exposure ? THREE.LinearToneMapping : THREE.NoToneMapping;  // Linear: saturate(exposure × c)
+  renderer.toneMappingExposure = 2 ** exposure;
   document.body.appendChild(renderer.domElement);
 
   const loader = new GLTFLoader();
@@ -61,7 +64,7 @@ export async function showBakedScene({ scene, camera = null, width, height, ligh
   // Behind the scene the bake's uniform sky (root extras irbakeSky), as irview draws it; else black.
   const sky = gltf.parser.json.extras?.irbakeSky?.radiance;
   if (Array.isArray(sky) && sky.length === 3 && sky.every(Number.isFinite))
-    renderer.setClearColor(new THREE.Color().setRGB(...sky, THREE.LinearSRGBColorSpace), 1);
+    renderer.setClearColor(new THREE.Color().setRGB(...sky.map(c => Math.min(c * 2 ** exposure, 1)), THREE.LinearSRGBColorSpace), 1);
   else
     renderer.setClearColor(0x000000, 1);
   renderer.render(gltf.scene, cam);

@@ -7,6 +7,9 @@
 #   - the grouped bake blended at 0.5/0.5 against that render of the relit file: ≤ 2;
 #   - the blend at the default weights (1, 1) against the grouped bake's own maps without the blend: ≤ 2;
 #   - the blend at (1, 1) against the relit file must fail (the comparison can fail);
+#   - the viewer's sliders (scenario_slider_check.mjs on index.html): a slider for day, for lamp and the day ⇄ lamp
+#     fade; day and lamp moved to 0.5 draw the blend at 0.5/0.5 (≤ 0.5 from it), the fade moved to the lamp alone
+#     changes the canvas;
 #   - a layer intensity of -1 and a weight naming no layer are refused, naming the field;
 #   - `gltf-transform optimize` (gltf-transform.config.mjs, WebP) keeps IRBAKE_lightmap_scenarios
 #     (gltf_transform_check.mjs scenarios), and the optimised file blended at 0.5/0.5 is ≤ 3 from the relit render;
@@ -44,6 +47,10 @@ if compare "$work/grouped/scene.gltf" "$work/web_relit.png" "$work/web_blend_ful
   echo "the blend at (1, 1) matched the relit file at 0.5/0.5: the comparison cannot fail"; cat "$work/full.log"; exit 1
 fi
 grep -o 'mean absolute difference [0-9.]*' "$work/full.log"
+node "$here/scenario_slider_check.mjs" --modules "$modules" --scene "$work/grouped/scene.gltf" --camera 0 --width $w --height $h \
+  --layers day,lamp --set 'day=0.5;lamp=0.5' --out-set "$work/slider_half.png" --out-fade "$work/slider_lamp.png"
+node "$here/render_compare.mjs" --modules "$modules" --image "$work/slider_half.png" --reference "$work/web_blend_half.png" \
+  --out "$work/slider_half_compared.png" --max-mean-abs 0.5
 # Bad data: a layer intensity of -1; a weight for a layer the file lacks.
 node -e '
 const fs = require("fs"); const [src, dst] = process.argv.slice(1);
