@@ -242,9 +242,9 @@ void addLightProbesExtension(GltfDocument& doc, const LightProbeGrid& grid) {
 
 void removeLightProbesExtension(json& root) { removeRootExtension(root, kLightProbesExtension); }
 
-LightProbeGrid readLightProbes(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  const GltfDocument doc = documentFromSource(path);
+LightProbeGrid readLightProbes(const std::filesystem::path& path) { return readLightProbes(documentFromSource(path), path.string()); }
+
+LightProbeGrid readLightProbes(const GltfDocument& doc, const std::string& file) {
   const json* ext = nullptr;
   if (doc.root.contains("extensions") && doc.root["extensions"].is_object() && doc.root["extensions"].contains(kLightProbesExtension))
     ext = &doc.root["extensions"][kLightProbesExtension];

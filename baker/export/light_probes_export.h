@@ -3,6 +3,7 @@
 // extensionsUsed only: clients that do not know it show the light maps as before.
 #pragma once
 #include <filesystem>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -24,5 +25,7 @@ void removeLightProbesExtension(nlohmann::json& root);
 // The probes of an exported glTF/GLB. Throws Error(InvalidData, file, ...) naming the problem: no extension,
 // counts or spacing out of range, an accessor of the wrong type or shorter than the grid, a non-finite value.
 LightProbeGrid readLightProbes(const std::filesystem::path& file);
+// The same from a document already read (its buffers loaded); `file` names it in errors.
+LightProbeGrid readLightProbes(const GltfDocument& doc, const std::string& file);
 
 }  // namespace irbake

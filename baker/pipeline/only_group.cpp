@@ -54,7 +54,7 @@ EarlierBake readEarlierBake(const fs::path& path) {
   const GltfDocument doc = documentFromSource(path);
   e.scenarios = readScenarios(doc, e.file);
   e.layers = readScenarioLayers(doc, e.scenarios, folderOf(path), e.file, nullptr);
-  if (doc.root["extensions"].contains(kLightProbesExtension)) e.probes = readLightProbes(path);
+  if (doc.root["extensions"].contains(kLightProbesExtension)) e.probes = readLightProbes(doc, e.file);
   const fs::path report = folderOf(path) / "report.json";
   std::error_code ec;
   if (fs::is_regular_file(report, ec)) {

@@ -206,22 +206,22 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
   return d;
 }
 
-// 1 / the page's mean unshadowed left-out light, from m candidates at up to `pilots` texels spread over the page
-// (tree walks, no ray): the unit drawAt's ray allocation scales by. 0 where the tail is nothing.
-double raysPerUnit(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, int m, size_t pilots, uint64_t seed) {
-  std::vector<size_t> at;
-  for (size_t t = 0; t < ts.valid.size() && t < ts.layerSize(); ++t)
-    if (ts.valid[t]) at.push_back(t);
-  if (at.empty() || m <= 0) return 0.0;
-  const size_t step = std::max<size_t>(1, at.size() / pilots);
+// 1 / the page's mean unshadowed left-out light, from m candidates at up to about `pilots` valid texels spread
+// over the page (tree walks, no ray): the unit drawAt's ray allocation scales by. 0 where the tail is nothing.
+double pageRaysPerUnit(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, int m, size_t pilots, uint64_t seed) {
+  const size_t texels = std::min(ts.valid.size(), ts.layerSize());
+  const size_t valid = size_t(std::count_if(ts.valid.begin(), ts.valid.begin() + std::ptrdiff_t(texels), [](uint8_t v) { return v != 0; }));
+  if (valid == 0 || m <= 0) return 0.0;
+  const size_t step = std::max<size_t>(1, valid / pilots);
   double sum = 0.0;
-  size_t count = 0;
+  size_t count = 0, seen = 0;
   Candidates room;
   Rng rng(hashSeed(seed, 0x9170));
-  for (size_t i = 0; i < at.size(); i += step) {
+  for (size_t t = 0; t < texels; ++t) {
+    if (!ts.valid[t] || seen++ % step != 0) continue;
     glm::vec3 x;
     ++count;
-    if (texelPosition(in, ts, at[i], x)) sum += drawCandidates(in, c, x, glm::vec3(ts.normal[at[i]]), m, rng.uniform(), room) / m;
+    if (texelPosition(in, ts, t, x)) sum += drawCandidates(in, c, x, glm::vec3(ts.normal[t]), m, rng.uniform(), room) / m;
   }
   return sum > 0.0 ? double(count) / sum : 0.0;
 }
@@ -250,7 +250,7 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
     std::vector<glm::vec3> a(layer, glm::vec3(0.0f)), b(layer, glm::vec3(0.0f));
     std::vector<uint8_t> valid(layer, 0);
     const double perUnit = options.allocate && candidates > 0
-                               ? raysPerUnit(in, c, ts, std::max(candidatesA, 4), 4096, hashSeed(options.seed, p)) : 0.0;
+                               ? pageRaysPerUnit(in, c, ts, std::max(candidatesA, 4), 4096, hashSeed(options.seed, p)) : 0.0;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 256), [&](const tbb::blocked_range<size_t>& range) {
       size_t traced = 0;
       Candidates room;
