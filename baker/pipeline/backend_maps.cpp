@@ -55,18 +55,22 @@ std::vector<Lightmap> directCall(BakeState& s, L1Pages* l1, const std::vector<ui
   return maps;
 }
 
-// The cut lights' left-out light added back to the punctual lights' pages, after their shadow edges (which
-// refine the lights within reach) and before D is kept for the final gather. The L1 pages keep the lights within
-// reach: the tail comes from many far directions. Lights left out of the map keep their cut.
-void lightTailStage(BakeState& s, StageContext& ctx, std::vector<Lightmap>& maps) {
-  if (!s.plan.eval.includeDirect || !s.lightGrid || !s.lightGrid->culls() || s.lightReach.cutLights() == 0) return;
+// The cut lights' left-out light for the punctual lights' pages, traced before their shadow edges (which weigh
+// a texel's jump against it) and added after them (they refine the lights within reach), before D is kept for the
+// final gather. The L1 pages keep the lights within reach: the tail comes from many far directions. Lights left
+// out of the map keep their cut.
+LightTailPages lightTailStage(BakeState& s, StageContext& ctx, const std::vector<Lightmap>& maps) {
+  if (!s.plan.eval.includeDirect || !s.lightGrid || !s.lightGrid->culls() || s.lightReach.cutLights() == 0) return {};
+  LightTailPages tail;
   ctx.timed("lightTail", [&] {
     LightTailOptions o = s.options.lightTail;
     o.seed = hashSeed(s.options.walk.seed, 0x7a11);
-    s.lightTail = addLightTail(ctx.inputs, maps, o, s.plan.leftOut);
+    tail = traceLightTail(ctx.inputs, maps, o, s.plan.leftOut);
+    s.lightTail = tail.stats;
     ctx.report["lightTail"] = s.lightTail.toJson();
     ctx.report["lightTail"]["samples"] = o.samples;
   });
+  return tail;
 }
 
 std::vector<Lightmap> referenceStage(BakeState& s) { return s.evaluator->evaluate(inputs(s, s.texels, s.vpls, s.plan.eval)); }
@@ -85,8 +89,12 @@ std::vector<Lightmap> backendMaps(BakeState& s, ExactVplSums& sums, nlohmann::js
                                                               " pages for " + std::to_string(s.texels.size()));
   // On the punctual lights alone, before D is kept for the final gather: its sources see the same edges.
   StageContext ctx = stageContext(s, report);
-  shadowEdgeStage(ctx, maps, l1, s.leftOutDirect.empty() ? nullptr : &s.leftOutDirect);
-  lightTailStage(s, ctx, maps);
+  LightTailPages tail = lightTailStage(s, ctx, maps);
+  const CutLightPages cut{&tail.added, &tail.unshadowed};
+  shadowEdgeStage(ctx, maps, l1, s.leftOutDirect.empty() ? nullptr : &s.leftOutDirect,
+                  tail.unshadowed.empty() ? nullptr : &cut);
+  ctx.timed("lightTail", [&] { addLightTailPages(tail, maps); });
+  tail = {};
   if (s.plan.finalGather) {
     s.directMaps = maps;
     for (size_t p = 0; p < s.directMaps.size(); ++p)

@@ -18,7 +18,8 @@ void StageContext::timed(const char* name, const std::function<void()>& stage) {
   cpuSeconds[name] = cpuSeconds.value(name, 0.0) + watch.cpuSeconds();
 }
 
-void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1, std::vector<Lightmap>* leftOut) {
+void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1, std::vector<Lightmap>* leftOut,
+                     const CutLightPages* cutLight) {
   const BakePlan& plan = ctx.plan;
   if (!plan.eval.includeDirect || ctx.scene.lights.empty() || plan.shadowEdges.subSamples <= 1) return;
   // The L1 pages keep the centre's direction, scaled with the value per channel so that |L1| stays within
@@ -27,7 +28,7 @@ void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1
   std::vector<Lightmap> before;
   if (l1) before = maps;
   ShadowEdgePart part{&plan.leftOut, leftOut};
-  const ShadowEdgeStats st = refineShadowEdges(ctx.inputs, maps, plan.shadowEdges, leftOut ? &part : nullptr);
+  const ShadowEdgeStats st = refineShadowEdges(ctx.inputs, maps, plan.shadowEdges, leftOut ? &part : nullptr, cutLight);
   for (size_t p = 0; l1 && p < maps.size(); ++p)
     for (size_t t = 0; t < maps[p].size(); ++t) {
       const glm::vec3 &was = before[p].texels[t], &now = maps[p].texels[t];

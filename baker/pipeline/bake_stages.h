@@ -33,9 +33,10 @@ struct StageContext {
 };
 
 // Punctual lights' shadow edges area-averaged, on their map alone (l1: scaled with it); leftOut: the direct
-// pages of the lights left out of the map (plan.leftOut), refined on the same edge texels.
+// pages of the lights left out of the map (plan.leftOut), refined on the same edge texels; cutLight: the cut
+// lights' left-out light per page and texel, unshadowed (refineShadowEdges).
 void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,
-                     std::vector<Lightmap>* leftOut = nullptr);
+                     std::vector<Lightmap>* leftOut = nullptr, const CutLightPages* cutLight = nullptr);
 // The sky's direct light, traced (every VPL evaluator; the reference integrator finds the sky itself).
 // Under the final gather an environment map's light goes into its D (direct) as well.
 void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct);

@@ -121,7 +121,8 @@ struct DrawShifts {
   double round = 0.0;  // the ray count's random rounding
 };
 
-// The left-out light at (x, n). Without candidates: `rays` shadow rays, each to its own light drawn from the tree
+// The left-out light at (x, n), and in `unshadowed` the candidates' estimate of it before its shadows (0 without
+// candidates). Without candidates: `rays` shadow rays, each to its own light drawn from the tree
 // (stratified over its unit interval, its order spatial), weighing value / pmf. With m candidates (drawCandidates):
 // the rays go to lights resampled among them in proportion to their weights (systematic: a light picked twice is
 // traced once), each weighing its shadowed light over its unshadowed light times the weights' mean. Resampled
@@ -132,8 +133,10 @@ struct DrawShifts {
 // where the tail is (Neyman's allocation). The estimate stays unbiased whatever the count, which depends on the
 // candidates only.
 glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, int rays,
-                  int candidates, double raysPerUnit, const DrawShifts& shifts, Candidates& room, size_t& traced) {
+                  int candidates, double raysPerUnit, const DrawShifts& shifts, Candidates& room, size_t& traced,
+                  double& unshadowed) {
   glm::dvec3 sum(0.0);
+  unshadowed = 0.0;
   if (candidates <= 0) {
     auto exact = [&](uint32_t i) { return double(channelMean(leftOutLight(in.scene, c, i, x, n).value)); };
     for (int k = 0; k < rays; ++k) {
@@ -147,6 +150,7 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
   const int m = std::max(candidates, rays);
   const double total = drawCandidates(in, c, x, n, m, shifts.walk, room);
   if (!(total > 0.0)) return sum;
+  unshadowed = total / double(m);
   double scale = 1.0;  // the ray count's share of the estimate: 1 unless Russian roulette kept one ray
   if (raysPerUnit > 0.0) {
     const double want = std::min(double(rays) * total / double(m) * raysPerUnit, 8.0 * rays);
@@ -182,6 +186,7 @@ bool texelPosition(const BakeInputs& in, const TexelSamples& ts, size_t s, glm::
 // rays share its candidates (`candidates` per `count` rays, in proportion). The weighted mean over the slots.
 struct TexelDraws {
   glm::dvec3 mean{0.0};
+  double unshadowed = 0.0;
   bool any = false;
 };
 TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, size_t t, int first, int count,
@@ -189,7 +194,7 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
   const size_t layer = ts.layerSize();
   const int layers = ts.supersample * ts.supersample;
   glm::dvec3 sum(0.0);
-  double weight = 0.0;
+  double weight = 0.0, unshadowed = 0.0;
   for (int k = 0; k < std::min(count, layers); ++k) {
     const size_t s = static_cast<size_t>((first + k) % layers) * layer + t;
     const int rays = count / layers + (k < count % layers ? 1 : 0);
@@ -198,11 +203,13 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
     if (!texelPosition(in, ts, s, x)) continue;
     const int m = candidates > 0 ? (candidates * rays + count - 1) / count : 0;
     const DrawShifts shifts{rng.uniform(), rng.uniform(), rng.uniform()};
-    sum += double(w) * drawAt(in, c, x, glm::vec3(ts.normal[s]), rays, m, raysPerUnit, shifts, room, traced);
+    double u = 0.0;
+    sum += double(w) * drawAt(in, c, x, glm::vec3(ts.normal[s]), rays, m, raysPerUnit, shifts, room, traced, u);
+    unshadowed += double(w) * u;
     weight += double(w);
   }
   TexelDraws d;
-  if (weight > 0.0) d.mean = sum / weight, d.any = true;
+  if (weight > 0.0) d.mean = sum / weight, d.unshadowed = unshadowed / weight, d.any = true;
   return d;
 }
 
@@ -228,13 +235,14 @@ double pageRaysPerUnit(const BakeInputs& in, const CutLights& c, const TexelSamp
 
 }  // namespace
 
-LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
-                            const std::vector<uint8_t>& skip) {
-  LightTailStats stats;
+LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>& maps, const LightTailOptions& options,
+                              const std::vector<uint8_t>& skip) {
+  LightTailPages out;
+  LightTailStats& stats = out.stats;
   Stopwatch watch;
   const CutLights c = cutLights(in.scene, in.eval, skip);
   stats.lights = c.tree.size();
-  if (c.tree.empty() || options.samples <= 0) return stats;
+  if (c.tree.empty() || options.samples <= 0) return out;
   // Two independent halves of the draws, each stratified with its own shift: their difference tells the noise of
   // their mean, filtered or not. One draw cannot be split: it is its own half and reports no noise.
   const int halfA = std::max(1, options.samples / 2), halfB = options.samples - halfA;
@@ -245,9 +253,9 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
   std::atomic<size_t> rays{0};
   for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
-    Lightmap& map = maps[p];
+    const Lightmap& map = maps[p];
     const size_t layer = ts.layerSize();
-    std::vector<glm::vec3> a(layer, glm::vec3(0.0f)), b(layer, glm::vec3(0.0f));
+    std::vector<glm::vec3> a(layer, glm::vec3(0.0f)), b(layer, glm::vec3(0.0f)), u(layer, glm::vec3(0.0f));
     std::vector<uint8_t> valid(layer, 0);
     const double perUnit = options.allocate && candidates > 0
                                ? pageRaysPerUnit(in, c, ts, std::max(candidatesA, 4), 4096, hashSeed(options.seed, p)) : 0.0;
@@ -260,27 +268,42 @@ LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, c
         Rng rng(hashSeed(options.seed, p, t));
         const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, candidatesA, perUnit, rng, room, traced);
         const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, candidatesB, perUnit, rng, room, traced) : da;
-        if (da.any && db.any) a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean);
+        if (da.any && db.any)
+          a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean), u[t] = glm::vec3(float(0.5 * (da.unshadowed + db.unshadowed)));
       }
       rays += traced;
     });
     if (options.filterRadius > 0) {
       TexelFilterOptions fo;
       fo.radius = options.filterRadius;
-      auto filtered = filterOnSurface(in.surfaceFilters, ts, std::vector<const std::vector<glm::vec3>*>{&a, &b}, valid, fo);
-      a = std::move(filtered[0]), b = std::move(filtered[1]);
+      auto filtered = filterOnSurface(in.surfaceFilters, ts, std::vector<const std::vector<glm::vec3>*>{&a, &b, &u}, valid, fo);
+      a = std::move(filtered[0]), b = std::move(filtered[1]), u = std::move(filtered[2]);
     }
+    std::vector<glm::vec3>& added = out.added.emplace_back(layer, glm::vec3(0.0f));
+    std::vector<float>& unshadowed = out.unshadowed.emplace_back(layer, 0.0f);
     for (size_t t = 0; t < layer; ++t) {
       if (!valid[t] || t >= map.valid.size() || !map.valid[t]) continue;
       const glm::vec3 mean = 0.5f * (a[t] + b[t]);
       const double half = halfB > 0 ? 0.5 * channelMean(a[t] - b[t]) : 0.0;
-      map.texels[t] += mean;
+      added[t] = mean, unshadowed[t] = u[t].x;
       ++stats.texels, stats.variance += half * half, stats.added += channelMean(mean);
     }
   }
   stats.rays = rays.load();
   stats.seconds = watch.seconds();
-  return stats;
+  return out;
+}
+
+void addLightTailPages(const LightTailPages& tail, std::vector<Lightmap>& maps) {
+  for (size_t p = 0; p < maps.size() && p < tail.added.size(); ++p)
+    for (size_t t = 0; t < maps[p].size() && t < tail.added[p].size(); ++t) maps[p].texels[t] += tail.added[p][t];
+}
+
+LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
+                            const std::vector<uint8_t>& skip) {
+  const LightTailPages tail = traceLightTail(in, maps, options, skip);
+  addLightTailPages(tail, maps);
+  return tail.stats;
 }
 
 }  // namespace irbake

@@ -38,8 +38,23 @@ struct LightTailStats {
   nlohmann::json toJson() const;
 };
 
-// Adds to each page of `maps` (the punctual lights' direct pages, one per in.texels page) the cut lights' left-out
-// light. skip: per scene light, 1: leave it alone (a light whose direct light is not in these pages); may be empty.
+// The cut lights' left-out light per page of the punctual lights' direct pages, traced but not yet added: the
+// shadow-edge stage weighs a texel's visibility jump against all of the lights' light, the cut part included.
+struct LightTailPages {
+  std::vector<std::vector<glm::vec3>> added;   // per page and texel: what addLightTailPages adds (0 where nothing)
+  std::vector<std::vector<float>> unshadowed;  // per page and texel: the candidates' estimate of the same light
+                                               // before its shadows (channel mean), filtered alike; 0 without candidates
+  LightTailStats stats;
+};
+
+// The cut lights' left-out light for each page of `maps` (the punctual lights' direct pages, one per in.texels
+// page; their validity is read). skip: per scene light, 1: leave it alone (a light whose direct light is not in
+// these pages); may be empty.
+LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>& maps, const LightTailOptions& options,
+                              const std::vector<uint8_t>& skip = {});
+void addLightTailPages(const LightTailPages& tail, std::vector<Lightmap>& maps);
+
+// Both at once: adds to each page of `maps` the cut lights' left-out light.
 LightTailStats addLightTail(const BakeInputs& in, std::vector<Lightmap>& maps, const LightTailOptions& options,
                             const std::vector<uint8_t>& skip = {});
 

@@ -151,6 +151,35 @@ TEST(LightTail, RaysWhereTheTailIsStayUnbiasedWithLessNoiseForTheSameRays) {
   EXPECT_LT(rms[1], 0.92 * rms[0]);  // 0.84 to 0.88 over seeds 1 to 9
 }
 
+// The candidates' unshadowed estimate the shadow edges weigh jumps against: on the open floor (nothing in the way)
+// it is the cut's left-out light, brute force less the culled bake, texel for texel within its noise and on the
+// mean within 1%, and the traced light equals it there (every ray sees its light).
+TEST(LightTail, UnshadowedEstimateIsTheLeftOutLight) {
+  const auto cc = lampsAndWall(false);
+  const testing::CutLightsCase& c = *cc;
+  const BakeInputs brute = c.bruteInputs(), culled = c.culledInputs();
+  const std::vector<Lightmap> a = bakeEmbree(brute, EmbreeOptions{}), b = bakeEmbree(culled, EmbreeOptions{});
+  LightTailOptions options;
+  options.seed = 11;
+  const LightTailPages tail = traceLightTail(culled, b, options);
+  ASSERT_EQ(tail.unshadowed.size(), 1u);
+  double exact = 0.0, estimate = 0.0, traced = 0.0, err2 = 0.0;
+  size_t n = 0;
+  for (size_t t = 0; t < a[0].size(); ++t) {
+    if (!a[0].valid[t]) continue;
+    const double left = a[0].texels[t].x - b[0].texels[t].x, u = tail.unshadowed[0][t];
+    ASSERT_TRUE(std::isfinite(u) && u >= 0.0) << "texel " << t;
+    exact += left, estimate += u, traced += tail.added[0][t].x, err2 += (u - left) * (u - left), ++n;
+  }
+  ASSERT_GT(n, 1000u);
+  const double rms = std::sqrt(err2 / double(n)), mean = exact / double(n);
+  std::printf("[ figure ] left-out light: exact mean %.4g, unshadowed estimate %.4g (RMS off %.3g), traced %.4g\n",
+              mean, estimate / double(n), rms, traced / double(n));
+  EXPECT_NEAR(estimate / exact, 1.0, 0.01);
+  EXPECT_NEAR(traced / estimate, 1.0, 0.01);
+  EXPECT_LT(rms, 0.1 * mean);
+}
+
 TEST(LightTail, NothingCutNothingAddedAndNoSamplesLeaveTheCut) {
   const auto cc = lampsAndWall();
   const testing::CutLightsCase& c = *cc;

@@ -1,7 +1,8 @@
 // Punctual lights' shadow edges, area-averaged. The backends evaluate a punctual light once per texel sample,
 // at the texel's centre: a texel a hard shadow edge crosses stores the centre's side of the edge, and the
 // bilinear read spreads that over the texel's whole square, so a region's mean is off by up to half a texel
-// of shadow along every edge (narrow sunlit strips show it most). Here the texels where the lights' visibility jumps between neighbours get the mean of that light over
+// of shadow along every edge (narrow sunlit strips show it most). Here the texels where the lights' visibility jumps
+// between neighbours, or a lamp's own falloff bends within the texel, get the mean of that light over
 // their own square instead: S×S sub-points on the chart's triangles that cover it, one shadow ray each, so the map's mean
 // over any region equals the irradiance's up to the bilinear blur. Both backends: the direct stage's pages
 // (punctual lights only) before the VPLs are added; the centre's value is replaced, not corrected, so GL's
@@ -37,7 +38,17 @@ struct ShadowEdgePart {
 
 // In place on the punctual lights' pages (one per in.texels page, as the direct stage returns them). Pages
 // with supersampled texels (S > 1) are left alone: their samples already spread over the texel.
+// The light the lights' cut leaves out, per page and texel (stages/light_tail's estimate), with and without its
+// shadows: the visible share counts it on both sides, so a texel's jump is weighed against all of the lights'
+// light and a bake with cut lights finds the edges a bake without the cut finds, far lights' shadows included.
+struct CutLightPages {
+  const std::vector<std::vector<glm::vec3>>* shadowed = nullptr;
+  const std::vector<std::vector<float>>* unshadowed = nullptr;  // channel mean
+};
+
+// cutLight: null where no light is cut.
 ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& directPages,
-                                  const ShadowEdgeOptions& options = {}, const ShadowEdgePart* part = nullptr);
+                                  const ShadowEdgeOptions& options = {}, const ShadowEdgePart* part = nullptr,
+                                  const CutLightPages* cutLight = nullptr);
 
 }  // namespace irbake

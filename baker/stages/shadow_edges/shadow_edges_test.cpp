@@ -203,6 +203,96 @@ TEST(ShadowEdges, AStripNarrowerThanATexelBetweenCentresIsFound) {
               crossed);
 }
 
+// The cut lights' left-out light counts as visible on both sides of an edge: with c times a lit texel's value
+// added, the sun edge's jump of 1 in the visible share becomes 1 / (1 + c). At c = 8 (1/9 > 0.1, the default jump)
+// its texels are still refined, to the same values; at c = 10 (1/11 < 0.1) none is.
+TEST(ShadowEdges, CutLightWeighsTheJumpAgainstAllOfTheLight) {
+  SunOverFloor f(false);
+  const BakeInputs in = f.inputs();
+  const std::vector<Lightmap> centre = bakeEmbree(in);
+  auto refine = [&](float c, std::vector<Lightmap>& maps) {
+    std::vector<std::vector<float>> unshadowed;
+    std::vector<std::vector<glm::vec3>> shadowed;
+    for (const TexelSamples& ts : f.texels) unshadowed.emplace_back(ts.layerSize(), c), shadowed.emplace_back(ts.layerSize(), glm::vec3(c));
+    maps = centre;
+    const CutLightPages cut{&shadowed, &unshadowed};
+    return refineShadowEdges(in, maps, subPoints(8), nullptr, &cut).edgeTexels;
+  };
+  std::vector<Lightmap> none = centre, eight, ten;
+  const size_t plain = refineShadowEdges(in, none, subPoints(8)).edgeTexels;
+  const size_t atEight = refine(8.0f, eight), atTen = refine(10.0f, ten);
+  std::printf("[ figure ] sun edge texels refined: %zu alone, %zu with 8x its light cut, %zu with 10x\n", plain, atEight,
+              atTen);
+  ASSERT_GT(plain, 10u);
+  EXPECT_GT(atEight, plain / 2);  // the neighbours' jump of 1/9 still finds the edge (the 2×2 probes' smaller
+  EXPECT_LE(atEight, plain);      // jumps of a quarter no longer do)
+  EXPECT_EQ(atTen, 0u);
+  for (size_t p = 0; p < centre.size(); ++p) {
+    EXPECT_EQ(ten[p].texels, centre[p].texels);
+    for (size_t t = 0; t < centre[p].size(); ++t)  // a texel refined at c = 8 gets what it gets alone
+      if (eight[p].texels[t] != centre[p].texels[t]) ASSERT_EQ(eight[p].texels[t], none[p].texels[t]) << "texel " << t;
+  }
+}
+
+// A lamp 0.3 texels above an open floor: no shadow anywhere, but its 1/d² falls so fast across the texels around its
+// foot that a centre is far from its square's mean. Those texels are refined: each gets the mean of I cos θ / (π d²)
+// over its 8×8 sub-points (computed here from the texel's own centre and its neighbours' spacing) within 0.5%, where
+// the centre alone is off by more than a fifth under the lamp.
+TEST(ShadowEdges, TexelsBesideALampGetTheirSquaresMeanFalloff) {
+  Scene s;
+  addQuad(s, addMaterial(s, glm::vec3(0.5f)), {-1, -1, 0}, {2, 0, 0}, {0, 2, 0});
+  AtlasOptions atlas;
+  atlas.targetPageSize = atlas.maxPageSize = 64;
+  buildAtlas(s, atlas);
+  RayTracer rt(s);
+  std::vector<TexelSamples> texels = buildTexelSamples(s, rt, {});
+  ASSERT_EQ(texels.size(), 1u);
+  const TexelSamples& ts = texels[0];
+  const int w = ts.width;
+  auto at = [&](size_t t) { return glm::vec3(ts.positionWeight[t]); };
+  auto interior = [&](size_t t) {  // a valid texel whose four neighbours are valid
+    return ts.valid[t] && t % w > 0 && t % w + 1 < size_t(w) && t >= size_t(w) && t + w < ts.layerSize() && ts.valid[t - 1] &&
+           ts.valid[t + 1] && ts.valid[t - w] && ts.valid[t + w];
+  };
+  size_t foot = SIZE_MAX;
+  for (size_t t = 0; t < ts.layerSize(); ++t)
+    if (interior(t) && (foot == SIZE_MAX || glm::length(at(t)) < glm::length(at(foot)))) foot = t;
+  ASSERT_NE(foot, size_t(SIZE_MAX));
+  const glm::vec3 ex = at(foot + 1) - at(foot), ey = at(foot + w) - at(foot);
+  const float spacing = glm::length(ex), intensity = 1.0f;
+  s.lights.push_back(pointLight(at(foot) + glm::vec3(0, 0, 0.3f * spacing), intensity));
+  const VplSet none;
+  const BakeInputs in{s, rt, texels, none, directOnly(), {}};
+  const std::vector<Lightmap> centre = bakeEmbree(in);
+  std::vector<Lightmap> refined = centre;
+  refineShadowEdges(in, refined, subPoints(8));
+  const glm::vec3 lamp = s.lights[0].position;
+  auto squareMean = [&](size_t t) {  // the 8×8 midpoints of texel t's square, as the stage places them
+    double sum = 0.0;
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 x = at(t) + ((i + 0.5f) / 8.0f - 0.5f) * ex + ((j + 0.5f) / 8.0f - 0.5f) * ey;
+        const glm::vec3 d = lamp - x;
+        sum += intensity * d.z / std::pow(glm::dot(d, d), 1.5f) / kPi;
+      }
+    return sum / 64.0;
+  };
+  size_t checked = 0;
+  double worstRefined = 0.0, underLamp = 0.0;
+  for (size_t t = 0; t < ts.layerSize(); ++t) {
+    if (!interior(t) || glm::length(at(t) - at(foot)) > 2.5f * spacing) continue;
+    const double exact = squareMean(t);
+    worstRefined = std::max(worstRefined, std::abs(refined[0].texels[t].x / exact - 1.0));
+    if (t == foot) underLamp = std::abs(centre[0].texels[t].x / exact - 1.0);
+    ++checked;
+  }
+  std::printf("[ figure ] lamp 0.3 texels up: %zu texels around its foot, worst %.3f%% off their square's mean refined, "
+              "the centre alone %.1f%% under the lamp\n", checked, 100.0 * worstRefined, 100.0 * underLamp);
+  EXPECT_GE(checked, 12u);
+  EXPECT_LT(worstRefined, 0.005);
+  EXPECT_GT(underLamp, 0.2);
+}
+
 TEST(ShadowEdges, OffWithOneSubSampleOrSupersampledTexels) {
   SunOverFloor f(false);
   const BakeInputs in = f.inputs();
