@@ -181,7 +181,11 @@ void mapsFromSums(BakeState& s, ExactVplSums sums, BakeResult& r, nlohmann::json
     part(s, "maps", [&] { r.maps = backendMaps(s, sums, report, s.plan.directional ? &r.directional : nullptr); });
   });
   StageContext ctx = stageContext(s, report);
-  skyStage(ctx, r.maps, s.directMaps);
+  // The estimate's second sky trace once: a round of paths traces the same sky again.
+  std::vector<Lightmap> sky;
+  const bool measure = !s.halves[0].empty() && !s.skyNoiseMeasured;
+  skyStage(ctx, r.maps, s.directMaps, measure ? &sky : nullptr);
+  if (!sky.empty()) timed(s, "errorEstimate", [&] { skyRayNoise(s, sky); });
 }
 
 }  // namespace irbake

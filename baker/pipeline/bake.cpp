@@ -176,7 +176,9 @@ void StagedBake::stagesToTarget(ExactVplSums& sums, BakeResult& r) {
     }
     if (!s.stoppedBy.empty()) return;  // a cap stopped the walk's rounds
     const double aim2 = (kTargetAim * o.targetError) * (kTargetAim * o.targetError);
-    const double walk2 = walk * walk, stages2 = std::max(0.0, total * total - walk2);
+    // The sky's pages are traced once, before the rounds: neither raise lowers skyRays.
+    const double sky = s.figure.breakdown.value("skyRays", 0.0);
+    const double walk2 = walk * walk, stages2 = std::max(0.0, total * total - walk2 - sky * sky);
     // The larger part is raised: to what the other leaves of the aim, or to half the aim where the other
     // needs more than half (the other is raised next).
     const bool rays = stages2 > walk2;

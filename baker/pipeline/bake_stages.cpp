@@ -43,24 +43,26 @@ void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1
                                {"subPoints", st.subPoints}, {"droppedInside", st.droppedInside}};
 }
 
-void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct) {
+void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct, std::vector<Lightmap>* traced) {
   const Scene& scene = ctx.scene;
   const BakePlan& plan = ctx.plan;
   if (!scene.environment.present() || plan.backend == BackendKind::Reference) return;
   ctx.timed("sky", [&] {
     SkyLightStats stats;
-    if (plan.finalGather && direct.size() == maps.size() && !plan.skyByGather) {
-      // An environment map's light goes into D as well (its importance sampling beats the gather's cosine
-      // rays): traced once into blank pages, added to both. A uniform sky stays out of D: the final
-      // gather's rays that leave the scene count it.
+    // An environment map's light goes into D as well under the final gather (its importance sampling beats
+    // the gather's cosine rays). A uniform sky stays out of D: the final gather's rays that leave the scene
+    // count it.
+    const bool intoDirect = plan.finalGather && direct.size() == maps.size() && !plan.skyByGather;
+    if (intoDirect || traced) {  // traced once into blank pages, added where it goes
       std::vector<Lightmap> sky = maps;
       for (Lightmap& m : sky) std::fill(m.texels.begin(), m.texels.end(), glm::vec3(0.0f));
       addSkyLight(ctx.inputs, sky, plan.sky, &stats);
       for (size_t p = 0; p < maps.size(); ++p)
         for (size_t t = 0; t < maps[p].size(); ++t) {
           maps[p].texels[t] += sky[p].texels[t];
-          direct[p].texels[t] += sky[p].texels[t];
+          if (intoDirect) direct[p].texels[t] += sky[p].texels[t];
         }
+      if (traced) *traced = std::move(sky);
     } else {
       addSkyLight(ctx.inputs, maps, plan.sky, &stats);
     }

@@ -38,8 +38,10 @@ struct StageContext {
 void shadowEdgeStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,
                      std::vector<Lightmap>* leftOut = nullptr, const CutLightPages* cutLight = nullptr);
 // The sky's direct light, traced (every VPL evaluator; the reference integrator finds the sky itself).
-// Under the final gather an environment map's light goes into its D (direct) as well.
-void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct);
+// Under the final gather an environment map's light goes into its D (direct) as well. traced: the sky's own
+// pages as added (the error estimate traces them again), or null.
+void skyStage(StageContext& ctx, std::vector<Lightmap>& maps, std::vector<Lightmap>& direct,
+              std::vector<Lightmap>* traced = nullptr);
 // The clamp's lost near-field light gathered back from the map; traced: its rays traced beforehand (beside
 // the GL evaluator), or null.
 void compensationStage(StageContext& ctx, std::vector<Lightmap>& maps, L1Pages* l1,

@@ -105,6 +105,8 @@ struct BakeState {
   FinalGatherOptions planGather;
   nlohmann::json stageNoise = nlohmann::json::object();          // a stage's own ray noise (RMS on bins, map units)
   nlohmann::json stageNoiseInterior = nlohmann::json::object();  // the same on interior bins (BinTexels)
+  bool skyNoiseMeasured = false;
+  std::vector<Lightmap> skyShift;  // under the final gather: the sky traced with another seed less the bake's
   ErrorFigure figure;                                             // the last one measured
 
   // Wall clock and the process's CPU time per stage (report "timings": seconds, cpuSeconds).
@@ -171,6 +173,8 @@ std::array<std::vector<Lightmap>, 2> mixedHalves(const BakeState& s, const Exact
 // The stages that trace rays of their own, on r's maps (and L1 pages): the clamp compensation and the final
 // gather; when estimating, each run a second time with another seed, then the figure (into s.figure).
 void rayStages(BakeState& s, BakeResult& r, nlohmann::json& report, bool estimate);
+// The sky stage's own ray noise, from its pages as the bake traced them (error_figure.cpp).
+void skyRayNoise(BakeState& s, const std::vector<Lightmap>& sky);
 void reportFigure(const BakeState& s, nlohmann::json& report);
 // light_cut_figure.cpp: the light the cut lights' fade leaves out, bounded at a subset of the texels against the
 // finished map, into report["lightCull"] and s.lightCutBound.

@@ -10,6 +10,7 @@
 #include "pipeline/bake_state.h"
 #include "sampling/sampling.h"
 #include "stages/interleave/interleaved_sampling.h"
+#include "stages/sky/sky_light.h"
 
 namespace irbake {
 namespace {
@@ -35,20 +36,58 @@ void rayNoise(BakeState& s, const std::string& stage, const std::vector<Lightmap
   s.stageNoiseInterior[stage] = std::sqrt(2.0) * replicateError({once, twice}, nullptr, bin, 1.0, BinTexels::Interior).noiseRms;
 }
 
-// before: the compensation's input, replaced by its second run's output.
+// maps += sign · s.skyShift (none without a sky).
+void shiftSky(const BakeState& s, std::vector<Lightmap>& maps, float sign) {
+  for (size_t p = 0; p < maps.size() && p < s.skyShift.size(); ++p)
+    for (size_t t = 0; t < maps[p].size() && t < s.skyShift[p].size(); ++t) maps[p].texels[t] += sign * s.skyShift[p].texels[t];
+}
+
+// before: the compensation's input, replaced by its second run's output. The second run reads the second sky
+// (its read of the sky's noise is its own figure's; the sky's pages themselves are skyRays'); under the final
+// gather the second sky stays in for the gather's second run.
 void compensationRayNoise(BakeState& s, std::vector<Lightmap>& before, const std::vector<Lightmap>& after) {
   ClampCompensationOptions o = s.plan.compensation;
   o.seed = static_cast<uint32_t>(hashSeed(s.options.walk.seed, 0x636f6d70ull));  // "comp"
+  shiftSky(s, before, 1.0f);
   ClampGather(*s.wholeInputs, o).apply(before);
-  if (!s.plan.finalGather) rayNoise(s, "compensationRays", after, before);
+  if (s.plan.finalGather) return;
+  shiftSky(s, before, -1.0f);
+  rayNoise(s, "compensationRays", after, before);
 }
 
+// before: the gather's input, the second sky in it (compensationRayNoise, or here): the second run's figure holds
+// the sky's noise as the gather reads it at its hits (a uniform sky that the gather counts itself: all of it
+// but the gather's own misses, which the second seed re-draws).
 void gatherRayNoise(BakeState& s, std::vector<Lightmap> before, const std::vector<Lightmap>& after) {
   FinalGatherOptions o = s.plan.gather;
   o.seed = static_cast<uint32_t>(hashSeed(s.options.walk.seed, 0x676174686572ull));  // "gather"
   finalGather(*s.wholeInputs, s.directMaps, before, o);
   rayNoise(s, s.plan.compensate ? "compensationAndGatherRays" : "finalGatherRays", after, before);
 }
+
+}  // namespace
+
+// The sky traced again with another seed into blank pages. Where its pages reach the written map as they are
+// (without the final gather, or in the gather's D) the two traces are compared on the sky's pages, not on two
+// gathered maps: the D copy passes the gather unchanged. The copy in the map the ray stages read reaches the
+// written map only through them (scaled by the albedo, averaged over their hits): their second runs read the
+// second sky (s.skyShift), so that share is in their figure and no sky noise counts twice. A uniform sky that
+// the final gather counts itself is read from the pages only at the gather's hits: no skyRays, the gather's
+// second run holds all of it.
+void skyRayNoise(BakeState& s, const std::vector<Lightmap>& sky) {
+  SkyLightOptions o = s.plan.sky;
+  o.seed = static_cast<uint32_t>(hashSeed(s.options.walk.seed, 0x736b79ull));  // "sky"
+  std::vector<Lightmap> again = sky;
+  for (Lightmap& m : again) std::fill(m.texels.begin(), m.texels.end(), glm::vec3(0.0f));
+  addSkyLight(*s.wholeInputs, again, o);
+  if (!s.plan.skyByGather) rayNoise(s, "skyRays", sky, again);
+  for (size_t p = 0; p < again.size(); ++p)
+    for (size_t t = 0; t < again[p].size(); ++t) again[p].texels[t] -= sky[p].texels[t];
+  if (s.plan.compensate || s.plan.finalGather) s.skyShift = std::move(again);
+  s.skyNoiseMeasured = true;
+}
+
+namespace {
 
 // The walk's figure with the stages' own ray noise added (independent of the walk's: the variances add),
 // each part relative to the same signal in `breakdown`.
@@ -136,8 +175,8 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
                             "bench/cycles/compare.py scores a map";
   j["binTexels"] = s.options.errorEstimate.bin;
   j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
-                "compensation's and final gather's own ray noise (each run again with another seed)";
-  j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail), the sky's ray noise";
+                "sky's, compensation's and final gather's own ray noise (each run again with another seed)";
+  j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail)";
   if (s.lightCutBound > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the light cut's bound (lightCull.cutBound)";
   if (s.lightTailNoise > 0.0) j["covers"] = j["covers"].get<std::string>() + ", and the sampled-back light tail's noise (lightCull.tailNoise)";
   const double moved = report.contains("finalGather") ? report["finalGather"].value("outlierFraction", 0.0) : 0.0;
@@ -167,7 +206,10 @@ void rayStages(BakeState& s, BakeResult& r, nlohmann::json& report, bool estimat
   // Under the final gather the map the gather reads is not written: the compensation's second run is
   // gathered again (with another gather seed), so both stages' ray noise is measured where it shows.
   if (!beforeStage.empty()) timed(s, "errorEstimate", [&] { compensationRayNoise(s, beforeStage, r.maps); });
-  if (estimate && s.plan.finalGather && beforeStage.empty()) beforeStage = r.maps;
+  if (estimate && s.plan.finalGather && beforeStage.empty()) {
+    beforeStage = r.maps;
+    shiftSky(s, beforeStage, 1.0f);
+  }
   finalGatherStage(ctx, s.directMaps, l1 ? &s.directL1 : nullptr, r.maps, l1);
   if (s.plan.finalGather && !beforeStage.empty()) timed(s, "errorEstimate", [&] { gatherRayNoise(s, std::move(beforeStage), r.maps); });
   if (estimate) timed(s, "errorEstimate", [&] { measureFigure(s, r.maps); });
