@@ -33,14 +33,11 @@ float shareWith(float visible, float unshadowed, glm::vec2 cut) {
 }
 
 // Per texel, the share of the punctual lights' unshadowed value that reached it (their visibility, weighted by
-// each light's value; -1 where no light faces the texel's centre, kNoTexel where it has none). Smooth falloff (a
-// point light's 1/r²) keeps it at 1; a shadow edge makes it jump. cut: the page's cut lights' left-out light.
-constexpr float kNoTexel = -2.0f;
-// total: per texel, the lights' unshadowed value at the centre (the cut's included), the share's denominator.
+// each light's value; -1 where no light faces the texel). Smooth falloff (a point light's 1/r²) keeps it at 1;
+// a shadow edge makes it jump. cut: the page's cut lights' left-out light per texel, or null.
 std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map,
-                                const std::vector<uint8_t>& valid, const PageCut& cut, std::vector<float>& total) {
-  std::vector<float> share(map.size(), kNoTexel);
-  total.assign(map.size(), 0.0f);
+                                const std::vector<uint8_t>& valid, const PageCut& cut) {
+  std::vector<float> share(map.size(), -1.0f);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, map.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (!valid[t] || ts.positionWeight[t].w <= 0.0f) continue;
@@ -50,65 +47,21 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
       glm::vec3 unshadowed(0.0f);
       for (uint32_t i : in.lightsNear(x)) unshadowed += punctualDirect(in.scene.lights[i], x, n).mapValue;
       share[t] = shareWith(channelMax(map.texels[t]), channelMax(unshadowed), cut.at(t));
-      total[t] = channelMax(unshadowed) + cut.at(t).y;
     }
   });
   return share;
 }
 
-// Texels where the lights' own falloff bends within a texel (a surface a few centimetres from a lamp): the centre's
-// value against the mean of two opposite valid neighbours' (row, column or diagonal) differs by more than `jump` of
-// its unshadowed light, or (at a chart's end, one neighbour) a neighbour's value differs by more than half of the
-// larger unshadowed light (1/d² falls that fast within about four texels of its light). A smooth falloff is straight
-// across a texel to second order, so the centre is its square's mean; beside a lamp it is not, and no share jumps.
-void markBentFalloff(const Lightmap& map, const std::vector<float>& share, const std::vector<float>& total, int w, int h,
-                     float jump, std::vector<uint8_t>& edge) {
-  tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const size_t t = size_t(y) * w + x;
-      if (edge[t] || share[t] == kNoTexel || !(total[t] > 0.0f)) continue;
-      const float centre = channelMax(map.texels[t]);
-      for (int dy = -1; dy <= 1 && !edge[t]; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const size_t b = size_t(ny) * w + nx;
-          if (share[b] != kNoTexel && std::abs(centre - channelMax(map.texels[b])) > 0.5f * std::max(total[t], total[b])) {
-            edge[t] = 1;
-            break;
-          }
-        }
-      if (edge[t]) continue;
-      static constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
-      for (const auto& d : kAxes) {
-        const int ax = x - d[0], ay = y - d[1], bx = x + d[0], by = y + d[1];
-        if (ax < 0 || ay < 0 || bx < 0 || by < 0 || ax >= w || ay >= h || bx >= w || by >= h) continue;
-        const size_t a = size_t(ay) * w + ax, b = size_t(by) * w + bx;
-        if (share[a] == kNoTexel || share[b] == kNoTexel) continue;
-        const float straight = 0.5f * (channelMax(map.texels[a]) + channelMax(map.texels[b]));
-        if (std::abs(centre - straight) > jump * total[t]) {
-          edge[t] = 1;
-          break;
-        }
-      }
-    }
-  });
-}
-
 // Texels whose centre agrees with its neighbours although a shadow or a lit strip narrower than a texel crosses
 // its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
-// centre's triangle, against the centre's; a texel where they differ by more than `jump` is marked too. A centre
-// no light faces counts as 0 against them: a light that faces part of its square only (one at the surface's
-// plane, beside a lamp) lights that part. So is a texel whose sub-points' visible light differs from the
-// centre's by more than `jump` of the centre's unshadowed light although the share agrees: beside a lamp the
-// light's own falloff across the square (1/d² from a few centimetres) is a jump as well.
-void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map, const std::vector<float>& share,
-                       const std::vector<float>& total, float jump, const PageCut& cut, std::vector<uint8_t>& edge) {
+// centre's triangle, against the centre's; a texel where they differ by more than `jump` is marked too.
+void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share, float jump,
+                       const PageCut& cut, std::vector<uint8_t>& edge) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
-      if (edge[t] || share[t] == kNoTexel) continue;
+      if (edge[t] || share[t] < 0.0f) continue;
       SquareMean mean;
       auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
         for (uint32_t i : in.lightsNear(xs)) {
@@ -126,9 +79,7 @@ void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const Light
       if (!(unshadowed > 0.0)) continue;
       const double visible = std::max(mean.sum[0].x, std::max(mean.sum[0].y, mean.sum[0].z));
       const float probe = shareWith(float(visible / mean.kept), float(unshadowed / mean.kept), cut.at(t));
-      if (probe >= 0.0f && std::abs(probe - std::max(share[t], 0.0f)) > jump) edge[t] = 1;
-      const double centre = t < map.size() ? double(channelMax(map.texels[t])) : 0.0;
-      if (total[t] > 0.0f && std::abs(visible / mean.kept - centre) > double(jump) * total[t]) edge[t] = 1;
+      if (std::abs(probe - share[t]) > jump) edge[t] = 1;
     }
   });
 }
@@ -153,11 +104,9 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     PageCut cut;
     if (cutLight && p < cutLight->unshadowed->size() && p < cutLight->shadowed->size())
       cut = {&(*cutLight->shadowed)[p], &(*cutLight->unshadowed)[p]};
-    std::vector<float> total;
-    const std::vector<float> share = visibleShare(in, ts, map, valid, cut, total);
+    const std::vector<float> share = visibleShare(in, ts, map, valid, cut);
     std::vector<uint8_t> edge = edgeTexels(share, ts.width, ts.height, options.jump);
-    markBentFalloff(map, share, total, ts.width, ts.height, options.jump, edge);
-    markSubTexelEdges(in, ts, map, share, total, options.jump, cut, edge);
+    markSubTexelEdges(in, ts, share, options.jump, cut, edge);
     const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {

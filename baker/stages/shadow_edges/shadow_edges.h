@@ -1,8 +1,7 @@
 // Punctual lights' shadow edges, area-averaged. The backends evaluate a punctual light once per texel sample,
 // at the texel's centre: a texel a hard shadow edge crosses stores the centre's side of the edge, and the
 // bilinear read spreads that over the texel's whole square, so a region's mean is off by up to half a texel
-// of shadow along every edge (narrow sunlit strips show it most). Here the texels where the lights' visibility jumps
-// between neighbours, or a lamp's own falloff bends within the texel, get the mean of that light over
+// of shadow along every edge (narrow sunlit strips show it most). Here the texels where the lights' visibility jumps between neighbours get the mean of that light over
 // their own square instead: S×S sub-points on the chart's triangles that cover it, one shadow ray each, so the map's mean
 // over any region equals the irradiance's up to the bilinear blur. Both backends: the direct stage's pages
 // (punctual lights only) before the VPLs are added; the centre's value is replaced, not corrected, so GL's

@@ -234,65 +234,6 @@ TEST(ShadowEdges, CutLightWeighsTheJumpAgainstAllOfTheLight) {
   }
 }
 
-// A lamp 0.3 texels above an open floor: no shadow anywhere, but its 1/d² falls so fast across the texels around its
-// foot that a centre is far from its square's mean. Those texels are refined: each gets the mean of I cos θ / (π d²)
-// over its 8×8 sub-points (computed here from the texel's own centre and its neighbours' spacing) within 0.5%, where
-// the centre alone is off by more than a fifth under the lamp.
-TEST(ShadowEdges, TexelsBesideALampGetTheirSquaresMeanFalloff) {
-  Scene s;
-  addQuad(s, addMaterial(s, glm::vec3(0.5f)), {-1, -1, 0}, {2, 0, 0}, {0, 2, 0});
-  AtlasOptions atlas;
-  atlas.targetPageSize = atlas.maxPageSize = 64;
-  buildAtlas(s, atlas);
-  RayTracer rt(s);
-  std::vector<TexelSamples> texels = buildTexelSamples(s, rt, {});
-  ASSERT_EQ(texels.size(), 1u);
-  const TexelSamples& ts = texels[0];
-  const int w = ts.width;
-  auto at = [&](size_t t) { return glm::vec3(ts.positionWeight[t]); };
-  auto interior = [&](size_t t) {  // a valid texel whose four neighbours are valid
-    return ts.valid[t] && t % w > 0 && t % w + 1 < size_t(w) && t >= size_t(w) && t + w < ts.layerSize() && ts.valid[t - 1] &&
-           ts.valid[t + 1] && ts.valid[t - w] && ts.valid[t + w];
-  };
-  size_t foot = SIZE_MAX;
-  for (size_t t = 0; t < ts.layerSize(); ++t)
-    if (interior(t) && (foot == SIZE_MAX || glm::length(at(t)) < glm::length(at(foot)))) foot = t;
-  ASSERT_NE(foot, size_t(SIZE_MAX));
-  const glm::vec3 ex = at(foot + 1) - at(foot), ey = at(foot + w) - at(foot);
-  const float spacing = glm::length(ex), intensity = 1.0f;
-  s.lights.push_back(pointLight(at(foot) + glm::vec3(0, 0, 0.3f * spacing), intensity));
-  const VplSet none;
-  const BakeInputs in{s, rt, texels, none, directOnly(), {}};
-  const std::vector<Lightmap> centre = bakeEmbree(in);
-  std::vector<Lightmap> refined = centre;
-  refineShadowEdges(in, refined, subPoints(8));
-  const glm::vec3 lamp = s.lights[0].position;
-  auto squareMean = [&](size_t t) {  // the 8×8 midpoints of texel t's square, as the stage places them
-    double sum = 0.0;
-    for (int j = 0; j < 8; ++j)
-      for (int i = 0; i < 8; ++i) {
-        const glm::vec3 x = at(t) + ((i + 0.5f) / 8.0f - 0.5f) * ex + ((j + 0.5f) / 8.0f - 0.5f) * ey;
-        const glm::vec3 d = lamp - x;
-        sum += intensity * d.z / std::pow(glm::dot(d, d), 1.5f) / kPi;
-      }
-    return sum / 64.0;
-  };
-  size_t checked = 0;
-  double worstRefined = 0.0, underLamp = 0.0;
-  for (size_t t = 0; t < ts.layerSize(); ++t) {
-    if (!interior(t) || glm::length(at(t) - at(foot)) > 2.5f * spacing) continue;
-    const double exact = squareMean(t);
-    worstRefined = std::max(worstRefined, std::abs(refined[0].texels[t].x / exact - 1.0));
-    if (t == foot) underLamp = std::abs(centre[0].texels[t].x / exact - 1.0);
-    ++checked;
-  }
-  std::printf("[ figure ] lamp 0.3 texels up: %zu texels around its foot, worst %.3f%% off their square's mean refined, "
-              "the centre alone %.1f%% under the lamp\n", checked, 100.0 * worstRefined, 100.0 * underLamp);
-  EXPECT_GE(checked, 12u);
-  EXPECT_LT(worstRefined, 0.005);
-  EXPECT_GT(underLamp, 0.2);
-}
-
 TEST(ShadowEdges, OffWithOneSubSampleOrSupersampledTexels) {
   SunOverFloor f(false);
   const BakeInputs in = f.inputs();
