@@ -54,7 +54,9 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
 
 // Texels whose centre agrees with its neighbours although a shadow or a lit strip narrower than a texel crosses
 // its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
-// centre's triangle, against the centre's; a texel where they differ by more than `jump` is marked too.
+// centre's triangle against the centre's, both traced alike; a texel where they differ by more than `jump` is
+// marked too. A light under a tenth of `jump` of the centre's unshadowed light (the cut's included) counts as
+// visible on both sides, no ray: alone it cannot make the probe jump, and a level's many faint lamps cost nothing.
 void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share, float jump,
                        const PageCut& cut, std::vector<uint8_t>& edge) {
   const RayTracer& rt = in.rayTracer;
@@ -62,24 +64,32 @@ void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (edge[t] || share[t] < 0.0f) continue;
-      SquareMean mean;
+      glm::vec3 x(ts.positionWeight[t]);
+      if (ts.primitive[t] < in.scene.primitives.size()) x = rt.insetPoint(ts.primitive[t], ts.triangle[t], x);
+      const glm::vec3 n(ts.normal[t]);
+      glm::vec3 whole(0.0f);
+      for (uint32_t i : in.lightsNear(x)) whole += punctualDirect(in.scene.lights[i], x, n).mapValue;
+      const float faint = 0.1f * jump * (channelMax(whole) + cut.at(t).y);
+      // At xs: values[0] the visible light (faint lights counted visible), values[1] the unshadowed light.
       auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
         for (uint32_t i : in.lightsNear(xs)) {
           const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
           if (c.mapValue == glm::vec3(0.0f)) continue;
           values[1] += c.mapValue;
           const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-          if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
+          if (channelMax(c.mapValue) >= faint && tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
           values[0] += c.mapValue;
         }
         return true;  // no covered test here: the full refinement drops what a surface cuts off
       };
+      SquareMean mean;
       if (!averageOverTexelSquare(in, ts, t, 2, nullptr, visit, mean) || mean.kept == 0) continue;
-      const double unshadowed = std::max(mean.sum[1].x, std::max(mean.sum[1].y, mean.sum[1].z));
-      if (!(unshadowed > 0.0)) continue;
-      const double visible = std::max(mean.sum[0].x, std::max(mean.sum[0].y, mean.sum[0].z));
-      const float probe = shareWith(float(visible / mean.kept), float(unshadowed / mean.kept), cut.at(t));
-      if (std::abs(probe - share[t]) > jump) edge[t] = 1;
+      glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+      visit(x, n, x + n * eps, centre);
+      const float k = float(mean.kept);
+      const float probe = shareWith(channelMax(glm::vec3(mean.sum[0])) / k, channelMax(glm::vec3(mean.sum[1])) / k, cut.at(t));
+      const float here = shareWith(channelMax(centre[0]), channelMax(centre[1]), cut.at(t));
+      if (probe >= 0.0f && here >= 0.0f && std::abs(probe - here) > jump) edge[t] = 1;
     }
   });
 }
