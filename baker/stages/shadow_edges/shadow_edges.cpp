@@ -6,6 +6,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "common/maths.h"
 #include "common/progress.h"
 #include "stages/shadow_edges/texel_square.h"
 #include "transport/geometry_term.h"
@@ -22,8 +23,7 @@ struct PageCut {
   const std::vector<float>* unshadowed = nullptr;
   glm::vec2 at(size_t t) const {  // (shadowed, unshadowed) at texel t
     if (!unshadowed || t >= unshadowed->size() || t >= shadowed->size()) return glm::vec2(0.0f);
-    const glm::vec3& v = (*shadowed)[t];
-    return glm::vec2((v.x + v.y + v.z) / 3.0f, (*unshadowed)[t]);
+    return glm::vec2(float(channelMean((*shadowed)[t])), (*unshadowed)[t]);
   }
 };
 
@@ -34,10 +34,12 @@ float shareWith(float visible, float unshadowed, glm::vec2 cut) {
 
 // Per texel, the share of the punctual lights' unshadowed value that reached it (their visibility, weighted by
 // each light's value; -1 where no light faces the texel). Smooth falloff (a point light's 1/r²) keeps it at 1;
-// a shadow edge makes it jump. cut: the page's cut lights' left-out light per texel, or null.
+// a shadow edge makes it jump. cut: the page's cut lights' left-out light per texel, or none. unshadowedAt: per
+// texel, the lights' unshadowed light at the centre (channel max, the cut's left out).
 std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map,
-                                const std::vector<uint8_t>& valid, const PageCut& cut) {
+                                const std::vector<uint8_t>& valid, const PageCut& cut, std::vector<float>& unshadowedAt) {
   std::vector<float> share(map.size(), -1.0f);
+  unshadowedAt.assign(map.size(), 0.0f);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, map.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (!valid[t] || ts.positionWeight[t].w <= 0.0f) continue;
@@ -46,7 +48,8 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
       const glm::vec3 n(ts.normal[t]);
       glm::vec3 unshadowed(0.0f);
       for (uint32_t i : in.lightsNear(x)) unshadowed += punctualDirect(in.scene.lights[i], x, n).mapValue;
-      share[t] = shareWith(channelMax(map.texels[t]), channelMax(unshadowed), cut.at(t));
+      unshadowedAt[t] = channelMax(unshadowed);
+      share[t] = shareWith(channelMax(map.texels[t]), unshadowedAt[t], cut.at(t));
     }
   });
   return share;
@@ -57,8 +60,8 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
 // centre's triangle against the centre's, both traced alike; a texel where they differ by more than `jump` is
 // marked too. A light under a tenth of `jump` of the centre's unshadowed light (the cut's included) counts as
 // visible on both sides, no ray: alone it cannot make the probe jump, and a level's many faint lamps cost nothing.
-void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share, float jump,
-                       const PageCut& cut, std::vector<uint8_t>& edge) {
+void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share,
+                       const std::vector<float>& unshadowedAt, float jump, const PageCut& cut, std::vector<uint8_t>& edge) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -67,9 +70,7 @@ void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::
       glm::vec3 x(ts.positionWeight[t]);
       if (ts.primitive[t] < in.scene.primitives.size()) x = rt.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
-      glm::vec3 whole(0.0f);
-      for (uint32_t i : in.lightsNear(x)) whole += punctualDirect(in.scene.lights[i], x, n).mapValue;
-      const float faint = 0.1f * jump * (channelMax(whole) + cut.at(t).y);
+      const float faint = 0.1f * jump * (unshadowedAt[t] + cut.at(t).y);
       // At xs: values[0] the visible light (faint lights counted visible), values[1] the unshadowed light.
       auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
         for (uint32_t i : in.lightsNear(xs)) {
@@ -112,11 +113,13 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     if (ts.supersample != 1 || map.size() != ts.layerSize()) continue;
     const std::vector<uint8_t>& valid = map.valid.size() == map.size() ? map.valid : ts.valid;
     PageCut cut;
-    if (cutLight && p < cutLight->unshadowed->size() && p < cutLight->shadowed->size())
+    if (cutLight && cutLight->shadowed && cutLight->unshadowed && p < cutLight->unshadowed->size() &&
+        p < cutLight->shadowed->size())
       cut = {&(*cutLight->shadowed)[p], &(*cutLight->unshadowed)[p]};
-    const std::vector<float> share = visibleShare(in, ts, map, valid, cut);
+    std::vector<float> unshadowedAt;
+    const std::vector<float> share = visibleShare(in, ts, map, valid, cut, unshadowedAt);
     std::vector<uint8_t> edge = edgeTexels(share, ts.width, ts.height, options.jump);
-    markSubTexelEdges(in, ts, share, options.jump, cut, edge);
+    markSubTexelEdges(in, ts, share, unshadowedAt, options.jump, cut, edge);
     const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {

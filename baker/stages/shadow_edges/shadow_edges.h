@@ -35,8 +35,6 @@ struct ShadowEdgePart {
   std::vector<Lightmap>* pages = nullptr;
 };
 
-// In place on the punctual lights' pages (one per in.texels page, as the direct stage returns them). Pages
-// with supersampled texels (S > 1) are left alone: their samples already spread over the texel.
 // The light the lights' cut leaves out, per page and texel (stages/light_tail's estimate), with and without its
 // shadows: the visible share counts it on both sides, so a texel's jump is weighed against all of the lights'
 // light and a bake with cut lights finds the edges a bake without the cut finds, far lights' shadows included.
@@ -45,7 +43,9 @@ struct CutLightPages {
   const std::vector<std::vector<float>>* unshadowed = nullptr;  // channel mean
 };
 
-// cutLight: null where no light is cut.
+// In place on the punctual lights' pages (one per in.texels page, as the direct stage returns them). Pages
+// with supersampled texels (S > 1) are left alone: their samples already spread over the texel. cutLight: null
+// where no light is cut.
 ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& directPages,
                                   const ShadowEdgeOptions& options = {}, const ShadowEdgePart* part = nullptr,
                                   const CutLightPages* cutLight = nullptr);
