@@ -244,6 +244,41 @@ TEST(OutputGuard, StalePagesAreRemovedOnlyWhenTheManifestProvesIrbakeWroteThem) 
   EXPECT_FALSE(fs::exists(dir / "o" / "lightmap_0_shadowmask.exr"));
 }
 
+TEST(OutputGuard, LayersOfAnEarlierBakesOtherGroupsAreRemovedWhenOurs) {
+  const fs::path dir = scratch("stale_layers");
+  const std::string scene = (irbake::testing::sampleScenes("output_guard_stale_layers") / "point_over_plane.gltf").string();
+  const fs::path o = dir / "o";
+  const std::vector<std::string> bake = {"bake", scene, "-o", o.string(), "--quality", "preview", "--probes", "off",
+                                         "--quiet", "--sun", "0.3,-1,0.2,2"};
+  auto grouped = [&](const std::string& sunGroup) {
+    std::vector<std::string> args = bake;
+    args.insert(args.end(), {"--light-group", sunGroup + "=sun", "--light-group", "lamp=*"});
+    return args;
+  };
+  const IrbakeRun first = irbake::testing::runIrbakeIn(dir, grouped("day"));
+  ASSERT_EQ(first.code, 0) << first.output;
+  for (const char* name : {"lightmap_0_day.exr", "lightmap_0_day.png", "lightmap_0_lamp.exr", "lightmap_0_lamp.png"})
+    ASSERT_TRUE(fs::exists(o / name)) << name;
+  { std::ofstream(o / "lightmap_0_mine.exr") << "the user's own file"; }
+  // Another name for the sun's group: the old layer goes, the lamp's is written again, the user's file stays.
+  const IrbakeRun second = irbake::testing::runIrbakeIn(dir, grouped("noon"));
+  ASSERT_EQ(second.code, 0) << second.output;
+  EXPECT_FALSE(fs::exists(o / "lightmap_0_day.exr")) << second.output;
+  EXPECT_FALSE(fs::exists(o / "lightmap_0_day.png")) << second.output;
+  EXPECT_TRUE(fs::exists(o / "lightmap_0_noon.exr"));
+  EXPECT_TRUE(fs::exists(o / "lightmap_0_lamp.exr"));
+  EXPECT_EQ(fileText(o / "lightmap_0_mine.exr"), "the user's own file");
+  EXPECT_NE(second.output.find("left " + (o / "lightmap_0_mine.exr").string()), std::string::npos) << second.output;
+  // No groups at all: every layer of ours goes; one edited since stays.
+  { std::ofstream(o / "lightmap_0_lamp.png", std::ios::app) << "edited"; }
+  const IrbakeRun third = irbake::testing::runIrbakeIn(dir, bake);
+  ASSERT_EQ(third.code, 0) << third.output;
+  for (const char* name : {"lightmap_0_noon.exr", "lightmap_0_noon.png", "lightmap_0_lamp.exr"})
+    EXPECT_FALSE(fs::exists(o / name)) << name << " stayed\n" << third.output;
+  EXPECT_TRUE(fs::exists(o / "lightmap_0_lamp.png")) << "an edited layer was removed";
+  EXPECT_TRUE(fs::exists(o / "lightmap_0.exr"));
+}
+
 TEST(OutputGuard, SamplesNeverReplaceAUsersFileButRewriteTheirOwn) {
   const fs::path dir = scratch("samples");
   const IrbakeRun first = irbake::testing::runIrbakeIn(dir, {"samples", (dir / "s").string(), "--quiet"});

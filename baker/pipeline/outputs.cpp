@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <fstream>
 #include <memory>
+#include <regex>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -14,6 +16,7 @@
 #include "export/directional_export.h"
 #include "export/exr_io.h"
 #include "export/gltf_export.h"
+#include "export/light_layers.h"
 #include "export/portable_export.h"
 #include "pipeline/bake.h"
 #include "pipeline/light_modes.h"
@@ -53,6 +56,24 @@ void removeStalePages(const BakeResult& result, const std::filesystem::path& out
     if (!fs::exists(fs::symlink_status(stale, ec))) break;
     removeStalePage(stale, guard, "with more pages");
   }
+  // Light-group layers of an earlier bake that this one does not have (other groups, fewer pages, or none):
+  // lightmap_<page>_<group>.exr and .png, the names the shadow-mask and directional pages use left aside.
+  std::set<std::string> layers;
+  for (const LightLayer& layer : result.layers)
+    for (const Lightmap& m : layer.maps)
+      for (const char* ext : {".exr", ".png"}) layers.insert(fs::path(layerPageUri("lightmap", m.page, layer.name)).replace_extension(ext).string());
+  static const std::regex kLayerPage("lightmap_[0-9]+_([A-Za-z0-9_-]{1,64})\\.(exr|png)");
+  std::vector<fs::path> staleLayers;
+  for (const fs::directory_entry& entry : fs::directory_iterator(outDir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::smatch m;
+    if (!std::regex_match(name, m, kLayerPage) || layers.count(name)) continue;
+    const std::string group = m[1].str();
+    if (group == "shadowmask" || group == "l1x" || group == "l1y" || group == "l1z") continue;
+    staleLayers.push_back(entry.path());
+  }
+  std::sort(staleLayers.begin(), staleLayers.end());
+  for (const fs::path& stale : staleLayers) removeStalePage(stale, guard, "with other light groups");
   // Shadow-mask pages of an earlier bake that this one does not have (fewer pages, or no mask light now).
   for (size_t page = result.shadowMask.rgb.size();; ++page) {
     bool found = false;
