@@ -29,6 +29,8 @@ int32_t LightTree::build(size_t begin, size_t end) {
     node.near = std::min(node.near, entries_[i].near);
   }
   node.radius = 0.5f * glm::length(node.hi - node.lo);
+  node.centre = 0.5f * (node.lo + node.hi);
+  node.full2 = (node.near + node.width) * (node.near + node.width);
   if (end - begin == 1) {
     node.entry = static_cast<uint32_t>(begin);
   } else {
@@ -58,7 +60,7 @@ double LightTree::importance(const Node& node, const glm::vec3& x, const glm::ve
   // The share of their value the lights give at most: their rise at the farthest corner, from the smallest near
   // over the narrowest band (both only raise it).
   float share = 1.0f;
-  if (node.width > 0.0f) {
+  if (node.width > 0.0f && farthest2 < node.full2) {
     const float t = std::min(1.0f, (std::sqrt(farthest2) - node.near) / node.width);
     share = t * t * (3.0f - 2.0f * t);
   }
@@ -67,7 +69,7 @@ double LightTree::importance(const Node& node, const glm::vec3& x, const glm::ve
   // box's diagonal (x inside the box) and the lights' near distance (where they give nothing), times the share. The
   // same scale as a single light's exact value, so a leaf and an inner node weigh alike. In float: an estimate
   // that only steers the walk (the draws weigh by their exact light), at the walk's every node.
-  const glm::vec3 towards = 0.5f * (node.lo + node.hi) - x;
+  const glm::vec3 towards = node.centre - x;
   const float centre2 = glm::dot(towards, towards), radius2 = node.radius * node.radius;
   float cosine = 1.0f;
   if (centre2 > radius2) {

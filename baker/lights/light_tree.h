@@ -85,6 +85,8 @@ class LightTree {
     glm::vec3 lo{0.0f}, hi{0.0f};
     float power = 0.0f, near = 0.0f, width = 0.0f;  // the lights' smallest near and far − near
     float radius = 0.0f;                              // half the box's diagonal
+    glm::vec3 centre{0.0f};                           // the box's
+    float full2 = 0.0f;                               // (near + width)²: from there on the share is 1
     int32_t left = -1, right = -1;  // children; -1: a leaf holding entries_[entry]
     uint32_t entry = 0;
   };

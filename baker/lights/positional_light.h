@@ -18,6 +18,10 @@ PunctualContribution positionalDirect(const Light& light, const glm::vec3& x, co
   glm::vec3 d = light.position - x;
   float r2 = glm::dot(d, d);
   if (!(r2 > 0.0f)) return c;
+  // Past the range or the cut both windows are 0: most of a grid cell's lights are, and need no root.
+  const float reach = light.range > 0.0f && light.cutoff > 0.0f ? std::min(light.range, light.cutoff)
+                                                                : std::max(light.range, light.cutoff);
+  if (reach > 0.0f && !(r2 < reach * reach)) return c;
   float r = std::sqrt(r2);
   glm::vec3 l = d / r;
   float cosX = glm::dot(nx, l);

@@ -59,34 +59,51 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
 // its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
 // centre's triangle against the centre's, both traced alike; a texel where they differ by more than `jump` is
 // marked too. A light under a tenth of `jump` of the centre's unshadowed light (the cut's included) counts as
-// visible on both sides, no ray: alone it cannot make the probe jump, and a level's many faint lamps cost nothing.
+// visible on both sides with its centre's light, no ray and no evaluation at the sub-points: alone it cannot make
+// the probe jump, and a level's many faint lamps cost nothing. Without a brighter light there is nothing to probe.
 void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share,
                        const std::vector<float>& unshadowedAt, float jump, const PageCut& cut, std::vector<uint8_t>& edge) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<uint32_t> bright;
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (edge[t] || share[t] < 0.0f) continue;
       glm::vec3 x(ts.positionWeight[t]);
       if (ts.primitive[t] < in.scene.primitives.size()) x = rt.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
       const float faint = 0.1f * jump * (unshadowedAt[t] + cut.at(t).y);
-      // At xs: values[0] the visible light (faint lights counted visible), values[1] the unshadowed light.
+      // The centre: [0] the visible light, [1] the unshadowed light; the faint lights' light apart.
+      glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);
+      bright.clear();
+      auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
+        const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+        return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
+      };
+      for (uint32_t i : in.lightsNear(x)) {
+        const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
+        if (c.mapValue == glm::vec3(0.0f)) continue;
+        centre[1] += c.mapValue;
+        if (channelMax(c.mapValue) < faint) {
+          faintLight += c.mapValue;
+        } else {
+          bright.push_back(i);
+          if (lit(x + n * eps, c)) centre[0] += c.mapValue;
+        }
+      }
+      if (bright.empty()) continue;
+      centre[0] += faintLight;
       auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
-        for (uint32_t i : in.lightsNear(xs)) {
+        values[0] += faintLight, values[1] += faintLight;
+        for (uint32_t i : bright) {
           const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
-          if (c.mapValue == glm::vec3(0.0f)) continue;
           values[1] += c.mapValue;
-          const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-          if (channelMax(c.mapValue) >= faint && tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-          values[0] += c.mapValue;
+          if (c.mapValue != glm::vec3(0.0f) && lit(origin, c)) values[0] += c.mapValue;
         }
         return true;  // no covered test here: the full refinement drops what a surface cuts off
       };
       SquareMean mean;
       if (!averageOverTexelSquare(in, ts, t, 2, nullptr, visit, mean) || mean.kept == 0) continue;
-      glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
-      visit(x, n, x + n * eps, centre);
       const float k = float(mean.kept);
       const float probe = shareWith(channelMax(glm::vec3(mean.sum[0])) / k, channelMax(glm::vec3(mean.sum[1])) / k, cut.at(t));
       const float here = shareWith(channelMax(centre[0]), channelMax(centre[1]), cut.at(t));
