@@ -217,6 +217,13 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
   return d;
 }
 
+// A texel's candidates: `candidates` times its expected share of the page's mean tail, at least one per ray and
+// at most eight times the mean.
+int candidatesFor(int candidates, double share, int samples) {
+  const double want = double(candidates) * share;
+  return int(std::clamp(std::floor(want + 0.5), double(samples), 8.0 * candidates));
+}
+
 // 1 / the page's mean unshadowed left-out light, from m candidates at up to about `pilots` valid texels spread
 // over the page (tree walks, no ray): the unit drawAt's ray allocation scales by. 0 where the tail is nothing.
 double pageRaysPerUnit(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, int m, size_t pilots, uint64_t seed) {
@@ -253,7 +260,6 @@ LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>&
   // Each half its own candidates, in proportion to its rays.
   const int candidates = options.candidates > 0 ? std::max(options.candidates, options.samples) : 0;
   const int candidatesA = candidates > 0 ? std::max(halfA, candidates * halfA / options.samples) : 0;
-  const int candidatesB = candidates > 0 ? std::max(halfB, candidates - candidatesA) : 0;
   std::atomic<size_t> rays{0};
   for (size_t p = 0; p < maps.size() && p < in.texels.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
@@ -263,17 +269,34 @@ LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>&
     std::vector<uint8_t> valid(layer, 0);
     const double perUnit = options.allocate && candidates > 0
                                ? pageRaysPerUnit(in, c, ts, std::max(candidatesA, 4), 4096, hashSeed(options.seed, p)) : 0.0;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 256), [&](const tbb::blocked_range<size_t>& range) {
+    // Texels in runs along a row, each run in order: a texel draws candidates in proportion to the unshadowed
+    // tail of the texels just before it in its run (a decaying mean; the page's mean at a run's start), the
+    // page's mean `candidates`, so the walks go where the tail is (Neyman's allocation, as the rays). Those
+    // texels' draws are independent of its own: its estimate stays unbiased. Runs are fixed, so is the bake.
+    constexpr size_t kRun = 256;
+    const double pageMean = perUnit > 0.0 ? 1.0 / perUnit : 0.0;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, (layer + kRun - 1) / kRun), [&](const tbb::blocked_range<size_t>& runs) {
       size_t traced = 0;
       Candidates room;
-      for (size_t t = range.begin(); t < range.end(); ++t) {
-        if (t >= ts.valid.size() || !ts.valid[t]) continue;
-        valid[t] = 1;  // the page's own validity, so the bake's filter plan serves it
-        Rng rng(hashSeed(options.seed, p, t));
-        const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, candidatesA, perUnit, rng, room, traced);
-        const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, candidatesB, perUnit, rng, room, traced) : da;
-        if (da.any && db.any)
-          a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean), u[t] = glm::vec3(float(0.5 * (da.unshadowed + db.unshadowed)));
+      for (size_t run = runs.begin(); run < runs.end(); ++run) {
+        double recent = pageMean;
+        for (size_t t = run * kRun; t < std::min(layer, (run + 1) * kRun); ++t) {
+          if (ts.width > 0 && t % size_t(ts.width) == 0) recent = pageMean;  // a new row: the last texel is far
+          if (t >= ts.valid.size() || !ts.valid[t]) continue;
+          valid[t] = 1;  // the page's own validity, so the bake's filter plan serves it
+          Rng rng(hashSeed(options.seed, p, t));
+          const int m = pageMean > 0.0 && options.allocateCandidates ? candidatesFor(candidates, recent / pageMean, options.samples) : candidates;
+          const int mA = m > 0 ? std::max(halfA, m * halfA / options.samples) : 0;
+          const int mB = m > 0 ? std::max(halfB, m - mA) : 0;
+          const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, mA, perUnit, rng, room, traced);
+          const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, mB, perUnit, rng, room, traced) : da;
+          if (da.any && db.any) {
+            a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean);
+            const double unshadowed = 0.5 * (da.unshadowed + db.unshadowed);
+            u[t] = glm::vec3(float(unshadowed));
+            recent = 0.5 * (recent + unshadowed);
+          }
+        }
       }
       rays += traced;
     });

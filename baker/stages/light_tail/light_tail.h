@@ -5,7 +5,8 @@
 // proportion to a bound on what each gives the texel, weighed by their exact unshadowed left-out light (their light
 // without the cut less their faded light); N shadow rays go to lights resampled among them in proportion to that
 // weight (resampled importance sampling), so the rays only find out the visibility; each texel's rays follow its
-// unshadowed estimate (the page's mean N). The tail is faint and smooth
+// unshadowed estimate (the page's mean N), and its candidates the estimate of the texels just before it along its
+// row. The tail is faint and smooth
 // (far lights), so the estimate is filtered on the surface like the sky; two independent halves of the candidates
 // and rays, filtered alike, tell its remaining noise for the error figure. docs/units.md, "Light reach".
 #pragma once
@@ -25,6 +26,8 @@ struct LightTailOptions {
   int filterRadius = 4;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
   bool allocate = true;  // with candidates: rays per texel in proportion to its unshadowed tail, the page's mean
                          // `samples` (false: `samples` everywhere)
+  bool allocateCandidates = true;  // with allocate: candidates per texel in proportion to the tail of the texels
+                                   // just before it, the page's mean `candidates` (false: `candidates` everywhere)
   uint64_t seed = 0;     // the draws' seed (the walk's)
 };
 

@@ -58,37 +58,51 @@ std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, co
 // Texels whose centre agrees with its neighbours although a shadow or a lit strip narrower than a texel crosses
 // its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
 // centre's triangle against the centre's, both traced alike; a texel where they differ by more than `jump` is
-// marked too. A light under a tenth of `jump` of the centre's unshadowed light (the cut's included) counts as
-// visible on both sides with its centre's light, no ray and no evaluation at the sub-points: alone it cannot make
-// the probe jump, and a level's many faint lamps cost nothing. Without a brighter light there is nothing to probe.
+// marked too. The faintest lights, together under half of `jump` of the centre's unshadowed light (the cut's
+// included), count as visible on both sides with their centre's light, no ray and no evaluation at the sub-points:
+// all of them shadowed at once cannot make the probe jump, and a level's many faint lamps cost nothing. Without a
+// brighter light there is nothing to probe.
 void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share,
                        const std::vector<float>& unshadowedAt, float jump, const PageCut& cut, std::vector<uint8_t>& edge) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    struct Facing {
+      float value;  // channel max
+      uint32_t light;
+      PunctualContribution c;
+    };
+    std::vector<Facing> facing;
     std::vector<uint32_t> bright;
+    auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
+      const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+      return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
+    };
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (edge[t] || share[t] < 0.0f) continue;
       glm::vec3 x(ts.positionWeight[t]);
       if (ts.primitive[t] < in.scene.primitives.size()) x = rt.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
-      const float faint = 0.1f * jump * (unshadowedAt[t] + cut.at(t).y);
-      // The centre: [0] the visible light, [1] the unshadowed light; the faint lights' light apart.
+      // The faintest lights, together under half the jump of all of the centre's unshadowed light (the cut's
+      // included): even all of them shadowed at once cannot make the probe jump.
+      float budget = 0.5f * jump * (unshadowedAt[t] + cut.at(t).y);
       glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);
-      bright.clear();
-      auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
-        const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-        return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
-      };
+      facing.clear();
       for (uint32_t i : in.lightsNear(x)) {
         const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
-        if (c.mapValue == glm::vec3(0.0f)) continue;
-        centre[1] += c.mapValue;
-        if (channelMax(c.mapValue) < faint) {
-          faintLight += c.mapValue;
+        if (c.mapValue != glm::vec3(0.0f)) facing.push_back({channelMax(c.mapValue), i, c});
+      }
+      std::sort(facing.begin(), facing.end(), [](const Facing& a, const Facing& b) {
+        return a.value < b.value || (a.value == b.value && a.light < b.light);
+      });
+      bright.clear();
+      for (const Facing& f : facing) {
+        centre[1] += f.c.mapValue;
+        if (f.value <= budget) {
+          budget -= f.value, faintLight += f.c.mapValue;
         } else {
-          bright.push_back(i);
-          if (lit(x + n * eps, c)) centre[0] += c.mapValue;
+          bright.push_back(f.light), budget = -1.0f;
+          if (lit(x + n * eps, f.c)) centre[0] += f.c.mapValue;
         }
       }
       if (bright.empty()) continue;
