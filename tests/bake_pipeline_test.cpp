@@ -300,7 +300,8 @@ TEST(BakePipeline, AutoBackendSaysWhatItChoseAndWhy) {
 }
 
 // Each clamp mode reaches the backends as one bound: derived = deriveClampBound at the plan's k (with bias
-// compensation) on the bake's own VPLs, off = 0 (no clamp), fixed = the given bound; fixed and off leave k at 0.
+// compensation) on the walk at seed 0 (in the closed furnace every seed's walk leaves as many VPLs, so the
+// bake's own), off = 0 (no clamp), fixed = the given bound; fixed and off leave k at 0.
 TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
   for (ClampMode mode : {ClampMode::Derived, ClampMode::Off, ClampMode::Fixed}) {
     BakeOptions o = smallEmbreeBake(4.0f, 64);
@@ -319,6 +320,30 @@ TEST(BakePipeline, ClampModeGivesTheBackendsOneBound) {
       EXPECT_GT(expected, 0.0f);
     }
   }
+}
+
+// The derived bound is settled once per scene: the walk at seed 0's lit VPLs, whatever the bake's seed, and with
+// the error estimate too (whose replicate 0 walks half the paths). In the open corner the walks of other seeds
+// leave other counts, so their own bounds would differ: bakes at two seeds would not share the clamp's bias.
+TEST(BakePipeline, DerivedClampIsSettledOncePerScene) {
+  const Scene corner = samples::makeCorner(0.5f);
+  BakeOptions o = smallEmbreeBake(8.0f, 64);
+  o.walk.seed = 0;
+  o.probes.enabled = false;
+  const BakeResult first = bake(corner, o);
+  const double k = first.report["eval"]["clampVplsPerMean"].get<double>();
+  const float bound = first.report["eval"]["clampBound"].get<float>();
+  EXPECT_GT(bound, 0.0f);
+  EXPECT_EQ(bound, deriveClampBound(first.scene, first.vpls, k));
+  int ownDiffers = 0;
+  for (const auto& [seed, estimate] : std::vector<std::pair<uint32_t, bool>>{{3, false}, {7, false}, {3, true}}) {
+    o.walk.seed = seed;
+    o.errorEstimate.enabled = estimate;
+    const BakeResult r = bake(corner, o);
+    EXPECT_EQ(r.report["eval"]["clampBound"].get<float>(), bound) << "seed " << seed << ", estimate " << estimate;
+    if (!estimate) ownDiffers += deriveClampBound(r.scene, r.vpls, k) != bound ? 1 : 0;  // the seed's own bound
+  }
+  EXPECT_EQ(ownDiffers, 2);
 }
 
 // A set option out of its range is a usage error naming the option, never a silent "automatic" (as 0 and

@@ -272,7 +272,7 @@ BakePlan planBake(const Scene& scene, bool transmission, const BakeOptions& opti
   return plan;
 }
 
-void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls) {
+void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, double vplCount) {
   plan.eval = options.eval;
   if (options.clamp != ClampMode::Derived) {
     plan.eval.clampBound = options.clamp == ClampMode::Fixed ? options.clampBound : 0.0f;
@@ -286,7 +286,7 @@ void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene,
                 : !plan.eval.biasCompensation  ? kClampVplsPerMean
                 : smallEmitters                ? kCompensatedClampVplsPerMean
                                                : kCompensatedClampVplsPerMeanNoEmitters;
-  plan.eval.clampBound = deriveClampBound(scene, vpls, plan.clampK);
+  plan.eval.clampBound = clampBoundForCount(scene, vplCount, plan.clampK);
   plan.clampDerived = true;
   plan.settle("clamp-k", plan.clampK,
               given                         ? "asked for"
@@ -295,7 +295,7 @@ void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene,
               : scene.hasEmissiveSurface()  ? "compensated, emitters cover at least half the surface (the gathers meet them)"
                                             : "compensated, no emissive surfaces",
               !given);
-  plan.settle("clamp", plan.eval.clampBound, "derived: no VPL adds more than 1/k of the mean (1/m²)");
+  plan.settle("clamp", plan.eval.clampBound, "derived from the walk at seed 0, once per scene: no VPL adds more than 1/k of the mean (1/m²)");
 }
 
 void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,

@@ -95,8 +95,8 @@ void settleLightModes(BakePlan& plan, const BakeOptions& options, const Scene& s
 // The checks of settleLightModes that need no texels, made before anything is traced.
 void checkLightModes(const BakeOptions& options, const Scene& scene);
 
-// The clamp: fixed, off, or derived from the scene and these VPLs (sets plan.eval.clampBound).
-void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, const VplSet& vpls);
+// The clamp: fixed, off, or derived from the scene and a VPL count (clampBoundForCount; sets plan.eval.clampBound).
+void settleClamp(BakePlan& plan, const BakeOptions& options, const Scene& scene, double vplCount);
 
 // The interleave classes, from the texels and the clamp (the evaluator settles its own options after it).
 void settleBlocks(BakePlan& plan, const BakeOptions& options, const std::vector<TexelSamples>& texels,

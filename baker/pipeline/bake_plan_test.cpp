@@ -73,7 +73,7 @@ TEST(BakePlan, TheTightClampWhereNoSmallEmitterIsNear) {
                                    {"corner", makeCorner(), 1024.0}}) {
     const RayTracer rt(c.scene);
     BakePlan plan = planBake(c.scene, rt, autoOptions(), softwareGl);
-    settleClamp(plan, autoOptions(), c.scene, VplSet{});
+    settleClamp(plan, autoOptions(), c.scene, 0.0);
     EXPECT_EQ(plan.clampK, c.k) << c.name;
     const nlohmann::json j = plan.toJson();
     ASSERT_TRUE(j.contains("clamp-k")) << c.name;

@@ -5,6 +5,7 @@
 
 #include "atlas/atlas_from_bake.h"
 #include "pipeline/bake_state.h"
+#include "transport/geometry_term.h"
 
 namespace irbake {
 namespace {
@@ -59,7 +60,7 @@ void chooseBackend(BakeState& s) {
 
 // Importance-driven selection: where the plain walk's VPLs matter unevenly (its pilot), the walk again with f
 // times the paths, then about the plain walk's count kept where they matter (transport/vpl_importance.h).
-// Settles f from the plain walk in s.vpls.
+// Settles f from the walk at seed 0 (s.sceneWalk), as the clamp: one choice per scene, whatever the seed.
 void settleImportanceFactor(BakeState& s) {
   if (s.plan.backend == BackendKind::Reference || !s.options.eval.includeVpls || s.vpls.vpls.empty()) return;
   double evenness = 0.0;
@@ -69,9 +70,9 @@ void settleImportanceFactor(BakeState& s) {
   const bool pilot = !s.options.vplImportance.candidateFactor;  // auto; a fixed factor needs none
   if (!pilot || s.plan.finalGather) {
     if (pilot) {
-      settleClamp(s.plan, s.options, s.scene, s.vpls);
-      evenness = vplImportanceEvenness(s.scene, *s.rayTracer, s.texels, s.vpls.vpls, s.options.vplImportance,
-                                       s.plan.eval.clampBound, s.options.walk.seed);
+      settleClamp(s.plan, s.options, s.scene, static_cast<double>(litVplCount(s.sceneWalk)));
+      evenness = vplImportanceEvenness(s.scene, *s.rayTracer, s.texels, s.sceneWalk.vpls, s.options.vplImportance,
+                                       s.plan.eval.clampBound, 0);
     }
     s.plan.importanceFactor = chooseCandidateFactor(s.options.vplImportance, s.vpls.vpls.size(), evenness);
   }
@@ -84,11 +85,33 @@ void settleImportanceFactor(BakeState& s) {
                 pilot);
 }
 
+// The walk that the derived clamp's count and the importance pilot read, once per scene: the plan's walk (all its
+// paths) at seed 0, the bake's own where it is that one. Neither then follows the seed, nor the estimate's halved
+// replicates (whose counts scatter over seeds and would halve the bound), so bakes at two seeds share the clamp's
+// bias as the two halves of one bake do (docs/units.md, "Estimated error").
+void walkOncePerScene(BakeState& s) {
+  WalkOptions o = s.plan.walk;
+  if (o.seed == 0 && !estimating(s)) {
+    s.sceneWalk = s.vpls;
+    return;
+  }
+  o.seed = 0;
+  o.progress = {};
+  s.sceneWalk = generateVpls(s.scene, *s.rayTracer, o);
+}
+
+// The clamp's count for the VPLs evaluated: the importance selection keeps about keepShare of the plain walk's.
+double evaluatedClampCount(const BakeState& s) {
+  const double lit = static_cast<double>(litVplCount(s.sceneWalk));
+  return s.plan.importanceFactor > 1.0 ? lit * s.options.vplImportance.keepShare : lit;
+}
+
 // The walk (replicate 0's with an estimate), again with f times the paths where the importance selection runs.
 void walkVpls(BakeState& s) {
   WalkOptions o = replicateWalk(s, 0);
   o.progress = withProgress(s, o.progress);
   s.vpls = generateVpls(s.scene, *s.rayTracer, o);
+  walkOncePerScene(s);
   settleImportanceFactor(s);
   if (s.plan.importanceFactor > 1.0) {
     o.paths = static_cast<int>(std::min(double(1 << 26), std::round(o.paths * s.plan.importanceFactor)));
@@ -114,12 +137,11 @@ void settleWalk(BakeState& s) {
 
 // The candidates thinned to about the plain walk's count, where they matter.
 void selectByImportance(BakeState& s) {
-  // The candidates' bound: the kept set's is about 1/f of it (B ∝ VPL count).
-  settleClamp(s.plan, s.options, s.scene, s.vpls);
+  // The candidates are measured with the kept set's bound (about 1/f of theirs: B ∝ VPL count).
+  settleClamp(s.plan, s.options, s.scene, evaluatedClampCount(s));
   VplSelection selection;
   selection.keepFraction = s.options.vplImportance.keepShare / s.plan.importanceFactor;
-  selection.clampBound = s.plan.clampDerived ? static_cast<float>(s.plan.eval.clampBound * selection.keepFraction)
-                                             : s.plan.eval.clampBound;
+  selection.clampBound = s.plan.eval.clampBound;
   selection.seed = estimating(s) ? replicateWalk(s, 0).seed : s.options.walk.seed;
   s.candidateBound = selection.clampBound;
   s.importanceStats.factor = s.plan.importanceFactor;
@@ -192,7 +214,8 @@ void prepare(BakeState& s) {
   timed(s, "vpls", [&] { walkVpls(s); });
   settleWalk(s);
   if (s.plan.importanceFactor > 1.0) timed(s, "vplImportance", [&] { selectByImportance(s); });
-  settleClamp(s.plan, s.options, s.scene, s.vpls);
+  settleClamp(s.plan, s.options, s.scene, evaluatedClampCount(s));
+  s.sceneWalk = VplSet{};  // settled: nothing reads it again
   if (estimating(s)) timed(s, "vpls", [&] { startReplicates(s); });
   makeWholeInputs(s);
   timed(s, "backend", [&] { part(s, "blocks", [&] { planBlocks(s); }); });

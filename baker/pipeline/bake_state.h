@@ -60,6 +60,8 @@ struct BakeState {
   std::unique_ptr<RayTracer> rayTracer;
   std::vector<TexelSamples> texels;
   VplSet vpls;
+  VplSet sceneWalk;                        // the plan's walk at seed 0: the derived clamp's N and the importance
+                                           // pilot read it, so both are settled once per scene
   BakePlan plan;                           // every automatic choice, settled once
   BakePrediction prediction;               // the preflight's time and memory, made before any work (report "prediction")
   VplImportanceStats importanceStats;

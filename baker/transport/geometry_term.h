@@ -56,5 +56,9 @@ PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, cons
 // bias compensation recovers. Returns 0 (no clamp) without VPLs.
 constexpr double kClampVplsPerMean = 16.0;  // k above
 float deriveClampBound(const Scene& scene, const VplSet& vpls, double vplsPerMean = kClampVplsPerMean);
+// The same bound for N = vplCount (0: no clamp): a count settled apart from the VPLs evaluated.
+float clampBoundForCount(const Scene& scene, double vplCount, double vplsPerMean = kClampVplsPerMean);
+// The VPLs with non-zero power: the N of deriveClampBound.
+size_t litVplCount(const VplSet& vpls);
 
 }  // namespace irbake
