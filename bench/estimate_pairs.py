@@ -16,7 +16,6 @@ valid ones, as the estimate's bins hold; without it the dilation's padding is sc
 "Estimated error"). One row per pair and a summary row ("all": the RMS of the pairs' ratios) are appended.
 """
 import argparse
-import csv
 import datetime
 import itertools
 import json
@@ -27,6 +26,8 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios"))
 import day_night  # noqa: E402  (pages, score)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "cycles"))
+import compare  # noqa: E402  (append_csv_rows)
 
 FIELDS = ["date", "commit", "scene", "label", "pair", "seeds", "rel_rmse_4", "expected", "ratio"]
 
@@ -62,15 +63,7 @@ def main():
     rows.append({"date": date, "commit": commit, "scene": args.name, "label": args.label, "pair": "all",
                  "seeds": ",".join(str(x[0]) for x in info), "ratio": "%.3f" % rms})
     print("ratio %.3f-%.3f over %d pairs, RMS %.3f" % (min(ratios), max(ratios), len(ratios), rms))
-    old = list(csv.DictReader(open(args.csv))) if os.path.isfile(args.csv) else []
-    tmp = args.csv + ".tmp"
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for r in old + rows:
-            w.writerow(r)
-    os.replace(tmp, args.csv)
-    print("appended %d rows to %s" % (len(rows), args.csv))
+    compare.append_csv_rows(args.csv, FIELDS, rows)
 
 
 if __name__ == "__main__":

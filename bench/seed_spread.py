@@ -15,7 +15,6 @@ next to an uncovered texel and the texels below 2% of the mean (as bench/cycles/
 Rows (one per seed, and a summary row with seed "all") are appended to bench/results/seed_spread.csv.
 """
 import argparse
-import csv
 import datetime
 import os
 import sys
@@ -80,15 +79,7 @@ def main():
     print("total ratio %s: spread %.2f%%; seed noise 4x4 %s (RMS %.2f%%)" % (
         " ".join("%.4f" % r for r in ratio), 100 * (ratio.max() - ratio.min()),
         " ".join("%.2f%%" % (100 * n) for n in noise), 100 * rows[-1]["noise_rms"]))
-    old = list(csv.DictReader(open(args.csv))) if os.path.isfile(args.csv) else []
-    tmp = args.csv + ".tmp"
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for r in old + rows:
-            w.writerow(r)
-    os.replace(tmp, args.csv)
-    print("appended %d rows to %s" % (len(rows), args.csv))
+    compare.append_csv_rows(args.csv, FIELDS, rows)
 
 
 if __name__ == "__main__":

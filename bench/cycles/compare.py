@@ -219,6 +219,19 @@ def score(ours, ref_a, ref_b, mask):
     return out
 
 
+def append_csv_rows(path, fields, rows):
+    """Appends rows to the CSV at path (its header `fields`), rewriting it through a temp name."""
+    old = list(csv.DictReader(open(path))) if os.path.isfile(path) else []
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for r in old + rows:
+            w.writerow(r)
+    os.replace(tmp, path)
+    print("appended %d rows to %s" % (len(rows), path))
+
+
 def git_commit(irbake):
     """The last commit that touched the baker's sources in the checkout irbake was built in (bench-only
     commits after it do not change the binary), with +dirty when those sources have local changes."""
