@@ -327,7 +327,9 @@ def t_scenarios():
         g = [r for r in rows if r["pair"] == pair]
         expected = [float(r["expected"]) for r in g if float(r["expected"]) > 0]
         ratio = [float(r["ratio"]) for r in g if r["ratio"]]
-        out.append([pair.replace("_", " "), last, ", ".join(r["seed"] for r in g),
+        seeds = [int(r["seed"]) for r in g]
+        span = seeds == list(range(seeds[0], seeds[0] + len(seeds))) and len(seeds) > 2
+        out.append([pair.replace("_", " "), last, f"{seeds[0]}–{seeds[-1]}" if span else ", ".join(map(str, seeds)),
                     pct(median([float(r["rel_rmse_4"]) for r in g]), 3), pct(median(expected), 3) if expected else "",
                     num(max(ratio)) if ratio else ""])
     relight = median([float(r["relight_cpu_s"]) for r in rows])
