@@ -174,8 +174,8 @@ void reportFigure(const BakeState& s, nlohmann::json& report) {
   j["interior"]["texels"] = "valid texels whose four neighbours are valid: the chart-border ring left out, as "
                             "bench/cycles/compare.py scores a map";
   j["binTexels"] = s.options.errorEstimate.bin;
-  j["bins"] = "relative RMS over bins of binTexels² texels, valid texels only: the dilation's padding is in none "
-              "(compare two bakes' pages over their valid texels: --no-dilate; docs/units.md, \"Padding\")";
+  j["binsHold"] = "valid texels only (relative RMS over bins of binTexels² texels): the dilation's padding is in "
+                  "none (compare two bakes' pages over their valid texels: --no-dilate; docs/units.md, \"Padding\")";
   j["covers"] = "the VPL sum's noise (two independent halves of the walk, mixed and gathered as the map), and the "
                 "sky's, compensation's and final gather's own ray noise (each run again with another seed)";
   j["notCovered"] = "bias (the clamp after compensation, the final gather, the geometric tail)";
