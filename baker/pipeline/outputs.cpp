@@ -58,16 +58,16 @@ void removeStalePages(const BakeResult& result, const std::filesystem::path& out
   }
   // Light-group layers of an earlier bake that this one does not have (other groups, fewer pages, or none):
   // lightmap_<page>_<group>.exr and .png, the names the shadow-mask and directional pages use left aside.
-  std::set<std::string> layers;
+  std::set<std::string> layers;  // this bake's, without the extension
   for (const LightLayer& layer : result.layers)
-    for (const Lightmap& m : layer.maps)
-      for (const char* ext : {".exr", ".png"}) layers.insert(fs::path(layerPageUri("lightmap", m.page, layer.name)).replace_extension(ext).string());
-  static const std::regex kLayerPage("lightmap_[0-9]+_([A-Za-z0-9_-]{1,64})\\.(exr|png)");
+    for (const Lightmap& m : layer.maps) layers.insert(fs::path(layerPageUri("lightmap", m.page, layer.name)).stem().string());
+  static const std::regex kLayerPage("lightmap_[0-9]+_(.+)\\.(exr|png)");
   std::vector<fs::path> staleLayers;
   for (const fs::directory_entry& entry : fs::directory_iterator(outDir, ec)) {
     const std::string name = entry.path().filename().string();
     std::smatch m;
-    if (!std::regex_match(name, m, kLayerPage) || layers.count(name)) continue;
+    if (!std::regex_match(name, m, kLayerPage) || !validLayerName(m[1].str()) || layers.count(entry.path().stem().string()))
+      continue;
     const std::string group = m[1].str();
     if (group == "shadowmask" || group == "l1x" || group == "l1y" || group == "l1z") continue;
     staleLayers.push_back(entry.path());

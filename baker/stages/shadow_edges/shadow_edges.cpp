@@ -32,98 +32,94 @@ float shareWith(float visible, float unshadowed, glm::vec2 cut) {
   return unshadowed + cut.y > 0.0f ? (visible + cut.x) / (unshadowed + cut.y) : -1.0f;
 }
 
+// A light facing a texel's centre: its light there (channel max) and its contribution.
+struct Facing {
+  float value;
+  uint32_t light;
+  PunctualContribution c;
+};
+
+// Whether a shadow or a lit strip narrower than a texel crosses texel t's square although its centre agrees with
+// its neighbours (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on
+// the centre's triangle against the centre's, both traced alike, differ by more than `jump`. facing: the lights
+// facing the centre x, unshadowed: their light there (channel max). The faintest lights, together under half of
+// `jump` of the centre's unshadowed light (the cut's included), count as visible on both sides with their centre's
+// light, no ray and no evaluation at the sub-points: all of them shadowed at once cannot make the probe jump, and
+// a level's many faint lamps cost nothing. Without a brighter light there is nothing to probe.
+bool subTexelJump(const BakeInputs& in, const TexelSamples& ts, size_t t, const glm::vec3& x, const glm::vec3& n,
+                  float unshadowed, float jump, glm::vec2 cut, std::vector<Facing>& facing, std::vector<uint32_t>& bright) {
+  const RayTracer& rt = in.rayTracer;
+  const float eps = rt.epsilon();
+  auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
+    const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+    return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
+  };
+  float budget = 0.5f * jump * (unshadowed + cut.y);
+  glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);  // visible, unshadowed
+  std::sort(facing.begin(), facing.end(), [](const Facing& a, const Facing& b) {
+    return a.value < b.value || (a.value == b.value && a.light < b.light);
+  });
+  bright.clear();
+  for (const Facing& f : facing) {
+    centre[1] += f.c.mapValue;
+    if (f.value <= budget) {
+      budget -= f.value, faintLight += f.c.mapValue;
+    } else {
+      bright.push_back(f.light), budget = -1.0f;
+      if (lit(x + n * eps, f.c)) centre[0] += f.c.mapValue;
+    }
+  }
+  if (bright.empty()) return false;
+  centre[0] += faintLight;
+  auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
+    values[0] += faintLight, values[1] += faintLight;
+    for (uint32_t i : bright) {
+      const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
+      values[1] += c.mapValue;
+      if (c.mapValue != glm::vec3(0.0f) && lit(origin, c)) values[0] += c.mapValue;
+    }
+    return true;  // no covered test here: the full refinement drops what a surface cuts off
+  };
+  SquareMean mean;
+  if (!averageOverTexelSquare(in, ts, t, 2, nullptr, visit, mean) || mean.kept == 0) return false;
+  const float k = float(mean.kept);
+  const float probe = shareWith(channelMax(glm::vec3(mean.sum[0])) / k, channelMax(glm::vec3(mean.sum[1])) / k, cut);
+  const float here = shareWith(channelMax(centre[0]), channelMax(centre[1]), cut);
+  return probe >= 0.0f && here >= 0.0f && std::abs(probe - here) > jump;
+}
+
 // Per texel, the share of the punctual lights' unshadowed value that reached it (their visibility, weighted by
 // each light's value; -1 where no light faces the texel). Smooth falloff (a point light's 1/r²) keeps it at 1;
-// a shadow edge makes it jump. cut: the page's cut lights' left-out light per texel, or none. unshadowedAt: per
-// texel, the lights' unshadowed light at the centre (channel max, the cut's left out).
-std::vector<float> visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map,
-                                const std::vector<uint8_t>& valid, const PageCut& cut, std::vector<float>& unshadowedAt) {
-  std::vector<float> share(map.size(), -1.0f);
-  unshadowedAt.assign(map.size(), 0.0f);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, map.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+// a shadow edge makes it jump. cut: the page's cut lights' left-out light per texel, or none. In the same pass,
+// from the same evaluation of the lights, probed: 1 where subTexelJump finds a jump within the texel.
+struct TexelShares {
+  std::vector<float> share;
+  std::vector<uint8_t> probed;
+};
+TexelShares visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map,
+                         const std::vector<uint8_t>& valid, const PageCut& cut, float jump) {
+  TexelShares out{std::vector<float>(map.size(), -1.0f), std::vector<uint8_t>(map.size(), 0)};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, map.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Facing> facing;
+    std::vector<uint32_t> bright;
     for (size_t t = r.begin(); t != r.end(); ++t) {
       if (!valid[t] || ts.positionWeight[t].w <= 0.0f) continue;
       glm::vec3 x(ts.positionWeight[t]);
       if (ts.primitive[t] < in.scene.primitives.size()) x = in.rayTracer.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
       glm::vec3 unshadowed(0.0f);
-      for (uint32_t i : in.lightsNear(x)) unshadowed += punctualDirect(in.scene.lights[i], x, n).mapValue;
-      unshadowedAt[t] = channelMax(unshadowed);
-      share[t] = shareWith(channelMax(map.texels[t]), unshadowedAt[t], cut.at(t));
-    }
-  });
-  return share;
-}
-
-// Texels whose centre agrees with its neighbours although a shadow or a lit strip narrower than a texel crosses
-// its square (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on the
-// centre's triangle against the centre's, both traced alike; a texel where they differ by more than `jump` is
-// marked too. The faintest lights, together under half of `jump` of the centre's unshadowed light (the cut's
-// included), count as visible on both sides with their centre's light, no ray and no evaluation at the sub-points:
-// all of them shadowed at once cannot make the probe jump, and a level's many faint lamps cost nothing. Without a
-// brighter light there is nothing to probe.
-void markSubTexelEdges(const BakeInputs& in, const TexelSamples& ts, const std::vector<float>& share,
-                       const std::vector<float>& unshadowedAt, float jump, const PageCut& cut, std::vector<uint8_t>& edge) {
-  const RayTracer& rt = in.rayTracer;
-  const float eps = rt.epsilon();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    struct Facing {
-      float value;  // channel max
-      uint32_t light;
-      PunctualContribution c;
-    };
-    std::vector<Facing> facing;
-    std::vector<uint32_t> bright;
-    auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
-      const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-      return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
-    };
-    for (size_t t = r.begin(); t != r.end(); ++t) {
-      if (edge[t] || share[t] < 0.0f) continue;
-      glm::vec3 x(ts.positionWeight[t]);
-      if (ts.primitive[t] < in.scene.primitives.size()) x = rt.insetPoint(ts.primitive[t], ts.triangle[t], x);
-      const glm::vec3 n(ts.normal[t]);
-      // The faintest lights, together under half the jump of all of the centre's unshadowed light (the cut's
-      // included): even all of them shadowed at once cannot make the probe jump.
-      float budget = 0.5f * jump * (unshadowedAt[t] + cut.at(t).y);
-      glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);
       facing.clear();
       for (uint32_t i : in.lightsNear(x)) {
         const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
+        unshadowed += c.mapValue;
         if (c.mapValue != glm::vec3(0.0f)) facing.push_back({channelMax(c.mapValue), i, c});
       }
-      std::sort(facing.begin(), facing.end(), [](const Facing& a, const Facing& b) {
-        return a.value < b.value || (a.value == b.value && a.light < b.light);
-      });
-      bright.clear();
-      for (const Facing& f : facing) {
-        centre[1] += f.c.mapValue;
-        if (f.value <= budget) {
-          budget -= f.value, faintLight += f.c.mapValue;
-        } else {
-          bright.push_back(f.light), budget = -1.0f;
-          if (lit(x + n * eps, f.c)) centre[0] += f.c.mapValue;
-        }
-      }
-      if (bright.empty()) continue;
-      centre[0] += faintLight;
-      auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
-        values[0] += faintLight, values[1] += faintLight;
-        for (uint32_t i : bright) {
-          const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
-          values[1] += c.mapValue;
-          if (c.mapValue != glm::vec3(0.0f) && lit(origin, c)) values[0] += c.mapValue;
-        }
-        return true;  // no covered test here: the full refinement drops what a surface cuts off
-      };
-      SquareMean mean;
-      if (!averageOverTexelSquare(in, ts, t, 2, nullptr, visit, mean) || mean.kept == 0) continue;
-      const float k = float(mean.kept);
-      const float probe = shareWith(channelMax(glm::vec3(mean.sum[0])) / k, channelMax(glm::vec3(mean.sum[1])) / k, cut.at(t));
-      const float here = shareWith(channelMax(centre[0]), channelMax(centre[1]), cut.at(t));
-      if (probe >= 0.0f && here >= 0.0f && std::abs(probe - here) > jump) edge[t] = 1;
+      out.share[t] = shareWith(channelMax(map.texels[t]), channelMax(unshadowed), cut.at(t));
+      if (out.share[t] >= 0.0f)
+        out.probed[t] = subTexelJump(in, ts, t, x, n, channelMax(unshadowed), jump, cut.at(t), facing, bright) ? 1 : 0;
     }
   });
+  return out;
 }
 
 }  // namespace
@@ -147,10 +143,9 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     if (cutLight && cutLight->shadowed && cutLight->unshadowed && p < cutLight->unshadowed->size() &&
         p < cutLight->shadowed->size())
       cut = {&(*cutLight->shadowed)[p], &(*cutLight->unshadowed)[p]};
-    std::vector<float> unshadowedAt;
-    const std::vector<float> share = visibleShare(in, ts, map, valid, cut, unshadowedAt);
-    std::vector<uint8_t> edge = edgeTexels(share, ts.width, ts.height, options.jump);
-    markSubTexelEdges(in, ts, share, unshadowedAt, options.jump, cut, edge);
+    const TexelShares shares = visibleShare(in, ts, map, valid, cut, options.jump);
+    std::vector<uint8_t> edge = edgeTexels(shares.share, ts.width, ts.height, options.jump);
+    for (size_t t = 0; t < edge.size() && t < shares.probed.size(); ++t) edge[t] |= shares.probed[t];
     const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t t = r.begin(); t != r.end(); ++t) {
