@@ -5,6 +5,7 @@
 // Sampling walks down from the root choosing a child in proportion to an estimate of what its lights give the
 // point; a child that is a single light is weighed by the caller's exact value.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -65,13 +66,15 @@ class LightTree {
   // that light by exact(light).
   template <class Exact, class Take>
   void sampleStratified(const glm::vec3& x, const glm::vec3& n, double shift, int m, Exact&& exact, Take&& take) const {
-    if (nodes_.empty() || m <= 0) return;
-    if (nodes_.size() == 1) {
-      if (exact(entries_[0].light) > 0.0)
-        for (int k = 0; k < m; ++k) take(k, Choice{entries_[0].light, 1.0});
-      return;
-    }
-    descend(0, 1.0, 0.0, 1.0, 0, m, shift, m, x, n, exact, take);
+    auto one = [&](int, int k, const Choice& c) { take(k, c); };
+    sampleSets<1>(x, n, &shift, &m, exact, one);
+  }
+  // Two independent sets of stratified draws at the same point, in one walk: what sampleStratified gives each set
+  // (set s: m[s] draws from shift[s]), each node weighed once for both. take(s, k, choice) as there, per set.
+  template <class Exact, class Take>
+  void sampleStratifiedPair(const glm::vec3& x, const glm::vec3& n, const double shift[2], const int m[2], Exact&& exact,
+                            Take&& take) const {
+    sampleSets<2>(x, n, shift, m, exact, take);
   }
   // The probability that sample() picks `light` at (x, n) (0 for a light not in the tree).
   template <class Exact>
@@ -103,22 +106,60 @@ class LightTree {
     }
     return importance(node, x, n);
   }
-  // The draws k in [k0, k1), whose u lie in [lo, hi), through node `at` reached with probability pmf.
-  template <class Exact, class Take>
-  void descend(int32_t at, double pmf, double lo, double hi, int k0, int k1, double shift, int m, const glm::vec3& x,
-               const glm::vec3& n, Exact& exact, Take& take) const {
+  // One set's draws k in [k0, k1), the k-th at u[k] = (k + shift) / m.
+  struct Draws {
+    int k0, k1;
+    const double* u;
+  };
+  template <int Sets, class Exact, class Take>
+  void sampleSets(const glm::vec3& x, const glm::vec3& n, const double* shift, const int* m, Exact& exact, Take& take) const {
+    int any = 0;
+    for (int s = 0; s < Sets; ++s) any += std::max(m[s], 0);
+    if (nodes_.empty() || any == 0) return;
+    if (nodes_.size() == 1) {
+      if (exact(entries_[0].light) > 0.0)
+        for (int s = 0; s < Sets; ++s)
+          for (int k = 0; k < m[s]; ++k) take(s, k, Choice{entries_[0].light, 1.0});
+      return;
+    }
+    // The draws' positions, computed once: the walk compares them at every node it splits.
+    constexpr int kLocal = 128;
+    double local[Sets][kLocal];
+    std::vector<double> heap[Sets];
+    Draws draws[Sets];
+    for (int s = 0; s < Sets; ++s) {
+      const int count = std::max(m[s], 0);
+      double* u = count <= kLocal ? local[s] : (heap[s].resize(size_t(count)), heap[s].data());
+      for (int k = 0; k < count; ++k) u[k] = (k + shift[s]) / m[s];
+      draws[s] = {0, count, u};
+    }
+    descend<Sets>(0, 1.0, 0.0, 1.0, draws, x, n, exact, take);
+  }
+  // The draws whose u lie in [lo, hi), through node `at` reached with probability pmf; a node is visited while any
+  // set has draws through it, and weighed once for all.
+  template <int Sets, class Exact, class Take>
+  void descend(int32_t at, double pmf, double lo, double hi, const Draws* draws, const glm::vec3& x, const glm::vec3& n,
+               Exact& exact, Take& take) const {
     const Node& node = nodes_[size_t(at)];
     if (node.left < 0) {
-      for (int k = k0; k < k1; ++k) take(k, Choice{entries_[node.entry].light, pmf});
+      for (int s = 0; s < Sets; ++s)
+        for (int k = draws[s].k0; k < draws[s].k1; ++k) take(s, k, Choice{entries_[node.entry].light, pmf});
       return;
     }
     const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
     if (!(a + b > 0.0)) return;
     const double pa = a / (a + b), split = lo + pa * (hi - lo);
-    int ks = k0;
-    while (ks < k1 && (ks + shift) / m < split) ++ks;
-    if (ks > k0) descend(node.left, pmf * pa, lo, split, k0, ks, shift, m, x, n, exact, take);
-    if (k1 > ks) descend(node.right, pmf * (1.0 - pa), split, hi, ks, k1, shift, m, x, n, exact, take);
+    Draws left[Sets], right[Sets];
+    bool anyLeft = false, anyRight = false;
+    for (int s = 0; s < Sets; ++s) {
+      const Draws& d = draws[s];
+      int ks = d.k0;
+      while (ks < d.k1 && d.u[ks] < split) ++ks;
+      left[s] = {d.k0, ks, d.u}, right[s] = {ks, d.k1, d.u};
+      anyLeft |= ks > d.k0, anyRight |= d.k1 > ks;
+    }
+    if (anyLeft) descend<Sets>(node.left, pmf * pa, lo, split, left, x, n, exact, take);
+    if (anyRight) descend<Sets>(node.right, pmf * (1.0 - pa), split, hi, right, x, n, exact, take);
   }
   template <class Exact>
   double pmfBelow(int32_t at, const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {

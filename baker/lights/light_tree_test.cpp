@@ -3,6 +3,7 @@
 // follow the probabilities.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -124,6 +125,41 @@ TEST(LightTree, StratifiedDrawsAtOnceAreTheDrawsOneByOne) {
   }
   EXPECT_GT(taken, 200);
   EXPECT_GE(same, taken - 2);  // a u on a split's rounding edge may go the other way
+}
+
+// Two sets of stratified draws in one walk give each set what its own walk gives, bit for bit, each light right
+// after the walk weighed it.
+TEST(LightTree, TwoSetsInOneWalkAreEachSetsOwnWalk) {
+  const Lamps lamps = scatteredLamps(64, 9);
+  const LightTree tree(lamps.entries);
+  Rng rng(7);
+  int taken = 0;
+  for (int p = 0; p < 20; ++p) {
+    const glm::vec3 x(float(rng.uniform() * 40.0 - 20.0), 0.0f, float(rng.uniform() * 40.0 - 20.0)), n(0, 1, 0);
+    const double shift[2] = {rng.uniform(), rng.uniform()};
+    const int m[2] = {12, 20};
+    std::vector<LightTree::Choice> own[2];
+    for (int s = 0; s < 2; ++s) {
+      own[s].assign(size_t(m[s]), LightTree::Choice{});
+      tree.sampleStratified(x, n, shift[s], m[s], [&](uint32_t i) { return lamps.value(i, x, n); },
+                            [&](int k, const LightTree::Choice& c) { own[s][size_t(k)] = c; });
+    }
+    uint32_t last[2] = {UINT32_MAX, UINT32_MAX};
+    int next = 0;
+    auto exact = [&](uint32_t i) { return last[next ^= 1] = i, lamps.value(i, x, n); };
+    int seen[2] = {0, 0};
+    tree.sampleStratifiedPair(x, n, shift, m, exact, [&](int s, int k, const LightTree::Choice& c) {
+      EXPECT_TRUE(c.light == last[0] || c.light == last[1]) << "point " << p << " set " << s << " draw " << k;
+      EXPECT_EQ(c.light, own[s][size_t(k)].light) << "point " << p << " set " << s << " draw " << k;
+      EXPECT_EQ(c.pmf, own[s][size_t(k)].pmf) << "point " << p << " set " << s << " draw " << k;
+      ++seen[s], ++taken;
+    });
+    for (int s = 0; s < 2; ++s)
+      EXPECT_EQ(seen[s], int(std::count_if(own[s].begin(), own[s].end(), [](const LightTree::Choice& c) {
+                  return c.light != UINT32_MAX;
+                })));
+  }
+  EXPECT_GT(taken, 400);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -270,22 +271,34 @@ std::vector<std::vector<glm::vec3>> SurfaceFilterPlan::apply(const std::vector<c
       add(i + offset_[k], weight[k]);
     }
   };
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
-    if (setCount == 1) {  // the common case, without the per-set loop
-      const std::vector<glm::vec3>& values = *sets[0];
-      std::vector<glm::vec3>& result = out[0];
+  // Up to four sets with their count known to the compiler (sums in registers, no per-set indirection); the
+  // sums per set are the same either way.
+  auto filterFixed = [&](auto sets_) {
+    constexpr size_t N = decltype(sets_)::value;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
+      const glm::vec3* values[N];
+      for (size_t s = 0; s < N; ++s) values[s] = sets[s]->data();
       for (size_t i = range.begin(); i != range.end(); ++i) {
         if (!(forward_[i] & kFiltered)) continue;
-        glm::vec3 sum(0.0f);
+        glm::vec3 sum[N];
+        for (size_t s = 0; s < N; ++s) sum[s] = glm::vec3(0.0f);
         float count = 0.0f;
         forEachInWindow(i, [&](size_t j, float w) {
-          sum += w * values[j];
+          for (size_t s = 0; s < N; ++s) sum[s] += w * values[s][j];
           count += w;
         });
-        result[i] = sum / count;
+        for (size_t s = 0; s < N; ++s) out[s][i] = sum[s] / count;
       }
-      return;
-    }
+    });
+  };
+  switch (setCount) {
+    case 1: filterFixed(std::integral_constant<size_t, 1>{}); return out;
+    case 2: filterFixed(std::integral_constant<size_t, 2>{}); return out;
+    case 3: filterFixed(std::integral_constant<size_t, 3>{}); return out;
+    case 4: filterFixed(std::integral_constant<size_t, 4>{}); return out;
+    default: break;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, layer, 4096), [&](const tbb::blocked_range<size_t>& range) {
     std::vector<glm::vec3> sum(setCount);
     for (size_t i = range.begin(); i != range.end(); ++i) {
       if (!(forward_[i] & kFiltered)) continue;

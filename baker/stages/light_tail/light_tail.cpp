@@ -88,34 +88,64 @@ struct Candidates {
   std::vector<double> weight, upTo;  // 1 / its unshadowed value; running sum of unshadowed value / pmf
 };
 
+// The walk's exact weights at (x, n): a leaf is weighed by its exact light just before the walk hands it over, so
+// the last two lights weighed are kept and a candidate's light is not evaluated twice.
+struct WalkWeights {
+  WalkWeights(const Scene& scene, const CutLights& c, const glm::vec3& x, const glm::vec3& n) : scene(scene), c(c), x(x), n(n) {}
+  const Scene& scene;
+  const CutLights& c;
+  glm::vec3 x, n;
+  uint32_t seen[2] = {UINT32_MAX, UINT32_MAX};
+  LeftOut seenLo[2];
+  int next = 0;
+  double operator()(uint32_t i) {
+    seen[next] = i, seenLo[next] = leftOutLight(scene, c, i, x, n);
+    const double v = channelMean(seenLo[next].value);
+    next ^= 1;
+    return v;
+  }
+  LeftOut of(uint32_t i) const {
+    return seen[0] == i ? seenLo[0] : seen[1] == i ? seenLo[1] : leftOutLight(scene, c, i, x, n);
+  }
+};
+
+void resizeCandidates(Candidates& room, int m) {
+  room.lo.resize(size_t(m)), room.weight.resize(size_t(m)), room.upTo.resize(size_t(m));
+  std::fill(room.weight.begin(), room.weight.end(), 0.0);
+}
+void takeCandidate(Candidates& room, int j, const LeftOut& lo, const LightTree::Choice& choice) {
+  room.lo[size_t(j)] = lo;
+  const double value = channelMean(lo.value);
+  if (value > 0.0 && choice.pmf > 0.0) room.weight[size_t(j)] = 1.0 / value, room.upTo[size_t(j)] = value / choice.pmf;
+}
+// Turns room.upTo into the running sum of the weights; returns their sum.
+double sumCandidates(Candidates& room, int m) {
+  double total = 0.0;
+  for (int j = 0; j < m; ++j) total += room.weight[size_t(j)] > 0.0 ? room.upTo[size_t(j)] : 0.0, room.upTo[size_t(j)] = total;
+  return total;
+}
+
 // m candidate lights at (x, n) drawn from the tree (stratified over the unit interval from `shift`), each weighed by
 // its exact unshadowed left-out light over its pmf, no ray. room.upTo holds the running sum of those weights;
 // returns their sum, m times the unbiased estimate of the unshadowed left-out light.
 double drawCandidates(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, int m, double shift,
                       Candidates& room) {
-  room.lo.resize(size_t(m)), room.weight.resize(size_t(m)), room.upTo.resize(size_t(m));
-  // The walk weighs a leaf by its exact light just before it hands that leaf over: the last two lights weighed are
-  // kept, so a candidate's light is not evaluated twice.
-  uint32_t seen[2] = {UINT32_MAX, UINT32_MAX};
-  LeftOut seenLo[2];
-  int next = 0;
-  auto weigh = [&](uint32_t i) {
-    seen[next] = i, seenLo[next] = leftOutLight(in.scene, c, i, x, n);
-    const double v = channelMean(seenLo[next].value);
-    next ^= 1;
-    return v;
-  };
-  std::fill(room.weight.begin(), room.weight.end(), 0.0);
-  c.tree.sampleStratified(x, n, shift, m, weigh, [&](int j, const LightTree::Choice& choice) {
-    LeftOut& lo = room.lo[size_t(j)];
-    lo = seen[0] == choice.light ? seenLo[0] : seen[1] == choice.light ? seenLo[1]
-                                                                        : leftOutLight(in.scene, c, choice.light, x, n);
-    const double value = channelMean(lo.value);
-    if (value > 0.0 && choice.pmf > 0.0) room.weight[size_t(j)] = 1.0 / value, room.upTo[size_t(j)] = value / choice.pmf;
+  resizeCandidates(room, m);
+  WalkWeights weigh{in.scene, c, x, n};
+  c.tree.sampleStratified(x, n, shift, m, weigh,
+                          [&](int j, const LightTree::Choice& choice) { takeCandidate(room, j, weigh.of(choice.light), choice); });
+  return sumCandidates(room, m);
+}
+
+// drawCandidates for two independent sets of draws at the same (x, n), in one walk of the tree.
+void drawCandidatePair(const BakeInputs& in, const CutLights& c, const glm::vec3& x, const glm::vec3& n, const int m[2],
+                       const double shift[2], Candidates room[2], double total[2]) {
+  resizeCandidates(room[0], m[0]), resizeCandidates(room[1], m[1]);
+  WalkWeights weigh{in.scene, c, x, n};
+  c.tree.sampleStratifiedPair(x, n, shift, m, weigh, [&](int s, int j, const LightTree::Choice& choice) {
+    takeCandidate(room[s], j, weigh.of(choice.light), choice);
   });
-  double total = 0.0;
-  for (int j = 0; j < m; ++j) total += room.weight[size_t(j)] > 0.0 ? room.upTo[size_t(j)] : 0.0, room.upTo[size_t(j)] = total;
-  return total;
+  total[0] = sumCandidates(room[0], m[0]), total[1] = sumCandidates(room[1], m[1]);
 }
 
 // How a position's rays are drawn.
@@ -124,6 +154,10 @@ struct DrawShifts {
   double pick = 0.0;   // the resampling's systematic shift
   double round = 0.0;  // the ray count's random rounding
 };
+
+glm::dvec3 traceCandidates(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, int m, double total,
+                           double raysPerUnit, const DrawShifts& shifts, const Candidates& room, size_t& traced,
+                           double& unshadowed);
 
 // The left-out light at (x, n), and in `unshadowed` the candidates' estimate of it before its shadows (0 without
 // candidates). Without candidates: `rays` shadow rays, each to its own light drawn from the tree
@@ -152,7 +186,16 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
     return sum / double(rays);
   }
   const int m = std::max(candidates, rays);
-  const double total = drawCandidates(in, c, x, n, m, shifts.walk, room);
+  return traceCandidates(in, x, n, rays, m, drawCandidates(in, c, x, n, m, shifts.walk, room), raysPerUnit, shifts, room,
+                         traced, unshadowed);
+}
+
+// drawAt's rays, once its m candidates are drawn into `room` (their weights summing to `total`).
+glm::dvec3 traceCandidates(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, int m, double total,
+                           double raysPerUnit, const DrawShifts& shifts, const Candidates& room, size_t& traced,
+                           double& unshadowed) {
+  glm::dvec3 sum(0.0);
+  unshadowed = 0.0;
   if (!(total > 0.0)) return sum;
   unshadowed = total / double(m);
   double scale = 1.0;  // the ray count's share of the estimate: 1 unless Russian roulette kept one ray
@@ -217,6 +260,29 @@ TexelDraws drawTexel(const BakeInputs& in, const CutLights& c, const TexelSample
   return d;
 }
 
+// drawTexel for both halves of a texel of one sample slot (no supersampling), each half `count[h]` rays and
+// `candidates[h]` candidates: the halves draw at the same point, so their candidates come from one walk of the
+// tree (drawCandidatePair); each half gets what drawTexel gives it.
+void drawTexelPair(const BakeInputs& in, const CutLights& c, const TexelSamples& ts, size_t t, const int count[2],
+                   const int candidates[2], double raysPerUnit, Rng& rng, Candidates room[2], size_t& traced,
+                   TexelDraws out[2]) {
+  glm::vec3 x;
+  if (!texelPosition(in, ts, t, x)) return;
+  const glm::vec3 n(ts.normal[t]);
+  DrawShifts shifts[2];
+  for (DrawShifts& sh : shifts) sh = {rng.uniform(), rng.uniform(), rng.uniform()};
+  const int m[2] = {std::max(candidates[0], count[0]), std::max(candidates[1], count[1])};
+  const double walk[2] = {shifts[0].walk, shifts[1].walk};
+  double total[2];
+  drawCandidatePair(in, c, x, n, m, walk, room, total);
+  for (int h = 0; h < 2; ++h) {
+    const double w = double(ts.positionWeight[t].w * float(count[h]));
+    double u = 0.0;
+    const glm::dvec3 sum = w * traceCandidates(in, x, n, count[h], m[h], total[h], raysPerUnit, shifts[h], room[h], traced, u);
+    if (w > 0.0) out[h].mean = sum / w, out[h].unshadowed = w * u / w, out[h].any = true;
+  }
+}
+
 // A texel's candidates: `candidates` times its expected share of the page's mean tail, at least one per ray and
 // at most eight times the mean.
 int candidatesFor(int candidates, double share, int samples) {
@@ -277,7 +343,7 @@ LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>&
     const double pageMean = perUnit > 0.0 ? 1.0 / perUnit : 0.0;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, (layer + kRun - 1) / kRun), [&](const tbb::blocked_range<size_t>& runs) {
       size_t traced = 0;
-      Candidates room;
+      Candidates rooms[2];
       for (size_t run = runs.begin(); run < runs.end(); ++run) {
         double recent = pageMean;
         for (size_t t = run * kRun; t < std::min(layer, (run + 1) * kRun); ++t) {
@@ -288,8 +354,16 @@ LightTailPages traceLightTail(const BakeInputs& in, const std::vector<Lightmap>&
           const int m = pageMean > 0.0 && options.allocateCandidates ? candidatesFor(candidates, recent / pageMean, options.samples) : candidates;
           const int mA = m > 0 ? std::max(halfA, m * halfA / options.samples) : 0;
           const int mB = m > 0 ? std::max(halfB, m - mA) : 0;
-          const TexelDraws da = drawTexel(in, c, ts, t, 0, halfA, mA, perUnit, rng, room, traced);
-          const TexelDraws db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, mB, perUnit, rng, room, traced) : da;
+          TexelDraws da, db;
+          if (ts.supersample == 1 && halfB > 0 && m > 0) {
+            const int count[2] = {halfA, halfB}, perHalf[2] = {mA, mB};
+            TexelDraws pair[2];
+            drawTexelPair(in, c, ts, t, count, perHalf, perUnit, rng, rooms, traced, pair);
+            da = pair[0], db = pair[1];
+          } else {
+            da = drawTexel(in, c, ts, t, 0, halfA, mA, perUnit, rng, rooms[0], traced);
+            db = halfB > 0 ? drawTexel(in, c, ts, t, halfA, halfB, mB, perUnit, rng, rooms[0], traced) : da;
+          }
           if (da.any && db.any) {
             a[t] = glm::vec3(da.mean), b[t] = glm::vec3(db.mean);
             const double unshadowed = 0.5 * (da.unshadowed + db.unshadowed);
