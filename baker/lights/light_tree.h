@@ -2,8 +2,11 @@
 // lights stochastically (after Conty Estevez and Kulla, "Importance Sampling of Many Lights", 2018, without
 // orientation cones: the lights here are points). Each node keeps its lights' bounding box, their summed power and
 // the band over which its lights' values rise from nothing (the light a cut leaves out rises over the cut's fade).
-// Sampling walks down from the root choosing a child in proportion to an estimate of what its lights give the
-// point; a child that is a single light is weighed by the caller's exact value.
+// Sampling walks down from the root, at each node choosing among its descendants kChoiceLevels levels down (a
+// branch that ends in a single light sooner stands there for itself) in proportion to an estimate of what their
+// lights give the point; a single light is weighed by the caller's exact value. Choosing among sixteen at once
+// rather than between two halves: a large box's estimate is loose, its descendants' are tighter, and each step
+// of the walk goes four levels down.
 #pragma once
 #include <algorithm>
 #include <cstdint>
@@ -30,12 +33,14 @@ class LightTree {
   bool empty() const { return nodes_.empty(); }
   size_t size() const { return entries_.size(); }
 
+  static constexpr int kChoiceLevels = 4;                // levels a walk's step goes down
+  static constexpr int kChoices = 1 << kChoiceLevels;  // the most choices one step weighs
   struct Choice {
     uint32_t light = UINT32_MAX;  // UINT32_MAX: no light gives the point anything
     double pmf = 0.0;             // the probability of this light
   };
   // One light for the point x with unit normal n, from a uniform u in [0, 1); exact(light) is the non-negative
-  // value that light gives x (it decides between a node's two children where one is a single light). Every light
+  // value that light gives x (it weighs a choice that is a single light). Every light
   // whose exact value is positive has a positive probability, so value / pmf is unbiased.
   template <class Exact>
   Choice sample(const glm::vec3& x, const glm::vec3& n, double u, Exact&& exact) const {
@@ -44,16 +49,21 @@ class LightTree {
     int32_t at = 0;
     double pmf = 1.0;
     while (nodes_[size_t(at)].left >= 0) {
-      const Node& node = nodes_[size_t(at)];
-      const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
-      if (!(a + b > 0.0)) return c;
-      const double pa = a / (a + b);
-      if (u < pa) {
-        at = node.left, pmf *= pa, u = pa > 0.0 ? u / pa : 0.0;
-      } else {
-        at = node.right, pmf *= 1.0 - pa, u = pa < 1.0 ? (u - pa) / (1.0 - pa) : 0.0;
-      }
-      u = u < 1.0 ? u : 0x1.fffffffffffffp-1;
+      int32_t next[kChoices];
+      double w[kChoices];
+      const int count = choices(nodes_[size_t(at)], next);
+      double total = 0.0;
+      for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+      if (!(total > 0.0)) return c;
+      // The choice whose share of the total holds u, u rescaled to it.
+      const double target = u * total;
+      double below = 0.0;
+      int i = 0;
+      while (i + 1 < count && !(target < below + w[i])) below += w[i++];
+      while (!(w[i] > 0.0)) --i, below -= w[i];  // u on the top rounding edge of a last choice that gives nothing
+      at = next[i], pmf *= w[i] / total;
+      u = (target - below) / w[i];
+      u = u < 0.0 ? 0.0 : u < 1.0 ? u : 0x1.fffffffffffffp-1;
     }
     const LightTreeEntry& e = entries_[nodes_[size_t(at)].entry];
     if (nodes_.size() == 1 && !(exact(e.light) > 0.0)) return c;
@@ -62,8 +72,8 @@ class LightTree {
     return c;
   }
   // What sample() gives each of u_k = (k + shift) / m, k < m (stratified draws), walking every node once for all
-  // of them: take(k, choice) for each k whose light gives x anything, in order of k, right after the walk weighed
-  // that light by exact(light).
+  // of them: take(k, choice) for each k whose light gives x anything, in order of k, after the walk weighed that
+  // light by exact(light), mostly within the last kChoices weighings (a caller may keep its recent values).
   template <class Exact, class Take>
   void sampleStratified(const glm::vec3& x, const glm::vec3& n, double shift, int m, Exact&& exact, Take&& take) const {
     auto one = [&](int, int k, const Choice& c) { take(k, c); };
@@ -146,28 +156,62 @@ class LightTree {
         for (int k = draws[s].k0; k < draws[s].k1; ++k) take(s, k, Choice{entries_[node.entry].light, pmf});
       return;
     }
-    const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
-    if (!(a + b > 0.0)) return;
-    const double pa = a / (a + b), split = lo + pa * (hi - lo);
-    Draws left[Sets], right[Sets];
-    bool anyLeft = false, anyRight = false;
-    for (int s = 0; s < Sets; ++s) {
-      const Draws& d = draws[s];
-      int ks = d.k0;
-      while (ks < d.k1 && d.u[ks] < split) ++ks;
-      left[s] = {d.k0, ks, d.u}, right[s] = {ks, d.k1, d.u};
-      anyLeft |= ks > d.k0, anyRight |= d.k1 > ks;
+    int32_t next[kChoices];
+    double w[kChoices];
+    const int count = choices(node, next);
+    double total = 0.0;
+    for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+    if (!(total > 0.0)) return;
+    Draws part[Sets];
+    for (int s = 0; s < Sets; ++s) part[s] = draws[s];
+    double below = 0.0, from = lo;
+    for (int i = 0; i < count; ++i) {
+      below += w[i];
+      const double to = i + 1 < count ? lo + below / total * (hi - lo) : hi;
+      bool any = false;
+      for (int s = 0; s < Sets; ++s) {
+        int ks = part[s].k0;
+        const int end = draws[s].k1;
+        while (ks < end && part[s].u[ks] < to) ++ks;
+        part[s].k1 = ks;
+        any |= ks > part[s].k0;
+      }
+      if (any && w[i] > 0.0) descend<Sets>(next[i], pmf * (w[i] / total), from, to, part, x, n, exact, take);
+      for (int s = 0; s < Sets; ++s) part[s].k0 = part[s].k1;
+      from = to;
     }
-    if (anyLeft) descend<Sets>(node.left, pmf * pa, lo, split, left, x, n, exact, take);
-    if (anyRight) descend<Sets>(node.right, pmf * (1.0 - pa), split, hi, right, x, n, exact, take);
+  }
+  // A node's choices: its descendants kChoiceLevels levels down (a single light sooner stands for itself).
+  int choices(const Node& node, int32_t next[kChoices]) const {
+    int count = 2;
+    next[0] = node.left, next[1] = node.right;
+    for (int level = 1; level < kChoiceLevels; ++level) {
+      int32_t below[kChoices];
+      int k = 0;
+      for (int i = 0; i < count; ++i) {
+        const Node& c = nodes_[size_t(next[i])];
+        if (c.left < 0) below[k++] = next[i];
+        else below[k++] = c.left, below[k++] = c.right;
+      }
+      std::copy(below, below + k, next);
+      count = k;
+    }
+    return count;
   }
   template <class Exact>
   double pmfBelow(int32_t at, const glm::vec3& x, const glm::vec3& n, uint32_t light, Exact&& exact) const {
     const Node& node = nodes_[size_t(at)];
     if (node.left < 0) return entries_[node.entry].light == light ? 1.0 : 0.0;
-    const double a = weight(node.left, x, n, exact), b = weight(node.right, x, n, exact);
-    if (!(a + b > 0.0)) return 0.0;
-    return a / (a + b) * pmfBelow(node.left, x, n, light, exact) + b / (a + b) * pmfBelow(node.right, x, n, light, exact);
+    int32_t next[kChoices];
+    double w[kChoices];
+    const int count = choices(node, next);
+    double total = 0.0;
+    for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+    if (!(total > 0.0)) return 0.0;
+    double p = 0.0;
+    for (int i = 0; i < count; ++i)
+      if (w[i] > 0.0) p += w[i] / total * pmfBelow(next[i], x, n, light, exact);
+    return p;
   }
 
   std::vector<LightTreeEntry> entries_;

@@ -88,24 +88,30 @@ struct Candidates {
   std::vector<double> weight, upTo;  // 1 / its unshadowed value; running sum of unshadowed value / pmf
 };
 
-// The walk's exact weights at (x, n): a leaf is weighed by its exact light just before the walk hands it over, so
-// the last two lights weighed are kept and a candidate's light is not evaluated twice.
+// The walk's exact weights at (x, n): the walk weighs a light by its exact light before it hands that light over,
+// mostly within its last kChoices weighings, so the recent ones are kept and a candidate's light is seldom
+// evaluated twice.
 struct WalkWeights {
-  WalkWeights(const Scene& scene, const CutLights& c, const glm::vec3& x, const glm::vec3& n) : scene(scene), c(c), x(x), n(n) {}
+  WalkWeights(const Scene& scene, const CutLights& c, const glm::vec3& x, const glm::vec3& n) : scene(scene), c(c), x(x), n(n) {
+    std::fill(seen, seen + kKept, UINT32_MAX);
+  }
   const Scene& scene;
   const CutLights& c;
   glm::vec3 x, n;
-  uint32_t seen[2] = {UINT32_MAX, UINT32_MAX};
-  LeftOut seenLo[2];
+  static constexpr int kKept = 2 * LightTree::kChoices;
+  uint32_t seen[kKept];
+  LeftOut seenLo[kKept];
   int next = 0;
   double operator()(uint32_t i) {
     seen[next] = i, seenLo[next] = leftOutLight(scene, c, i, x, n);
     const double v = channelMean(seenLo[next].value);
-    next ^= 1;
+    next = (next + 1) % kKept;
     return v;
   }
-  LeftOut of(uint32_t i) const {
-    return seen[0] == i ? seenLo[0] : seen[1] == i ? seenLo[1] : leftOutLight(scene, c, i, x, n);
+  LeftOut of(uint32_t i) const {  // the most recent first
+    for (int k = 1; k <= kKept; ++k)
+      if (const int at = (next - k + kKept) % kKept; seen[at] == i) return seenLo[at];
+    return leftOutLight(scene, c, i, x, n);
   }
 };
 

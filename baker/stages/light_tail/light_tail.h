@@ -22,8 +22,8 @@ namespace irbake {
 
 struct LightTailOptions {
   int samples = 8;       // shadow rays per texel (0: the cut light stays left out)
-  int candidates = 32;   // lights drawn per texel, among which the rays are resampled (0: each ray its own draw)
-  int filterRadius = 4;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
+  int candidates = 16;   // lights drawn per texel, among which the rays are resampled (0: each ray its own draw)
+  int filterRadius = 3;  // (2r+1)² window of the texel filter on the same surface over the estimate; 0: none
   bool allocate = true;  // with candidates: rays per texel in proportion to its unshadowed tail, the page's mean
                          // `samples` (false: `samples` everywhere)
   bool allocateCandidates = true;  // with allocate: candidates per texel in proportion to the tail of the texels
