@@ -39,33 +39,44 @@ struct Facing {
   PunctualContribution c;
 };
 
+// The faintest facing lights, together under `budget` (channel max, the centre's), go first: facing sorted by
+// their light, and how many of its first entries are faint. All of them shadowed at once, or lit, cannot move
+// the texel by more than the budget.
+size_t sortFaintFirst(std::vector<Facing>& facing, float budget) {
+  std::sort(facing.begin(), facing.end(), [](const Facing& a, const Facing& b) {
+    return a.value < b.value || (a.value == b.value && a.light < b.light);
+  });
+  size_t faint = 0;
+  for (; faint < facing.size() && facing[faint].value <= budget; ++faint) budget -= facing[faint].value;
+  return faint;
+}
+
 // Whether a shadow or a lit strip narrower than a texel crosses texel t's square although its centre agrees with
 // its neighbours (between two centres, where no neighbour sees a jump): the visible share of 2×2 sub-points on
 // the centre's triangle against the centre's, both traced alike, differ by more than `jump`. facing: the lights
-// facing the centre x, unshadowed: their light there (channel max). The faintest lights, together under half of
-// `jump` of the centre's unshadowed light (the cut's included), count as visible on both sides with their centre's
-// light, no ray and no evaluation at the sub-points: all of them shadowed at once cannot make the probe jump, and
-// a level's many faint lamps cost nothing. Without a brighter light there is nothing to probe.
+// facing the centre x, unshadowed: their light there (channel max). The faintest lights, together under
+// faintShare × `jump` of the centre's unshadowed light (the cut's included), count as visible on both sides with
+// their centre's light, no ray and no evaluation at the sub-points: all of them shadowed at once cannot make the
+// probe jump, and a level's many faint lamps cost nothing. Without a brighter light there is nothing to probe.
 bool subTexelJump(const BakeInputs& in, const TexelSamples& ts, size_t t, const glm::vec3& x, const glm::vec3& n,
-                  float unshadowed, float jump, glm::vec2 cut, std::vector<Facing>& facing, std::vector<uint32_t>& bright) {
+                  float unshadowed, float jump, float faintShare, glm::vec2 cut, std::vector<Facing>& facing,
+                  std::vector<uint32_t>& bright) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
     const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
     return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
   };
-  float budget = 0.5f * jump * (unshadowed + cut.y);
   glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);  // visible, unshadowed
-  std::sort(facing.begin(), facing.end(), [](const Facing& a, const Facing& b) {
-    return a.value < b.value || (a.value == b.value && a.light < b.light);
-  });
+  const size_t faint = sortFaintFirst(facing, faintShare * jump * (unshadowed + cut.y));
   bright.clear();
-  for (const Facing& f : facing) {
+  for (size_t k = 0; k < facing.size(); ++k) {
+    const Facing& f = facing[k];
     centre[1] += f.c.mapValue;
-    if (f.value <= budget) {
-      budget -= f.value, faintLight += f.c.mapValue;
+    if (k < faint) {
+      faintLight += f.c.mapValue;
     } else {
-      bright.push_back(f.light), budget = -1.0f;
+      bright.push_back(f.light);
       if (lit(x + n * eps, f.c)) centre[0] += f.c.mapValue;
     }
   }
@@ -97,7 +108,7 @@ struct TexelShares {
   std::vector<uint8_t> probed;
 };
 TexelShares visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lightmap& map,
-                         const std::vector<uint8_t>& valid, const PageCut& cut, float jump) {
+                         const std::vector<uint8_t>& valid, const PageCut& cut, const ShadowEdgeOptions& options) {
   TexelShares out{std::vector<float>(map.size(), -1.0f), std::vector<uint8_t>(map.size(), 0)};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, map.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<Facing> facing;
@@ -116,10 +127,75 @@ TexelShares visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lig
       }
       out.share[t] = shareWith(channelMax(map.texels[t]), channelMax(unshadowed), cut.at(t));
       if (out.share[t] >= 0.0f)
-        out.probed[t] = subTexelJump(in, ts, t, x, n, channelMax(unshadowed), jump, cut.at(t), facing, bright) ? 1 : 0;
+        out.probed[t] = subTexelJump(in, ts, t, x, n, channelMax(unshadowed), options.jump, options.faintShare,
+                                     cut.at(t), facing, bright) ? 1 : 0;
     }
   });
   return out;
+}
+
+// A thread's room for refineTexel.
+struct RefineRoom {
+  std::vector<Facing> facing;
+  std::vector<uint8_t> faint;  // per scene light, 1: faint at the texel being refined
+};
+
+// Texel t's mean of the lights' shadowed light over its square (averageOverTexelSquare, S×S sub-points): each
+// sub-point traces the lights that reach it, except the faintest at the centre, together under faintShare × `jump`
+// of the centre's unshadowed light (the cut's included, as the probe's): those are traced once, at the centre, and
+// their light there counts at every sub-point (all of them shadowed at once, or lit, cannot move the texel by
+// more). values[1]: the part's lights alone.
+bool refineTexel(const BakeInputs& in, const TexelSamples& ts, size_t t, const SquareTriangles& squares,
+                 const ShadowEdgePart* part, const ShadowEdgeOptions& options, glm::vec2 cut, RefineRoom& room,
+                 SquareMean& mean) {
+  const RayTracer& rt = in.rayTracer;
+  const float eps = rt.epsilon();
+  // What a light gives a point along c, seen from origin: 0 where shadowed, else through what transmits.
+  auto arriving = [&](const glm::vec3& origin, const PunctualContribution& c) {
+    const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+    if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) return glm::vec3(-1.0f);
+    if (!(tmax > 0.0f) || !rt.hasTransmission()) return c.mapValue;
+    return c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax);
+  };
+  glm::vec3 faintLight[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};  // the faint lights' at the centre: all, the part's
+  room.facing.clear();
+  if (ts.positionWeight[t].w > 0.0f && ts.primitive[t] < in.scene.primitives.size()) {
+    const glm::vec3 x = rt.insetPoint(ts.primitive[t], ts.triangle[t], glm::vec3(ts.positionWeight[t]));
+    const glm::vec3 n(ts.normal[t]);
+    glm::vec3 unshadowed(0.0f);
+    for (uint32_t i : in.lightsNear(x)) {
+      const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
+      unshadowed += c.mapValue;
+      if (c.mapValue != glm::vec3(0.0f)) room.facing.push_back({channelMax(c.mapValue), i, c});
+    }
+    const float budget = options.faintShare * options.jump * (channelMax(unshadowed) + cut.y);
+    room.facing.resize(sortFaintFirst(room.facing, budget));
+    for (const Facing& f : room.facing) {
+      room.faint[f.light] = 1;
+      const glm::vec3 v = arriving(x + n * eps, f.c);
+      if (v.x < 0.0f) continue;
+      faintLight[0] += v;
+      if (part && (*part->lights)[f.light]) faintLight[1] += v;
+    }
+  }
+  auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
+    values[0] += faintLight[0], values[1] += faintLight[1];
+    bool anyLit = false;  // of the lights traced here: a sub-point they all miss gets the covered test
+    for (uint32_t i : in.lightsNear(xs)) {
+      if (room.faint[i]) continue;
+      const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
+      if (c.mapValue == glm::vec3(0.0f)) continue;
+      const glm::vec3 v = arriving(origin, c);
+      if (v.x < 0.0f) continue;
+      anyLit = true;
+      values[0] += v;
+      if (part && (*part->lights)[i]) values[1] += v;
+    }
+    return anyLit;
+  };
+  const bool sampled = averageOverTexelSquare(in, ts, t, options.subSamples, &squares, visit, mean);
+  for (const Facing& f : room.facing) room.faint[f.light] = 0;
+  return sampled;
 }
 
 }  // namespace
@@ -131,8 +207,6 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
   const int S = options.subSamples;
   if (S <= 1 || in.scene.lights.empty()) return stats;
   Stopwatch watch;
-  const RayTracer& rt = in.rayTracer;
-  const float eps = rt.epsilon();
   std::atomic<size_t> edges{0}, points{0}, dropped{0};
   for (size_t p = 0; p < directPages.size() && p < in.texels.size(); ++p) {
     const TexelSamples& ts = in.texels[p];
@@ -143,30 +217,17 @@ ShadowEdgeStats refineShadowEdges(const BakeInputs& in, std::vector<Lightmap>& d
     if (cutLight && cutLight->shadowed && cutLight->unshadowed && p < cutLight->unshadowed->size() &&
         p < cutLight->shadowed->size())
       cut = {&(*cutLight->shadowed)[p], &(*cutLight->unshadowed)[p]};
-    const TexelShares shares = visibleShare(in, ts, map, valid, cut, options.jump);
+    const TexelShares shares = visibleShare(in, ts, map, valid, cut, options);
     std::vector<uint8_t> edge = edgeTexels(shares.share, ts.width, ts.height, options.jump);
     for (size_t t = 0; t < edge.size() && t < shares.probed.size(); ++t) edge[t] |= shares.probed[t];
     const SquareTriangles squares = squareTriangles(in.scene, ts, edge);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, ts.layerSize(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      RefineRoom room;
+      room.faint.assign(in.scene.lights.size(), 0);
       for (size_t t = r.begin(); t != r.end(); ++t) {
         if (!edge[t]) continue;
         SquareMean mean;
-        auto visit = [&](const glm::vec3& xs, const glm::vec3& nx, const glm::vec3& origin, glm::vec3* values) {
-          bool anyLit = false;
-          for (uint32_t i : in.lightsNear(xs)) {
-            const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
-            if (c.mapValue == glm::vec3(0.0f)) continue;
-            const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-            if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
-            anyLit = true;
-            const glm::vec3 v = tmax > 0.0f && rt.hasTransmission() ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax)
-                                                                    : c.mapValue;
-            values[0] += v;
-            if (part && (*part->lights)[i]) values[1] += v;
-          }
-          return anyLit;
-        };
-        const bool sampled = averageOverTexelSquare(in, ts, t, S, &squares, visit, mean);
+        const bool sampled = refineTexel(in, ts, t, squares, part, options, cut.at(t), room, mean);
         points += static_cast<size_t>(mean.points);
         dropped += static_cast<size_t>(mean.dropped);
         if (!sampled || mean.kept == 0) continue;  // no sub-point on the chart in the square: the centre's value stays

@@ -19,6 +19,8 @@ struct ShadowEdgeOptions {
   int subSamples = 8;           // S: S×S sub-points per edge texel (0 or 1: the stage is off)
   float jump = 0.1f;            // an edge: the share of the lights' unshadowed value that arrives differs from a
                                 // valid neighbour's by more (smooth falloff leaves the share at 1)
+  float faintShare = 0.5f;      // the faintest lights at a texel's centre, together under faintShare × jump of its
+                                // light, are traced at the centre only, in the probe and the refinement (0: none)
 };
 
 struct ShadowEdgeStats {

@@ -107,6 +107,44 @@ TEST(ShadowEdges, EdgeTexelsGetTheLitShareOfTheirSquare) {
               straddling, errCentre, errRefined);
 }
 
+// A faint second sun (3% of the first's light, tilted along the roof's edge, so its shadow edge is the first's)
+// is under the faint budget (half the jump): on the edge texels it counts with its visibility at the centre, so
+// the refined pair is exactly the first sun refined alone plus the faint one's centre value; refined as a bright
+// light (faintShare 0) it gets its lit share instead, and the two differ by at most its own light.
+TEST(ShadowEdges, FaintLightsCountWithTheirCentresVisibility) {
+  const Light faint = directionalLight(glm::normalize(glm::vec3(0.0f, 0.6f, -0.8f)), 0.03f * kPiF);
+  auto bake = [&](int lights, float faintShare, bool refine) {  // lights: 1 the sun, 2 the faint one, 3 both
+    SunOverFloor f(false);
+    if (lights == 2) f.s.lights.clear();
+    if (lights & 2) f.s.lights.push_back(faint);
+    const BakeInputs in = f.inputs();
+    std::vector<Lightmap> maps = bakeEmbree(in);
+    ShadowEdgeOptions o;
+    o.subSamples = 8, o.faintShare = faintShare;
+    if (refine) refineShadowEdges(in, maps, o);
+    return maps;
+  };
+  const std::vector<Lightmap> both = bake(3, ShadowEdgeOptions{}.faintShare, true), sun = bake(1, 0.0f, true);
+  const std::vector<Lightmap> faintCentre = bake(2, 0.0f, false), traced = bake(3, 0.0f, true),
+                              sunCentre = bake(1, 0.0f, false);
+  size_t edges = 0, differ = 0;
+  double largest = 0.0;
+  for (size_t p = 0; p < both.size(); ++p)
+    for (size_t t = 0; t < both[p].size(); ++t) {
+      if (!both[p].valid[t] || sun[p].texels[t] == sunCentre[p].texels[t]) continue;  // the sun's edge texels
+      ++edges;
+      EXPECT_NEAR(both[p].texels[t].x, sun[p].texels[t].x + faintCentre[p].texels[t].x, 1e-5) << "texel " << t;
+      const double gap = std::abs(double(traced[p].texels[t].x) - double(both[p].texels[t].x));
+      largest = std::max(largest, gap);
+      differ += gap > 1e-4 ? 1 : 0;
+    }
+  std::printf("[ figure ] %zu edge texels, %zu of them off the fully traced value, by at most %.4f (the faint "
+              "light: %.4f)\n", edges, differ, largest, 0.03 * 0.8);
+  EXPECT_GT(edges, 10u);
+  EXPECT_GT(differ, 5u);                // the faint light's edge crosses these texels too
+  EXPECT_LE(largest, 0.03 * 0.8 + 1e-4);  // at most the faint light's own value (irradiance 0.03π at cos 0.8)
+}
+
 TEST(ShadowEdges, UnderABoxRestingOnTheFloorIsCoveredNotShadowed) {
   SunOverFloor f(true);
   const BakeInputs in = f.inputs();
