@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """light_cull_seeds.py IRBAKE OUTROOT SCENE [--seeds 0,1,2,3,4]: the culled bake against brute force, per seed.
 
 For each seed the scene is baked twice with the same options and seed: brute force (--light-cull 0, every light
@@ -8,7 +8,7 @@ valid texels, weighted by surface area) goes into bench/results/light_cull_seeds
 force bake already in OUTROOT (report.json present, same options and seed) is kept unless --rebake.
 
   python3 bench/levels/town.py /tmp/town16r0.glb --blocks 16 --lamps 1000 --range 0
-  python3 bench/levels/light_cull_seeds.py build/baker/irbake /tmp/seeds /tmp/town16r0.glb --name town16r0
+  /usr/bin/python3 bench/levels/light_cull_seeds.py build/baker/irbake /tmp/seeds /tmp/town16r0.glb --name town16r0
 """
 import argparse
 import datetime
@@ -50,11 +50,11 @@ def main():
         brute = os.path.join(args.outroot, "brute-seed%d" % seed)
         culled = os.path.join(args.outroot, "culled-seed%d" % seed)
         bake(args.irbake, args.scene, brute, 0, seed, args.rebake)
-        report = bake(args.irbake, args.scene, culled, args.cull, seed, True)
+        bake(args.irbake, args.scene, culled, args.cull, seed, True)
         p = subprocess.run([args.irbake, "diff", "--json", culled, brute], capture_output=True, text=True, check=True)
         figures = json.loads(p.stdout)
         rows.append({"date": datetime.date.today().isoformat(), "commit": commit, "scene": args.name,
-                     "texels": report.get("texels", {}).get("valid", ""), "seed": seed, "cull": args.cull,
+                     "texels": figures["texels"], "seed": seed, "cull": args.cull,
                      "rel_rmse_vs_brute": "%.5f" % figures["relativeRmse"],
                      "rel_bias_vs_brute": "%.5f" % figures["relativeBias"],
                      "options": " ".join(OPTIONS + ["--light-cull", str(args.cull)]) + " (brute force: 0)"})
