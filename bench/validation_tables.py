@@ -340,12 +340,21 @@ def t_scenarios():
 
 
 def t_plan_accuracy():
-    """bench/levels/plan_accuracy.sh: `irbake plan`'s prediction against the bake, the latest date's rows."""
+    """bench/levels/plan_accuracy.sh: `irbake plan`'s prediction against the bake, the latest date's rows; a level
+    ladder's runs of one scene (NAME_runK) as one row of their medians."""
     rows = read("plan_accuracy.csv")
     last = max(r["date"] for r in rows)
-    out = [[r["scene"], r["role"], num(r["plan_s"], 1), num(r["predicted_cpu_s"], 1), num(r["measured_cpu_s"], 1),
-            f"**{num(r['time_ratio'])}**", r["predicted_mib"], r["measured_mib"], f"**{num(r['memory_ratio'])}**"]
-           for r in rows if r["date"] == last]
+    groups = {}
+    for r in rows:
+        if r["date"] == last:
+            groups.setdefault(re.sub(r"_run\d+$", "", r["scene"]), []).append(r)
+    out = []
+    for scene, g in groups.items():
+        m = lambda k: median(float(x[k]) for x in g)
+        runs = f" ({len(g)} runs)" if len(g) > 1 else ""
+        out.append([scene + runs, g[0]["role"], num(m("plan_s"), 1), num(m("predicted_cpu_s"), 1),
+                    num(m("measured_cpu_s"), 1), f"**{num(m('time_ratio'))}**", f"{m('predicted_mib'):.0f}",
+                    f"{m('measured_mib'):.0f}", f"**{num(m('memory_ratio'))}**"])
     return table(["scene", "role", "plan (s)", "predicted CPU (s)", "measured CPU (s)", "time ratio",
                   "predicted peak (MiB)", "measured peak (MiB)", "memory ratio"], out)
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""fit_cost_model.py IRBAKE DIR... [--levels CSV] [--hold-out NAME,...] [--write] [--accuracy CSV]: calibrates
-the bake's cost model, and checks the binary's predictions against the measured bakes.
+"""fit_cost_model.py IRBAKE DIR... [--levels CSV [--levels-commit C]] [--hold-out NAME,...] [--write] [--accuracy CSV]:
+calibrates the bake's cost model, and checks the binary's predictions against the measured bakes.
 
 Each DIR is a measured bake as bench/levels/cost_bakes.py leaves it (report.json, measured.json); --levels adds
 the rows of bench/results/levels_scale.csv whose towns bench/levels/town.py makes again (their density given
@@ -163,10 +163,10 @@ def town_scene(name):
     return path
 
 
-def load_levels(irbake, path):
+def load_levels(irbake, path, commit=""):
     runs = []
     for row in csv.DictReader(open(path)):
-        if row["scene"] not in TOWNS or "--shard" in row["options"]:
+        if row["scene"] not in TOWNS or "--shard" in row["options"] or (commit and row["commit"] != commit):
             continue
         options = row["options"].split()
         if "--texels-per-unit" not in options:  # the density the bake had, so the plan predicts its atlas
@@ -267,12 +267,13 @@ def main():
     ap.add_argument("--hold-out", default="", help="comma-separated run names checked but not fitted")
     ap.add_argument("--write", action="store_true", help="paste the coefficients into baker/pipeline/cost_model.cpp")
     ap.add_argument("--levels", help="bench/results/levels_scale.csv: its towns' rows as more runs")
+    ap.add_argument("--levels-commit", default="", help="only the --levels rows measured at this commit")
     ap.add_argument("--accuracy", help="append the binary's predictions against the runs to this CSV")
     a = ap.parse_args()
     held = set(filter(None, a.hold_out.split(",")))
     runs = [load(a.irbake, f) for f in a.folders if os.path.exists(os.path.join(f, "measured.json"))]
     if a.levels:
-        runs += load_levels(a.irbake, a.levels)
+        runs += load_levels(a.irbake, a.levels, a.levels_commit)
     # A run whose atlas the plan does not predict (the density rule differs from the bake's) teaches nothing.
     for r in [r for r in runs if abs(r["plan"]["atlas"]["texelsPerMetre"] / r["density"] - 1.0) > 0.02]:
         print("# %s left out: the plan predicts %.3g texels per metre, the bake had %.3g" %

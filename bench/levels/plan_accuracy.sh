@@ -11,7 +11,7 @@
 #   HOLD_OUT=sponza_sunsky_preview,town16_lamps_range,town8_lamps,town8_sunsky_tpu3_preview LARGE=1 \
 #     bash bench/levels/plan_accuracy.sh [IRBAKE]
 # HOLD_OUT names the runs left out of the fit (fit_cost_model.py --hold-out, the same names); LEVELS_CSV adds a
-# level ladder's CSV rows (measured with the binary that wrote them).
+# level ladder's CSV rows (measured with the binary that wrote them), LEVELS_COMMIT only those of one commit.
 set -euo pipefail
 IRBAKE=${1:-build/baker/irbake}
 W=build/calibration
@@ -52,7 +52,7 @@ if [[ ${LARGE:-0} == 1 ]]; then
     --texels-per-unit 0.67
 fi
 LEVELS=()
-[[ -n ${LEVELS_CSV:-} ]] && LEVELS=(--levels "$LEVELS_CSV")
+[[ -n ${LEVELS_CSV:-} ]] && LEVELS=(--levels "$LEVELS_CSV" --levels-commit "${LEVELS_COMMIT:-}")
 python3 bench/levels/fit_cost_model.py "$IRBAKE" $W/*/ "${LEVELS[@]}" --hold-out "${HOLD_OUT:-}" \
   --accuracy bench/results/plan_accuracy.csv > /dev/null
 tail -n +2 bench/results/plan_accuracy.csv
