@@ -164,10 +164,12 @@ class LightTree {
     if (!(total > 0.0)) return;
     Draws part[Sets];
     for (int s = 0; s < Sets; ++s) part[s] = draws[s];
+    int last = count - 1;  // the last choice that gives anything ends at hi (sample() goes there on the top edge)
+    while (!(w[last] > 0.0)) --last;
     double below = 0.0, from = lo;
     for (int i = 0; i < count; ++i) {
       below += w[i];
-      const double to = i + 1 < count ? lo + below / total * (hi - lo) : hi;
+      const double to = i < last ? lo + below / total * (hi - lo) : hi;
       bool any = false;
       for (int s = 0; s < Sets; ++s) {
         int ks = part[s].k0;
