@@ -44,6 +44,10 @@ bool validLayerName(const std::string& name) {
   });
 }
 
+bool otherPageName(const std::string& name) {
+  return name == "shadowmask" || name == "l1x" || name == "l1y" || name == "l1z";
+}
+
 CombinedLayers combineLayers(const std::vector<LightLayer>& layers, const std::vector<glm::vec3>& weights) {
   if (layers.empty() || weights.size() != layers.size())
     throw Error(ErrorCode::InvalidData, "", "combining light layers: " + std::to_string(weights.size()) + " weights for " +

@@ -31,6 +31,9 @@ struct LightLayer {
 
 // True for a name of [A-Za-z0-9_-]{1,64}: a layer's, a group's (and so a file name's part).
 bool validLayerName(const std::string& name);
+// True for the names other pages beside lightmap_<page> take in its place (the shadow mask's, the L1 pages'):
+// no group may take one, and a lightmap_<page>_<name> file with one is not a layer.
+bool otherPageName(const std::string& name);
 
 // What a scenario's weights make of the layers.
 struct CombinedLayers {

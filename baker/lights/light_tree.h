@@ -51,9 +51,8 @@ class LightTree {
     while (nodes_[size_t(at)].left >= 0) {
       int32_t next[kChoices];
       double w[kChoices];
-      const int count = choices(nodes_[size_t(at)], next);
-      double total = 0.0;
-      for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+      int count = 0;
+      const double total = weighChoices(nodes_[size_t(at)], x, n, exact, next, w, count);
       if (!(total > 0.0)) return c;
       // The choice whose share of the total holds u, u rescaled to it.
       const double target = u * total;
@@ -158,9 +157,8 @@ class LightTree {
     }
     int32_t next[kChoices];
     double w[kChoices];
-    const int count = choices(node, next);
-    double total = 0.0;
-    for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+    int count = 0;
+    const double total = weighChoices(node, x, n, exact, next, w, count);
     if (!(total > 0.0)) return;
     Draws part[Sets];
     for (int s = 0; s < Sets; ++s) part[s] = draws[s];
@@ -182,6 +180,15 @@ class LightTree {
       for (int s = 0; s < Sets; ++s) part[s].k0 = part[s].k1;
       from = to;
     }
+  }
+  // The node's choices (choices()) into next[0, count), each weighed (weight()) into w; returns their sum.
+  template <class Exact>
+  double weighChoices(const Node& node, const glm::vec3& x, const glm::vec3& n, Exact& exact, int32_t next[kChoices],
+                      double w[kChoices], int& count) const {
+    count = choices(node, next);
+    double total = 0.0;
+    for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+    return total;
   }
   // A node's choices: its descendants kChoiceLevels levels down (a single light sooner stands for itself).
   int choices(const Node& node, int32_t next[kChoices]) const {
@@ -206,9 +213,8 @@ class LightTree {
     if (node.left < 0) return entries_[node.entry].light == light ? 1.0 : 0.0;
     int32_t next[kChoices];
     double w[kChoices];
-    const int count = choices(node, next);
-    double total = 0.0;
-    for (int i = 0; i < count; ++i) total += w[i] = weight(next[i], x, n, exact);
+    int count = 0;
+    const double total = weighChoices(node, x, n, exact, next, w, count);
     if (!(total > 0.0)) return 0.0;
     double p = 0.0;
     for (int i = 0; i < count; ++i)

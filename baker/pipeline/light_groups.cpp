@@ -122,6 +122,9 @@ class GroupResolver {
     if (!validLayerName(name))
       throw Error(ErrorCode::Usage, scene_.sourcePath,
                   what + ": the group name " + quotedExcerpt(name) + " must be 1 to 64 of A-Z a-z 0-9 _ -");
+    if (otherPageName(name))
+      throw Error(ErrorCode::Usage, scene_.sourcePath,
+                  what + ": the group name " + quotedExcerpt(name) + " is what the shadow-mask or L1 pages are called");
     for (size_t g = 0; g < groups_.size(); ++g)
       if (groups_[g].name == name) return static_cast<int>(g);
     groups_.push_back(LightGroup{name, {}, false, {}, json::array()});

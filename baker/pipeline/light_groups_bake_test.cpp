@@ -287,6 +287,8 @@ TEST(LightGroups, RefusesDuplicatesBadNamesUnknownLightsAndSourcesInNoGroup) {
   EXPECT_NE(duplicate.find("group 'a'"), std::string::npos) << duplicate;
   const std::string badName = refusal({request("day time", {"*"})});
   EXPECT_NE(badName.find("'day time'"), std::string::npos) << badName;
+  const std::string pageName = refusal({request("shadowmask", {"*"})});
+  EXPECT_NE(pageName.find("shadow-mask"), std::string::npos) << pageName;
   const std::string unknown = refusal({request("a", {"lamp7"}), request("b", {"*"})});
   EXPECT_NE(unknown.find("'lamp7'"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("left"), std::string::npos) << unknown;  // the sources it has

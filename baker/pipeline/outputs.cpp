@@ -57,7 +57,8 @@ void removeStalePages(const BakeResult& result, const std::filesystem::path& out
     removeStalePage(stale, guard, "with more pages");
   }
   // Light-group layers of an earlier bake that this one does not have (other groups, fewer pages, or none):
-  // lightmap_<page>_<group>.exr and .png, the names the shadow-mask and directional pages use left aside.
+  // lightmap_<page>_<group>.exr and .png, the names the shadow-mask and directional pages use left aside
+  // (otherPageName).
   std::set<std::string> layers;  // this bake's, without the extension
   for (const LightLayer& layer : result.layers)
     for (const Lightmap& m : layer.maps) layers.insert(fs::path(layerPageUri("lightmap", m.page, layer.name)).stem().string());
@@ -66,10 +67,9 @@ void removeStalePages(const BakeResult& result, const std::filesystem::path& out
   for (const fs::directory_entry& entry : fs::directory_iterator(outDir, ec)) {
     const std::string name = entry.path().filename().string();
     std::smatch m;
-    if (!std::regex_match(name, m, kLayerPage) || !validLayerName(m[1].str()) || layers.count(entry.path().stem().string()))
+    if (!std::regex_match(name, m, kLayerPage) || !validLayerName(m[1].str()) || otherPageName(m[1].str()) ||
+        layers.count(entry.path().stem().string()))
       continue;
-    const std::string group = m[1].str();
-    if (group == "shadowmask" || group == "l1x" || group == "l1y" || group == "l1z") continue;
     staleLayers.push_back(entry.path());
   }
   std::sort(staleLayers.begin(), staleLayers.end());

@@ -46,6 +46,12 @@ inline glm::vec3 vplMapValue(const glm::vec3& power, float geometryTerm) { retur
 // A punctual light at a receiver, before the shadow test: its kind's direct term (lights/light_kind.h).
 PunctualContribution punctualDirect(const Light& light, const glm::vec3& x, const glm::vec3& nx);
 
+// How far the shadow ray toward c's light runs from ε off the receiver (at most 0: the light is that close; a
+// light at infinity: 1e30).
+inline float shadowRayLength(const PunctualContribution& c, float eps) {
+  return std::isinf(c.distance) ? 1e30f : c.distance - eps;
+}
+
 // The clamp bound B (1/m²) derived from the scene and the VPL set:
 //   B = π · N / (k · A),  N = VPLs with non-zero power, A = total one-sided surface area, k = 16.
 // Why: each VPL stands for the light of A/N of the surface, so the mean irradiance the set represents is

@@ -129,7 +129,7 @@ void visitDirect(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, V
     PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
     if (c.mapValue == glm::vec3(0.0f)) continue;
     glm::vec3 origin = x + n * eps;
-    float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+    float tmax = shadowRayLength(c, eps);
     if (tmax > 0.0f && in.rayTracer.occluded(origin, c.toLight, 0.0f, tmax)) continue;
     visit(tmax > 0.0f ? c.mapValue * in.rayTracer.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue,
           c.toLight);

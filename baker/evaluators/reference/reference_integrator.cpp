@@ -25,7 +25,7 @@ glm::vec3 punctualAt(const Scene& scene, const RayTracer& rt, const glm::vec3& o
   for (const Light& l : scene.lights) {
     PunctualContribution c = punctualDirect(l, x, n);
     if (c.mapValue == glm::vec3(0.0f)) continue;
-    float tmax = std::isinf(c.distance) ? 1e30f : c.distance - rt.epsilon();
+    float tmax = shadowRayLength(c, rt.epsilon());
     if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) continue;
     sum += tmax > 0.0f ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
   }

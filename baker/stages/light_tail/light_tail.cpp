@@ -75,7 +75,7 @@ namespace {
 glm::vec3 shadowed(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, const LeftOut& lo, size_t& traced) {
   const float eps = in.rayTracer.epsilon();
   const glm::vec3 origin = x + n * eps;
-  const float tmax = std::isinf(lo.whole.distance) ? 1e30f : lo.whole.distance - eps;
+  const float tmax = shadowRayLength(lo.whole, eps);
   ++traced;
   if (!(tmax > 0.0f)) return lo.value;
   if (in.rayTracer.occluded(origin, lo.whole.toLight, 0.0f, tmax)) return glm::vec3(0.0f);
@@ -161,9 +161,34 @@ struct DrawShifts {
   double round = 0.0;  // the ray count's random rounding
 };
 
+// drawAt's rays (below), once its m candidates are drawn into `room` (their weights summing to `total`).
 glm::dvec3 traceCandidates(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, int m, double total,
                            double raysPerUnit, const DrawShifts& shifts, const Candidates& room, size_t& traced,
-                           double& unshadowed);
+                           double& unshadowed) {
+  glm::dvec3 sum(0.0);
+  unshadowed = 0.0;
+  if (!(total > 0.0)) return sum;
+  unshadowed = total / double(m);
+  double scale = 1.0;  // the ray count's share of the estimate: 1 unless Russian roulette kept one ray
+  if (raysPerUnit > 0.0) {
+    const double want = std::min(double(rays) * total / double(m) * raysPerUnit, 8.0 * rays);
+    if (want < 1.0) {
+      if (!(shifts.round < want)) return sum;
+      rays = 1, scale = 1.0 / want;
+    } else {
+      rays = int(std::floor(want + shifts.round));
+    }
+  }
+  int j = 0, last = -1;
+  glm::dvec3 v(0.0);
+  for (int k = 0; k < rays; ++k) {
+    const double at = (k + shifts.pick) / rays * total;
+    while (j + 1 < m && !(at < room.upTo[size_t(j)])) ++j;
+    if (j != last) v = glm::dvec3(shadowed(in, x, n, room.lo[size_t(j)], traced)) * room.weight[size_t(j)], last = j;
+    sum += v;
+  }
+  return sum * (scale * total / double(m)) / double(rays);
+}
 
 // The left-out light at (x, n), and in `unshadowed` the candidates' estimate of it before its shadows (0 without
 // candidates). Without candidates: `rays` shadow rays, each to its own light drawn from the tree
@@ -194,35 +219,6 @@ glm::dvec3 drawAt(const BakeInputs& in, const CutLights& c, const glm::vec3& x, 
   const int m = std::max(candidates, rays);
   return traceCandidates(in, x, n, rays, m, drawCandidates(in, c, x, n, m, shifts.walk, room), raysPerUnit, shifts, room,
                          traced, unshadowed);
-}
-
-// drawAt's rays, once its m candidates are drawn into `room` (their weights summing to `total`).
-glm::dvec3 traceCandidates(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, int rays, int m, double total,
-                           double raysPerUnit, const DrawShifts& shifts, const Candidates& room, size_t& traced,
-                           double& unshadowed) {
-  glm::dvec3 sum(0.0);
-  unshadowed = 0.0;
-  if (!(total > 0.0)) return sum;
-  unshadowed = total / double(m);
-  double scale = 1.0;  // the ray count's share of the estimate: 1 unless Russian roulette kept one ray
-  if (raysPerUnit > 0.0) {
-    const double want = std::min(double(rays) * total / double(m) * raysPerUnit, 8.0 * rays);
-    if (want < 1.0) {
-      if (!(shifts.round < want)) return sum;
-      rays = 1, scale = 1.0 / want;
-    } else {
-      rays = int(std::floor(want + shifts.round));
-    }
-  }
-  int j = 0, last = -1;
-  glm::dvec3 v(0.0);
-  for (int k = 0; k < rays; ++k) {
-    const double at = (k + shifts.pick) / rays * total;
-    while (j + 1 < m && !(at < room.upTo[size_t(j)])) ++j;
-    if (j != last) v = glm::dvec3(shadowed(in, x, n, room.lo[size_t(j)], traced)) * room.weight[size_t(j)], last = j;
-    sum += v;
-  }
-  return sum * (scale * total / double(m)) / double(rays);
 }
 
 // A texel sample's position on its surface (inset into its triangle), or false where it has none.

@@ -39,6 +39,18 @@ struct Facing {
   PunctualContribution c;
 };
 
+// The lights near x that give it anything, with their light there, into facing; returns all of their light.
+glm::vec3 facingLights(const BakeInputs& in, const glm::vec3& x, const glm::vec3& n, std::vector<Facing>& facing) {
+  facing.clear();
+  glm::vec3 unshadowed(0.0f);
+  for (uint32_t i : in.lightsNear(x)) {
+    const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
+    unshadowed += c.mapValue;
+    if (c.mapValue != glm::vec3(0.0f)) facing.push_back({channelMax(c.mapValue), i, c});
+  }
+  return unshadowed;
+}
+
 // The faintest facing lights, together under `budget` (channel max, the centre's), go first: facing sorted by
 // their light, and how many of its first entries are faint. All of them shadowed at once, or lit, cannot move
 // the texel by more than the budget.
@@ -64,7 +76,7 @@ bool subTexelJump(const BakeInputs& in, const TexelSamples& ts, size_t t, const 
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
   auto lit = [&](const glm::vec3& origin, const PunctualContribution& c) {
-    const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
+    const float tmax = shadowRayLength(c, eps);
     return !(tmax > 0.0f) || !rt.occluded(origin, c.toLight, 0.0f, tmax);
   };
   glm::vec3 centre[2] = {glm::vec3(0.0f), glm::vec3(0.0f)}, faintLight(0.0f);  // visible, unshadowed
@@ -118,13 +130,7 @@ TexelShares visibleShare(const BakeInputs& in, const TexelSamples& ts, const Lig
       glm::vec3 x(ts.positionWeight[t]);
       if (ts.primitive[t] < in.scene.primitives.size()) x = in.rayTracer.insetPoint(ts.primitive[t], ts.triangle[t], x);
       const glm::vec3 n(ts.normal[t]);
-      glm::vec3 unshadowed(0.0f);
-      facing.clear();
-      for (uint32_t i : in.lightsNear(x)) {
-        const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
-        unshadowed += c.mapValue;
-        if (c.mapValue != glm::vec3(0.0f)) facing.push_back({channelMax(c.mapValue), i, c});
-      }
+      const glm::vec3 unshadowed = facingLights(in, x, n, facing);
       out.share[t] = shareWith(channelMax(map.texels[t]), channelMax(unshadowed), cut.at(t));
       if (out.share[t] >= 0.0f)
         out.probed[t] = subTexelJump(in, ts, t, x, n, channelMax(unshadowed), options.jump, options.faintShare,
@@ -150,30 +156,25 @@ bool refineTexel(const BakeInputs& in, const TexelSamples& ts, size_t t, const S
                  SquareMean& mean) {
   const RayTracer& rt = in.rayTracer;
   const float eps = rt.epsilon();
-  // What a light gives a point along c, seen from origin: 0 where shadowed, else through what transmits.
-  auto arriving = [&](const glm::vec3& origin, const PunctualContribution& c) {
-    const float tmax = std::isinf(c.distance) ? 1e30f : c.distance - eps;
-    if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) return glm::vec3(-1.0f);
-    if (!(tmax > 0.0f) || !rt.hasTransmission()) return c.mapValue;
-    return c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax);
+  // Whether c's light reaches origin, and in v what arrives (through what transmits).
+  auto arrives = [&](const glm::vec3& origin, const PunctualContribution& c, glm::vec3& v) {
+    const float tmax = shadowRayLength(c, eps);
+    if (tmax > 0.0f && rt.occluded(origin, c.toLight, 0.0f, tmax)) return false;
+    v = tmax > 0.0f && rt.hasTransmission() ? c.mapValue * rt.transmittance(origin, c.toLight, 0.0f, tmax) : c.mapValue;
+    return true;
   };
   glm::vec3 faintLight[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};  // the faint lights' at the centre: all, the part's
   room.facing.clear();
   if (ts.positionWeight[t].w > 0.0f && ts.primitive[t] < in.scene.primitives.size()) {
     const glm::vec3 x = rt.insetPoint(ts.primitive[t], ts.triangle[t], glm::vec3(ts.positionWeight[t]));
     const glm::vec3 n(ts.normal[t]);
-    glm::vec3 unshadowed(0.0f);
-    for (uint32_t i : in.lightsNear(x)) {
-      const PunctualContribution c = punctualDirect(in.scene.lights[i], x, n);
-      unshadowed += c.mapValue;
-      if (c.mapValue != glm::vec3(0.0f)) room.facing.push_back({channelMax(c.mapValue), i, c});
-    }
+    const glm::vec3 unshadowed = facingLights(in, x, n, room.facing);
     const float budget = options.faintShare * options.jump * (channelMax(unshadowed) + cut.y);
     room.facing.resize(sortFaintFirst(room.facing, budget));
     for (const Facing& f : room.facing) {
       room.faint[f.light] = 1;
-      const glm::vec3 v = arriving(x + n * eps, f.c);
-      if (v.x < 0.0f) continue;
+      glm::vec3 v;
+      if (!arrives(x + n * eps, f.c, v)) continue;
       faintLight[0] += v;
       if (part && (*part->lights)[f.light]) faintLight[1] += v;
     }
@@ -184,9 +185,8 @@ bool refineTexel(const BakeInputs& in, const TexelSamples& ts, size_t t, const S
     for (uint32_t i : in.lightsNear(xs)) {
       if (room.faint[i]) continue;
       const PunctualContribution c = punctualDirect(in.scene.lights[i], xs, nx);
-      if (c.mapValue == glm::vec3(0.0f)) continue;
-      const glm::vec3 v = arriving(origin, c);
-      if (v.x < 0.0f) continue;
+      glm::vec3 v;
+      if (c.mapValue == glm::vec3(0.0f) || !arrives(origin, c, v)) continue;
       anyLit = true;
       values[0] += v;
       if (part && (*part->lights)[i]) values[1] += v;
